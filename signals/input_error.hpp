@@ -1,0 +1,27 @@
+// The typed exception for bad input at the edges (files, configs, command line): it names the file,
+// optionally the line, and what is wrong. The `ultratrack` program turns it into one message and exit 2.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace ultratrack::signals {
+
+class InputError : public std::runtime_error {
+ public:
+  InputError(std::string file, std::string problem, int line = 0)
+      : std::runtime_error(format(file, problem, line)), file_(std::move(file)), line_(line) {}
+  const std::string& file() const { return file_; }
+  int line() const { return line_; }
+
+ private:
+  static std::string format(const std::string& file, const std::string& problem, int line) {
+    std::string where = file.empty() ? std::string("input") : file;
+    if (line > 0) where += ":" + std::to_string(line);
+    return where + ": " + problem;
+  }
+  std::string file_;
+  int line_;
+};
+
+}  // namespace ultratrack::signals

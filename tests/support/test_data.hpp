@@ -1,0 +1,25 @@
+// Test helpers: where the optional shared recordings are, and a scratch folder per test.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+namespace ultratrack::test {
+
+// The folder of shared real recordings (../shared/data), or nothing when it is absent.
+std::optional<std::filesystem::path> shared_data_dir();
+// A fresh empty folder under the system temp dir, unique to the calling test.
+std::filesystem::path scratch_dir();
+
+}  // namespace ultratrack::test
+
+// Skips the current test with a clear message when the shared data folder (or one file in it) is absent.
+#define ULTRATRACK_REQUIRE_SHARED_FILE(var, name)                                           \
+  std::filesystem::path var;                                                                \
+  {                                                                                         \
+    auto dir_ = ::ultratrack::test::shared_data_dir();                                      \
+    if (!dir_ || !std::filesystem::exists(*dir_ / (name)))                                  \
+      GTEST_SKIP() << "shared data file " << (name)                                         \
+                   << " not found (../shared/data or $ULTRATRACK_SHARED_DATA): skipped";     \
+    var = *dir_ / (name);                                                                   \
+  }

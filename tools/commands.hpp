@@ -1,0 +1,14 @@
+// The subcommands of `ultratrack`. Each add_*_command registers its options and its callback on the
+// CLI11 app; the callback does the work and throws on bad input (main turns that into one message).
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+namespace ultratrack::tools {
+
+void add_simulate_command(CLI::App& app);
+void add_demo_command(CLI::App& app);
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,30 @@
+// `ultratrack`: one program, one subcommand per job (see docs/architecture.md, "Command line").
+// Errors from the edges arrive here as exceptions and leave as one line on stderr and a non-zero exit.
+#include <CLI/CLI.hpp>
+#include <fmt/core.h>
+
+#include <cstdio>
+#include <exception>
+
+#include "commands.hpp"
+#include "signals/input_error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ultratrack: GPS L1 C/A software receiver with inertial aiding"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "ultratrack 0.1.0");
+  ultratrack::tools::add_simulate_command(app);
+  ultratrack::tools::add_demo_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const ultratrack::signals::InputError& e) {
+    fmt::print(stderr, "ultratrack: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "ultratrack: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The two commands of the README, and a plain build:
+#   tools/run.sh demo   install missing Debian packages, build (Release, 2 jobs), run `ultratrack demo`
+#   tools/run.sh test   the same build, then the whole test suite through ctest
+#   tools/run.sh build  only the build
+# Idempotent: a second run installs nothing and rebuilds only what changed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-dev libcli11-dev
+          libtomlplusplus-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "tools/run.sh: installing ${missing[*]}"
+  sudo_cmd=()
+  [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+build_dir=${ULTRATRACK_BUILD_DIR:-build}
+jobs=${ULTRATRACK_JOBS:-2}
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build_dir" -j"$jobs"
+
+case "${1:-build}" in
+  demo) shift; exec "$build_dir/tools/ultratrack" demo "$@" ;;
+  test) exec ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" ;;
+  build) ;;
+  *) echo "usage: tools/run.sh demo|test|build" >&2; exit 2 ;;
+esac
