@@ -90,7 +90,6 @@ Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) 
   spectrum_scratch_ = FftwBuffer(block_size_);
   code_spectra_.resize(signals::kMaxPrn);
   row_.resize(lags_);
-  column_sum_.resize(lags_);
 }
 
 double Acquisition::cells() const { return static_cast<double>(doppler_grid(std::nullopt).size() * lags_); }
@@ -185,51 +184,70 @@ double Acquisition::power_at(std::span<const std::complex<float>> samples, int p
 
 AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> samples, int prn,
                                            const std::vector<double>& dopplers, bool cached) {
-  std::fill(column_sum_.begin(), column_sum_.end(), 0.0f);
+  const std::size_t bins = dopplers.size();
+  if (grid_.size() < bins * lags_) grid_.resize(bins * lags_);
+  row_noise_.resize(bins);
+  // Candidate peak on rows normalised by their plain means (the signal raises its row's mean a little).
+  double candidate = -1.0;
+  std::size_t candidate_lag = 0;
+  for (std::size_t d = 0; d < bins; ++d) {
+    correlate_bin(samples, cached ? &spectrum_cache_[d * static_cast<std::size_t>(options_.noncoherent)] : nullptr,
+                  prn, dopplers[d]);
+    std::copy(row_.begin(), row_.end(), grid_.begin() + static_cast<std::ptrdiff_t>(d * lags_));
+    double sum = 0.0;
+    for (float v : row_) sum += v;
+    const double mean = sum / static_cast<double>(lags_);
+    for (std::size_t lag = 0; lag < lags_; ++lag) {
+      if (row_[lag] > candidate * mean) {
+        candidate = row_[lag] / mean;
+        candidate_lag = lag;
+      }
+    }
+  }
+
+  // Noise per Doppler row (a cell-averaging CFAR along the code): the mean of the row's cells away from the
+  // candidate's code phase (+-1.5 chips; in every row, which also removes the signal's Doppler side
+  // lobes). Per row because real front ends leave narrowband spurs that raise whole rows evenly: one
+  // noise level for the whole grid would turn those rows into false alarms.
+  const auto guard = static_cast<std::ptrdiff_t>(std::ceil(1.5 * samples_per_chip_)) + 1;
+  const auto lags = static_cast<std::ptrdiff_t>(lags_);
+  auto excluded = [&](std::size_t lag) {
+    std::ptrdiff_t distance = std::abs(static_cast<std::ptrdiff_t>(lag) - static_cast<std::ptrdiff_t>(candidate_lag));
+    return std::min(distance, lags - distance) <= guard;
+  };
   double best = -1.0;
   int best_bin = 0;
   std::size_t best_lag = 0;
-  const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
-  for (std::size_t d = 0; d < dopplers.size(); ++d) {
-    correlate_bin(samples, cached ? &spectrum_cache_[d * k_blocks] : nullptr, prn, dopplers[d]);
+  for (std::size_t d = 0; d < bins; ++d) {
+    const float* row = &grid_[d * lags_];
+    double sum = 0.0;
+    std::size_t count = 0;
     for (std::size_t lag = 0; lag < lags_; ++lag) {
-      column_sum_[lag] += row_[lag];
-      if (row_[lag] > best) {
-        best = row_[lag];
+      if (excluded(lag)) continue;
+      sum += row[lag];
+      ++count;
+    }
+    row_noise_[d] = sum / static_cast<double>(count);
+    for (std::size_t lag = 0; lag < lags_; ++lag) {
+      if (row[lag] > best * row_noise_[d]) {
+        best = row[lag] / row_noise_[d];
         best_bin = static_cast<int>(d);
         best_lag = lag;
       }
     }
   }
-
-  // Noise: mean cell away from the peak's code phase (+-1.5 chips, all Doppler bins: this also removes
-  // the signal's Doppler side lobes).
-  const auto guard = static_cast<std::ptrdiff_t>(std::ceil(1.5 * samples_per_chip_)) + 1;
-  const auto lags = static_cast<std::ptrdiff_t>(lags_);
-  double noise_sum = 0.0;
-  std::size_t noise_columns = 0;
-  for (std::ptrdiff_t lag = 0; lag < lags; ++lag) {
-    std::ptrdiff_t distance = std::abs(lag - static_cast<std::ptrdiff_t>(best_lag));
-    distance = std::min(distance, lags - distance);
-    if (distance > guard) {
-      noise_sum += column_sum_[static_cast<std::size_t>(lag)];
-      ++noise_columns;
-    }
-  }
   const double k = options_.noncoherent;
-  const double noise_cell = noise_sum / static_cast<double>(noise_columns * dopplers.size());
-  const double noise_power = noise_cell / k;  // P_n, one coherent block
+  const double noise_power = row_noise_[static_cast<std::size_t>(best_bin)] / k;  // P_n, one coherent block
 
   AcquisitionResult result;
   result.prn = prn;
-  result.metric = best / noise_cell;
-  result.threshold =
-      acquisition_threshold(options_.noncoherent, static_cast<double>(dopplers.size() * lags_), options_.pfa) / k;
+  result.metric = best;
+  result.threshold = acquisition_threshold(options_.noncoherent, static_cast<double>(bins * lags_), options_.pfa) / k;
   result.detected = result.metric > result.threshold;
 
   double doppler = dopplers[static_cast<std::size_t>(best_bin)];
   double lag = static_cast<double>(best_lag);
-  double peak_power = best;
+  double peak_power = best * k * noise_power;
   if (result.detected) {
     // Fine Doppler: step/8 over +-1 coarse step at the peak lag, then a parabola through the best three.
     const double fine = options_.step_hz() / 8.0;

@@ -5,7 +5,9 @@
 //
 // Test statistic and threshold. Per cell (Doppler bin d, code lag n) Z = sum_k |Y_k|^2 / P_n, Y_k the
 // coherent correlation of block k and P_n = E|Y|^2 under noise alone (estimated as the mean of the
-// grid's cells away from the peak's code phase, divided by K; ~1e4..1e6 cells make its error negligible).
+// cells of the same Doppler row away from the peak's code phase, divided by K: a cell-averaging CFAR along
+// the code, robust to narrowband spurs that raise whole rows; its error, 1/sqrt(K x lags) with 1e3..4e4
+// lags per row, moves the false-alarm rate by a few per cent at most).
 // For complex circular Gaussian noise each |Y_k|^2 / P_n is exponential(1) (chi-square with 2 dof, / 2),
 // so under noise Z ~ Gamma(K, 1) (chi-square with 2K dof, / 2), whose tail is
 //     Q(K, g) = P(Z > g) = exp(-g) sum_{i=0}^{K-1} g^i / i!.
@@ -124,7 +126,8 @@ class Acquisition {
   FftwBuffer mixed_, product_, correlation_, spectrum_scratch_;
   std::vector<std::optional<FftwBuffer>> code_spectra_;  // index prn - 1
   std::vector<FftwBuffer> spectrum_cache_;                 // [bin * K + k] for a multi-PRN search
-  std::vector<float> row_, column_sum_;  // one Doppler row, sums over Doppler per lag
+  std::vector<float> row_, grid_;  // one Doppler row; all rows [bin * lags + lag]
+  std::vector<double> row_noise_;   // noise cell mean per Doppler row
   std::size_t memory_budget_bytes_ = std::size_t{256} << 20;
 };
 
