@@ -39,9 +39,7 @@ inline float chip_at(const signals::CaCodeChips& code, double phase_chips) {
 }
 
 // Code chip rate of a signal with carrier Doppler doppler_hz (the code Doppler is coherent with it).
-inline double code_rate_hz(double doppler_hz) {
-  return kChipRate_hz * (1.0 + doppler_hz / signals::kL1Frequency_hz);
-}
+inline double code_rate_hz(double doppler_hz) { return kChipRate_hz * (1.0 + doppler_hz / signals::kL1Frequency_hz); }
 
 }  // namespace
 
@@ -191,8 +189,8 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
   double candidate = -1.0;
   std::size_t candidate_lag = 0;
   for (std::size_t d = 0; d < bins; ++d) {
-    correlate_bin(samples, cached ? &spectrum_cache_[d * static_cast<std::size_t>(options_.noncoherent)] : nullptr,
-                  prn, dopplers[d]);
+    correlate_bin(samples, cached ? &spectrum_cache_[d * static_cast<std::size_t>(options_.noncoherent)] : nullptr, prn,
+                  dopplers[d]);
     std::copy(row_.begin(), row_.end(), grid_.begin() + static_cast<std::ptrdiff_t>(d * lags_));
     double sum = 0.0;
     for (float v : row_) sum += v;

@@ -111,23 +111,22 @@ class Acquisition {
                      double doppler_hz);
   std::complex<double> correlate_time(std::span<const std::complex<float>> samples, int prn, int block,
                                       double doppler_hz, double lag_samples) const;
-  double power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz,
-                  double lag_samples) const;
+  double power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz, double lag_samples) const;
   AcquisitionResult search_grid(std::span<const std::complex<float>> samples, int prn,
                                 const std::vector<double>& dopplers, bool cached);
   std::vector<double> doppler_grid(std::optional<DopplerWindow> assist) const;
   void check(std::span<const std::complex<float>> samples, int prn) const;
 
   AcquisitionOptions options_;
-  std::size_t block_size_;     // N = round(fs T_coh)
-  std::size_t lags_;           // code lags searched: one code period, min(N, ceil(1023 fs / f_chip))
+  std::size_t block_size_;  // N = round(fs T_coh)
+  std::size_t lags_;        // code lags searched: one code period, min(N, ceil(1023 fs / f_chip))
   double samples_per_chip_;
   FftwPlan forward_, backward_;
   FftwBuffer mixed_, product_, correlation_, spectrum_scratch_;
   std::vector<std::optional<FftwBuffer>> code_spectra_;  // index prn - 1
-  std::vector<FftwBuffer> spectrum_cache_;                 // [bin * K + k] for a multi-PRN search
-  std::vector<float> row_, grid_;  // one Doppler row; all rows [bin * lags + lag]
-  std::vector<double> row_noise_;   // noise cell mean per Doppler row
+  std::vector<FftwBuffer> spectrum_cache_;               // [bin * K + k] for a multi-PRN search
+  std::vector<float> row_, grid_;                        // one Doppler row; all rows [bin * lags + lag]
+  std::vector<double> row_noise_;                        // noise cell mean per Doppler row
   std::size_t memory_budget_bytes_ = std::size_t{256} << 20;
 };
 

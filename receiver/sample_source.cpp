@@ -89,8 +89,7 @@ float gain_for(signals::SampleFormat format) {
 
 }  // namespace
 
-SampleSource::SampleSource(std::filesystem::path path, signals::SampleFormat format,
-                           const SampleSourceOptions& options)
+SampleSource::SampleSource(std::filesystem::path path, signals::SampleFormat format, const SampleSourceOptions& options)
     : options_(checked(path, format, options)),
       reader_(path, format, options.start_sample),
       converter_(options_, signals::is_complex(format)),
@@ -105,9 +104,7 @@ SampleBlock SampleSource::read(std::span<std::complex<float>> out) {
 SampleBlock SampleSource::read(std::span<std::complex<std::int16_t>> out) {
   if (scratch_.size() < out.size()) scratch_.resize(out.size());
   const SampleBlock block = read(std::span(scratch_.data(), out.size()));
-  auto to_int16 = [](float v) {
-    return static_cast<std::int16_t>(std::clamp(std::nearbyint(v), -32768.0f, 32767.0f));
-  };
+  auto to_int16 = [](float v) { return static_cast<std::int16_t>(std::clamp(std::nearbyint(v), -32768.0f, 32767.0f)); };
   for (std::size_t i = 0; i < block.count; ++i)
     out[i] = {to_int16(scratch_[i].real() * int16_gain_), to_int16(scratch_[i].imag() * int16_gain_)};
   return block;

@@ -26,9 +26,9 @@
 namespace ultratrack::receiver {
 
 struct SampleSourceOptions {
-  double fs_hz = 0.0;       // sample rate, > 0
-  double if_hz = 0.0;       // intermediate frequency, |if_hz| < fs_hz / 2; 0 for complex baseband
-  bool iq_swap = false;     // complex formats only
+  double fs_hz = 0.0;    // sample rate, > 0
+  double if_hz = 0.0;    // intermediate frequency, |if_hz| < fs_hz / 2; 0 for complex baseband
+  bool iq_swap = false;  // complex formats only
   bool q_negate = false;
   std::int64_t start_sample = 0;  // samples of the file to skip; the counter still counts from the file start
 

@@ -1,13 +1,13 @@
 // `ultratrack acquire`: FFT acquisition of the first K x T_coh of a recording (receiver/acquisition.hpp
 // on receiver/sample_source.hpp); one row per detected PRN as a table, or JSON with --json.
 // Every bad input (numbers, format, PRN list, file, options out of range) is an InputError (exit 2).
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <charconv>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -40,7 +40,8 @@ double parse_double(const std::string& option, const std::string& text) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used == 0 || used != text.size() || !std::isfinite(value)) throw bad_option(option, "'" + text + "' is not a number");
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw bad_option(option, "'" + text + "' is not a number");
   return value;
 }
 
@@ -62,7 +63,8 @@ std::vector<int> parse_prn_list(const std::string& text) {
     const std::size_t dash = item.find('-');
     const int first = parse_int("--prn", item.substr(0, dash));
     const int last = dash == std::string::npos ? first : parse_int("--prn", item.substr(dash + 1));
-    if (first < 1 || last > 32 || first > last) throw bad_option("--prn", "'" + item + "' is not a PRN range within 1-32");
+    if (first < 1 || last > 32 || first > last)
+      throw bad_option("--prn", "'" + item + "' is not a PRN range within 1-32");
     for (int prn = first; prn <= last; ++prn)
       if (std::find(prns.begin(), prns.end(), prn) == prns.end()) prns.push_back(prn);
     start = comma + 1;
@@ -113,16 +115,18 @@ void run_acquire(const AcquireArgs& args) {
   for (const auto& r : results)
     if (r.detected || args.all) shown.push_back(r);
   if (args.json) {
-    fmt::print("{{\"input\": \"{}\", \"format\": \"{}\", \"fs_hz\": {}, \"if_hz\": {}, \"coherent_ms\": {}, "
-               "\"noncoherent\": {}, \"pfa\": {}, \"satellites\": [",
-               args.input, args.format, options.fs_hz, source_options.if_hz, options.coherent_ms,
-               options.noncoherent, options.pfa);
+    fmt::print(
+        "{{\"input\": \"{}\", \"format\": \"{}\", \"fs_hz\": {}, \"if_hz\": {}, \"coherent_ms\": {}, "
+        "\"noncoherent\": {}, \"pfa\": {}, \"satellites\": [",
+        args.input, args.format, options.fs_hz, source_options.if_hz, options.coherent_ms, options.noncoherent,
+        options.pfa);
     for (std::size_t i = 0; i < shown.size(); ++i) {
       const auto& r = shown[i];
-      fmt::print("{}\n  {{\"prn\": {}, \"detected\": {}, \"doppler_hz\": {:.1f}, \"code_phase_chips\": {:.3f}, "
-                 "\"code_phase_samples\": {:.3f}, \"cn0_dbhz\": {:.1f}, \"metric\": {:.2f}, \"threshold\": {:.2f}}}",
-                 i ? "," : "", r.prn, r.detected, r.doppler_hz, r.code_phase_chips, r.code_phase_samples,
-                 r.cn0_dbhz, r.metric, r.threshold);
+      fmt::print(
+          "{}\n  {{\"prn\": {}, \"detected\": {}, \"doppler_hz\": {:.1f}, \"code_phase_chips\": {:.3f}, "
+          "\"code_phase_samples\": {:.3f}, \"cn0_dbhz\": {:.1f}, \"metric\": {:.2f}, \"threshold\": {:.2f}}}",
+          i ? "," : "", r.prn, r.detected, r.doppler_hz, r.code_phase_chips, r.code_phase_samples, r.cn0_dbhz, r.metric,
+          r.threshold);
     }
     fmt::print("\n]}}\n");
     return;

@@ -51,13 +51,15 @@ void check_recording(const std::filesystem::path& path, const Recording& rec) {
     EXPECT_NEAR(it->doppler_hz, l.doppler_hz, 250.0) << "PRN " << l.prn;
     const double expected_phase = std::fmod(1023.0 - l.readme_delay_chips, 1023.0);
     EXPECT_NEAR(std::remainder(it->code_phase_chips - expected_phase, 1023.0), 0.0, 0.5) << "PRN " << l.prn;
-    std::printf("  PRN %2d  doppler %8.1f Hz (README %+.0f)  code phase %8.3f chips (README delay %.1f)  "
-                "C/N0 %.1f dB-Hz  metric %.1f / %.2f\n",
-                l.prn, it->doppler_hz, l.doppler_hz, it->code_phase_chips, l.readme_delay_chips, it->cn0_dbhz,
-                it->metric, it->threshold);
+    std::printf(
+        "  PRN %2d  doppler %8.1f Hz (README %+.0f)  code phase %8.3f chips (README delay %.1f)  "
+        "C/N0 %.1f dB-Hz  metric %.1f / %.2f\n",
+        l.prn, it->doppler_hz, l.doppler_hz, it->code_phase_chips, l.readme_delay_chips, it->cn0_dbhz, it->metric,
+        it->threshold);
   }
   for (const auto& r : results) {
-    const bool listed = std::any_of(rec.listed.begin(), rec.listed.end(), [&](const Listed& l) { return l.prn == r.prn; });
+    const bool listed =
+        std::any_of(rec.listed.begin(), rec.listed.end(), [&](const Listed& l) { return l.prn == r.prn; });
     if (r.detected && !listed)
       std::printf("  extra detection: PRN %2d  doppler %8.1f Hz  code phase %8.3f  C/N0 %.1f  metric %.2f / %.2f\n",
                   r.prn, r.doppler_hz, r.code_phase_chips, r.cn0_dbhz, r.metric, r.threshold);
@@ -106,8 +108,8 @@ TEST(AcquisitionRealData, PocketSdr12MHzRealAt3MHzIf) {
   rec.source.if_hz = 3e6;
   rec.acquisition.fs_hz = 12e6;
   rec.acquisition.noncoherent = 10;
-  rec.listed = {{2, -2750, 454.2},  {5, 250, 478.3},   {11, -3250, 938.1}, {13, -250, 511.8},
-                {15, 1750, 794.3},  {18, 3250, 561.0}, {20, -1250, 696.7}, {30, -2000, 402.3}};
+  rec.listed = {{2, -2750, 454.2}, {5, 250, 478.3},   {11, -3250, 938.1}, {13, -250, 511.8},
+                {15, 1750, 794.3}, {18, 3250, 561.0}, {20, -1250, 696.7}, {30, -2000, 402.3}};
   rec.searched = all_prns();
   check_recording(path, rec);
 }
@@ -121,7 +123,7 @@ TEST(AcquisitionRealData, Ugsdr38MHzRealAt9p548MHzIf) {
   rec.source.if_hz = 9.548e6;
   rec.acquisition.fs_hz = 38.192e6;
   rec.acquisition.noncoherent = 5;
-  rec.listed = {{3, 2000, 916.4},  {6, -3750, 755.4}, {9, 2750, 125.8},  {15, 2000, 972.9}, {18, 250, 555.1},
+  rec.listed = {{3, 2000, 916.4},  {6, -3750, 755.4}, {9, 2750, 125.8},   {15, 2000, 972.9}, {18, 250, 555.1},
                 {21, -500, 359.0}, {22, 1750, 168.4}, {26, -3000, 718.5}, {29, -3250, 862.2}};
   for (const auto& l : rec.listed) rec.searched.push_back(l.prn);  // 38 MHz: listed PRNs only, for speed
   check_recording(path, rec);
@@ -135,8 +137,11 @@ TEST(AcquisitionRealData, Cttc4MHzFloatWithFrontEndOffset) {
   rec.acquisition.fs_hz = 4e6;
   rec.acquisition.noncoherent = 4;  // the whole 4 ms file
   rec.acquisition.doppler_max_hz = 14000.0;
-  rec.listed = {{25, 9000, std::nan("")}, {29, 9750, std::nan("")}, {31, 11750, std::nan("")},
-                {12, 7250, std::nan("")}, {2, 8000, std::nan("")}};
+  rec.listed = {{25, 9000, std::nan("")},
+                {29, 9750, std::nan("")},
+                {31, 11750, std::nan("")},
+                {12, 7250, std::nan("")},
+                {2, 8000, std::nan("")}};
   rec.searched = all_prns();
   // The README gives no code phases for this file: check Doppler and detection only.
   SampleSource source(path, rec.format, rec.source);
@@ -150,7 +155,8 @@ TEST(AcquisitionRealData, Cttc4MHzFloatWithFrontEndOffset) {
     EXPECT_NEAR(r.doppler_hz, l.doppler_hz, 250.0) << "PRN " << l.prn;
   }
   for (const auto& r : results) {
-    const bool listed = std::any_of(rec.listed.begin(), rec.listed.end(), [&](const Listed& l) { return l.prn == r.prn; });
+    const bool listed =
+        std::any_of(rec.listed.begin(), rec.listed.end(), [&](const Listed& l) { return l.prn == r.prn; });
     std::printf("  %s PRN %2d  doppler %8.1f Hz  code phase %8.3f  C/N0 %.1f  metric %.2f / %.2f\n",
                 listed ? "listed" : (r.detected ? "extra " : "absent"), r.prn, r.doppler_hz, r.code_phase_chips,
                 r.cn0_dbhz, r.metric, r.threshold);

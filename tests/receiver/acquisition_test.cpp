@@ -29,9 +29,9 @@ double chip_error(double a, double b) {
 TEST(AcquisitionThreshold, MatchesChiSquareTables) {
   // One cell: Z ~ Gamma(K, 1) = chi2(2K) / 2, so g = chi2 upper quantile / 2 (NIST/SEMATECH table values).
   EXPECT_NEAR(acquisition_threshold(1, 1, 0.01), std::log(100.0), 1e-9);  // exponential tail
-  EXPECT_NEAR(acquisition_threshold(2, 1, 0.01), 13.277 / 2.0, 1e-3);    // chi2(4), 0.99
-  EXPECT_NEAR(acquisition_threshold(5, 1, 0.05), 18.307 / 2.0, 1e-3);    // chi2(10), 0.95
-  EXPECT_NEAR(acquisition_threshold(10, 1, 0.01), 37.566 / 2.0, 1e-3);   // chi2(20), 0.99
+  EXPECT_NEAR(acquisition_threshold(2, 1, 0.01), 13.277 / 2.0, 1e-3);     // chi2(4), 0.99
+  EXPECT_NEAR(acquisition_threshold(5, 1, 0.05), 18.307 / 2.0, 1e-3);     // chi2(10), 0.95
+  EXPECT_NEAR(acquisition_threshold(10, 1, 0.01), 37.566 / 2.0, 1e-3);    // chi2(20), 0.99
   // M cells: per-cell probability 1 - (1 - pfa)^(1/M); K = 1 has the closed form -ln(p_cell).
   const double p_cell = 1.0 - std::pow(1.0 - 1e-3, 1.0 / 68000.0);
   EXPECT_NEAR(acquisition_threshold(1, 68000, 1e-3), -std::log(p_cell), 1e-6);

@@ -23,7 +23,8 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 std::complex<double> tone_amplitude(const std::vector<std::complex<float>>& y, double f, double fs, std::int64_t n0) {
   std::complex<double> sum;
   for (std::size_t i = 0; i < y.size(); ++i)
-    sum += std::complex<double>(y[i]) * std::polar(1.0, -kTwoPi * f * static_cast<double>(n0 + static_cast<std::int64_t>(i)) / fs);
+    sum += std::complex<double>(y[i]) *
+           std::polar(1.0, -kTwoPi * f * static_cast<double>(n0 + static_cast<std::int64_t>(i)) / fs);
   return sum / static_cast<double>(y.size());
 }
 
@@ -36,7 +37,9 @@ TEST(BasebandConverter, ComplexToneAtIfComesOutAtItsOffsetWhateverTheBlockSplit)
   const double df = 1234.5;
   const std::size_t n = 40000;
   std::vector<std::complex<float>> x(n);
-  for (std::size_t i = 0; i < n; ++i) x[i] = std::polar(1.0f, static_cast<float>(std::fmod(kTwoPi * (o.if_hz + df) * static_cast<double>(i) / o.fs_hz + 0.5, kTwoPi)));
+  for (std::size_t i = 0; i < n; ++i)
+    x[i] = std::polar(
+        1.0f, static_cast<float>(std::fmod(kTwoPi * (o.if_hz + df) * static_cast<double>(i) / o.fs_hz + 0.5, kTwoPi)));
   BasebandConverter converter(o, true);
   std::vector<std::complex<float>> y = x;
   const std::size_t splits[] = {1, 999, 4000, 7, 15000};  // odd block sizes, then the rest
@@ -48,7 +51,8 @@ TEST(BasebandConverter, ComplexToneAtIfComesOutAtItsOffsetWhateverTheBlockSplit)
   converter.convert(std::span(y).subspan(at));
   EXPECT_EQ(converter.next_sample(), static_cast<std::int64_t>(n));
   for (std::size_t i = 0; i < n; i += 997) {
-    const std::complex<float> expected = std::polar(1.0f, static_cast<float>(std::fmod(kTwoPi * df * static_cast<double>(i) / o.fs_hz + 0.5, kTwoPi)));
+    const std::complex<float> expected =
+        std::polar(1.0f, static_cast<float>(std::fmod(kTwoPi * df * static_cast<double>(i) / o.fs_hz + 0.5, kTwoPi)));
     ASSERT_NEAR(std::abs(y[i] - expected), 0.0, 2e-4) << "sample " << i;
   }
 }
@@ -73,7 +77,8 @@ TEST(BasebandConverter, RealInputGivesHalfAmplitudeToneAndImageAtMinusTwoIf) {
   const double df = -2500.0;
   const std::size_t n = 120000;  // 10 ms: tones 1 kHz apart or more are orthogonal to 1e-4
   std::vector<std::complex<float>> y(n);
-  for (std::size_t i = 0; i < n; ++i) y[i] = {static_cast<float>(std::cos(kTwoPi * (o.if_hz + df) * static_cast<double>(i) / o.fs_hz)), 0.0f};
+  for (std::size_t i = 0; i < n; ++i)
+    y[i] = {static_cast<float>(std::cos(kTwoPi * (o.if_hz + df) * static_cast<double>(i) / o.fs_hz)), 0.0f};
   auto y_inverted = y;
   BasebandConverter(o, false).convert(y);
   EXPECT_NEAR(std::abs(tone_amplitude(y, df, o.fs_hz, 0) - 0.5), 0.0, 1e-3);
@@ -139,7 +144,8 @@ TEST(SampleSource, ReadsBlocksWithCountersAndInt16Output) {
   const SampleBlock b = source.read(ints);
   EXPECT_EQ(b.first_sample, 610);
   EXPECT_EQ(b.count, 390u);  // the end of the file
-  EXPECT_EQ(ints[0], (std::complex<std::int16_t>(static_cast<std::int16_t>((610 % 7 - 3) * 64), static_cast<std::int16_t>((610 % 5) * 64))));
+  EXPECT_EQ(ints[0], (std::complex<std::int16_t>(static_cast<std::int16_t>((610 % 7 - 3) * 64),
+                                                 static_cast<std::int16_t>((610 % 5) * 64))));
   EXPECT_EQ(source.read(block).count, 0u);
 }
 

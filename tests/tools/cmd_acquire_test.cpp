@@ -1,8 +1,8 @@
 // `ultratrack acquire` through CLI11 as main() runs it: bad input is an InputError (exit 2 in main), and a
 // real recording gives a JSON row for each satellite the data README lists.
-#include <CLI/CLI.hpp>
 #include <gtest/gtest.h>
 
+#include <CLI/CLI.hpp>
 #include <fstream>
 #include <string>
 #include <vector>
