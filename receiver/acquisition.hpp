@@ -7,7 +7,7 @@
 // coherent correlation of block k and P_n = E|Y|^2 under noise alone (estimated as the mean of the
 // cells of the same Doppler row away from the peak's code phase, divided by K: a cell-averaging CFAR along
 // the code, robust to narrowband spurs that raise whole rows; its error, 1/sqrt(K x lags) with 1e3..4e4
-// lags per row, moves the false-alarm rate by a few per cent at most).
+// lags per row, moves the false-alarm rate by a few per cent).
 // For complex circular Gaussian noise each |Y_k|^2 / P_n is exponential(1) (chi-square with 2 dof, / 2),
 // so under noise Z ~ Gamma(K, 1) (chi-square with 2K dof, / 2), whose tail is
 //     Q(K, g) = P(Z > g) = exp(-g) sum_{i=0}^{K-1} g^i / i!.
@@ -20,7 +20,7 @@
 // white noise (tests): 38 and 50 false alarms where 38.4 +- 6.1 were expected (K = 1, 4; 1 sample/chip),
 // 14 where 9.6 +- 3.1 (4 MHz, K = 2). Strong satellites' cross-correlations are not noise: they can lift
 // an absent PRN over g (real recordings: see tests/receiver/acquisition_real_data_test.cpp).
-metric and threshold are reported as Z / K (peak power over mean noise power).
+// metric and threshold are reported as Z / K (peak power over mean noise power).
 //
 // Data bits: the 50 bit/s LNAV data flips the sign at most once per 20 ms. For T_coh > 1 ms a block that
 // holds a flip loses coherent power (at worst all of it, on average 2/3 of it when it holds one); we
