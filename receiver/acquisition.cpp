@@ -331,7 +331,8 @@ void Acquisition::cancel(std::span<std::complex<float>> samples, const Acquisiti
   const auto segment = static_cast<std::size_t>(std::llround(options_.fs_hz * 1e-3));
   for (std::size_t first = 0; first < samples.size(); first += segment) {
     const std::size_t count = std::min(segment, samples.size() - first);
-    const std::complex<double> start = std::polar(1.0, kTwoPi * r.doppler_hz * static_cast<double>(first) / options_.fs_hz);
+    const std::complex<double> start =
+        std::polar(1.0, kTwoPi * r.doppler_hz * static_cast<double>(first) / options_.fs_hz);
     std::complex<double> replica_phase = start, sum;
     for (std::size_t j = first; j < first + count; ++j) {
       const double chip = chip_at(code, (static_cast<double>(j) - lag) * chips_per_sample);
@@ -361,7 +362,8 @@ std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<
   for (std::size_t i = 0; i < results.size(); ++i)
     if (results[i].detected) order.push_back(i);
   if (order.empty()) return results;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return results[a].metric > results[b].metric; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return results[a].metric > results[b].metric; });
   cleaned_.assign(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples_needed()));
   for (std::size_t n = 0; n < order.size(); ++n) {
     AcquisitionResult& r = results[order[n]];

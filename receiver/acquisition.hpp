@@ -138,7 +138,7 @@ class Acquisition {
   std::vector<FftwBuffer> spectrum_cache_;               // [bin * K + k] for a multi-PRN search
   std::vector<float> row_, grid_;                        // one Doppler row; all rows [bin * lags + lag]
   std::vector<double> row_noise_;                        // noise cell mean per Doppler row
-  std::vector<std::complex<float>> cleaned_;            // samples with confirmed signals cancelled
+  std::vector<std::complex<float>> cleaned_;             // samples with confirmed signals cancelled
   std::size_t memory_budget_bytes_ = std::size_t{256} << 20;
 };
 
