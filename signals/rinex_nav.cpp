@@ -378,11 +378,11 @@ void write_rinex_nav_304(const std::filesystem::path& path, const RinexNavData& 
     header(fmt::format("GPUT {:17.10E}{:16.9E} {:6d} {:4d}", data.utc.a0_s, data.utc.a1_sps, data.utc.tot_s,
                        data.utc.wnt),
            "TIME SYSTEM CORR");
-  if (data.utc.valid)
+  if (data.utc.valid && data.utc.wn_lsf > 0)
     header(fmt::format("{:6d}{:6d}{:6d}{:6d}", data.utc.delta_t_ls_s, data.utc.delta_t_lsf_s, data.utc.wn_lsf,
                        data.utc.dn),
            "LEAP SECONDS");
-  else if (data.has_leap_seconds)
+  else if (data.utc.valid || data.has_leap_seconds)
     header(fmt::format("{:6d}", data.utc.delta_t_ls_s), "LEAP SECONDS");
   header("", "END OF HEADER");
 

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -344,5 +345,34 @@ TEST(RinexNav, MissingFileThrowsInputErrorNamingIt) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.file(), p.string());
     EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+  }
+}
+
+// RTKLIB (an independent RINEX implementation) must read what we write: when its convbin is installed,
+// our 3.04 file goes through convbin (RINEX 3.04 in, RINEX 3.04 out) and the result is read back.
+TEST(RinexNav, RtklibConvbinReadsOurFile) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(path, "brdc0010.22n");
+  if (std::system("command -v convbin >/dev/null 2>&1") != 0) GTEST_SKIP() << "RTKLIB convbin not installed";
+  const RinexNavData in = read_rinex_nav(path);
+  const auto dir = ultratrack::test::scratch_dir();
+  write_rinex_nav_304(dir / "ours.rnx", in);
+  const std::string cmd = "cd '" + dir.string() + "' && convbin -r rinex -v 3.04 -n rtklib.rnx ours.rnx >/dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const RinexNavData back = read_rinex_nav(dir / "rtklib.rnx");
+  ASSERT_EQ(back.ephemerides.size(), in.ephemerides.size());
+  // RTKLIB sorts by PRN and time: match records by (PRN, toe, IODE) and compare to the printed precision.
+  for (const Ephemeris& a : in.ephemerides) {
+    const Ephemeris* b = nullptr;
+    for (const Ephemeris& x : back.ephemerides)
+      if (x.prn == a.prn && x.toe_s == a.toe_s && x.iode == a.iode && x.iodc == a.iodc) b = &x;
+    ASSERT_NE(b, nullptr) << "PRN " << a.prn << " toe " << a.toe_s;
+    EXPECT_EQ(b->week, a.week);
+    EXPECT_EQ(b->health, a.health);
+    EXPECT_DOUBLE_EQ(b->toc_s, a.toc_s);
+    EXPECT_NEAR(b->af0_s, a.af0_s, 5e-13 * std::abs(a.af0_s));
+    EXPECT_NEAR(b->m0_rad, a.m0_rad, 5e-13 * std::abs(a.m0_rad));
+    EXPECT_NEAR(b->sqrt_a_sqrtm, a.sqrt_a_sqrtm, 5e-13 * a.sqrt_a_sqrtm);
+    EXPECT_NEAR(b->omega0_rad, a.omega0_rad, 5e-13 * std::abs(a.omega0_rad));
+    EXPECT_NEAR(b->tgd_s, a.tgd_s, 5e-13 * std::abs(a.tgd_s) + 1e-30);
   }
 }
