@@ -302,15 +302,14 @@ double ura_metres_from_index(int ura_index) {
 double fit_interval_hours(const Ephemeris& eph) {
   if (eph.fit_interval_flag == 0) return 4.0;
   const int c = eph.iodc;
-  // IODC ranges of the extended-operations table (ICD-GPS-200C Table 20-XII).
+  // IODC ranges of the extended-operations table (ICD-GPS-200C Table 20-XII) as receivers implement it
+  // (libswiftnav, GPSTk); longer entries are not used: a shorter interval is the safe side.
   if (c >= 240 && c <= 247) return 8.0;
   if ((c >= 248 && c <= 255) || c == 496) return 14.0;
   if ((c >= 497 && c <= 503) || (c >= 1021 && c <= 1023)) return 26.0;
   if (c >= 504 && c <= 510) return 50.0;
   if (c == 511 || (c >= 752 && c <= 756)) return 74.0;
-  if (c >= 757 && c <= 763) return 98.0;
-  if ((c >= 764 && c <= 767) || (c >= 1008 && c <= 1010)) return 122.0;
-  if (c >= 1011 && c <= 1020) return 146.0;
+  if (c == 757) return 98.0;
   return 6.0;
 }
 
@@ -391,6 +390,9 @@ void write_rinex_nav_304(const std::filesystem::path& path, const RinexNavData& 
   };
   for (size_t i = 0; i < data.ephemerides.size(); ++i) {
     const Ephemeris& e = data.ephemerides[i];
+    if (e.prn < kMinPrn || e.prn > kMaxPrn || e.week < 0)
+      throw InputError(path.string(), fmt::format("cannot write ephemeris {} (PRN {}, week {}): out of range", i,
+                                                  e.prn, e.week));
     const CalendarTime c = calendar_from_gps_time(normalised(e.toc()));
     const int sec = static_cast<int>(std::lround(c.second));
     s += fmt::format("G{:02d} {:04d} {:02d} {:02d} {:02d} {:02d} {:02d}{:19.12E}{:19.12E}{:19.12E}\n", e.prn,

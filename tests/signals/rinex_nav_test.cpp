@@ -376,3 +376,14 @@ TEST(RinexNav, RtklibConvbinReadsOurFile) {
     EXPECT_NEAR(b->tgd_s, a.tgd_s, 5e-13 * std::abs(a.tgd_s) + 1e-30);
   }
 }
+
+TEST(RinexNav, WriterReportsUnwritablePathAndBadRecords) {
+  RinexNavData d;
+  const auto dir = ultratrack::test::scratch_dir();
+  EXPECT_THROW(write_rinex_nav_304(dir / "no_such_dir" / "x.rnx", d), InputError);
+  Ephemeris bad;
+  bad.prn = 40;
+  d.ephemerides.push_back(bad);
+  EXPECT_THROW(write_rinex_nav_304(dir / "x.rnx", d), InputError);
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.rnx"));
+}
