@@ -29,72 +29,35 @@ int resolve_week_mod256(std::uint32_t raw, int week) {
   return full;
 }
 
-constexpr std::uint32_t kInvertedPreamble = ~kLnavPreamble & 0xFFu;
-
 }  // namespace
 
-double LnavSubframe::start_tow_s() const {
-  const int count = (tow_count + kLnavTowCountModulus - 1) % kLnavTowCountModulus;
-  return count * kSubframeDuration_s;
-}
-
-LnavSubframeResult decode_lnav_subframe(std::span<const std::uint8_t, 300> bits,
-                                        std::optional<std::array<std::uint8_t, 2>> previous_bits) {
-  LnavSubframeResult result;
-  const std::uint32_t preamble = pack_bits(bits.subspan(0, 8));
-  bool inverted = false;
-  if (preamble == kInvertedPreamble) {
-    inverted = true;
-  } else if (preamble != kLnavPreamble) {
-    result.status = LnavStatus::kNoPreamble;
-    return result;
-  }
-  const std::uint32_t flip30 = inverted ? 0x3FFFFFFFu : 0u;
-  int d29 = 0, d30 = 0;
-  if (previous_bits) {
-    d29 = ((*previous_bits)[0] & 1) ^ (inverted ? 1 : 0);
-    d30 = ((*previous_bits)[1] & 1) ^ (inverted ? 1 : 0);
-  }
-  LnavSubframe& sf = result.subframe;
-  for (int i = 0; i < 10; ++i) {
-    const std::uint32_t word = pack_bits(bits.subspan(static_cast<std::size_t>(30 * i), 30)) ^ flip30;
-    const auto data = check_word(word, d29, d30);
-    if (!data) {
-      result.status = LnavStatus::kParityError;
-      result.failed_word = i + 1;
-      return result;
-    }
-    sf.words[static_cast<std::size_t>(i)] = *data;
-    d29 = static_cast<int>((word >> 1) & 1u);
-    d30 = static_cast<int>(word & 1u);
-  }
-  sf.inverted = inverted;
-  sf.tow_count = static_cast<int>(get(sf.words, kTowCount));
-  sf.alert = get(sf.words, kAlert) != 0;
-  sf.anti_spoof = get(sf.words, kAntiSpoof) != 0;
-  sf.subframe_id = static_cast<int>(get(sf.words, kSubframeId));
-  if (sf.subframe_id < 1 || sf.subframe_id > 5 || sf.tow_count >= kLnavTowCountModulus) {
-    result.status = LnavStatus::kBadSubframeId;
-    return result;
-  }
-  if (sf.subframe_id >= 4) sf.page_sv_id = static_cast<int>(get(sf.words, kPageSvId));
-  result.status = LnavStatus::kOk;
-  return result;
-}
-
 LnavDecoder::LnavDecoder(int prn, int reference_week) : prn_(prn), week_(reference_week) {}
+
+void LnavDecoder::count(LnavStatus status) {
+  switch (status) {
+    case LnavStatus::kOk: break;
+    case LnavStatus::kNoPreamble: ++counters_.no_preamble; break;
+    case LnavStatus::kParityError: ++counters_.parity_errors; break;
+    case LnavStatus::kBadSubframeId: ++counters_.bad_subframe_id; break;
+  }
+}
 
 LnavStatus LnavDecoder::add_bits(std::span<const std::uint8_t, 300> bits,
                                  std::optional<std::array<std::uint8_t, 2>> previous_bits) {
   const LnavSubframeResult r = decode_lnav_subframe(bits, previous_bits);
   last_update_ = {};
-  switch (r.status) {
-    case LnavStatus::kOk: add(r.subframe); break;
-    case LnavStatus::kNoPreamble: ++counters_.no_preamble; break;
-    case LnavStatus::kParityError: ++counters_.parity_errors; break;
-    case LnavStatus::kBadSubframeId: ++counters_.bad_subframe_id; break;
-  }
+  count(r.status);
+  if (r.status == LnavStatus::kOk) add(r.subframe);
   return r.status;
+}
+
+std::optional<LnavFrameSyncOutput> LnavDecoder::add_bit(std::uint8_t bit) {
+  auto out = frame_sync_.push(bit);
+  if (!out) return out;
+  last_update_ = {};
+  count(out->result.status);
+  if (out->result.status == LnavStatus::kOk) add(out->result.subframe);
+  return out;
 }
 
 LnavUpdate LnavDecoder::add(const LnavSubframe& sf) {

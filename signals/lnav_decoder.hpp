@@ -1,12 +1,12 @@
-// Reads the LNAV message back (IS-GPS-200 20.3): decode_lnav_subframe checks one 300-bit subframe word by
-// word (parity 20.3.5, either polarity) and returns its TLM/HOW fields and 24-bit data words;
-// LnavDecoder collects one satellite's subframes into an Ephemeris (SI units, full weeks), the Klobuchar and
-// UTC parameters, and the GPS time of each subframe start.
+// Reads the LNAV message back (IS-GPS-200 20.3): LnavDecoder collects one satellite's parity-checked
+// subframes (lnav_subframe.hpp) into an Ephemeris (SI units, full weeks), the Klobuchar and UTC
+// parameters, and the GPS time of each subframe start.
 //
-// Use from a receiver: once the bit synchroniser has found the preamble (frame sync), hand each
-// consecutive block of 300 bits (0/1 as received, any polarity) to LnavDecoder::add_bits together with the
-// two bits received just before it. Subframes may arrive starting anywhere in the frame; a subframe with
-// a parity failure is counted and dropped, never used.
+// Use from a receiver: either push every bit from the bit synchroniser with LnavDecoder::add_bit (frame
+// sync by preamble search inside, lnav_frame_sync.hpp), or, with frame sync done elsewhere, hand each
+// block of 300 bits (0/1 as received, any polarity) to add_bits with the two bits received before it.
+// Subframes may arrive starting anywhere in the frame; a subframe with a parity failure is counted and
+// dropped, never used.
 #pragma once
 
 #include <array>
@@ -16,41 +16,10 @@
 
 #include "signals/ephemeris.hpp"
 #include "signals/gps_time.hpp"
-#include "signals/lnav_fields.hpp"
+#include "signals/lnav_frame_sync.hpp"
+#include "signals/lnav_subframe.hpp"
 
 namespace ultratrack::signals {
-
-enum class LnavStatus {
-  kOk,
-  kNoPreamble,      // bits 1-8 are neither 10001011 nor its complement
-  kParityError,     // some word failed its parity check
-  kBadSubframeId,   // HOW subframe ID outside 1..5
-};
-
-struct LnavSubframe {
-  LnavDataWords words{};   // d1..d24 of each word, polarity restored (d1 in bit 23)
-  int subframe_id = 0;     // 1..5
-  int tow_count = 0;       // HOW TOW count: start of the NEXT subframe in 6 s units, 0..100799
-  bool alert = false;
-  bool anti_spoof = false;
-  bool inverted = false;   // the bits were received with inverted polarity
-  int page_sv_id = -1;     // subframes 4/5: the page's SV ID (IS-GPS-200 Table 20-V); -1 for 1-3
-
-  // Seconds of week at which this subframe's first bit was transmitted (TOW count x 6 s - 6 s, wrapped).
-  double start_tow_s() const;
-};
-
-struct LnavSubframeResult {
-  LnavStatus status = LnavStatus::kNoPreamble;
-  int failed_word = 0;     // kParityError: the first word (1..10) whose parity failed
-  LnavSubframe subframe;   // meaningful only when status == kOk
-};
-
-// previous_bits: the two bits received just before the subframe (the previous word's D29*, D30*) in the
-// received polarity; without them the IS-GPS-200 value 0, 0 (upright) is assumed. Polarity comes from the
-// preamble: a complemented preamble means the whole subframe (and previous_bits) is inverted.
-LnavSubframeResult decode_lnav_subframe(std::span<const std::uint8_t, 300> bits,
-                                        std::optional<std::array<std::uint8_t, 2>> previous_bits = std::nullopt);
 
 // What one accepted subframe changed.
 struct LnavUpdate {
@@ -77,6 +46,11 @@ class LnavDecoder {
   // Decodes 300 received bits (see decode_lnav_subframe) and accepts them when they pass.
   LnavStatus add_bits(std::span<const std::uint8_t, 300> bits,
                       std::optional<std::array<std::uint8_t, 2>> previous_bits = std::nullopt);
+  // Pushes one received bit into the internal frame synchroniser; a completed subframe is decoded and
+  // accepted as by add_bits. Returns the status and stream position of a subframe when one completed.
+  std::optional<LnavFrameSyncOutput> add_bit(std::uint8_t bit);
+  bool frame_locked() const { return frame_sync_.locked(); }
+
   // Accepts one parity-checked subframe.
   LnavUpdate add(const LnavSubframe& subframe);
   // The last result of add/add_bits.
@@ -97,6 +71,7 @@ class LnavDecoder {
 
  private:
   void try_complete_ephemeris();
+  void count(LnavStatus status);
 
   int prn_;
   int week_;  // current full week of transmission
@@ -109,6 +84,7 @@ class LnavDecoder {
   std::optional<int> last_tow_count_;
   Counters counters_;
   LnavUpdate last_update_;
+  LnavFrameSync frame_sync_;
 };
 
 }  // namespace ultratrack::signals
