@@ -383,3 +383,30 @@ TEST(LnavTransmitter, DataSymbolsAcrossSubframeAndWeekBoundary) {
     EXPECT_EQ(tx.data_symbol_at(add_seconds(start, 0.02 * k)), bits[static_cast<std::size_t>(k)] ? -1 : 1) << k;
   }
 }
+
+// The almanac of PRN 1 (subframe 5 page 1) against the ephemeris moved to toa = 516096 s (518400 s
+// taken down to a multiple of 2^12 s): positions and scale factors of IS-GPS-200 Table 20-VI.
+TEST(LnavTransmitter, AlmanacPageHoldsEphemerisAtToa) {
+  const Ephemeris e = brdc_2022_001_ephemerides()[0];
+  const LnavTransmitter tx = make_transmitter(e);
+  EXPECT_EQ(tx.almanac_reference().tow_s, 516096.0);
+  const SubframeBits p1 = tx.subframe_starting_at({kWeek, 750.0 * 100 + 24});  // page 1 of subframe 5
+  ASSERT_EQ(raw_field(p1, 63, 6), 1u);
+  const double dt = 516096.0 - kToe;
+  EXPECT_EQ(raw_field(p1, 91, 8) * 4096.0, 516096.0);
+  // delta i is relative to 0.30 semicircles, 2^-19 semicircles.
+  EXPECT_NEAR((signed_field(p1, 99, 16) * std::ldexp(1.0, -19) + 0.30) * kPi, e.i0_rad + e.idot_radps * dt,
+              std::ldexp(0.5, -19) * kPi + 1e-15);
+  EXPECT_NEAR(signed_field(p1, 121, 16) * std::ldexp(1.0, -38) * kPi, e.omega_dot_radps, std::ldexp(0.5, -38) * kPi);
+  EXPECT_NEAR(signed_field(p1, 211, 24) * std::ldexp(1.0, -23) * kPi, e.omega_rad, std::ldexp(0.5, -23) * kPi);
+  // M0 moved by the mean motion over dt (n = sqrt(mu / A^3) + delta n), wrapped to [-pi, pi).
+  const double a = e.sqrt_a_sqrtm * e.sqrt_a_sqrtm;
+  const double n = std::sqrt(3.986005e14 / (a * a * a)) + e.delta_n_radps;
+  const double m_toa = std::remainder(e.m0_rad + n * dt, 2.0 * kPi);
+  EXPECT_NEAR(signed_field(p1, 241, 24) * std::ldexp(1.0, -23) * kPi, m_toa, std::ldexp(0.5, -23) * kPi + 1e-12);
+  // af0: 8 MSBs at bits 271-278, 3 LSBs at 290-292, 2^-20 s; af1: bits 279-289, 2^-38 s/s.
+  std::int64_t af0 = (std::int64_t{raw_field(p1, 271, 8)} << 3) | raw_field(p1, 290, 3);
+  if (af0 >= 1024) af0 -= 2048;
+  EXPECT_NEAR(af0 * std::ldexp(1.0, -20), e.af0_s + e.af1_sps * dt, std::ldexp(0.5, -20));
+  EXPECT_NEAR(signed_field(p1, 279, 11) * std::ldexp(1.0, -38), e.af1_sps, std::ldexp(0.5, -38));
+}
