@@ -38,7 +38,7 @@ void LnavDecoder::count(LnavStatus status) {
     case LnavStatus::kOk: break;
     case LnavStatus::kNoPreamble: ++counters_.no_preamble; break;
     case LnavStatus::kParityError: ++counters_.parity_errors; break;
-    case LnavStatus::kBadSubframeId: ++counters_.bad_subframe_id; break;
+    case LnavStatus::kBadHow: ++counters_.bad_how; break;
   }
 }
 

@@ -34,7 +34,7 @@ class LnavDecoder {
     int accepted = 0;        // subframes that passed parity
     int parity_errors = 0;   // subframes dropped for a parity failure
     int no_preamble = 0;
-    int bad_subframe_id = 0;
+    int bad_how = 0;
     int inconsistent = 0;    // subframes 1-3 all present but IODC/IODE disagree (waiting for a new set)
   };
 

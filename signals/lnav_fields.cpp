@@ -23,14 +23,14 @@ Place place_of(int first_bit, int length) {
   assert(length >= 1 && length <= 24 && pos + length <= 24 && word < 10);
   return {word, 24 - pos - length};
 }
-// Out of line so that GCC 12 does not constant-fold InputError's message building into a false -Wrestrict.
-[[noreturn, gnu::noinline]] void throw_out_of_range(const std::string& problem) {
-  throw InputError("LNAV encoder", problem);
-}
-
 std::uint32_t low_mask(int bits) { return bits >= 32 ? 0xFFFFFFFFu : ((1u << bits) - 1u); }
 
 }  // namespace
+
+// Out of line so that GCC 12 does not constant-fold InputError's message building into a false -Wrestrict.
+[[gnu::noinline]] void throw_lnav_encoding_error(const std::string& problem) {
+  throw InputError("LNAV encoder", problem);
+}
 
 void put_lnav_field(LnavDataWords& words, int first_bit, int length, std::uint32_t value) {
   const Place p = place_of(first_bit, length);
@@ -60,7 +60,7 @@ std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_vi
   const double half_range = std::ldexp(1.0, bits - 1);
   const double r = std::nearbyint(scaled);
   if (!std::isfinite(scaled) || r < -half_range || r >= half_range) {
-    throw_out_of_range(fmt::format("{} = {} does not fit {} signed bits of 2^{}", what, value, bits, scale_log2));
+    throw_lnav_encoding_error(fmt::format("{} = {} does not fit {} signed bits of 2^{}", what, value, bits, scale_log2));
   }
   return static_cast<std::uint32_t>(static_cast<std::int64_t>(r)) & low_mask(bits);
 }
@@ -69,7 +69,7 @@ std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_
   const double scaled = std::ldexp(value, -scale_log2);
   const double r = std::nearbyint(scaled);
   if (!std::isfinite(scaled) || r < 0.0 || r >= std::ldexp(1.0, bits)) {
-    throw_out_of_range(fmt::format("{} = {} does not fit {} unsigned bits of 2^{}", what, value, bits, scale_log2));
+    throw_lnav_encoding_error(fmt::format("{} = {} does not fit {} unsigned bits of 2^{}", what, value, bits, scale_log2));
   }
   return static_cast<std::uint32_t>(static_cast<std::int64_t>(r));
 }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 namespace ultratrack::signals {
@@ -28,6 +29,9 @@ std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_vi
 std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_view what);
 // An angle in radians as a two's complement semicircle field, wrapped into [-1, 1) semicircles first.
 std::uint32_t lnav_angle(double radians, int scale_log2, int bits);
+
+// Throws InputError("LNAV encoder", problem): a value that cannot be broadcast.
+[[noreturn]] void throw_lnav_encoding_error(const std::string& problem);
 
 double lnav_from_signed(std::uint32_t raw, int scale_log2, int bits);
 double lnav_from_unsigned(std::uint32_t raw, int scale_log2);

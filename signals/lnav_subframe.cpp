@@ -55,7 +55,7 @@ LnavSubframeResult decode_lnav_subframe(std::span<const std::uint8_t, 300> bits,
   sf.anti_spoof = get(sf.words, kAntiSpoof) != 0;
   sf.subframe_id = static_cast<int>(get(sf.words, kSubframeId));
   if (sf.subframe_id < 1 || sf.subframe_id > 5 || sf.tow_count >= kLnavTowCountModulus) {
-    result.status = LnavStatus::kBadSubframeId;
+    result.status = LnavStatus::kBadHow;
     return result;
   }
   if (sf.subframe_id >= 4) sf.page_sv_id = static_cast<int>(get(sf.words, kPageSvId));

@@ -15,7 +15,7 @@ enum class LnavStatus {
   kOk,
   kNoPreamble,      // bits 1-8 are neither 10001011 nor its complement
   kParityError,     // some word failed its parity check
-  kBadSubframeId,   // HOW subframe ID outside 1..5
+  kBadHow,          // HOW subframe ID outside 1..5 or TOW count >= 100800
 };
 
 struct LnavSubframe {

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "signals/gps_constants.hpp"
 #include "signals/lnav_layout.hpp"
 #include "signals/lnav_parity.hpp"
@@ -75,6 +77,20 @@ LnavTransmitter::LnavTransmitter(Ephemeris ephemeris, KlobucharParameters iono, 
                                  std::vector<Ephemeris> almanac_source)
     : ephemeris_(std::move(ephemeris)), iono_(iono), utc_(utc), almanac_source_(std::move(almanac_source)) {
   // Fail at construction, not in the middle of a synthesis run, when a field does not fit.
+  const auto check = [&](int value, int bits, const char* what) {
+    if (value < 0 || value >= (1 << bits))
+      throw_lnav_encoding_error(fmt::format("PRN {} {} = {} does not fit {} bits", ephemeris_.prn, what, value, bits));
+  };
+  check(ephemeris_.iodc, 10, "IODC");
+  check(ephemeris_.iode, 8, "IODE");
+  check(ephemeris_.health, 6, "health");
+  check(ephemeris_.ura_index, 4, "URA index");
+  check(ephemeris_.code_on_l2, 2, "code on L2");
+  check(ephemeris_.l2p_data_flag, 1, "L2 P data flag");
+  check(ephemeris_.fit_interval_flag, 1, "fit interval flag");
+  check(ephemeris_.aodo, 5, "AODO");
+  check(utc_.dn, 8, "UTC DN");
+  for (const auto& a : almanac_source_) check(a.health, 6, "almanac health");
   const GpsTime start{ephemeris_.week, std::floor(ephemeris_.toe_s / 30.0) * 30.0};
   (void)subframe1(start.week), (void)subframe2(), (void)subframe3();
   for (int page = 1; page <= 25; ++page) (void)subframe4(page), (void)subframe5(page);

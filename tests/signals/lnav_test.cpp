@@ -10,6 +10,7 @@
 
 #include "lnav_test_ephemerides.hpp"
 #include "signals/gps_constants.hpp"
+#include "signals/input_error.hpp"
 #include "signals/lnav_decoder.hpp"
 #include "signals/lnav_transmitter.hpp"
 
@@ -409,4 +410,16 @@ TEST(LnavTransmitter, AlmanacPageHoldsEphemerisAtToa) {
   if (af0 >= 1024) af0 -= 2048;
   EXPECT_NEAR(af0 * std::ldexp(1.0, -20), e.af0_s + e.af1_sps * dt, std::ldexp(0.5, -20));
   EXPECT_NEAR(signed_field(p1, 279, 11) * std::ldexp(1.0, -38), e.af1_sps, std::ldexp(0.5, -38));
+}
+
+TEST(LnavTransmitter, RejectsValuesThatCannotBeBroadcast) {
+  Ephemeris e = brdc_2022_001_ephemerides()[0];
+  e.af0_s = 1.0e-3;  // beyond the 22-bit 2^-31 s range of +-0.977 ms
+  EXPECT_THROW(make_transmitter(e), InputError);
+  e = brdc_2022_001_ephemerides()[0];
+  e.iodc = 1024;
+  EXPECT_THROW(make_transmitter(e), InputError);
+  e = brdc_2022_001_ephemerides()[0];
+  e.e = 1.0;  // 32 bits of 2^-33: e < 0.5
+  EXPECT_THROW(make_transmitter(e), InputError);
 }
