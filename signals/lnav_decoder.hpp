@@ -31,11 +31,11 @@ struct LnavUpdate {
 class LnavDecoder {
  public:
   struct Counters {
-    int accepted = 0;        // subframes that passed parity
-    int parity_errors = 0;   // subframes dropped for a parity failure
+    int accepted = 0;       // subframes that passed parity
+    int parity_errors = 0;  // subframes dropped for a parity failure
     int no_preamble = 0;
     int bad_how = 0;
-    int inconsistent = 0;    // subframes 1-3 all present but IODC/IODE disagree (waiting for a new set)
+    int inconsistent = 0;  // subframes 1-3 all present but IODC/IODE disagree (waiting for a new set)
   };
 
   // reference_week: a full GPS week within +-512 weeks of the signal's time (e.g. from the recording's
@@ -74,7 +74,7 @@ class LnavDecoder {
   void count(LnavStatus status);
 
   int prn_;
-  int week_;  // current full week of transmission
+  int week_;                           // current full week of transmission
   std::optional<LnavSubframe> sf_[3];  // latest subframes 1, 2, 3
   int sf1_week_ = 0;                   // full transmission week of the stored subframe 1
   std::optional<Ephemeris> ephemeris_;
