@@ -59,7 +59,8 @@ class LnavDecoder {
   // The latest complete ephemeris (subframes 1-3 with IODE2 = IODE3 = IODC mod 256).
   const std::optional<Ephemeris>& ephemeris() const { return ephemeris_; }
   // Valid once subframe 4 page 18 has been decoded (valid flags set). wnt and wn_lsf are full weeks
-  // resolved from their 8 bits against the current week.
+  // resolved from their 8 bits to the nearest week to the current one (IS-GPS-200 keeps WN_LSF within
+  // 127 weeks of WN when a leap second is pending; otherwise, delta_t_lsf = delta_t_ls, its week is moot).
   const KlobucharParameters& klobuchar() const { return iono_; }
   const UtcParameters& utc() const { return utc_; }
   // GPS time at which the last accepted subframe's first bit left the satellite, and its HOW TOW count.
