@@ -35,10 +35,17 @@ LnavDecoder::LnavDecoder(int prn, int reference_week) : prn_(prn), week_(referen
 
 void LnavDecoder::count(LnavStatus status) {
   switch (status) {
-    case LnavStatus::kOk: break;
-    case LnavStatus::kNoPreamble: ++counters_.no_preamble; break;
-    case LnavStatus::kParityError: ++counters_.parity_errors; break;
-    case LnavStatus::kBadHow: ++counters_.bad_how; break;
+    case LnavStatus::kOk:
+      break;
+    case LnavStatus::kNoPreamble:
+      ++counters_.no_preamble;
+      break;
+    case LnavStatus::kParityError:
+      ++counters_.parity_errors;
+      break;
+    case LnavStatus::kBadHow:
+      ++counters_.bad_how;
+      break;
   }
 }
 

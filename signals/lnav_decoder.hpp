@@ -31,11 +31,11 @@ struct LnavUpdate {
 class LnavDecoder {
  public:
   struct Counters {
-    int accepted = 0;        // subframes that passed parity
-    int parity_errors = 0;   // subframes dropped for a parity failure
+    int accepted = 0;       // subframes that passed parity
+    int parity_errors = 0;  // subframes dropped for a parity failure
     int no_preamble = 0;
     int bad_how = 0;
-    int inconsistent = 0;    // subframes 1-3 all present but IODC/IODE disagree (waiting for a new set)
+    int inconsistent = 0;  // subframes 1-3 all present but IODC/IODE disagree (waiting for a new set)
   };
 
   // reference_week: a full GPS week within +-512 weeks of the signal's time (e.g. from the recording's
@@ -59,7 +59,8 @@ class LnavDecoder {
   // The latest complete ephemeris (subframes 1-3 with IODE2 = IODE3 = IODC mod 256).
   const std::optional<Ephemeris>& ephemeris() const { return ephemeris_; }
   // Valid once subframe 4 page 18 has been decoded (valid flags set). wnt and wn_lsf are full weeks
-  // resolved from their 8 bits against the current week.
+  // resolved from their 8 bits to the nearest week to the current one (IS-GPS-200 keeps WN_LSF within
+  // 127 weeks of WN when a leap second is pending; otherwise, delta_t_lsf = delta_t_ls, its week is moot).
   const KlobucharParameters& klobuchar() const { return iono_; }
   const UtcParameters& utc() const { return utc_; }
   // GPS time at which the last accepted subframe's first bit left the satellite, and its HOW TOW count.
@@ -74,7 +75,7 @@ class LnavDecoder {
   void count(LnavStatus status);
 
   int prn_;
-  int week_;  // current full week of transmission
+  int week_;                           // current full week of transmission
   std::optional<LnavSubframe> sf_[3];  // latest subframes 1, 2, 3
   int sf1_week_ = 0;                   // full transmission week of the stored subframe 1
   std::optional<Ephemeris> ephemeris_;

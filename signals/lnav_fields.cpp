@@ -1,10 +1,10 @@
 #include "signals/lnav_fields.hpp"
 
+#include <fmt/format.h>
+
 #include <cassert>
 #include <cmath>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "signals/gps_constants.hpp"
 #include "signals/input_error.hpp"
@@ -49,10 +49,8 @@ void put_lnav_split(LnavDataWords& words, int msb_first, int msb_length, int lsb
   put_lnav_field(words, lsb_first, lsb_length, value & low_mask(lsb_length));
 }
 
-std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_length, int lsb_first,
-                             int lsb_length) {
-  return (get_lnav_field(words, msb_first, msb_length) << lsb_length) |
-         get_lnav_field(words, lsb_first, lsb_length);
+std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_length, int lsb_first, int lsb_length) {
+  return (get_lnav_field(words, msb_first, msb_length) << lsb_length) | get_lnav_field(words, lsb_first, lsb_length);
 }
 
 std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_view what) {
@@ -60,7 +58,8 @@ std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_vi
   const double half_range = std::ldexp(1.0, bits - 1);
   const double r = std::nearbyint(scaled);
   if (!std::isfinite(scaled) || r < -half_range || r >= half_range) {
-    throw_lnav_encoding_error(fmt::format("{} = {} does not fit {} signed bits of 2^{}", what, value, bits, scale_log2));
+    throw_lnav_encoding_error(
+        fmt::format("{} = {} does not fit {} signed bits of 2^{}", what, value, bits, scale_log2));
   }
   return static_cast<std::uint32_t>(static_cast<std::int64_t>(r)) & low_mask(bits);
 }
@@ -69,7 +68,8 @@ std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_
   const double scaled = std::ldexp(value, -scale_log2);
   const double r = std::nearbyint(scaled);
   if (!std::isfinite(scaled) || r < 0.0 || r >= std::ldexp(1.0, bits)) {
-    throw_lnav_encoding_error(fmt::format("{} = {} does not fit {} unsigned bits of 2^{}", what, value, bits, scale_log2));
+    throw_lnav_encoding_error(
+        fmt::format("{} = {} does not fit {} unsigned bits of 2^{}", what, value, bits, scale_log2));
   }
   return static_cast<std::uint32_t>(static_cast<std::int64_t>(r));
 }

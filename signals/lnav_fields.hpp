@@ -20,8 +20,7 @@ std::uint32_t get_lnav_field(const LnavDataWords& words, int first_bit, int leng
 // A field transmitted as an MSB part and an LSB part in different words (e.g. M0: 8 + 24 bits).
 void put_lnav_split(LnavDataWords& words, int msb_first, int msb_length, int lsb_first, int lsb_length,
                     std::uint32_t value);
-std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_length, int lsb_first,
-                             int lsb_length);
+std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_length, int lsb_first, int lsb_length);
 
 // Fixed-point encoding of value (in units of the scale factor 2^scale_log2) to an n-bit two's complement
 // or unsigned field, rounded to nearest. Throws InputError naming `what` when it does not fit.
@@ -39,7 +38,7 @@ double lnav_from_unsigned(std::uint32_t raw, int scale_log2);
 double lnav_angle_from_signed(std::uint32_t raw, int scale_log2, int bits);
 
 inline constexpr std::uint32_t kLnavPreamble = 0x8B;  // 10001011
-inline constexpr int kLnavDataIdNav = 1;             // data ID "01" of subframes 4 and 5
-inline constexpr int kLnavTowCountModulus = 100800;  // 17-bit HOW TOW count, 6 s units, per week
+inline constexpr int kLnavDataIdNav = 1;              // data ID "01" of subframes 4 and 5
+inline constexpr int kLnavTowCountModulus = 100800;   // 17-bit HOW TOW count, 6 s units, per week
 
 }  // namespace ultratrack::signals

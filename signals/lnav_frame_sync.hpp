@@ -13,8 +13,8 @@
 namespace ultratrack::signals {
 
 struct LnavFrameSyncOutput {
-  LnavSubframeResult result;        // decoded subframe, or the reason it failed (only while locked)
-  std::int64_t first_bit_index = 0; // index (0 = first bit pushed) of the subframe's first bit
+  LnavSubframeResult result;         // decoded subframe, or the reason it failed (only while locked)
+  std::int64_t first_bit_index = 0;  // index (0 = first bit pushed) of the subframe's first bit
 };
 
 class LnavFrameSync {

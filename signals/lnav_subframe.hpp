@@ -13,19 +13,19 @@ namespace ultratrack::signals {
 
 enum class LnavStatus {
   kOk,
-  kNoPreamble,      // bits 1-8 are neither 10001011 nor its complement
-  kParityError,     // some word failed its parity check
-  kBadHow,          // HOW subframe ID outside 1..5 or TOW count >= 100800
+  kNoPreamble,   // bits 1-8 are neither 10001011 nor its complement
+  kParityError,  // some word failed its parity check
+  kBadHow,       // HOW subframe ID outside 1..5 or TOW count >= 100800
 };
 
 struct LnavSubframe {
-  LnavDataWords words{};   // d1..d24 of each word, polarity restored (d1 in bit 23)
-  int subframe_id = 0;     // 1..5
-  int tow_count = 0;       // HOW TOW count: start of the NEXT subframe in 6 s units, 0..100799
+  LnavDataWords words{};  // d1..d24 of each word, polarity restored (d1 in bit 23)
+  int subframe_id = 0;    // 1..5
+  int tow_count = 0;      // HOW TOW count: start of the NEXT subframe in 6 s units, 0..100799
   bool alert = false;
   bool anti_spoof = false;
-  bool inverted = false;   // the bits were received with inverted polarity
-  int page_sv_id = -1;     // subframes 4/5: the page's SV ID (IS-GPS-200 Table 20-V); -1 for 1-3
+  bool inverted = false;  // the bits were received with inverted polarity
+  int page_sv_id = -1;    // subframes 4/5: the page's SV ID (IS-GPS-200 Table 20-V); -1 for 1-3
 
   // Seconds of week at which this subframe's first bit was transmitted (TOW count x 6 s - 6 s, wrapped).
   double start_tow_s() const;
@@ -33,8 +33,8 @@ struct LnavSubframe {
 
 struct LnavSubframeResult {
   LnavStatus status = LnavStatus::kNoPreamble;
-  int failed_word = 0;     // kParityError: the first word (1..10) whose parity failed
-  LnavSubframe subframe;   // meaningful only when status == kOk
+  int failed_word = 0;    // kParityError: the first word (1..10) whose parity failed
+  LnavSubframe subframe;  // meaningful only when status == kOk
 };
 
 // previous_bits: the two bits received just before the subframe (the previous word's D29*, D30*) in the

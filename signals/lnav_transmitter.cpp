@@ -1,9 +1,9 @@
 #include "signals/lnav_transmitter.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <string>
-
-#include <fmt/format.h>
 
 #include "signals/gps_constants.hpp"
 #include "signals/lnav_layout.hpp"
@@ -46,8 +46,8 @@ std::uint32_t almanac_health(int health6) {
   return (nav << 5) | (static_cast<std::uint32_t>(health6) & 0x1Fu);
 }
 
-constexpr std::uint32_t kAbsentHealth6 = 0x3F;   // no almanac for this SV
-constexpr std::uint32_t kConfigAsOnIIF = 0xB;    // A-S on, configuration 011 (Block IIF-like)
+constexpr std::uint32_t kAbsentHealth6 = 0x3F;  // no almanac for this SV
+constexpr std::uint32_t kConfigAsOnIIF = 0xB;   // A-S on, configuration 011 (Block IIF-like)
 
 }  // namespace
 
@@ -112,11 +112,21 @@ LnavDataWords LnavTransmitter::subframe_data(const GpsTime& start_in) const {
   const int id = lnav_subframe_id_at(start.tow_s);
   LnavDataWords w{};
   switch (id) {
-    case 1: w = subframe1(start.week); break;
-    case 2: w = subframe2(); break;
-    case 3: w = subframe3(); break;
-    case 4: w = subframe4(lnav_page_at(start.tow_s)); break;
-    default: w = subframe5(lnav_page_at(start.tow_s)); break;
+    case 1:
+      w = subframe1(start.week);
+      break;
+    case 2:
+      w = subframe2();
+      break;
+    case 3:
+      w = subframe3();
+      break;
+    case 4:
+      w = subframe4(lnav_page_at(start.tow_s));
+      break;
+    default:
+      w = subframe5(lnav_page_at(start.tow_s));
+      break;
   }
   // TLM: preamble, TLM message 0, integrity status 0 (legacy accuracy), reserved 0.
   put(w, kPreamble, kLnavPreamble);
@@ -218,8 +228,9 @@ void LnavTransmitter::almanac_page(LnavDataWords& w, int prn) const {
   put(w, kPageSvId, static_cast<std::uint32_t>(prn));
   put(w, kAlmE, uns(a->e, kAlmEScale, kAlmE, "almanac e"));
   put(w, kAlmToa, uns(toa.tow_s, kAlmToaScale, kAlmToa, "toa"));
-  put(w, kAlmDeltaI, sgn((a->i0_rad + a->idot_radps * dt) / kPi - kAlmReferenceInclination_sc, kAlmDeltaIScale,
-                         kAlmDeltaI, "almanac delta i"));
+  put(w, kAlmDeltaI,
+      sgn((a->i0_rad + a->idot_radps * dt) / kPi - kAlmReferenceInclination_sc, kAlmDeltaIScale, kAlmDeltaI,
+          "almanac delta i"));
   put(w, kAlmOmegaDot, sgn(a->omega_dot_radps / kPi, kAlmOmegaDotScale, kAlmOmegaDot, "almanac Omega dot"));
   put(w, kAlmHealth, almanac_health(a->health));
   put(w, kAlmSqrtA, uns(sqrt_a, kAlmSqrtAScale, kAlmSqrtA, "almanac sqrt A"));

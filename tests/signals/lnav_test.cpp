@@ -200,7 +200,7 @@ TEST(LnavTransmitter, SubframeAndPageNumbering) {
       EXPECT_NEAR(raw_field(sf5, 69, 16) * std::ldexp(1.0, -21), e->e, std::ldexp(0.5, -21));
       EXPECT_NEAR(raw_field(sf5, 151, 24) * std::ldexp(1.0, -11), e->sqrt_a_sqrtm, std::ldexp(0.5, -11));
       EXPECT_EQ(raw_field(sf5, 137, 8), 0u);  // healthy
-    } else if (page <= 24) {  // dummy SV: alternating 1010 fill from bit 9 of word 3
+    } else if (page <= 24) {                  // dummy SV: alternating 1010 fill from bit 9 of word 3
       EXPECT_EQ(raw_field(sf5, 69, 16), 0xAAAAu);
       EXPECT_EQ(raw_field(sf5, 91, 24), 0xAAAAAAu);
     }
@@ -328,11 +328,11 @@ TEST(LnavDecoder, InconsistentIssueOfDataIsNotCombined) {
   new_e.iode = 40, new_e.iodc = 40, new_e.toe_s = kToe + 7200, new_e.toc_s = new_e.toe_s;
   const LnavTransmitter tx_old = make_transmitter(old_e), tx_new = make_transmitter(new_e);
   LnavDecoder decoder(1, kWeek);
-  feed(decoder, tx_new, {kWeek, kToe}, 1);             // subframe 1 of the new upload
-  feed(decoder, tx_old, {kWeek, kToe + 6.0}, 2);       // subframes 2, 3 of the old one
+  feed(decoder, tx_new, {kWeek, kToe}, 1);        // subframe 1 of the new upload
+  feed(decoder, tx_old, {kWeek, kToe + 6.0}, 2);  // subframes 2, 3 of the old one
   EXPECT_FALSE(decoder.ephemeris().has_value());
   EXPECT_GE(decoder.counters().inconsistent, 1);
-  feed(decoder, tx_new, {kWeek, kToe + 36.0}, 2);      // new subframes 2, 3
+  feed(decoder, tx_new, {kWeek, kToe + 36.0}, 2);  // new subframes 2, 3
   ASSERT_TRUE(decoder.ephemeris().has_value());
   EXPECT_EQ(decoder.ephemeris()->iode, 40);
   EXPECT_EQ(decoder.ephemeris()->toe_s, kToe + 7200);
