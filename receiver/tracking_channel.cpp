@@ -172,6 +172,7 @@ TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, 
       if (k > 0) {
         const int m = static_cast<int>(std::min<std::int64_t>(k, remaining));
         advance(m);
+        aligned_ = m == k;  // the NCO now sits on the first sample of the new period
         return {m, false};
       }
       aligned_ = true;

@@ -85,9 +85,9 @@ class TrackingChannel final {
   void advance(std::int64_t samples);
 
   ChannelConfig config_;
-  CorrelatorEngine engine_;
-  // Tap index in the engine for each role, -1 when off.
+  // Tap index in the engine for each role, -1 when off (declared before engine_, whose initialiser sets them).
   int tap_ve_ = -1, tap_e_ = -1, tap_p_ = -1, tap_l_ = -1, tap_vl_ = -1, tap_n_ = -1;
+  CorrelatorEngine engine_;
 
   CodePhase code_;        // chips since the channel's start reference (continuous)
   CarrierPhase carrier_;  // cycles since the channel's start (continuous)
