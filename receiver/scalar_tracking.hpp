@@ -23,7 +23,9 @@ struct ScalarTrackingOptions {
   // Carrier loop
   int pll_order = 3;                   // 2 or 3
   double pll_bw_hz = 15.0;             // PLL noise bandwidth with 1 ms epochs; (0, 50]
-  double pll_bw_coherent_hz = 10.0;    // with 20 ms epochs after bit sync; (0, 15] (Bn*T <= 0.3)
+  double pll_bw_coherent_hz = 5.0;     // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
+                                       // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
+
   double fll_bw_hz = 10.0;             // FLL assist during pull-in; (0, 50]
   double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
   double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30]
