@@ -21,6 +21,11 @@ class CarrierLoopFilter final {
   CarrierLoopFilter(int order, double pll_bw_hz, double fll_bw_hz, double initial_frequency_hz);
 
   void set_bandwidths(double pll_bw_hz, double fll_bw_hz);
+  // Restarts the integrators (e.g. when the integration time changes and the old state is too noisy).
+  void reset(double frequency_hz, double frequency_rate_hzps) {
+    frequency_hz_ = frequency_hz;
+    rate_hzps_ = frequency_rate_hzps;
+  }
   // One update with the phase error (cycles) and frequency error (Hz, ignored when the FLL is off) measured over
   // an integration of t_s seconds. Returns the NCO carrier frequency for the next integration, Hz.
   double update(double phase_error_cycles, double frequency_error_hz, double t_s);

@@ -31,6 +31,9 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.pll_bw_hz > 0 && o.pll_bw_hz <= 50, "pll_bw_hz", o.pll_bw_hz, "(0, 50] Hz");
   c.check(o.pll_bw_coherent_hz > 0 && o.pll_bw_coherent_hz <= 15, "pll_bw_coherent_hz", o.pll_bw_coherent_hz, "(0, 15] Hz");
   c.check(o.fll_bw_hz > 0 && o.fll_bw_hz <= 50, "fll_bw_hz", o.fll_bw_hz, "(0, 50] Hz");
+  c.check(o.fll_wide_time_s >= 0.01 && o.fll_wide_time_s <= 5, "fll_wide_time_s", o.fll_wide_time_s, "[0.01, 5] s");
+  c.check(o.fll_narrow_time_s >= 0 && o.fll_narrow_time_s <= 5, "fll_narrow_time_s", o.fll_narrow_time_s, "[0, 5] s");
+  c.check(o.fll_narrow_bw_hz > 0 && o.fll_narrow_bw_hz <= 20, "fll_narrow_bw_hz", o.fll_narrow_bw_hz, "(0, 20] Hz");
   c.check(o.pullin_lock_time_s >= 0.01 && o.pullin_lock_time_s <= 2, "pullin_lock_time_s", o.pullin_lock_time_s, "[0.01, 2] s");
   c.check(o.pullin_timeout_s >= 0.1 && o.pullin_timeout_s <= 30, "pullin_timeout_s", o.pullin_timeout_s, "[0.1, 30] s");
   c.check(o.dll_bw_hz > 0 && o.dll_bw_hz <= 10, "dll_bw_hz", o.dll_bw_hz, "(0, 10] Hz");
@@ -123,7 +126,11 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
 
   r.phase_error_cycles = costas_atan_cycles(taps.prompt);
-  r.frequency_error_hz = fll_atan2_hz(e.prompt_halves[0], e.prompt_halves[1], 0.5 * t);
+  const bool wide_fll = time_s_ <= opt_.fll_wide_time_s || previous_t_s_ == 0.0;
+  r.frequency_error_hz = wide_fll ? fll_atan2_hz(e.prompt_halves[0], e.prompt_halves[1], 0.5 * t)
+                                  : fll_atan_hz(previous_prompt_, taps.prompt, 0.5 * (previous_t_s_ + t));
+  previous_prompt_ = taps.prompt;
+  previous_t_s_ = t;
   r.code_error_chips = dll_nelp_chips(taps.early, taps.late, opt_.early_late_offset_chips);
 
   if (state_ == TrackingState::kLost) {
@@ -155,6 +162,9 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
     if (coherent_requested_ && e.num_code_periods == opt_.coherent_ms) {
       state_ = TrackingState::kBitSynced;
       carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
+      // The wide 1 ms loop's frequency (and more so its frequency rate) carries noise that would make the narrow
+      // loop ring for seconds: restart it from the smoothed frequency, and no rate (a static or vehicle receiver sees < ~10 Hz/s).
+      carrier_.reset(smoothed_frequency_hz_, 0.0);
     }
   }
   if (bits_) r.bit = bits_->add(e);
@@ -171,9 +181,17 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   }
 
   // Loops.
+  if (state_ == TrackingState::kPullIn)
+    carrier_.set_bandwidths(opt_.pll_bw_hz, time_s_ <= opt_.fll_wide_time_s ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz);
   const bool coherent = state_ == TrackingState::kBitSynced;
-  const double f = carrier_.update(r.phase_error_cycles, r.frequency_error_hz, t);
+  // The wide FLL runs alone: a PLL fed with the phase of a signal it does not yet follow only random-walks
+  // its integrators.
+  const bool fll_only = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s;
+  const double f = carrier_.update(fll_only ? 0.0 : r.phase_error_cycles, r.frequency_error_hz, t);
   const double dll_bw = coherent ? opt_.dll_bw_coherent_hz : opt_.dll_bw_hz;
+  if (state_ == TrackingState::kPhaseLocked) {
+    smoothed_frequency_hz_ = smoothed_frequency_hz_ == 0.0 ? f : smoothed_frequency_hz_ + std::min(1.0, t / 0.1) * (f - smoothed_frequency_hz_);
+  }
   command_.carrier_frequency_hz = f;
   command_.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 + f / signals::kL1Frequency_hz) +
                                    dll_rate_correction_chips_per_s(r.code_error_chips, dll_bw);
