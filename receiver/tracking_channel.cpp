@@ -1,6 +1,7 @@
 #include "receiver/tracking_channel.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -52,6 +53,18 @@ const ChannelConfig& checked(const ChannelConfig& c) {
 }
 
 }  // namespace
+
+ChannelStart start_from_code_start(std::int64_t first_sample, double samples_to_code_start, double doppler_hz,
+                                   double sample_rate_hz) {
+  ChannelStart s;
+  s.sample_index = first_sample;
+  s.carrier_frequency_hz = doppler_hz;
+  const double rate = signals::kCaChipRate_hz * (1.0 + doppler_hz / signals::kL1Frequency_hz);
+  const double phase = std::fmod(-samples_to_code_start * rate / sample_rate_hz, 1023.0);
+  s.code_phase_chips = phase < 0.0 ? phase + 1023.0 : phase;
+  if (s.code_phase_chips >= 1023.0) s.code_phase_chips = 0.0;
+  return s;
+}
 
 TrackingChannel::TrackingChannel(const ChannelConfig& config, const ChannelStart& start)
     : config_(checked(config)),
@@ -157,8 +170,10 @@ void TrackingChannel::finish_epoch() {
 TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, int offset) {
   const int remaining = block.num_samples - offset;
   if (remaining <= 0) return {0, false};
+  assert(block.num_antennas >= config_.num_antennas);
   const std::int64_t s = block.first_sample + offset;
   if (s < nco_sample_) return {static_cast<int>(std::min<std::int64_t>(remaining, nco_sample_ - s)), false};
+  if (in_epoch_ && s > nco_sample_) in_epoch_ = false;  // samples went missing: drop the partial epoch
   if (!in_epoch_) {
     if (s > nco_sample_) {  // samples we never saw: dead-reckon the replica over them
       advance(s - nco_sample_);

@@ -31,7 +31,10 @@ struct ChannelConfig {
   CorrelatorLayout layout;
 };
 
-// Where the replica starts, e.g. from acquisition: the code phase holds at sample_index.
+// Where the replica starts, e.g. from acquisition: the code phase holds at sample_index. code_phase_chips is the
+// position within the code at that sample (chip index plus fraction: 0 = the first chip of a period is just
+// starting), so the next period starts (1023 - code_phase_chips) / rate seconds later. An acquisition that reports
+// the delay to the next code start instead converts with code_phase_chips = 1023 - delay_chips.
 struct ChannelStart {
   std::int64_t sample_index = 0;  // receiver sample index at which code_phase_chips holds
   double code_phase_chips = 0.0;  // [0, 1023): replica code phase at that sample
@@ -40,6 +43,11 @@ struct ChannelStart {
   // Code rate, chips/s; 0 means derived from the carrier (1.023e6 * (1 + f / f_L1), carrier-aided).
   double code_rate_chips_per_s = 0.0;
 };
+
+// A start from an acquisition that reports where the next code period begins: samples_to_code_start samples
+// (fractional) after first_sample, with carrier Doppler doppler_hz, at sample rate fs (code rate carrier-aided).
+ChannelStart start_from_code_start(std::int64_t first_sample, double samples_to_code_start, double doppler_hz,
+                                   double sample_rate_hz);
 
 // Views on one block of samples (one pointer per antenna, same length, same receiver sample indices).
 struct SampleBlockView {
@@ -66,8 +74,9 @@ class TrackingChannel final {
   };
   // Consumes samples of block from `offset` until an epoch completes or the block ends. Call again with
   // offset + consumed until the block is used up; between calls, read epoch() and give the next command.
-  // Samples before the channel's start are skipped; a jump forward in sample index between epochs is
-  // bridged by the NCO (dead reckoning); within an epoch the samples must be contiguous.
+  // Samples before the channel's start are skipped; a jump forward in sample index (samples lost) is bridged by
+  // the NCO (dead reckoning) and drops a partially integrated epoch; the next epoch starts at the next period.
+  // block.num_antennas must be at least the configured number of antennas.
   FeedResult feed(const SampleBlockView& block, int offset);
 
   const CorrelationEpoch& epoch() const { return epoch_; }

@@ -215,3 +215,22 @@ TEST(TrackingChannel, AntennasShareTheReplica) {
   }
   EXPECT_GE(n, 2);
 }
+
+TEST(TrackingChannel, StartsFromAnAcquisitionCodeStart) {
+  test::TestSatellite sat;
+  sat.prn = 4;
+  sat.doppler_hz = -3210.0;
+  sat.code_phase_chips = 123.456;
+  // The true code start after sample 1000: where the code phase reaches the next multiple of 1023.
+  const double rate = code_rate(sat.doppler_hz);
+  const double chips_at_1000 = test::true_code_phase_chips(sat, 1000 / kFs);
+  const double samples_to_start = (1023.0 * std::ceil(chips_at_1000 / 1023.0) - chips_at_1000) / rate * kFs;
+  const auto start = start_from_code_start(1000, samples_to_start, sat.doppler_hz, kFs);
+  EXPECT_NEAR(start.code_phase_chips, std::fmod(chips_at_1000, 1023.0), 1e-6);
+  const auto x = test::generate({sat}, {kFs, false, 1}, 0, 12000);
+  TrackingChannel ch(ChannelConfig{4, kFs, 1, {}}, start);
+  const auto epochs = run(ch, x, 0, 3000);
+  ASSERT_GE(epochs.size(), 1u);
+  EXPECT_NEAR(epochs[0].first_sample, 1000 + samples_to_start, 1.0);
+  EXPECT_NEAR(std::abs(epochs[0].master().prompt), epochs[0].num_samples, 1e-3 * epochs[0].num_samples);
+}
