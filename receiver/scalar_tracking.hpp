@@ -10,6 +10,7 @@
 
 #include "receiver/bit_sync.hpp"
 #include "receiver/correlation_epoch.hpp"
+#include "receiver/discriminators.hpp"
 #include "receiver/lock_detectors.hpp"
 #include "receiver/loop_filters.hpp"
 #include "receiver/nco_command.hpp"
@@ -27,12 +28,13 @@ struct ScalarTrackingOptions {
                                        // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
 
   // Pull-in: (1) a wide FLL alone on the two halves of each code period (range +-1 kHz, bit-edge safe); (2) a
-  // narrow FLL alone on successive 1 ms prompts (bit-tolerant atan, range +-250 Hz, 8x less noise); (3) the PLL
-  // assisted by the narrow FLL until the phase lock indicator holds; then the PLL alone.
+  // narrow FLL alone on successive 1 ms prompts (bit-tolerant, range +-250 Hz, 8x less noise); (3) the PLL alone
+  // (2nd order while pulling in) until the phase lock indicator holds, then the PLL of pll_order. Both FLLs are
+  // first order and average cross and dot over ~4 epochs before the arctangent.
   double fll_bw_hz = 10.0;             // wide FLL; (0, 50]
   double fll_wide_time_s = 0.25;       // stage (1) length; [0.01, 5]
-  double fll_narrow_bw_hz = 5.0;       // narrow FLL; (0, 20]
-  double fll_narrow_time_s = 0.2;      // stage (2) length; [0, 5]
+  double fll_narrow_bw_hz = 2.0;       // narrow FLL; (0, 20]
+  double fll_narrow_time_s = 0.4;      // stage (2) length; [0, 5]
   double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
   double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30]
   // Code loop
@@ -115,7 +117,10 @@ class ScalarTracking final {
   double time_s_ = 0.0, locked_time_s_ = 0.0, loss_time_s_ = 0.0;
   bool ever_locked_ = false;
   std::complex<float> previous_prompt_{};
-  double smoothed_frequency_hz_ = 0.0;  // NCO frequency low-passed over ~0.1 s while phase-locked at 1 ms
+  CrossDot fll_average_{};
+  bool wide_fll_ = true;
+  double smoothed_frequency_hz_ = 0.0;  // NCO frequency and rate low-passed while phase-locked at 1 ms
+  bool smoothing_started_ = false;
   double previous_t_s_ = 0.0;
 };
 

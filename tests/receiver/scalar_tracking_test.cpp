@@ -115,7 +115,7 @@ TEST(ScalarTracking, DefaultOptionsAreValidAndBadOnesAreNamed) {
 TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   const auto sat = satellite(7, 45.0);
   ScalarTrackingOptions opt;
-  const auto recs = track(sat, opt, +230.0, 0.5, 5.0);
+  const auto recs = track(sat, opt, +240.0, 0.5, 6.0);
   double t_locked = -1, t_synced = -1;
   std::vector<double> code_err, phase_err, cn0;
   int bit_errors_plus = 0, bit_errors_minus = 0, bits = 0;
@@ -134,7 +134,7 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
       bit_errors_minus += r.report.bit->value != -truth;
       ++bits;
     }
-    if (r.t_s > 2.5) {
+    if (r.t_s > 3.5) {  // the narrow 20 ms loop settles within ~2 s of bit sync
       code_err.push_back(r.code_error_chips);
       phase_err.push_back(r.phase_error_cycles);
       if (r.report.cn0_dbhz) cn0.push_back(*r.report.cn0_dbhz);
@@ -142,8 +142,8 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   }
   ASSERT_GT(t_locked, 0.0);
   ASSERT_GT(t_synced, 0.0);
-  EXPECT_LT(t_locked, 1.0);
-  EXPECT_LT(t_synced, 2.0);
+  EXPECT_LT(t_locked, 1.5);  // FLL stages 0.65 s, then PLL lock judged over >= 0.2 s
+  EXPECT_LT(t_synced, 2.5);
   EXPECT_GE(bits, 100);
   EXPECT_EQ(std::min(bit_errors_plus, bit_errors_minus), 0);
   ASSERT_GT(code_err.size(), 50u);
@@ -151,7 +151,7 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   const double sigma_phase = pll_jitter_cycles(6.0, 45.0, 0.02);
   const double sigma_code = dll_jitter_chips(1.0, 2 * opt.early_late_offset_chips, 45.0, 0.02);
   const double code_rms = rms(code_err), phase_rms = rms(phase_err);
-  // Factors: 1.5 on the carrier (~100 independent samples in 2.5 s at 6 Hz: the RMS itself scatters ~10 %);
+  // Factors: 1.5 on the carrier (~30 independent samples in 2.5 s at 6 Hz: the RMS itself scatters ~13 %);
   // 2.5 on the code (a 1 Hz loop gives only ~10 independent samples, chi-square 99 % ~ 1.7, plus the sampled,
   // non-ideal triangle at 2.44 samples per chip).
   std::printf("45 dB-Hz: carrier RMS %.5f cycles (bound %.5f), code RMS %.5f chips (bound %.5f), lock %.3f s, "
@@ -164,10 +164,10 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   EXPECT_NEAR(mean_cn0, 45.0, 1.0);
 }
 
-TEST(ScalarTracking, PullsInFromNegativeDopplerErrorAndTracksAt35DbHz) {
+TEST(ScalarTracking, PullsInFrom240HzBelowAndTracksAt35DbHz) {
   const auto sat = satellite(23, 35.0);
   ScalarTrackingOptions opt;
-  const auto recs = track(sat, opt, -150.0, -0.4, 5.0, 7);
+  const auto recs = track(sat, opt, -240.0, -0.5, 6.0, 7);
   std::vector<double> cn0, phase_err;
   bool synced = false;
   for (const auto& r : recs) {
@@ -176,7 +176,7 @@ TEST(ScalarTracking, PullsInFromNegativeDopplerErrorAndTracksAt35DbHz) {
       synced = true;
       EXPECT_EQ(((r.true_period + sat.bit_offset_periods) % 20 + 20) % 20, 0);
     }
-    if (r.t_s > 3.0) {
+    if (r.t_s > 3.5) {
       if (r.report.cn0_dbhz) cn0.push_back(*r.report.cn0_dbhz);
       phase_err.push_back(r.phase_error_cycles);
     }
