@@ -26,7 +26,6 @@ struct ScalarTrackingOptions {
   double pll_bw_hz = 15.0;             // PLL noise bandwidth with 1 ms epochs; (0, 50]
   double pll_bw_coherent_hz = 5.0;     // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
                                        // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
-
   // Pull-in: (1) a wide FLL alone on the two halves of each code period (range +-1 kHz, bit-edge safe); (2) a
   // narrow FLL alone on successive 1 ms prompts (bit-tolerant, range +-250 Hz, 8x less noise); (3) the PLL alone
   // (2nd order while pulling in) until the phase lock indicator holds, then the PLL of pll_order. Both FLLs are
@@ -36,7 +35,8 @@ struct ScalarTrackingOptions {
   double fll_narrow_bw_hz = 2.0;       // narrow FLL; (0, 20]
   double fll_narrow_time_s = 0.4;      // stage (2) length; [0, 5]
   double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
-  double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30]
+  double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30] and longer than
+                                       // the FLL stages plus pli_time_constant_s plus pullin_lock_time_s
   // Code loop
   double dll_bw_hz = 2.0;              // DLL noise bandwidth with 1 ms epochs; (0, 10]
   double dll_bw_coherent_hz = 1.0;     // after bit sync; (0, 5]
@@ -63,7 +63,7 @@ std::string validation_error(const ScalarTrackingOptions& options);
 ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz, int num_antennas = 1);
 
 enum class TrackingState {
-  kPullIn,       // FLL-assisted PLL, 1 ms epochs
+  kPullIn,       // FLL stages, then the PLL until phase lock; 1 ms epochs
   kPhaseLocked,  // Costas PLL, 1 ms epochs, bit sync running
   kBitSynced,    // 20 ms (coherent_ms) epochs, bits flowing
   kLost,         // lock lost: the command only coasts; re-acquire

@@ -107,6 +107,9 @@ TEST(ScalarTracking, DefaultOptionsAreValidAndBadOnesAreNamed) {
   o.coherent_ms = 3;
   EXPECT_NE(validation_error(o).find("coherent_ms"), std::string::npos);
   o = {};
+  o.pullin_timeout_s = 0.5;  // shorter than the FLL stages: could never lock
+  EXPECT_NE(validation_error(o).find("pullin_timeout_s"), std::string::npos);
+  o = {};
   o.pli_loss_threshold = 0.9;
   EXPECT_NE(validation_error(o).find("pli_loss_threshold"), std::string::npos);
   EXPECT_THROW(ScalarTracking(o, NcoCommand{}), std::invalid_argument);
