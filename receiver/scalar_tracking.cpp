@@ -25,6 +25,13 @@ constexpr double kSmoothing_s = 0.1;
 
 int epochs_in(double window_s, double t_s) { return std::max(1, static_cast<int>(std::lround(window_s / t_s))); }
 
+// The moments method estimates the noise as a small difference of large moments at high SNR: it needs more
+// epochs per window than the noise-tap ratio (50 keeps its spread below ~0.5 dB at 45 dB-Hz, 20 ms).
+int cn0_window_epochs(Cn0Method method, double window_s, double t_s) {
+  const int n = epochs_in(window_s, t_s);
+  return method == Cn0Method::kMoments ? std::max(n, 50) : n;
+}
+
 }  // namespace
 
 std::string validation_error(const ScalarTrackingOptions& o) {
@@ -38,9 +45,12 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.fll_narrow_bw_hz > 0 && o.fll_narrow_bw_hz <= 20, "fll_narrow_bw_hz", o.fll_narrow_bw_hz, "(0, 20] Hz");
   c.check(o.pullin_lock_time_s >= 0.01 && o.pullin_lock_time_s <= 2, "pullin_lock_time_s", o.pullin_lock_time_s, "[0.01, 2] s");
   c.check(o.pullin_timeout_s >= 0.1 && o.pullin_timeout_s <= 30, "pullin_timeout_s", o.pullin_timeout_s, "[0.1, 30] s");
-  const double pullin_min_s = o.fll_wide_time_s + o.fll_narrow_time_s + o.pli_time_constant_s + o.pullin_lock_time_s;
+  c.check(o.fll_fine_time_s >= 0 && o.fll_fine_time_s <= 5, "fll_fine_time_s", o.fll_fine_time_s, "[0, 5] s");
+  c.check(o.fll_fine_bw_hz > 0 && o.fll_fine_bw_hz <= 10, "fll_fine_bw_hz", o.fll_fine_bw_hz, "(0, 10] Hz");
+  const double pullin_min_s = o.fll_wide_time_s + o.fll_narrow_time_s + o.fll_fine_time_s + o.pli_time_constant_s +
+                              o.pullin_lock_time_s;
   c.check(o.pullin_timeout_s > pullin_min_s, "pullin_timeout_s", o.pullin_timeout_s,
-          "(fll_wide_time_s + fll_narrow_time_s + pli_time_constant_s + pullin_lock_time_s, 30] s");
+          "(sum of the FLL stage times + pli_time_constant_s + pullin_lock_time_s, 30] s");
   c.check(o.dll_bw_hz > 0 && o.dll_bw_hz <= 10, "dll_bw_hz", o.dll_bw_hz, "(0, 10] Hz");
   c.check(o.dll_bw_coherent_hz > 0 && o.dll_bw_coherent_hz <= 5, "dll_bw_coherent_hz", o.dll_bw_coherent_hz, "(0, 5] Hz");
   c.check(o.early_late_offset_chips > 0 && o.early_late_offset_chips <= 0.5, "early_late_offset_chips",
@@ -100,10 +110,31 @@ ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCo
       carrier_(2, options.pll_bw_hz, 0.0, initial.carrier_frequency_hz),
       command_(initial),
       pli_(options.pli_time_constant_s),
-      cn0_(options.cn0_method, epochs_in(options.cn0_window_s, 1e-3)),
+      cn0_(options.cn0_method, cn0_window_epochs(options.cn0_method, options.cn0_window_s, 1e-3)),
       bit_sync_(options.bit_sync) {
   command_.code_phase_jump_chips = 0.0;
   command_.carrier_phase_jump_cycles = 0.0;
+}
+
+double ScalarTracking::fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz) {
+  constexpr int kFineSumEpochs = 5;  // 5 ms sums: +-50 Hz range, at most one bit edge inside (bit-tolerant)
+  fine_sum_ += std::complex<double>(prompt);
+  fine_time_s_ += t_s;
+  if (++fine_count_ < kFineSumEpochs) return carrier_.frequency_hz();
+  double frequency = carrier_.frequency_hz();
+  if (fine_have_previous_) {
+    const std::complex<float> a(fine_previous_), b(fine_sum_);
+    CrossDot cd = cross_dot(a, b);
+    if (cd.dot < 0.0) cd = {-cd.cross, -cd.dot};
+    *frequency_error_hz = std::atan2(cd.cross, cd.dot) / (kTwoPi * fine_time_s_);
+    frequency = carrier_.update_fll_only(*frequency_error_hz, opt_.fll_fine_bw_hz, fine_time_s_);
+  }
+  fine_previous_ = fine_sum_;
+  fine_have_previous_ = true;
+  fine_sum_ = {};
+  fine_count_ = 0;
+  fine_time_s_ = 0.0;
+  return frequency;
 }
 
 TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
@@ -115,7 +146,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   // Lock detectors. Their statistics depend on the epoch length: restart them when it changes.
   if (e.num_code_periods != cn0_epoch_periods_) {
     cn0_epoch_periods_ = e.num_code_periods;
-    cn0_ = Cn0Estimator(opt_.cn0_method, epochs_in(opt_.cn0_window_s, t));
+    cn0_ = Cn0Estimator(opt_.cn0_method, cn0_window_epochs(opt_.cn0_method, opt_.cn0_window_s, t));
     pli_.reset();
   }
   if (opt_.cn0_method == Cn0Method::kNoiseTap) {
@@ -158,7 +189,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   // State machine.
   if (state_ == TrackingState::kPullIn) {
     // Phase lock can only be judged once the PLL runs (after the FLL stages) and the PLI has settled on it.
-    const double pll_start_s = opt_.fll_wide_time_s + opt_.fll_narrow_time_s;
+    const double pll_start_s = opt_.fll_wide_time_s + opt_.fll_narrow_time_s + opt_.fll_fine_time_s;
     if (time_s_ > pll_start_s && time_s_ - t <= pll_start_s) pli_.reset();
     const bool judged = time_s_ > pll_start_s + opt_.pli_time_constant_s;
     locked_time_s_ = judged && r.phase_locked ? locked_time_s_ + t : 0.0;
@@ -206,10 +237,17 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   // Pull-in stages (see ScalarTrackingOptions): a first-order FLL alone, then the PLL alone.
   const bool wide_stage = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s;
   const bool fll_only = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s;
+  const bool fine_stage = state_ == TrackingState::kPullIn && !fll_only &&
+                          time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s + opt_.fll_fine_time_s;
   const bool coherent = state_ == TrackingState::kBitSynced;
-  const double f = fll_only ? carrier_.update_fll_only(r.frequency_error_hz,
-                                                       wide_stage ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz, t)
-                            : carrier_.update(r.phase_error_cycles, 0.0, t);
+  double f = 0.0;
+  if (fll_only) {
+    f = carrier_.update_fll_only(r.frequency_error_hz, wide_stage ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz, t);
+  } else if (fine_stage) {
+    f = fine_fll(taps.prompt, t, &r.frequency_error_hz);
+  } else {
+    f = carrier_.update(r.phase_error_cycles, 0.0, t);
+  }
   const double dll_bw = coherent ? opt_.dll_bw_coherent_hz : opt_.dll_bw_hz;
   if (state_ == TrackingState::kPhaseLocked) {  // smoothed over kSmoothing_s for the switch to coherent epochs
     if (!smoothing_started_) smoothed_frequency_hz_ = f;

@@ -33,7 +33,11 @@ struct ScalarTrackingOptions {
   double fll_bw_hz = 10.0;             // wide FLL; (0, 50]
   double fll_wide_time_s = 0.25;       // stage (1) length; [0.01, 5]
   double fll_narrow_bw_hz = 2.0;       // narrow FLL; (0, 20]
-  double fll_narrow_time_s = 0.4;      // stage (2) length; [0, 5]
+  double fll_narrow_time_s = 0.25;     // stage (2) length; [0, 5]
+  // (2b) a fine FLL on successive 5 ms prompt sums (bit-tolerant, range +-50 Hz, 5x the SNR per measurement):
+  // brings the frequency within the PLL's few-Hz lock-in range at low C/N0.
+  double fll_fine_bw_hz = 2.0;         // fine FLL; (0, 10]
+  double fll_fine_time_s = 0.3;        // stage (2b) length; [0, 5]
   double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
   double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30] and longer than
                                        // the FLL stages plus pli_time_constant_s plus pullin_lock_time_s
@@ -47,7 +51,7 @@ struct ScalarTrackingOptions {
   int coherent_ms = 20;                // coherent integration after bit sync, ms; 1, 2, 4, 5, 10 or 20
   BitSyncOptions bit_sync;
   // Lock detection
-  Cn0Method cn0_method = Cn0Method::kNoiseTap;  // kMoments works without the noise tap
+  Cn0Method cn0_method = Cn0Method::kNoiseTap;  // kMoments works without the noise tap (windows >= 50 epochs)
   double cn0_window_s = 0.2;           // C/N0 averaging window; [0.02, 5] (a multiple of the epoch length)
   double cn0_loss_threshold_dbhz = 25.0;  // C/N0 below this counts toward loss of lock; [0, 45]
   double pli_time_constant_s = 0.1;    // phase lock indicator low-pass; [0.005, 5]
@@ -101,6 +105,8 @@ class ScalarTracking final {
   std::int64_t bit_edge_period() const { return bit_sync_.edge_period(); }
 
  private:
+  double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
+
   ScalarTrackingOptions opt_;
   TrackingState state_ = TrackingState::kPullIn;
   CarrierLoopFilter carrier_;
@@ -118,6 +124,10 @@ class ScalarTracking final {
   bool ever_locked_ = false;
   std::complex<float> previous_prompt_{};
   CrossDot fll_average_{};
+  std::complex<double> fine_sum_{}, fine_previous_{};
+  int fine_count_ = 0;
+  double fine_time_s_ = 0.0;
+  bool fine_have_previous_ = false;
   bool wide_fll_ = true;
   double smoothed_frequency_hz_ = 0.0;  // NCO frequency and rate low-passed while phase-locked at 1 ms
   bool smoothing_started_ = false;
