@@ -1,5 +1,5 @@
-// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. FLL-assisted Costas
-// PLL pull-in, then Costas PLL (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
+// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. FLL pull-in (wide,
+// narrow, fine stages) handing over to the Costas PLL (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
 // 1 ms epochs, then 20 ms coherent after bit sync; C/N0, phase-lock and C/N0 lock detectors; loss of lock is
 // a state (kLost), never silently tracked noise. Units: Hz, chips, cycles, seconds; C/N0 in dB-Hz at the edge.
 #pragma once
