@@ -50,9 +50,12 @@ Eigen::Vector3d alignment_error_from_biases(const Eigen::Vector3d& accel_bias_b,
   return {psi_n, psi_e, psi_d};
 }
 
-Eigen::Vector3d alignment_noise_sigma(double vrw, double arw, double T, double lat_rad, double g) {
-  const double tilt = vrw / (g * std::sqrt(T));
-  const double heading_gyro = arw / (kEarthRate_rps * std::cos(lat_rad) * std::sqrt(T));
+Eigen::Vector3d alignment_noise_sigma(const ImuErrorSpec& spec, double T, double lat_rad, double g) {
+  auto mean_sigma = [T](const SensorErrorSpec& s) {
+    return std::sqrt(s.random_walk * s.random_walk / T + 2.0 * s.output_white_noise * s.output_white_noise / (T * T));
+  };
+  const double tilt = mean_sigma(spec.accel) / g;
+  const double heading_gyro = mean_sigma(spec.gyro) / (kEarthRate_rps * std::cos(lat_rad));
   const double heading_tilt = tilt * std::fabs(std::tan(lat_rad));
   return {tilt, tilt, std::hypot(heading_gyro, heading_tilt)};
 }

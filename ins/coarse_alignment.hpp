@@ -10,6 +10,7 @@
 #include <span>
 
 #include "ins/attitude.hpp"
+#include "ins/imu_error_model.hpp"
 #include "ins/nav_state.hpp"
 
 namespace ultratrack::ins {
@@ -37,9 +38,10 @@ AlignmentResult coarse_align(std::span<const ImuIncrement> imu, double t_start_s
 Eigen::Vector3d alignment_error_from_biases(const Eigen::Vector3d& accel_bias_b, const Eigen::Vector3d& gyro_bias_b,
                                             const Eigen::Quaterniond& q_nb, double lat_rad, double gravity_mps2);
 
-// 1-sigma alignment error from white sensor noise averaged over T seconds: tilt VRW/(g sqrt T) and
-// heading ARW/(W cos L sqrt T) (the noise terms of the same closed form). Returns (north, east, down).
-Eigen::Vector3d alignment_noise_sigma(double vrw_mps_per_sqrt_s, double arw_rad_per_sqrt_s, double duration_s,
-                                      double lat_rad, double gravity_mps2);
+// 1-sigma alignment error (north, east, down psi-angles) from the white noise of an IMU spec averaged
+// over T seconds: the mean rate error is sqrt(RW^2 / T + 2 w^2 / T^2) per axis (random walk RW, output white
+// noise w, which telescopes), mapped by the same closed form: tilt / g, heading / (W cos L), plus the
+// tilt-to-heading term tan L.
+Eigen::Vector3d alignment_noise_sigma(const ImuErrorSpec& spec, double duration_s, double lat_rad, double gravity_mps2);
 
 }  // namespace ultratrack::ins
