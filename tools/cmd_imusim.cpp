@@ -70,7 +70,10 @@ void run_imusim(const ImuSimOptions& o) {
   truth_out.write(gen.truth().nav());
   if (o.odometer) truth_for_odometer.push_back(gen.truth());
   std::size_t rows = 0;
+  const auto total = static_cast<std::size_t>(std::llround(spec.duration_s() * o.rate_hz));
+  const bool show_progress = total >= 500000;  // long runs report every 10 % on stderr
   while (!gen.done()) {
+    if (show_progress && rows % (total / 10) == 0 && rows > 0) fmt::print(stderr, "imusim: {}%\n", 100 * rows / total);
     const ins::ImuIncrement ideal = gen.advance();
     imu_out.write(errors.apply(ideal, gen.dt_s()));
     truth_out.write(gen.truth().nav());
