@@ -52,7 +52,10 @@ void Strapdown::step(const Eigen::Vector3d& dtheta, const Eigen::Vector3d& dv, d
   const Eigen::Vector3d zeta_x = (w_ie + w_en) * dt;
 
   Eigen::Vector3d dv_b = dv;
-  if (opt_.rotation_correction) dv_b += 0.5 * dtheta.cross(dv);
+  if (opt_.rotation_correction) {  // constant-rate rotation of dv within the interval, to second order
+    const Eigen::Vector3d r1 = dtheta.cross(dv);
+    dv_b += 0.5 * r1 + dtheta.cross(r1) / 6.0;
+  }
   if (opt_.sculling_correction) dv_b += (dth_p.cross(dv) + dv_p.cross(dtheta)) / 12.0;
   const Eigen::Vector3d dv_n_sf = state_.q_nb * dv_b - 0.5 * zeta_x.cross(state_.q_nb * dv_b);
   Eigen::Vector3d g = gravity_n(lat_mid_x, h_mid_x);

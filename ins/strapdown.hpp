@@ -12,7 +12,7 @@ namespace ultratrack::ins {
 
 struct StrapdownOptions {
   bool coning_correction = true;    // dtheta_prev x dtheta / 12
-  bool rotation_correction = true;  // dtheta x dv / 2
+  bool rotation_correction = true;  // dtheta x dv / 2 + dtheta x (dtheta x dv) / 6
   bool sculling_correction = true;  // (dtheta_prev x dv + dv_prev x dtheta) / 12
 };
 
