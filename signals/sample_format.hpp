@@ -20,5 +20,7 @@ std::string_view to_string(SampleFormat format);
 bool is_complex(SampleFormat format);
 // Bytes of one sample (one complex pair or one real value).
 std::size_t bytes_per_sample(SampleFormat format);
+// The largest magnitude an integer format holds (127, 32767); 1.0 for f32 (a nominal scale, not a limit).
+double full_scale(SampleFormat format);
 
 }  // namespace ultratrack::signals
