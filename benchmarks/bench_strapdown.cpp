@@ -24,14 +24,16 @@ static void BM_StrapdownStep(benchmark::State& state) {
     benchmark::DoNotOptimize(ins.state().q_nb);
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()));
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["steps_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_StrapdownStep);
 
 static void BM_TrajectoryGeneratorStep100Hz(benchmark::State& state) {
   TrajectoryGenerator gen(profile_spec("s", 1e6, 0.63, 2.2, 1000.0), 100.0);
   for (auto _ : state) benchmark::DoNotOptimize(gen.advance());
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["steps_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_TrajectoryGeneratorStep100Hz);
 
@@ -39,6 +41,7 @@ static void BM_ImuErrorModelHg1700ae(benchmark::State& state) {
   ImuErrorModel m(imu_preset("hg1700ae"), 1);
   const ImuIncrement ideal{0.01, {1e-5, 2e-5, 3e-5}, {0.0, 0.0, -0.098}};
   for (auto _ : state) benchmark::DoNotOptimize(m.apply(ideal, 0.01));
-  state.counters["samples_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["samples_per_s"] =
+      benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_ImuErrorModelHg1700ae);

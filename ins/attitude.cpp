@@ -27,7 +27,7 @@ EulerAngles euler_from_quaternion(const Eigen::Quaterniond& q_nb) {
 
 Eigen::Quaterniond quaternion_from_rotation_vector(const Eigen::Vector3d& phi) {
   const double n2 = phi.squaredNorm();
-  double c, s;  // cos(n/2), sin(n/2)/n
+  double c, s;       // cos(n/2), sin(n/2)/n
   if (n2 < 1e-12) {  // series keeps full precision for tiny angles
     c = 1.0 - n2 / 8.0 + n2 * n2 / 384.0;
     s = 0.5 - n2 / 48.0 + n2 * n2 / 3840.0;

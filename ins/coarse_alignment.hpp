@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <span>
 
 #include "ins/attitude.hpp"
@@ -18,7 +17,7 @@ namespace ultratrack::ins {
 struct AlignmentResult {
   Eigen::Quaterniond q_nb = Eigen::Quaterniond::Identity();
   EulerAngles euler;
-  Eigen::Vector3d mean_f_b = Eigen::Vector3d::Zero();   // m/s^2
+  Eigen::Vector3d mean_f_b = Eigen::Vector3d::Zero();     // m/s^2
   Eigen::Vector3d mean_w_ib_b = Eigen::Vector3d::Zero();  // rad/s
   double duration_s = 0.0;
 };

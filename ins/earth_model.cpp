@@ -3,7 +3,6 @@
 #include <GeographicLib/Constants.hpp>
 #include <GeographicLib/Geocentric.hpp>
 #include <GeographicLib/NormalGravity.hpp>
-
 #include <cmath>
 #include <numbers>
 
@@ -43,8 +42,7 @@ Eigen::Vector3d gravity_n(double lat_rad, double height_m) {
 
 Eigen::Vector3d geodetic_rates(double lat_rad, double height_m, const Eigen::Vector3d& v_n) {
   const Radii r = radii_of_curvature(lat_rad);
-  return {v_n.x() / (r.meridian_m + height_m), v_n.y() / ((r.transverse_m + height_m) * std::cos(lat_rad)),
-          -v_n.z()};
+  return {v_n.x() / (r.meridian_m + height_m), v_n.y() / ((r.transverse_m + height_m) * std::cos(lat_rad)), -v_n.z()};
 }
 
 Eigen::Vector3d ecef_from_geodetic(double lat_rad, double lon_rad, double height_m) {
@@ -58,9 +56,11 @@ Eigen::Matrix3d C_en(double lat_rad, double lon_rad) {
   const double sl = std::sin(lat_rad), cl = std::cos(lat_rad);
   const double so = std::sin(lon_rad), co = std::cos(lon_rad);
   Eigen::Matrix3d m;  // columns: north, east, down unit vectors in ECEF
+  // clang-format off
   m << -sl * co, -so, -cl * co,
-       -sl * so, co, -cl * so,
-       cl, 0.0, -sl;
+       -sl * so,  co, -cl * so,
+             cl, 0.0,      -sl;
+  // clang-format on
   return m;
 }
 

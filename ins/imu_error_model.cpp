@@ -9,8 +9,8 @@ namespace ultratrack::ins {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kDegPerHour = kDeg / 3600.0;        // rad/s
-constexpr double kDegPerSqrtHour = kDeg / 60.0;      // rad/sqrt(s)
+constexpr double kDegPerHour = kDeg / 3600.0;    // rad/s
+constexpr double kDegPerSqrtHour = kDeg / 60.0;  // rad/sqrt(s)
 constexpr double kG = 9.80665;
 constexpr double kFoot = 0.3048;
 

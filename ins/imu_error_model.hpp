@@ -5,7 +5,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <cstdint>
 #include <random>
 #include <string>
@@ -21,11 +20,11 @@ struct SensorErrorSpec {
   double bias_sigma = 0.0;              // turn-on bias [rad/s | m/s^2]
   double bias_instability_sigma = 0.0;  // steady-state sigma of the Gauss-Markov bias [rad/s | m/s^2]
   double bias_correlation_time_s = 3600.0;
-  double random_walk = 0.0;             // ARW [rad/sqrt(s)] | VRW [m/s/sqrt(s)]
-  double output_white_noise = 0.0;      // white noise on the integrated output [rad | m/s], does not accumulate
-  double scale_factor_sigma = 0.0;      // [ratio]
-  double misalignment_sigma = 0.0;      // axis misalignment [rad]
-  double quantum = 0.0;                 // output quantisation step [rad | m/s]; 0 = none
+  double random_walk = 0.0;         // ARW [rad/sqrt(s)] | VRW [m/s/sqrt(s)]
+  double output_white_noise = 0.0;  // white noise on the integrated output [rad | m/s], does not accumulate
+  double scale_factor_sigma = 0.0;  // [ratio]
+  double misalignment_sigma = 0.0;  // axis misalignment [rad]
+  double quantum = 0.0;             // output quantisation step [rad | m/s]; 0 = none
 };
 
 struct ImuErrorSpec {
@@ -39,7 +38,7 @@ ImuErrorSpec imu_preset(std::string_view name);
 
 // The errors one unit has (drawn once from the spec at turn-on).
 struct SensorErrors {
-  Eigen::Vector3d bias = Eigen::Vector3d::Zero();           // turn-on bias
+  Eigen::Vector3d bias = Eigen::Vector3d::Zero();                // turn-on bias
   Eigen::Matrix3d scale_misalignment = Eigen::Matrix3d::Zero();  // output = (I + M) * input
 };
 struct ImuErrors {

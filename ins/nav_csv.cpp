@@ -74,8 +74,8 @@ NavCsvWriter::~NavCsvWriter() = default;
 
 void NavCsvWriter::write(const NavState& s) {
   const EulerAngles e = euler_from_quaternion(s.q_nb);
-  fmt::print(out_->handle(), "{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg,
-             s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+  fmt::print(out_->handle(), "{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
+             s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
 }
 
 void NavCsvWriter::commit() { out_->commit(); }

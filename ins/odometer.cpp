@@ -12,7 +12,9 @@ std::vector<OdometerSample> simulate_odometer(std::span<const TruthSample> truth
   const long long stride = std::llround(1.0 / (o.rate_hz * truth_dt));
   if (stride < 1 || std::fabs(stride * truth_dt * o.rate_hz - 1.0) > 1e-6)
     throw std::invalid_argument("simulate_odometer: odometer rate must divide the truth rate");
-  auto count = [&](double d) { return static_cast<std::int64_t>(std::floor(d * (1.0 + o.scale_factor_error) / o.meters_per_pulse)); };
+  auto count = [&](double d) {
+    return static_cast<std::int64_t>(std::floor(d * (1.0 + o.scale_factor_error) / o.meters_per_pulse));
+  };
   std::vector<OdometerSample> out;
   std::int64_t prev = count(truth[0].distance_m);
   for (std::size_t i = static_cast<std::size_t>(stride); i < truth.size(); i += static_cast<std::size_t>(stride)) {

@@ -61,21 +61,21 @@ TrajectorySpec profile_spec(std::string_view name, double duration_s, double lat
   } else if (name == "land") {
     // One cycle (230 s): speeds 0-30 m/s, two stops, right and left turns, a hill up and down.
     const std::vector<Segment> cycle{
-        {10.0},                                // stopped
-        {10.0, 2.0},                           // 0 -> 20 m/s
-        {20.0},                                // cruise
-        {20.0, 0.0, 0.0, 0.0, 4.0 * kDeg},     // uphill 4 %
-        {20.0, 0.0, 0.0, 0.0, -4.0 * kDeg},    // downhill
-        {10.0, -1.0},                          // 20 -> 10 m/s
-        {10.0, 0.0, 9.0 * kDeg},               // 90 deg right turn
-        {10.0, 2.0},                           // 10 -> 30 m/s
-        {30.0},                                // cruise
-        {10.0, -3.0},                          // 30 -> 0 m/s
-        {10.0},                                // stopped
-        {10.0, 1.0},                           // 0 -> 10 m/s
-        {15.0, 0.0, -6.0 * kDeg},              // 90 deg left turn
-        {25.0, 0.0, 0.0, 0.0, 2.0 * kDeg},     // gentle hill
-        {10.0, -1.0},                          // 10 -> 0 m/s
+        {10.0},                              // stopped
+        {10.0, 2.0},                         // 0 -> 20 m/s
+        {20.0},                              // cruise
+        {20.0, 0.0, 0.0, 0.0, 4.0 * kDeg},   // uphill 4 %
+        {20.0, 0.0, 0.0, 0.0, -4.0 * kDeg},  // downhill
+        {10.0, -1.0},                        // 20 -> 10 m/s
+        {10.0, 0.0, 9.0 * kDeg},             // 90 deg right turn
+        {10.0, 2.0},                         // 10 -> 30 m/s
+        {30.0},                              // cruise
+        {10.0, -3.0},                        // 30 -> 0 m/s
+        {10.0},                              // stopped
+        {10.0, 1.0},                         // 0 -> 10 m/s
+        {15.0, 0.0, -6.0 * kDeg},            // 90 deg left turn
+        {25.0, 0.0, 0.0, 0.0, 2.0 * kDeg},   // gentle hill
+        {10.0, -1.0},                        // 10 -> 0 m/s
     };
     double t = 0.0;
     while (t < duration_s) {
@@ -101,8 +101,7 @@ TrajectorySpec read_segments_csv(const std::filesystem::path& file, const Trajec
   if (!in) throw InputError(fname, "cannot open segment file");
   TrajectorySpec spec = start;
   spec.segments.clear();
-  const std::vector<std::string> header{"duration_s", "accel_mps2", "turn_rate_dps", "climb_rate_mps",
-                                        "grade_deg"};
+  const std::vector<std::string> header{"duration_s", "accel_mps2", "turn_rate_dps", "climb_rate_mps", "grade_deg"};
   std::string line;
   int line_no = 0;
   bool have_header = false;

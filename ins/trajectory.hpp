@@ -23,7 +23,7 @@ struct TrajectorySpec {
   double lat0_rad = 0.0;
   double lon0_rad = 0.0;
   double height0_m = 0.0;
-  double speed0_mps = 0.0;    // initial horizontal speed
+  double speed0_mps = 0.0;  // initial horizontal speed
   double heading0_rad = 0.0;
   bool coordinated_turns = false;  // bank into turns (roll = atan(speed * turn_rate / g0)), aircraft-like
   double ramp_s = 1.0;             // command blend time at each segment start (capped at half the segment)

@@ -56,9 +56,9 @@ TrajectoryGenerator::Commands TrajectoryGenerator::commands(double t) const {
   }
   auto mix = [&](double p, double c) { return p + (c - p) * w; };
   auto rate = [&](double p, double c) { return (c - p) * dw; };
-  return Commands{mix(prev.accel_mps2, cur.accel_mps2),         mix(prev.turn_rate_rps, cur.turn_rate_rps),
-                  mix(prev.climb_rate_mps, cur.climb_rate_mps), mix(prev.grade_rad, cur.grade_rad),
-                  rate(prev.accel_mps2, cur.accel_mps2),        rate(prev.turn_rate_rps, cur.turn_rate_rps),
+  return Commands{mix(prev.accel_mps2, cur.accel_mps2),          mix(prev.turn_rate_rps, cur.turn_rate_rps),
+                  mix(prev.climb_rate_mps, cur.climb_rate_mps),  mix(prev.grade_rad, cur.grade_rad),
+                  rate(prev.accel_mps2, cur.accel_mps2),         rate(prev.turn_rate_rps, cur.turn_rate_rps),
                   rate(prev.climb_rate_mps, cur.climb_rate_mps), rate(prev.grade_rad, cur.grade_rad)};
 }
 
@@ -71,8 +71,8 @@ struct Kinematics {
   Eigen::Vector3d euler_rate;  // roll, pitch, yaw rates
 };
 
-Kinematics kinematics(double s, double psi, double a, double r, double c, double gr, double dr, double dc,
-                      double dgr, bool coordinated) {
+Kinematics kinematics(double s, double psi, double a, double r, double c, double gr, double dr, double dc, double dgr,
+                      bool coordinated) {
   Kinematics k;
   const double cp = std::cos(psi), sp = std::sin(psi);
   const double tg = std::tan(gr), sec2 = 1.0 + tg * tg;
@@ -106,8 +106,8 @@ Eigen::Vector3d w_nb_b(const EulerAngles& e, const Eigen::Vector3d& rate) {
 
 TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State& y) const {
   const Commands u = commands(t);
-  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade,
-                                  spec_.coordinated_turns);
+  const Kinematics k =
+      kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_.coordinated_turns);
   const double lat = y[2], h = y[4];
   const Eigen::Vector3d pos_rate = geodetic_rates(lat, h, k.v_n);
   const Eigen::Vector3d w_ie = earth_rate_n(lat);
@@ -132,8 +132,8 @@ TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State
 
 void TrajectoryGenerator::fill_truth(double t, const State& y, TruthSample& out) const {
   const Commands u = commands(t);
-  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade,
-                                  spec_.coordinated_turns);
+  const Kinematics k =
+      kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_.coordinated_turns);
   out.t_s = t;
   out.lat_rad = y[2];
   out.lon_rad = y[3];

@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <array>
 #include <cstddef>
 #include <vector>
@@ -34,7 +33,7 @@ class TrajectoryGenerator {
   TrajectoryGenerator(TrajectorySpec spec, double imu_rate_hz);
 
   const TruthSample& truth() const { return truth_; }  // the current sample (t = 0 before any advance)
-  bool done() const;                                    // the trajectory's duration has been reached
+  bool done() const;                                   // the trajectory's duration has been reached
   // Advances one IMU interval: returns the ideal increment over it and updates truth().
   ImuIncrement advance();
   double dt_s() const { return dt_; }
@@ -42,8 +41,8 @@ class TrajectoryGenerator {
  private:
   using State = std::array<double, 12>;  // speed, heading, lat, lon, h, distance, int(w_ib_b), int(f_b)
   struct Commands {
-    double a, r, climb, grade;          // values
-    double da, dr, dclimb, dgrade;      // time derivatives
+    double a, r, climb, grade;      // values
+    double da, dr, dclimb, dgrade;  // time derivatives
   };
   Commands commands(double t) const;
   State derivative(double t, const State& y) const;

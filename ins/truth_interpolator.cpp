@@ -24,8 +24,8 @@ TruthInterpolator::TruthInterpolator(std::vector<TruthSample> samples) : samples
 }
 
 std::size_t TruthInterpolator::index(double t) const {
-  const auto it = std::upper_bound(samples_.begin(), samples_.end(), t,
-                                   [](double v, const TruthSample& s) { return v < s.t_s; });
+  const auto it =
+      std::upper_bound(samples_.begin(), samples_.end(), t, [](double v, const TruthSample& s) { return v < s.t_s; });
   const std::size_t i = it == samples_.begin() ? 0 : static_cast<std::size_t>(it - samples_.begin()) - 1;
   return std::min(i, samples_.size() - 2);
 }

@@ -6,7 +6,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
 #include <vector>
 
 #include "ins/trajectory_simulator.hpp"

@@ -1,8 +1,8 @@
 // `ultratrack imusim`: a trajectory (named profile or segment file) to DIR/imu.csv (with an IMU error preset),
 // DIR/truth.csv (nav columns at the IMU rate), optionally DIR/odometer.csv, and DIR/summary.json.
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -104,18 +104,20 @@ void run_imusim(const ImuSimOptions& o) {
   ins::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);
   summary.commit();
-  fmt::print("imusim: {} IMU rows at {} Hz ({} s, preset {}, seed {}); wrote {}/imu.csv, truth.csv{}\n", rows, o.rate_hz,
-             spec.duration_s(), o.preset, o.seed, o.out_dir, o.odometer ? ", odometer.csv" : "");
+  fmt::print("imusim: {} IMU rows at {} Hz ({} s, preset {}, seed {}); wrote {}/imu.csv, truth.csv{}\n", rows,
+             o.rate_hz, spec.duration_s(), o.preset, o.seed, o.out_dir, o.odometer ? ", odometer.csv" : "");
 }
 
 }  // namespace
 
 void add_imusim_command(CLI::App& app) {
   auto o = std::make_shared<ImuSimOptions>();
-  auto* cmd = app.add_subcommand("imusim", "Simulate a trajectory: truth.csv and imu.csv (exact increments + error preset)");
+  auto* cmd =
+      app.add_subcommand("imusim", "Simulate a trajectory: truth.csv and imu.csv (exact increments + error preset)");
   cmd->add_option("--profile", o->profile, "static, straight, circle, s, spiral or land");
   cmd->add_option("--segments", o->segments_file,
-                  "segment CSV: duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg")->check(CLI::ExistingFile);
+                  "segment CSV: duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--duration", o->duration_s, "seconds (profiles)");
   cmd->add_option("--rate", o->rate_hz, "IMU rate in Hz (50-1000, default 100)");
   cmd->add_option("--preset", o->preset, "IMU errors: ideal, hg1700ae, dmu6x, navigation, mems (default ideal)");

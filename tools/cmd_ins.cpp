@@ -1,9 +1,9 @@
 // `ultratrack ins`: free inertial navigation from an IMU CSV file, started from a given state (first row of a
 // truth/nav CSV) or from a coarse alignment over the first seconds of stationary data. Writes DIR/nav.csv
 // and DIR/summary.json; when the --init file is a whole truth trajectory, the summary compares against it.
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -65,7 +65,8 @@ std::string state_json(const ins::NavState& s) {
   const ins::EulerAngles e = ins::euler_from_quaternion(s.q_nb);
   return fmt::format(
       "{{\"t_s\": {}, \"lat_deg\": {:.10f}, \"lon_deg\": {:.10f}, \"height_m\": {:.4f}, \"vel_n_mps\": {:.6f}, "
-      "\"vel_e_mps\": {:.6f}, \"vel_d_mps\": {:.6f}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": {:.6f}}}",
+      "\"vel_e_mps\": {:.6f}, \"vel_d_mps\": {:.6f}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": "
+      "{:.6f}}}",
       s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg,
       e.pitch_rad / kDeg, e.yaw_rad / kDeg);
 }
@@ -85,7 +86,8 @@ void run_ins(const InsOptions& o) {
   if (!truth.empty()) {
     init = truth.front();
   } else {
-    if (o.position.size() != 3) throw InputError("command line", "--align without --init needs --position LAT_DEG LON_DEG HEIGHT_M");
+    if (o.position.size() != 3)
+      throw InputError("command line", "--align without --init needs --position LAT_DEG LON_DEG HEIGHT_M");
     init.lat_rad = o.position[0] * kDeg;
     init.lon_rad = o.position[1] * kDeg;
     init.height_m = o.position[2];
@@ -93,12 +95,14 @@ void run_ins(const InsOptions& o) {
     init.t_s = imu.size() > 1 ? imu[0].t_s - (imu[1].t_s - imu[0].t_s) : imu[0].t_s - 0.01;
   }
   while (first < imu.size() && imu[first].t_s <= init.t_s) ++first;
-  if (first == imu.size()) throw InputError(o.imu_file, "no IMU rows after the initial time " + fmt::format("{}", init.t_s));
+  if (first == imu.size())
+    throw InputError(o.imu_file, "no IMU rows after the initial time " + fmt::format("{}", init.t_s));
 
   if (o.align_s > 0.0) {
     std::size_t end = first;
     while (end < imu.size() && imu[end].t_s <= init.t_s + o.align_s + 1e-9) ++end;
-    if (end - first < 2) throw InputError(o.imu_file, fmt::format("fewer than 2 IMU rows in the {} s alignment span", o.align_s));
+    if (end - first < 2)
+      throw InputError(o.imu_file, fmt::format("fewer than 2 IMU rows in the {} s alignment span", o.align_s));
     alignment = ins::coarse_align(std::span(imu).subspan(first, end - first), init.t_s, init.lat_rad);
     init.q_nb = alignment->q_nb;
     init.v_n.setZero();
@@ -134,7 +138,8 @@ void run_ins(const InsOptions& o) {
   writer.commit();
 
   std::string json = "{\n";
-  json += fmt::format("  \"imu_file\": \"{}\",\n  \"imu_rows\": {},\n  \"steps\": {},\n", o.imu_file, imu.size(), steps);
+  json +=
+      fmt::format("  \"imu_file\": \"{}\",\n  \"imu_rows\": {},\n  \"steps\": {},\n", o.imu_file, imu.size(), steps);
   json += fmt::format("  \"mode\": \"{}\",\n  \"height_aiding\": {},\n", alignment ? "align" : "init", o.aid_height);
   if (alignment) {
     json += fmt::format(
@@ -146,7 +151,8 @@ void run_ins(const InsOptions& o) {
   json += "  \"final\": " + state_json(nav.state()) + ",\n";
   if (cmp.matched > 0) {
     json += fmt::format(
-        "  \"truth_comparison\": {{\"rows_matched\": {}, \"max_horizontal_error_m\": {:.6g}, \"max_vertical_error_m\": {:.6g}, "
+        "  \"truth_comparison\": {{\"rows_matched\": {}, \"max_horizontal_error_m\": {:.6g}, \"max_vertical_error_m\": "
+        "{:.6g}, "
         "\"max_velocity_error_mps\": {:.6g}, \"max_attitude_error_deg\": {:.6g}, \"final_horizontal_error_m\": {:.6g}, "
         "\"final_vertical_error_m\": {:.6g}, \"final_attitude_error_deg\": {:.6g}}},\n",
         cmp.matched, cmp.max_horizontal_m, cmp.max_vertical_m, cmp.max_velocity_mps, cmp.max_attitude_deg,
@@ -159,9 +165,9 @@ void run_ins(const InsOptions& o) {
 
   const ins::EulerAngles e = ins::euler_from_quaternion(nav.state().q_nb);
   fmt::print("ins: {} steps from t = {:.3f} s to {:.3f} s ({})\n", steps, init.t_s, nav.state().t_s,
-             alignment ? fmt::format("aligned over {:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg", alignment->duration_s,
-                                     alignment->euler.roll_rad / kDeg, alignment->euler.pitch_rad / kDeg,
-                                     alignment->euler.yaw_rad / kDeg)
+             alignment ? fmt::format("aligned over {:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg",
+                                     alignment->duration_s, alignment->euler.roll_rad / kDeg,
+                                     alignment->euler.pitch_rad / kDeg, alignment->euler.yaw_rad / kDeg)
                        : "initial state from " + o.init_file);
   fmt::print("ins: final lat {:.8f} lon {:.8f} deg, h {:.2f} m, attitude {:.4f} {:.4f} {:.4f} deg\n",
              nav.state().lat_rad / kDeg, nav.state().lon_rad / kDeg, nav.state().height_m, e.roll_rad / kDeg,
@@ -177,7 +183,9 @@ void run_ins(const InsOptions& o) {
 void add_ins_command(CLI::App& app) {
   auto opts = std::make_shared<InsOptions>();
   auto* cmd = app.add_subcommand("ins", "Free inertial navigation from IMU increments (strapdown, WGS-84 NED)");
-  cmd->add_option("--imu", opts->imu_file, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--imu", opts->imu_file, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps)")
+      ->required()
+      ->check(CLI::ExistingFile);
   cmd->add_option("--init", opts->init_file, "truth/nav CSV: first row is the initial state; later rows are compared")
       ->check(CLI::ExistingFile);
   cmd->add_option("--align", opts->align_s, "coarse alignment over the first SECONDS of stationary data");

@@ -14,9 +14,11 @@ TEST(Attitude, EulerDcmMatchesSeed002Eq12) {
   const double sf = std::sin(phi), cf = std::cos(phi), st = std::sin(theta), ct = std::cos(theta);
   const double sp = std::sin(psi), cp = std::cos(psi);
   Eigen::Matrix3d C_bn;  // seed 002 eq. (12): the n -> b transformation
-  C_bn << ct * cp, ct * sp, -st,
+  // clang-format off
+  C_bn << ct * cp,                ct * sp,                -st,
           sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct,
           cf * st * cp + sf * sp, cf * st * sp - sf * cp, cf * ct;
+  // clang-format on
   const Eigen::Quaterniond q = quaternion_from_euler({phi, theta, psi});
   EXPECT_LT((q.toRotationMatrix().transpose() - C_bn).norm(), 1e-15);
   const EulerAngles e = euler_from_quaternion(q);

@@ -58,7 +58,8 @@ TEST(CoarseAlignment, Hg1700aeErrorsMatchClosedFormFromBiases) {
   const Eigen::Vector3d sigma_noise = alignment_noise_sigma(spec, T, lat, g);
   // Spec-level bounds (3 sigma of bias plus noise): tilt ~ 1 mg / g, heading ~ 1 deg/h / (W cos L).
   const double tilt_bound = 3.0 * std::hypot(spec.accel.bias_sigma / g, sigma_noise.x());
-  const double heading_bound = 3.0 * std::hypot(spec.gyro.bias_sigma / (kEarthRate_rps * std::cos(lat)), sigma_noise.z());
+  const double heading_bound =
+      3.0 * std::hypot(spec.gyro.bias_sigma / (kEarthRate_rps * std::cos(lat)), sigma_noise.z());
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     ImuErrorModel model(spec, seed);
     std::vector<ImuIncrement> imu;
@@ -74,13 +75,14 @@ TEST(CoarseAlignment, Hg1700aeErrorsMatchClosedFormFromBiases) {
     const Eigen::Quaterniond q_level = quaternion_from_euler({a.euler.roll_rad, a.euler.pitch_rad, e_true.yaw_rad});
     Eigen::Vector3d psi = attitude_error_n(q_level, q_true);
     psi.z() = attitude_error_n(a.q_nb, q_true).z();
-    const Eigen::Vector3d predicted =
-        alignment_error_from_biases(model.turn_on_errors().accel.bias, model.turn_on_errors().gyro.bias, q_true, lat, g);
-    std::printf("[ alignment ] seed %llu: psi N/E/D = %+.5f %+.5f %+.3f deg, closed form %+.5f %+.5f %+.3f deg "
-                "(noise 1 sigma %.5f %.5f %.3f deg)\n",
-                static_cast<unsigned long long>(seed), psi.x() / kDeg, psi.y() / kDeg, psi.z() / kDeg,
-                predicted.x() / kDeg, predicted.y() / kDeg, predicted.z() / kDeg, sigma_noise.x() / kDeg,
-                sigma_noise.y() / kDeg, sigma_noise.z() / kDeg);
+    const Eigen::Vector3d predicted = alignment_error_from_biases(model.turn_on_errors().accel.bias,
+                                                                  model.turn_on_errors().gyro.bias, q_true, lat, g);
+    std::printf(
+        "[ alignment ] seed %llu: psi N/E/D = %+.5f %+.5f %+.3f deg, closed form %+.5f %+.5f %+.3f deg "
+        "(noise 1 sigma %.5f %.5f %.3f deg)\n",
+        static_cast<unsigned long long>(seed), psi.x() / kDeg, psi.y() / kDeg, psi.z() / kDeg, predicted.x() / kDeg,
+        predicted.y() / kDeg, predicted.z() / kDeg, sigma_noise.x() / kDeg, sigma_noise.y() / kDeg,
+        sigma_noise.z() / kDeg);
     // 4 sigma of noise plus the second-order terms the closed form drops (tilt^2, ~2e-6 rad here).
     const double second_order = predicted.head<2>().squaredNorm();
     for (int i = 0; i < 3; ++i)

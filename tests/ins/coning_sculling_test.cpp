@@ -49,7 +49,13 @@ Eigen::Vector3d integrate(const std::function<Eigen::Vector3d(double)>& f, doubl
 struct Slope {
   double sx = 0, sy = 0, sxx = 0, sxy = 0;
   int n = 0;
-  void add(double x, double y) { sx += x; sy += y; sxx += x * x; sxy += x * y; ++n; }
+  void add(double x, double y) {
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    ++n;
+  }
   double value() const { return (n * sxy - sx * sy) / (n * sxx - sx * sx); }
 };
 
@@ -59,7 +65,8 @@ double coning_drift(bool corrected, double alpha, double w, double rate_hz, doub
   auto q_nb = [&](double t) { return Eigen::Quaterniond(c, 0.0, s * std::cos(w * t), s * std::sin(w * t)); };
   const Eigen::Vector3d w_ie = earth_rate_n(kLat), g = gravity_n(kLat, 0.0);
   auto w_ib = [&](double t) {
-    const Eigen::Vector3d w_nb(-2 * s * s * w, -std::sin(alpha) * w * std::sin(w * t), std::sin(alpha) * w * std::cos(w * t));
+    const Eigen::Vector3d w_nb(-2 * s * s * w, -std::sin(alpha) * w * std::sin(w * t),
+                               std::sin(alpha) * w * std::cos(w * t));
     return Eigen::Vector3d(w_nb + q_nb(t).conjugate() * w_ie);
   };
   auto f_b = [&](double t) { return Eigen::Vector3d(q_nb(t).conjugate() * (-g)); };
@@ -147,10 +154,12 @@ TEST(Sculling, DriftMatchesClosedFormWithAndWithoutCorrection) {
                               (0.5 * (1.0 - std::sin(lambda) / lambda) - (1.0 - std::cos(lambda)) / 6.0);
   const double predicted_uncorrected = -theta0 * a_body * (lambda - std::sin(lambda)) / (2 * lambda) - gravity_term;
   const double predicted_residual =
-      -theta0 * a_body * ((lambda - std::sin(lambda)) / 2 - (2 * std::sin(lambda) - std::sin(2 * lambda)) / 12) / lambda -
+      -theta0 * a_body * ((lambda - std::sin(lambda)) / 2 - (2 * std::sin(lambda) - std::sin(2 * lambda)) / 12) /
+          lambda -
       gravity_term;
-  std::printf("[ sculling ] uncorrected drift %.4e m/s^2 (closed form %.4e), two-sample %.4e m/s^2 (closed form %.4e)\n",
-              unc, predicted_uncorrected, cor, predicted_residual);
+  std::printf(
+      "[ sculling ] uncorrected drift %.4e m/s^2 (closed form %.4e), two-sample %.4e m/s^2 (closed form %.4e)\n", unc,
+      predicted_uncorrected, cor, predicted_residual);
   // Closed forms drop terms of relative order theta0 g / A (2 %: lateral errors mapped to down through the
   // oscillating roll) and of third order in the roll angle.
   EXPECT_NEAR(unc, predicted_uncorrected, 0.02 * std::fabs(predicted_uncorrected));

@@ -63,7 +63,11 @@ TEST(ImuCsv, RoundTripIsExact) {
 TEST(ImuCsv, RejectsBadInputNamingFileAndLine) {
   const fs::path dir = ultratrack::test::scratch_dir();
   const std::string ok = "0.01,0,0,0,0,0,-0.098\n";
-  struct Case { std::string name, text; int line; std::string what; };
+  struct Case {
+    std::string name, text;
+    int line;
+    std::string what;
+  };
   const std::vector<Case> cases{
       {"missing_field.csv", std::string(kImuHeader) + ok + "0.02,0,0,0,0,0\n", 3, "fields"},
       {"extra_field.csv", std::string(kImuHeader) + ok + "0.02,0,0,0,0,0,0,1\n", 3, "more than"},
@@ -114,7 +118,11 @@ TEST(NavCsv, RoundTripKeepsStateToRoundingPrecision) {
 TEST(NavCsv, RejectsBadInputNamingFileAndLine) {
   const fs::path dir = ultratrack::test::scratch_dir();
   const std::string ok = "0,36.3,127.3,100,0,0,0,0,0,0\n";
-  struct Case { std::string name, text; int line; std::string what; };
+  struct Case {
+    std::string name, text;
+    int line;
+    std::string what;
+  };
   const std::vector<Case> cases{
       {"short.csv", std::string(kNavHeader) + ok + "1,36.3,127.3,100,0,0,0,0,0\n", 3, "fields"},
       {"nan.csv", std::string(kNavHeader) + "0,NaN,127.3,100,0,0,0,0,0,0\n", 2, "not finite"},
@@ -143,9 +151,11 @@ TEST(SegmentsCsv, ReadsSegmentsAndRejectsBadRows) {
   EXPECT_NEAR(spec.segments[1].turn_rate_rps, 3 * std::numbers::pi / 180, 1e-15);
   EXPECT_NEAR(spec.segments[1].grade_rad, 2 * std::numbers::pi / 180, 1e-15);
   EXPECT_DOUBLE_EQ(spec.duration_s(), 30.0);
-  const fs::path neg = write_text(dir, "neg.csv", "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n-1,0,0,0,0\n");
+  const fs::path neg =
+      write_text(dir, "neg.csv", "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n-1,0,0,0,0\n");
   expect_error_at([&] { read_segments_csv(neg, start); }, neg, 2, "duration");
-  const fs::path bad = write_text(dir, "bad.csv", "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n5,x,0,0,0\n");
+  const fs::path bad =
+      write_text(dir, "bad.csv", "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n5,x,0,0,0\n");
   expect_error_at([&] { read_segments_csv(bad, start); }, bad, 2, "not a number");
 }
 

@@ -2,10 +2,10 @@
 // (independent of our closed forms): radii from the ECEF position's derivative, gravity at equator/pole.
 #include "ins/earth_model.hpp"
 
-#include <Eigen/LU>
-#include <GeographicLib/NormalGravity.hpp>
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
+#include <GeographicLib/NormalGravity.hpp>
 #include <cmath>
 #include <numbers>
 

@@ -93,8 +93,10 @@ TEST(StationaryInsErrors, AccelBiasGivesSchulerOscillation) {
   double peak = 0.0;
   for (double x : s.east_m) peak = std::max(peak, x);
   const double ws2 = std::pow(2 * kPi / T, 2);
-  std::printf("[ schuler ] accel bias %.3e m/s^2: period %.3f min (closed form %.3f min), peak east error %.1f m "
-              "(closed form 2 b / w_s^2 = %.1f m)\n", b, measured_T / 60, T / 60, peak, 2 * b / ws2);
+  std::printf(
+      "[ schuler ] accel bias %.3e m/s^2: period %.3f min (closed form %.3f min), peak east error %.1f m "
+      "(closed form 2 b / w_s^2 = %.1f m)\n",
+      b, measured_T / 60, T / 60, peak, 2 * b / ws2);
   EXPECT_NEAR(measured_T, T, 0.002 * T);
   EXPECT_NEAR(measured_T / 60.0, 84.4, 0.5);  // the textbook 84.4 min (R = 6371 km, g = 9.81) within 0.6 %
   EXPECT_NEAR(peak, 2 * b / ws2, 0.005 * 2 * b / ws2);
@@ -113,8 +115,10 @@ TEST(StationaryInsErrors, InitialTiltGivesSchulerOscillation) {
   const double R = radii_of_curvature(0.0).transverse_m;
   double peak = 0.0;
   for (double x : s.east_m) peak = std::max(peak, x);
-  std::printf("[ schuler ] initial roll error %.1e rad: period %.3f min, peak east error %.1f m (closed form 2 phi0 R = %.1f m)\n",
-              phi0, measured_T / 60, peak, 2 * phi0 * R);
+  std::printf(
+      "[ schuler ] initial roll error %.1e rad: period %.3f min, peak east error %.1f m (closed form 2 phi0 R = %.1f "
+      "m)\n",
+      phi0, measured_T / 60, peak, 2 * phi0 * R);
   EXPECT_NEAR(measured_T, T, 0.002 * T);
   EXPECT_NEAR(peak, 2 * phi0 * R, 0.005 * 2 * phi0 * R);
 }
@@ -132,9 +136,11 @@ TEST(StationaryInsErrors, NorthGyroBiasGivesRampPlusSchuler) {
     worst = std::max(worst, std::fabs(s.east_m[i] - predicted));
   }
   const double at_T = eps * R * T;
-  std::printf("[ schuler ] north gyro bias 0.01 deg/h: east error after one Schuler period %.1f m (closed form eps R T = %.1f m), "
-              "worst deviation from eps R (t - sin(w t)/w) %.2f m\n",
-              s.east_m[static_cast<std::size_t>(T / (s.t[1] - s.t[0])) - 1], at_T, worst);
+  std::printf(
+      "[ schuler ] north gyro bias 0.01 deg/h: east error after one Schuler period %.1f m (closed form eps R T = %.1f "
+      "m), "
+      "worst deviation from eps R (t - sin(w t)/w) %.2f m\n",
+      s.east_m[static_cast<std::size_t>(T / (s.t[1] - s.t[0])) - 1], at_T, worst);
   EXPECT_LT(worst, 0.005 * 1.5 * at_T);
 }
 

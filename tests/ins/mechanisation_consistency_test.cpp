@@ -42,8 +42,9 @@ Errors run_profile(const std::string& name, double duration_s, double rate_hz) {
     e.max_vel_mps = std::max(e.max_vel_mps, (ins.state().v_n - t.v_n).norm());
     e.max_att_deg = std::max(e.max_att_deg, attitude_error_n(ins.state().q_nb, t.q_nb).norm() / kDeg);
   }
-  std::printf("[ consistency ] %-8s %6.0f s @ %4.0f Hz: max position error %.3e m, velocity %.3e m/s, attitude %.3e deg\n",
-              name.c_str(), duration_s, rate_hz, e.max_pos_m, e.max_vel_mps, e.max_att_deg);
+  std::printf(
+      "[ consistency ] %-8s %6.0f s @ %4.0f Hz: max position error %.3e m, velocity %.3e m/s, attitude %.3e deg\n",
+      name.c_str(), duration_s, rate_hz, e.max_pos_m, e.max_vel_mps, e.max_att_deg);
   return e;
 }
 

@@ -17,8 +17,8 @@ TEST(NavCorrection, FeedingBackMeasuredErrorsRecoversTheTruth) {
   truth.v_n = {10.0, -3.0, 0.5};
   truth.q_nb = quaternion_from_euler({0.1, -0.05, 1.2});
   NavState est = truth;
-  est.lat_rad += 3e-6;   // ~19 m north
-  est.lon_rad -= 5e-6;   // ~25 m west
+  est.lat_rad += 3e-6;  // ~19 m north
+  est.lon_rad -= 5e-6;  // ~25 m west
   est.height_m -= 7.0;
   est.v_n += Eigen::Vector3d(0.2, -0.1, 0.05);
   est.q_nb = quaternion_from_rotation_vector(Eigen::Vector3d(1e-3, -2e-3, 5e-3)) * truth.q_nb;

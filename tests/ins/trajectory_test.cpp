@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <numbers>
 
+#include "ins/attitude.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/odometer.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
-#include "ins/attitude.hpp"
 
 using namespace ultratrack::ins;
 
@@ -54,7 +54,9 @@ TEST(Profiles, CircleIs500kmhTurningPiOver100) {
 TEST(Profiles, SReversesTheTurnAt100s) {
   const SimulatedRun run = simulate(profile_spec("s", 200.0, kLat, kLon, 1000.0), 100.0);
   auto yaw_rate = [&](std::size_t k) {
-    return wrap_pi(euler_from_quaternion(run.truth[k + 1].q_nb).yaw_rad - euler_from_quaternion(run.truth[k].q_nb).yaw_rad) * 100.0;
+    return wrap_pi(euler_from_quaternion(run.truth[k + 1].q_nb).yaw_rad -
+                   euler_from_quaternion(run.truth[k].q_nb).yaw_rad) *
+           100.0;
   };
   EXPECT_NEAR(yaw_rate(5000), std::numbers::pi / 100, 1e-9);
   EXPECT_NEAR(yaw_rate(15000), -std::numbers::pi / 100, 1e-9);
@@ -91,8 +93,8 @@ TEST(TruthInterpolator, AntennaMotionMatchesExactSamplesAndDerivatives) {
   const Eigen::Vector3d lever(1.2, -0.4, -0.8);  // antenna ahead, left, above the IMU
   // at a sample: IMU position from GeographicLib plus the rotated lever arm
   const TruthSample& s0 = coarse.truth[500];
-  const Eigen::Vector3d expect = ecef_from_geodetic(s0.lat_rad, s0.lon_rad, s0.height_m) +
-                                 C_en(s0.lat_rad, s0.lon_rad) * (s0.q_nb * lever);
+  const Eigen::Vector3d expect =
+      ecef_from_geodetic(s0.lat_rad, s0.lon_rad, s0.height_m) + C_en(s0.lat_rad, s0.lon_rad) * (s0.q_nb * lever);
   EXPECT_LT((interp.antenna(s0.t_s, lever).r_e - expect).norm(), 1e-6);
   double worst_r = 0.0, worst_v = 0.0;
   for (std::size_t k = 2; k + 2 < fine.truth.size(); k += 37) {
@@ -102,7 +104,8 @@ TEST(TruthInterpolator, AntennaMotionMatchesExactSamplesAndDerivatives) {
     worst_r = std::max(worst_r, (m.r_e - exact.r_e).norm());
     // velocity against the central difference of exact antenna positions (independent of the w x l formula)
     const Eigen::Vector3d dr = (antenna_motion_at_sample(fine.truth[k + 1], lever).r_e -
-                                antenna_motion_at_sample(fine.truth[k - 1], lever).r_e) / (2.0 / 400.0);
+                                antenna_motion_at_sample(fine.truth[k - 1], lever).r_e) /
+                               (2.0 / 400.0);
     worst_v = std::max(worst_v, (m.v_e - dr).norm());
   }
   std::printf("[ antenna ] S profile, 100 Hz truth: worst interpolated position error %.2e m, velocity %.2e m/s\n",

@@ -1,8 +1,8 @@
 // `ultratrack imusim` and `ultratrack ins` end to end, in process: simulated files navigate back onto their
 // own truth; coarse alignment mode runs from the stationary start; bad input is a typed error.
-#include <CLI/CLI.hpp>
 #include <gtest/gtest.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -74,15 +74,18 @@ TEST(InsCommands, BadInputIsATypedError) {
   const fs::path dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "imu.csv") << "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n"
                                     "0.01,0,0,0,0,0,-0.098\n0.01,0,0,0,0,0,-0.098\n";
-  std::ofstream(dir / "truth.csv") << "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n"
-                                      "0,36,127,100,0,0,0,0,0,0\n";
+  std::ofstream(dir / "truth.csv")
+      << "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n"
+         "0,36,127,100,0,0,0,0,0,0\n";
   try {
-    run({"ins", "--imu", (dir / "imu.csv").string(), "--init", (dir / "truth.csv").string(), "--out", (dir / "o").string()});
+    run({"ins", "--imu", (dir / "imu.csv").string(), "--init", (dir / "truth.csv").string(), "--out",
+         (dir / "o").string()});
     ADD_FAILURE() << "no error";
   } catch (const ultratrack::ins::InputError& e) {
     EXPECT_EQ(e.line(), 3);
   }
-  EXPECT_THROW(run({"ins", "--imu", (dir / "imu.csv").string(), "--out", (dir / "o").string()}), ultratrack::ins::InputError);
+  EXPECT_THROW(run({"ins", "--imu", (dir / "imu.csv").string(), "--out", (dir / "o").string()}),
+               ultratrack::ins::InputError);
   EXPECT_THROW(run({"imusim", "--profile", "loop", "--duration", "10", "--out", (dir / "o").string()}),
                ultratrack::ins::InputError);
   EXPECT_FALSE(fs::exists(dir / "o/nav.csv"));
