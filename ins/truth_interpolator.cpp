@@ -1,6 +1,7 @@
 #include "ins/truth_interpolator.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "ins/earth_model.hpp"
@@ -21,9 +22,22 @@ TruthInterpolator::TruthInterpolator(std::vector<TruthSample> samples) : samples
   if (samples_.size() < 2) throw std::invalid_argument("TruthInterpolator needs at least two samples");
   for (std::size_t i = 1; i < samples_.size(); ++i)
     if (!(samples_[i].t_s > samples_[i - 1].t_s)) throw std::invalid_argument("truth times must increase");
+  const double dt = (samples_.back().t_s - samples_.front().t_s) / static_cast<double>(samples_.size() - 1);
+  bool uniform = true;
+  for (std::size_t i = 0; i < samples_.size() && uniform; ++i)
+    uniform = std::fabs(samples_[i].t_s - (samples_.front().t_s + static_cast<double>(i) * dt)) < 1e-6 * dt;
+  if (uniform) uniform_dt_ = dt;
 }
 
 std::size_t TruthInterpolator::index(double t) const {
+  if (uniform_dt_ > 0.0) {
+    const double x = std::floor((t - samples_.front().t_s) / uniform_dt_);
+    auto i = static_cast<std::size_t>(std::clamp(x, 0.0, static_cast<double>(samples_.size() - 2)));
+    // rounding at a sample time: step to the interval that really holds t
+    if (i > 0 && t < samples_[i].t_s) --i;
+    if (i + 2 < samples_.size() && t >= samples_[i + 1].t_s) ++i;
+    return i;
+  }
   const auto it =
       std::upper_bound(samples_.begin(), samples_.end(), t, [](double v, const TruthSample& s) { return v < s.t_s; });
   const std::size_t i = it == samples_.begin() ? 0 : static_cast<std::size_t>(it - samples_.begin()) - 1;

@@ -36,6 +36,7 @@ class TruthInterpolator {
  private:
   std::size_t index(double t_s) const;  // i with samples_[i].t <= t < samples_[i+1].t
   std::vector<TruthSample> samples_;
+  double uniform_dt_ = 0.0;  // > 0 when the samples are evenly spaced: O(1) look-up
 };
 
 }  // namespace ultratrack::ins

@@ -132,3 +132,21 @@ TEST(Odometer, CountsDistanceWithScaleFactorError) {
   EXPECT_NEAR(measured, 1.02 * distance, opt.meters_per_pulse + 1e-3);
   EXPECT_EQ(odo.front().pulses, 0);  // the land profile starts standing
 }
+
+TEST(TruthInterpolator, UnevenSamplesAndSampleTimesAgree) {
+  const SimulatedRun run = simulate(profile_spec("circle", 20.0, kLat, kLon, 1000.0), 100.0);
+  std::vector<TruthSample> uneven;
+  for (std::size_t k = 0; k < run.truth.size(); ++k)
+    if (k % 7 != 3) uneven.push_back(run.truth[k]);  // gaps of 20 ms: binary-search path
+  const TruthInterpolator even(run.truth), odd(uneven);
+  const Eigen::Vector3d lever(0.5, 0.2, -1.0);
+  for (std::size_t k = 0; k < run.truth.size(); k += 13) {
+    const double t = run.truth[k].t_s;
+    const EcefMotion exact = antenna_motion_at_sample(run.truth[k], lever);
+    EXPECT_LT((even.antenna(t, lever).r_e - exact.r_e).norm(), 1e-9) << t;  // at a sample: the sample itself
+    EXPECT_LT((odd.antenna(t + 0.004, lever).r_e - even.antenna(t + 0.004, lever).r_e).norm(), 1e-4) << t;
+  }
+  // outside the span: clamped to the ends
+  EXPECT_LT((even.antenna(-5.0, lever).r_e - antenna_motion_at_sample(run.truth.front(), lever).r_e).norm(), 1e-9);
+  EXPECT_LT((even.antenna(99.0, lever).r_e - antenna_motion_at_sample(run.truth.back(), lever).r_e).norm(), 1e-9);
+}
