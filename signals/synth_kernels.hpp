@@ -1,0 +1,27 @@
+// The per-sample inner loops of the IF synthesiser, kept apart so they can be benchmarked and reasoned
+// about alone: code x carrier accumulation with a fixed-point code phase and a 4096-entry carrier table,
+// Gaussian noise, and seeded random engines. No allocation, no exceptions.
+#pragma once
+
+#include <complex>
+#include <cstddef>
+#include <cstdint>
+#include <random>
+
+namespace ultratrack::signals::synth {
+
+// A 64-bit Mersenne Twister seeded from the full 64-bit scenario seed and a stream number (so that the
+// noise of each antenna, the clock, ... draw independent sequences from one seed).
+std::mt19937_64 seeded_engine(std::uint64_t seed, std::uint64_t stream);
+
+// out[i] += data * chip_amplitude[chip(i)] * exp(j 2 pi phase(i)) for i < count, where
+// chip(i) = floor(code0_chips + i * code_rate) mod 1023 (code0_chips in [0, 1023)) and
+// phase(i) = carrier0_cycles + i * carrier_rate (cycles). Real output adds only the real part.
+void add_code_carrier(std::complex<float>* out, std::size_t count, const float* chip_amplitude, float data,
+                      double code0_chips, double code_rate_chips_per_sample, double carrier0_cycles,
+                      double carrier_rate_cycles_per_sample, bool real_output);
+
+// out[i] = sigma * (x + j y) with x, y independent N(0, 1); real output: y = 0.
+void fill_noise(std::complex<float>* out, std::size_t count, float sigma, bool real_output, std::mt19937_64& rng);
+
+}  // namespace ultratrack::signals::synth
