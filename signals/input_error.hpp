@@ -16,10 +16,9 @@ class InputError : public std::runtime_error {
 
  private:
   static std::string format(const std::string& file, const std::string& problem, int line) {
-    // Built with append(): GCC 12 warns falsely (-Wrestrict) on operator+ chains here once inlined.
     std::string where = file.empty() ? std::string("input") : file;
-    if (line > 0) where.append(":").append(std::to_string(line));
-    return where.append(": ").append(problem);
+    if (line > 0) where += ":" + std::to_string(line);
+    return where + ": " + problem;
   }
   std::string file_;
   int line_;
