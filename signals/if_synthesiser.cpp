@@ -73,7 +73,7 @@ struct IfSynthesiser::Impl {
   ReceiverClock clock;
   std::vector<Sat> sats;
   std::vector<Track> tracks;  // antenna-major: tracks[a * sats.size() + k]
-  std::vector<std::mt19937_64> noise_rng;
+  std::vector<synth::GaussianNoise> noise;
   std::int64_t block_samples = 1;
   std::int64_t visibility_blocks = 1000;
   std::int64_t current_block = -1;
@@ -283,7 +283,7 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
   m.geo1.resize(n_ant);
   m.tracks.resize(static_cast<std::size_t>(n_ant) * m.sats.size());
   for (int a = 0; a < n_ant; ++a) {
-    m.noise_rng.push_back(synth::seeded_engine(options_.seed, 1000 + static_cast<std::uint64_t>(a)));
+    m.noise.emplace_back(options_.seed, 1000 + static_cast<std::uint64_t>(a));
     for (std::size_t k = 0; k < m.sats.size(); ++k) {
       auto& tr = m.tracks[static_cast<std::size_t>(a) * m.sats.size() + k];
       if (options_.nav_data)
@@ -324,7 +324,7 @@ void IfSynthesiser::generate(std::span<const std::span<std::complex<float>>> out
     for (std::size_t a = 0; a < out.size(); ++a) {
       std::complex<float>* dst = out[a].data() + done;
       if (options_.noise) {
-        synth::fill_noise(dst, seg, static_cast<float>(gain_), options_.real_output, m.noise_rng[a]);
+        m.noise[a].fill(dst, seg, static_cast<float>(gain_), options_.real_output);
       } else {
         std::fill(dst, dst + seg, std::complex<float>(0.0f, 0.0f));
       }

@@ -70,15 +70,44 @@ void add_code_carrier(std::complex<float>* out, std::size_t count, const float* 
   }
 }
 
-void fill_noise(std::complex<float>* out, std::size_t count, float sigma, bool real_output, std::mt19937_64& rng) {
-  std::normal_distribution<float> gauss(0.0f, sigma);
+void GaussianNoise::pair(float& a, float& b) {
+  constexpr float kScale = 1.0f / 2147483648.0f;  // 2^-31: int32 -> [-1, 1)
+  for (;;) {
+    const std::uint64_t r = rng_();
+    const float u = static_cast<float>(static_cast<std::int32_t>(r & 0xffffffffu)) * kScale;
+    const float v = static_cast<float>(static_cast<std::int32_t>(r >> 32)) * kScale;
+    const float s = u * u + v * v;
+    if (s >= 1.0f || s == 0.0f) continue;
+    const float f = std::sqrt(-2.0f * std::log(s) / s);
+    a = u * f;
+    b = v * f;
+    return;
+  }
+}
+
+void GaussianNoise::fill(std::complex<float>* out, std::size_t count, float sigma, bool real_output) {
+  float a = 0.0f, b = 0.0f;
   if (real_output) {
-    for (std::size_t i = 0; i < count; ++i) out[i] = {gauss(rng), 0.0f};
+    std::size_t i = 0;
+    if (has_spare_ && count > 0) {
+      out[i++] = {sigma * spare_, 0.0f};
+      has_spare_ = false;
+    }
+    for (; i + 1 < count; i += 2) {
+      pair(a, b);
+      out[i] = {sigma * a, 0.0f};
+      out[i + 1] = {sigma * b, 0.0f};
+    }
+    if (i < count) {
+      pair(a, b);
+      out[i] = {sigma * a, 0.0f};
+      spare_ = b;
+      has_spare_ = true;
+    }
   } else {
     for (std::size_t i = 0; i < count; ++i) {
-      const float x = gauss(rng);
-      const float y = gauss(rng);
-      out[i] = {x, y};
+      pair(a, b);
+      out[i] = {sigma * a, sigma * b};
     }
   }
 }

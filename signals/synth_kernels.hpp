@@ -21,7 +21,19 @@ void add_code_carrier(std::complex<float>* out, std::size_t count, const float* 
                       double code0_chips, double code_rate_chips_per_sample, double carrier0_cycles,
                       double carrier_rate_cycles_per_sample, bool real_output);
 
-// out[i] = sigma * (x + j y) with x, y independent N(0, 1); real output: y = 0.
-void fill_noise(std::complex<float>* out, std::size_t count, float sigma, bool real_output, std::mt19937_64& rng);
+// Independent N(0, 1) values from a seeded engine (Marsaglia's polar method, both values of each pair
+// used), so the sequence does not depend on how the samples are split into calls.
+class GaussianNoise {
+ public:
+  GaussianNoise(std::uint64_t seed, std::uint64_t stream) : rng_(seeded_engine(seed, stream)) {}
+  // out[i] = sigma * (x + j y); real output: y = 0.
+  void fill(std::complex<float>* out, std::size_t count, float sigma, bool real_output);
+
+ private:
+  void pair(float& a, float& b);
+  std::mt19937_64 rng_;
+  bool has_spare_ = false;
+  float spare_ = 0.0f;
+};
 
 }  // namespace ultratrack::signals::synth
