@@ -1,0 +1,61 @@
+// IF synthesiser speed: 8 satellites at 4 MHz complex, quantised to i8 and written to a file, on one core.
+// The counter realtime_factor is seconds of signal per second of wall time (> 1: faster than real time).
+#include <benchmark/benchmark.h>
+
+#include <GeographicLib/Geocentric.hpp>
+
+#include <cmath>
+#include <complex>
+#include <filesystem>
+#include <vector>
+
+#include "signals/if_synthesiser.hpp"
+#include "signals/sample_writer.hpp"
+
+namespace {
+
+using namespace ultratrack::signals;
+
+std::vector<Ephemeris> eight_satellites(const GpsTime& t) {
+  std::vector<Ephemeris> out;
+  for (int k = 0; k < 8; ++k) {
+    Ephemeris e;
+    e.prn = k + 1;
+    e.week = t.week;
+    e.toe_s = e.toc_s = t.tow_s;
+    e.sqrt_a_sqrtm = 5153.7;
+    e.e = 0.005;
+    e.i0_rad = 0.96;
+    e.omega0_rad = (k % 4) * 1.047;
+    e.m0_rad = k * 0.785;
+    e.af0_s = 1e-5 * k;
+    out.push_back(e);
+  }
+  return out;
+}
+
+void BM_Synthesise8Satellites4MHzI8(benchmark::State& state) {
+  SynthesiserOptions o;
+  o.sample_rate_hz = 4e6;
+  o.start = {2190, 518400.0};
+  o.elevation_mask_rad = -M_PI / 2;  // all eight transmitted, wherever they are
+  o.troposphere = true;
+  Eigen::Vector3d r;
+  GeographicLib::Geocentric::WGS84().Forward(35.27, 137.01, 100.0, r.x(), r.y(), r.z());
+  IfSynthesiser synth(o, eight_satellites(o.start), std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r}));
+  const auto path = std::filesystem::temp_directory_path() / "ultratrack_bench_synth.i8";
+  SampleWriter writer(path, SampleFormat::i8);
+  std::vector<std::complex<float>> buf(400000);  // 100 ms
+  std::span<std::complex<float>> span(buf);
+  for (auto _ : state) {
+    synth.generate(std::span<const std::span<std::complex<float>>>(&span, 1));
+    writer.write(buf);
+    benchmark::ClobberMemory();
+  }
+  const double signal_s = static_cast<double>(state.iterations()) * 0.1;
+  state.counters["realtime_factor"] = benchmark::Counter(signal_s, benchmark::Counter::kIsRate);
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(buf.size()));
+}
+BENCHMARK(BM_Synthesise8Satellites4MHzI8)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
