@@ -17,7 +17,10 @@ class InputError : public std::runtime_error {
  private:
   static std::string format(const std::string& file, const std::string& problem, int line) {
     std::string where = file.empty() ? std::string("input") : file;
-    if (line > 0) where += ":" + std::to_string(line);
+    if (line > 0) {  // appended in two steps: `":" + std::to_string()` trips GCC 12's false -Wrestrict
+      where += ':';
+      where += std::to_string(line);
+    }
     return where + ": " + problem;
   }
   std::string file_;
