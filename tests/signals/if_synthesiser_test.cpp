@@ -13,7 +13,7 @@
 #include "signals/sample_writer.hpp"
 #include "signals/satellite_state.hpp"
 #include "support/test_data.hpp"
-#include "synth_test_support.hpp"
+#include "support/brute_force_acquisition.hpp"
 
 namespace ultratrack::signals {
 namespace {
