@@ -340,8 +340,10 @@ std::vector<SatelliteView> IfSynthesiser::visible_satellites(std::int64_t sample
   Impl& m = *impl_;
   const double tau = m.tau_of(sample);
   const RxGeo rx = m.rx_geo(0, tau);
-  const RxGeo rx_minus = m.rx_geo(0, tau - kDopplerHalfStep_s);
-  const RxGeo rx_plus = m.rx_geo(0, tau + kDopplerHalfStep_s);
+  // Central difference over 1 ms (one-sided at the very start: the clock has no past before sample 0).
+  const double tau_minus = std::max(0.0, tau - kDopplerHalfStep_s);
+  const RxGeo rx_minus = m.rx_geo(0, tau_minus);
+  const RxGeo rx_plus = m.rx_geo(0, tau_minus + 2.0 * kDopplerHalfStep_s);
   std::vector<SatelliteView> views;
   for (const auto& sat : m.sats) {
     const Solution s = m.solve(sat, rx, 0.075, 0.0);

@@ -373,6 +373,51 @@ TEST(IfSynthesiser, SamplesFollowTheExactTimingOnEveryAntenna) {
   }
 }
 
+// The data bits sit at the satellite's time: the symbol received at a sample whose code left the
+// satellite at SV time t is bit floor((t - subframe start) / 20 ms) of the LNAV subframe that starts at the
+// 6 s boundary before t (as the LNAV encoder builds it), +1 for bit 0. Noise-free, one satellite, 1.5 s.
+TEST(IfSynthesiser, DataBitsFollowTheSatelliteTime) {
+  auto o = base_options(1.024e6);
+  o.noise = false;
+  o.output_rms = 1.0;
+  auto eph = walker_constellation(kStart);
+  IfSynthesiser probe(o, eph, static_receiver());
+  const int prn = probe.visible_satellites(0).front().prn;
+  IfSynthesiser synth(o, {eph[prn - 1]}, static_receiver());
+  const auto x = synthesise(synth, static_cast<std::size_t>(1.5 * o.sample_rate_hz));
+  const LnavTransmitter tx(eph[prn - 1], o.klobuchar, o.utc, {eph[prn - 1]});
+  const auto& code = ca_code(prn);
+  const double t_sv0 = synth.timing(prn, 0, 0).code_sv_time_s;
+  int checked = 0, flips = 0, previous = 0;
+  for (int k = static_cast<int>(std::ceil(t_sv0 / 0.02)); k < 70; ++k) {
+    // The sample whose code left the satellite in the middle of bit k (relative SV time 0.02 k + 0.01).
+    const double target = 0.02 * k + 0.01;
+    auto n = static_cast<std::int64_t>(std::llround((target - t_sv0) * o.sample_rate_hz));
+    n += static_cast<std::int64_t>(std::llround((target - synth.timing(prn, 0, n).code_sv_time_s) * o.sample_rate_hz));
+    if (n >= static_cast<std::int64_t>(x.size())) break;
+    const SignalTiming t = synth.timing(prn, 0, n);
+    const double frac = t.code_phase_chips - std::floor(t.code_phase_chips);
+    if (frac < 0.01 || frac > 0.99) ++n;  // one sample on: away from the chip edge (0.5 chip per sample)
+    const SignalTiming u = synth.timing(prn, 0, n);
+    const std::complex<double> wiped = std::complex<double>(x[n].real(), x[n].imag()) *
+                                       std::polar(1.0, -2 * std::numbers::pi * u.carrier_phase_cycles) *
+                                       static_cast<double>(code[static_cast<int>(u.code_phase_chips)]);
+    const int symbol = wiped.real() > 0 ? 1 : -1;
+    EXPECT_GT(std::abs(wiped.real()), 0.99 * synth.amplitude(prn));
+    // Expected: the transmitted bit at SV time start + u.code_sv_time_s.
+    const GpsTime t_sv = add_seconds(kStart, u.code_sv_time_s);
+    const GpsTime sf_start{t_sv.week, 6.0 * std::floor(t_sv.tow_s / 6.0)};
+    const int bit = static_cast<int>(std::floor((t_sv.tow_s - sf_start.tow_s) / 0.02));
+    const int expected = tx.subframe_starting_at(sf_start)[bit] ? -1 : 1;
+    EXPECT_EQ(symbol, expected) << "bit " << k << " at SV tow " << t_sv.tow_s;
+    flips += previous != 0 && symbol != previous;
+    previous = symbol;
+    ++checked;
+  }
+  EXPECT_GT(checked, 60);
+  EXPECT_GT(flips, 10);  // real data, not a constant
+}
+
 TEST(IfSynthesiser, RejectsInvalidOptions) {
   auto o = base_options(2e6);
   o.real_output = true;
