@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "ultratrack 0.1.0");
   ultratrack::tools::add_simulate_command(app);
   ultratrack::tools::add_demo_command(app);
+  ultratrack::tools::add_acquire_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,325 @@
+#include "receiver/acquisition.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "signals/ca_code.hpp"
+#include "signals/gps_constants.hpp"
+
+namespace ultratrack::receiver {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kChipRate_hz = signals::kCaChipRate_hz;
+constexpr int kCodeLength = signals::kCaCodeLength_chips;
+
+// log(sum_{i<K} g^i / i!) by log-sum-exp (terms grow then shrink; K up to 1000).
+double log_partial_exp_series(int k, double g) {
+  if (g <= 0.0) return 0.0;  // only the i = 0 term, which is 1
+  std::vector<double> log_terms(static_cast<std::size_t>(k));
+  double largest = -INFINITY;
+  for (int i = 0; i < k; ++i) {
+    log_terms[static_cast<std::size_t>(i)] = i * std::log(g) - std::lgamma(i + 1.0);
+    largest = std::max(largest, log_terms[static_cast<std::size_t>(i)]);
+  }
+  double sum = 0.0;
+  for (double t : log_terms) sum += std::exp(t - largest);
+  return largest + std::log(sum);
+}
+
+// Code chip (+1/-1) at a code phase in chips (any real number; the code repeats every 1023 chips).
+inline float chip_at(const signals::CaCodeChips& code, double phase_chips) {
+  double wrapped = phase_chips - kCodeLength * std::floor(phase_chips / kCodeLength);
+  auto index = static_cast<int>(wrapped);
+  if (index >= kCodeLength) index = kCodeLength - 1;  // rounding at the upper edge
+  return static_cast<float>(code[static_cast<std::size_t>(index)]);
+}
+
+// Code chip rate of a signal with carrier Doppler doppler_hz (the code Doppler is coherent with it).
+inline double code_rate_hz(double doppler_hz) { return kChipRate_hz * (1.0 + doppler_hz / signals::kL1Frequency_hz); }
+
+}  // namespace
+
+bool AcquisitionOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string why) {
+    if (error) *error = std::move(why);
+    return false;
+  };
+  if (!(fs_hz >= kChipRate_hz) || !std::isfinite(fs_hz)) return fail("sample rate must be at least 1.023 MHz");
+  if (coherent_ms < 1 || coherent_ms > 10) return fail("coherent integration must be 1 to 10 ms");
+  if (noncoherent < 1 || noncoherent > 1000) return fail("non-coherent blocks must be 1 to 1000");
+  if (!(doppler_max_hz > 0.0) || doppler_max_hz > fs_hz / 4.0)
+    return fail("Doppler range must be positive and at most fs/4");
+  if (doppler_step_hz < 0.0 || doppler_step_hz > 1.0 / coherent_s() || !std::isfinite(doppler_step_hz))
+    return fail("Doppler step must be 0 (automatic) or within (0, 1/T_coh]");
+  if (!(pfa > 0.0) || pfa > 0.5) return fail("false-alarm probability must be within (0, 0.5]");
+  return true;
+}
+
+double acquisition_threshold(int noncoherent, double cells, double pfa) {
+  if (noncoherent < 1 || !(cells >= 1.0) || !(pfa > 0.0 && pfa < 1.0))
+    throw std::invalid_argument("acquisition_threshold: K >= 1, cells >= 1, 0 < pfa < 1");
+  // Per-cell probability so that 1 - (1 - p)^M = pfa, without cancellation for tiny p.
+  const double log_p_cell = std::log(-std::expm1(std::log1p(-pfa) / cells));
+  auto log_tail = [&](double g) { return -g + log_partial_exp_series(noncoherent, g); };
+  double lo = 0.0, hi = 1.0;
+  while (log_tail(hi) > log_p_cell) hi *= 2.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * hi; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (log_tail(mid) > log_p_cell ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) {
+  std::string why;
+  if (!options_.IsValid(&why)) throw std::invalid_argument("acquisition options: " + why);
+  block_size_ = static_cast<std::size_t>(std::llround(options_.fs_hz * options_.coherent_s()));
+  samples_per_chip_ = options_.fs_hz / kChipRate_hz;
+  lags_ = std::min(block_size_, static_cast<std::size_t>(std::ceil(kCodeLength * samples_per_chip_)));
+  forward_ = FftwPlan(block_size_, FftwPlan::Direction::forward);
+  backward_ = FftwPlan(block_size_, FftwPlan::Direction::backward);
+  mixed_ = FftwBuffer(block_size_);
+  product_ = FftwBuffer(block_size_);
+  correlation_ = FftwBuffer(block_size_);
+  spectrum_scratch_ = FftwBuffer(block_size_);
+  code_spectra_.resize(signals::kMaxPrn);
+  row_.resize(lags_);
+}
+
+double Acquisition::cells() const { return static_cast<double>(doppler_grid(std::nullopt).size() * lags_); }
+
+std::vector<double> Acquisition::doppler_grid(std::optional<DopplerWindow> assist) const {
+  const double step = options_.step_hz();
+  const double center = assist ? assist->center_hz : 0.0;
+  const double half_width = assist ? std::max(assist->half_width_hz, 0.0) : options_.doppler_max_hz;
+  const int half_bins = static_cast<int>(std::ceil(half_width / step - 1e-9));
+  std::vector<double> grid;
+  for (int i = -half_bins; i <= half_bins; ++i) grid.push_back(center + i * step);
+  return grid;
+}
+
+const FftwBuffer& Acquisition::code_spectrum(int prn) {
+  auto& slot = code_spectra_[static_cast<std::size_t>(prn - 1)];
+  if (!slot) {
+    // Replica sampled at the actual rate (non-integer samples per chip), code phase 0 at sample 0,
+    // as conj(FFT) / N so that IFFT(X conj(C) / N) is the plain correlation sum.
+    const auto& code = signals::ca_code(prn);
+    for (std::size_t m = 0; m < block_size_; ++m)
+      mixed_[m] = {chip_at(code, static_cast<double>(m) / samples_per_chip_), 0.0f};
+    FftwBuffer spectrum(block_size_);
+    forward_.execute(mixed_, spectrum);
+    const float scale = 1.0f / static_cast<float>(block_size_);
+    for (std::size_t i = 0; i < block_size_; ++i) spectrum[i] = std::conj(spectrum[i]) * scale;
+    slot = std::move(spectrum);
+  }
+  return *slot;
+}
+
+void Acquisition::doppler_spectrum(std::span<const std::complex<float>> samples, int block, double doppler_hz,
+                                   FftwBuffer& out) {
+  const std::size_t first = static_cast<std::size_t>(block) * block_size_;
+  const std::complex<double> step = std::polar(1.0, -kTwoPi * doppler_hz / options_.fs_hz);
+  std::complex<double> nco(1.0, 0.0);
+  for (std::size_t m = 0; m < block_size_; ++m) {
+    const std::complex<float> x = samples[first + m];
+    const std::complex<double> y = std::complex<double>(x.real(), x.imag()) * nco;
+    mixed_[m] = {static_cast<float>(y.real()), static_cast<float>(y.imag())};
+    nco *= step;
+  }
+  forward_.execute(mixed_, out);
+}
+
+void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, const FftwBuffer* cached, int prn,
+                                double doppler_hz) {
+  const FftwBuffer& code = code_spectrum(prn);
+  std::fill(row_.begin(), row_.end(), 0.0f);
+  // Code-phase drift per block from the code Doppler (and from N not being a whole number of periods).
+  const double period = kCodeLength * options_.fs_hz / code_rate_hz(doppler_hz);
+  const auto n = static_cast<std::ptrdiff_t>(block_size_);
+  for (int k = 0; k < options_.noncoherent; ++k) {
+    const FftwBuffer* spectrum = cached ? cached + k : &spectrum_scratch_;
+    if (!cached) doppler_spectrum(samples, k, doppler_hz, spectrum_scratch_);
+    for (std::size_t i = 0; i < block_size_; ++i) product_[i] = (*spectrum)[i] * code[i];
+    backward_.execute(product_, correlation_);
+    const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
+    const auto shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period)));
+    for (std::size_t lag = 0; lag < lags_; ++lag) {
+      std::ptrdiff_t index = (static_cast<std::ptrdiff_t>(lag) + shift) % n;
+      if (index < 0) index += n;
+      row_[lag] += std::norm(correlation_[static_cast<std::size_t>(index)]);
+    }
+  }
+}
+
+std::complex<double> Acquisition::correlate_time(std::span<const std::complex<float>> samples, int prn, int block,
+                                                 double doppler_hz, double lag_samples) const {
+  const auto& code = signals::ca_code(prn);
+  const std::size_t first = static_cast<std::size_t>(block) * block_size_;
+  const double chips_per_sample = code_rate_hz(doppler_hz) / options_.fs_hz;
+  const std::complex<double> step = std::polar(1.0, -kTwoPi * doppler_hz / options_.fs_hz);
+  std::complex<double> nco(1.0, 0.0), sum(0.0, 0.0);
+  double phase = (static_cast<double>(first) - lag_samples) * chips_per_sample;
+  for (std::size_t m = 0; m < block_size_; ++m) {
+    const std::complex<float> x = samples[first + m];
+    sum += std::complex<double>(x.real(), x.imag()) * nco * static_cast<double>(chip_at(code, phase));
+    nco *= step;
+    phase += chips_per_sample;
+  }
+  return sum;
+}
+
+double Acquisition::power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz,
+                             double lag_samples) const {
+  double power = 0.0;
+  for (int k = 0; k < options_.noncoherent; ++k)
+    power += std::norm(correlate_time(samples, prn, k, doppler_hz, lag_samples));
+  return power;
+}
+
+AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> samples, int prn,
+                                           const std::vector<double>& dopplers, bool cached) {
+  const std::size_t bins = dopplers.size();
+  if (grid_.size() < bins * lags_) grid_.resize(bins * lags_);
+  row_noise_.resize(bins);
+  // Candidate peak on rows normalised by their plain means (the signal raises its row's mean a little).
+  double candidate = -1.0;
+  std::size_t candidate_lag = 0;
+  for (std::size_t d = 0; d < bins; ++d) {
+    correlate_bin(samples, cached ? &spectrum_cache_[d * static_cast<std::size_t>(options_.noncoherent)] : nullptr, prn,
+                  dopplers[d]);
+    std::copy(row_.begin(), row_.end(), grid_.begin() + static_cast<std::ptrdiff_t>(d * lags_));
+    double sum = 0.0;
+    for (float v : row_) sum += v;
+    const double mean = sum / static_cast<double>(lags_);
+    for (std::size_t lag = 0; lag < lags_; ++lag) {
+      if (row_[lag] > candidate * mean) {
+        candidate = row_[lag] / mean;
+        candidate_lag = lag;
+      }
+    }
+  }
+
+  // Noise per Doppler row (a cell-averaging CFAR along the code): the mean of the row's cells away from the
+  // candidate's code phase (+-1.5 chips; in every row, which also removes the signal's Doppler side
+  // lobes). Per row because real front ends leave narrowband spurs that raise whole rows evenly: one
+  // noise level for the whole grid would turn those rows into false alarms.
+  const auto guard = static_cast<std::ptrdiff_t>(std::ceil(1.5 * samples_per_chip_)) + 1;
+  const auto lags = static_cast<std::ptrdiff_t>(lags_);
+  auto excluded = [&](std::size_t lag) {
+    std::ptrdiff_t distance = std::abs(static_cast<std::ptrdiff_t>(lag) - static_cast<std::ptrdiff_t>(candidate_lag));
+    return std::min(distance, lags - distance) <= guard;
+  };
+  double best = -1.0;
+  int best_bin = 0;
+  std::size_t best_lag = 0;
+  for (std::size_t d = 0; d < bins; ++d) {
+    const float* row = &grid_[d * lags_];
+    double sum = 0.0;
+    std::size_t count = 0;
+    for (std::size_t lag = 0; lag < lags_; ++lag) {
+      if (excluded(lag)) continue;
+      sum += row[lag];
+      ++count;
+    }
+    row_noise_[d] = sum / static_cast<double>(count);
+    for (std::size_t lag = 0; lag < lags_; ++lag) {
+      if (row[lag] > best * row_noise_[d]) {
+        best = row[lag] / row_noise_[d];
+        best_bin = static_cast<int>(d);
+        best_lag = lag;
+      }
+    }
+  }
+  const double k = options_.noncoherent;
+  const double noise_power = row_noise_[static_cast<std::size_t>(best_bin)] / k;  // P_n, one coherent block
+
+  AcquisitionResult result;
+  result.prn = prn;
+  result.metric = best;
+  result.threshold = acquisition_threshold(options_.noncoherent, static_cast<double>(bins * lags_), options_.pfa) / k;
+  result.detected = result.metric > result.threshold;
+
+  double doppler = dopplers[static_cast<std::size_t>(best_bin)];
+  double lag = static_cast<double>(best_lag);
+  double peak_power = best * k * noise_power;
+  if (result.detected) {
+    // Fine Doppler: step/8 over +-1 coarse step at the peak lag, then a parabola through the best three.
+    const double fine = options_.step_hz() / 8.0;
+    std::array<double, 17> powers{};
+    std::size_t top = 0;
+    for (std::size_t i = 0; i < powers.size(); ++i) {
+      powers[i] = power_at(samples, prn, doppler + (static_cast<double>(i) - 8.0) * fine, lag);
+      if (powers[i] > powers[top]) top = i;
+    }
+    double offset = static_cast<double>(top) - 8.0;
+    if (top > 0 && top + 1 < powers.size()) {
+      const double curvature = powers[top - 1] - 2.0 * powers[top] + powers[top + 1];
+      if (curvature < 0.0) offset += 0.5 * (powers[top - 1] - powers[top + 1]) / curvature;
+    }
+    doppler += offset * fine;
+
+    // Fine code phase: triangle fit through the signal amplitudes (noise power removed) at lag -1, 0, +1.
+    auto amplitude = [&](double l) {
+      return std::sqrt(std::max(power_at(samples, prn, doppler, l) / k - noise_power, 0.0));
+    };
+    const double before = amplitude(lag - 1.0), centre = amplitude(lag), after = amplitude(lag + 1.0);
+    const double drop = centre - std::min(before, after);
+    if (drop > 0.0) lag += std::clamp((after - before) / (2.0 * drop), -0.5, 0.5);
+    peak_power = power_at(samples, prn, doppler, lag);
+  }
+  const double snr = peak_power / (k * noise_power) - 1.0;  // coherent SNR = C/N0 T_coh
+  result.cn0_dbhz = 10.0 * std::log10(std::max(snr, 1e-3) / options_.coherent_s());
+  result.doppler_hz = doppler;
+  const double chips_per_sample = code_rate_hz(doppler) / options_.fs_hz;
+  // The code epoch starts at sample `lag`, so the code phase at sample 0 is -lag chips-per-sample.
+  double phase = std::fmod(-lag * chips_per_sample, static_cast<double>(kCodeLength));
+  if (phase < 0.0) phase += kCodeLength;
+  if (phase >= kCodeLength) phase -= kCodeLength;
+  result.code_phase_chips = phase;
+  const double period = kCodeLength / chips_per_sample;
+  result.code_phase_samples = std::fmod(std::fmod(lag, period) + period, period);
+  return result;
+}
+
+void Acquisition::check(std::span<const std::complex<float>> samples, int prn) const {
+  if (prn < signals::kMinPrn || prn > signals::kMaxPrn)
+    throw std::invalid_argument("acquisition: PRN " + std::to_string(prn) + " is not 1..32");
+  if (samples.size() < samples_needed())
+    throw std::invalid_argument("acquisition: " + std::to_string(samples.size()) + " samples given, " +
+                                std::to_string(samples_needed()) + " needed");
+}
+
+AcquisitionResult Acquisition::search(std::span<const std::complex<float>> samples, int prn,
+                                      std::optional<DopplerWindow> assist) {
+  check(samples, prn);
+  return search_grid(samples, prn, doppler_grid(assist), false);
+}
+
+std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<float>> samples,
+                                                   std::span<const int> prns) {
+  for (int prn : prns) check(samples, prn);
+  const std::vector<double> dopplers = doppler_grid(std::nullopt);
+  const std::size_t spectra = dopplers.size() * static_cast<std::size_t>(options_.noncoherent);
+  const bool cache = prns.size() > 1 && spectra * block_size_ * sizeof(std::complex<float>) <= memory_budget_bytes_;
+  if (cache) {
+    // One forward FFT per (Doppler bin, block), shared by every PRN.
+    if (spectrum_cache_.size() != spectra) {
+      spectrum_cache_.clear();
+      for (std::size_t i = 0; i < spectra; ++i) spectrum_cache_.emplace_back(block_size_);
+    }
+    const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
+    for (std::size_t d = 0; d < dopplers.size(); ++d)
+      for (std::size_t k = 0; k < k_blocks; ++k)
+        doppler_spectrum(samples, static_cast<int>(k), dopplers[d], spectrum_cache_[d * k_blocks + k]);
+  }
+  std::vector<AcquisitionResult> results;
+  results.reserve(prns.size());
+  for (int prn : prns) results.push_back(search_grid(samples, prn, dopplers, cache));
+  return results;
+}
+
+}  // namespace ultratrack::receiver

@@ -1,0 +1,69 @@
+// Bit synchronisation for GPS LNAV (50 bit/s, 20 code periods per bit): a histogram of prompt sign changes
+// between successive 1 ms epochs over the 20 possible bit-edge positions; then assembly of 20 ms bits (+1/-1 with
+// a soft value) from epochs aligned to the found edge, for the LNAV decoder. Code periods are the channel's.
+#pragma once
+
+#include <array>
+#include <complex>
+#include <cstdint>
+#include <optional>
+
+#include "receiver/correlation_epoch.hpp"
+
+namespace ultratrack::receiver {
+
+struct BitSyncOptions {
+  int min_edges = 10;          // transitions counted in the winning bin before deciding; [3, 1000]
+  double min_ratio = 3.0;      // winning bin / runner-up bin; [1.5, 100]
+  int max_periods = 10000;     // give up (failed()) after this many 1 ms epochs; >= 200
+};
+
+class BitSynchronizer final {
+ public:
+  explicit BitSynchronizer(const BitSyncOptions& options = {}) : options_(options) {}
+  // One 1 ms prompt with its code period index (consecutive calls should be consecutive periods; a gap only
+  // suppresses the comparison across it). Sign change = Re(P_k conj(P_k-1)) < 0, valid without phase lock.
+  void add(std::int64_t code_period, std::complex<float> prompt);
+  bool synchronised() const { return synchronised_; }
+  bool failed() const { return !synchronised_ && periods_ >= options_.max_periods; }
+  // Once synchronised: a code period at which a bit starts; edges are every 20 periods from it.
+  std::int64_t edge_period() const { return edge_; }
+  const std::array<int, 20>& histogram() const { return bins_; }
+  void reset() { *this = BitSynchronizer(options_); }
+
+ private:
+  BitSyncOptions options_;
+  std::array<int, 20> bins_{};
+  int periods_ = 0;
+  bool have_previous_ = false;
+  std::int64_t previous_period_ = 0;
+  std::complex<float> previous_{};
+  bool synchronised_ = false;
+  std::int64_t edge_ = 0;
+};
+
+// One navigation bit: value +1/-1 (sign of the in-phase prompt; a Costas loop leaves a 180 degree ambiguity that
+// the LNAV preamble resolves), soft = I / (mean |P| of recent bits), about +-1 when clean.
+struct NavBit {
+  std::int64_t first_sample = 0;       // receiver sample index where the bit starts
+  std::int64_t first_code_period = 0;  // channel code period where the bit starts (an edge period)
+  int value = 0;
+  float soft = 0.0f;
+};
+
+// Sums prompts of epochs lying inside one bit (1, 2, 4, 5, 10 or 20 periods each, aligned to the edges) into bits.
+class BitAssembler final {
+ public:
+  explicit BitAssembler(std::int64_t edge_period) : edge_(edge_period) {}
+  std::optional<NavBit> add(const CorrelationEpoch& epoch);
+
+ private:
+  std::int64_t edge_;
+  bool active_ = false;
+  NavBit current_{};
+  std::complex<double> sum_{};
+  int periods_ = 0;
+  double amplitude_ = 0.0;
+};
+
+}  // namespace ultratrack::receiver

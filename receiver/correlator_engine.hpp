@@ -1,0 +1,61 @@
+// Correlator engine: the hot path's single home. Carrier wipe-off and up to kMaxTaps code correlators (very
+// early, early, prompt, late, very late, noise: any set of code offsets in chips) over one block of complex
+// baseband samples, for 1..kMaxAntennas antennas against one replica in one pass. Code chips come from a table
+// built once per PRN; the carrier from a 32-bit fixed-point phase and a polynomial sin/cos (|error| < 1e-6).
+// No allocation, no exceptions per call. Scalar C++ written for auto-vectorisation; SIMD arrives behind this API.
+#pragma once
+
+#include <array>
+#include <complex>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "receiver/correlation_epoch.hpp"
+
+namespace ultratrack::receiver {
+
+inline constexpr int kMaxTaps = 6;
+
+// The replica over one block: prompt code phase at the first sample, chips, measured from a code period start
+// and within [-1023, 2046), with at most 1023 chips covered by the block (so that every tap stays in the
+// engine's 5-period table); code step in chips per sample; carrier phase at the first sample and its step per sample in 2^-32 cycles (wrapping).
+struct ReplicaSegment {
+  double code_phase_chips = 0.0;
+  double code_step_chips = 0.0;
+  std::uint32_t carrier_phase_q32 = 0;
+  std::uint32_t carrier_step_q32 = 0;
+};
+
+// Sums per tap (in the order of the engine's offsets) for one antenna.
+using TapSums = std::array<std::complex<double>, kMaxTaps>;
+
+class CorrelatorEngine final {
+ public:
+  // tap_offsets_chips: code offset of each tap relative to prompt, chips, |offset| <= 1023 (positive = early:
+  // the tap reads the code that many chips ahead of prompt). At most kMaxTaps taps. Throws std::invalid_argument.
+  CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips);
+
+  int num_taps() const { return num_taps_; }
+  int prn() const { return prn_; }
+
+  // Adds to sums[a][t] the correlation of antennas[a][0..num_samples) with tap t of the replica.
+  // Preconditions: antennas.size() == sums.size() <= kMaxAntennas; the replica stays inside the table.
+  void correlate(std::span<const std::complex<float>* const> antennas, int num_samples, const ReplicaSegment& replica,
+                 std::span<TapSums> sums) const;
+
+ private:
+  int prn_;
+  int num_taps_;
+  std::array<double, kMaxTaps> offsets_{};
+  std::vector<std::int8_t> table_;  // 5 code periods of +1/-1 chips: index = chip + 2046
+};
+
+// A lag (chips, -723..-300: the noise replica lags prompt) where this PRN's periodic autocorrelation is -1/1023 at that lag and its two neighbours
+// on each side: a replica shifted by it sees noise only, whatever the fractional code error. Throws for bad PRNs.
+double noise_tap_offset_chips(int prn);
+
+// cos and sin of 2*pi*phase for a 2^-32-cycle fixed-point phase; |error| < 1e-6. Exposed for tests.
+void fixed_point_sincos(std::uint32_t phase_q32, float* cos_out, float* sin_out);
+
+}  // namespace ultratrack::receiver

@@ -1,0 +1,52 @@
+// One channel's navigation-data chain after bit sync: LNAV frame sync and decoding (signals/), plus the
+// tie between the channel's code-period count and GPS transmit time. After sync, the code period at which
+// the latest subframe began is known together with the GPS time that subframe left the satellite; that
+// tag turns a replica code phase into a transmit time, and so into a pseudorange.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "signals/gps_time.hpp"
+#include "signals/lnav_decoder.hpp"
+#include "signals/lnav_frame_sync.hpp"
+
+namespace ultratrack::receiver {
+
+// The code period (counted by the channel) at which a subframe's first bit began, and the GPS time at
+// which that bit was transmitted.
+struct TransmitTimeTag {
+  std::int64_t code_period = 0;
+  signals::GpsTime transmit_time;
+};
+
+class NavigationDataChannel {
+ public:
+  NavigationDataChannel(int prn, int reference_week);
+
+  // One navigation bit: soft value (its sign is the bit as received: positive = 0) that began at the
+  // channel's code period first_code_period. Bits must be consecutive; after a gap call reset().
+  void add_bit(float soft, std::int64_t first_code_period);
+  // Forget the bit history (after loss of lock or a bit slip); the decoded data are kept.
+  void reset();
+
+  bool synchronised() const { return frame_sync_.locked() && tag_.has_value(); }
+  const std::optional<TransmitTimeTag>& time_tag() const { return tag_; }
+  // +1 if the received bits are upright, -1 if inverted (resolves the Costas loop's half-cycle ambiguity).
+  int polarity() const { return polarity_; }
+  const signals::LnavDecoder& decoder() const { return decoder_; }
+  // True once after each subframe that completed a new ephemeris (cleared by the call).
+  bool take_new_ephemeris();
+
+ private:
+  static constexpr int kHistory = 302;  // a subframe and the two bits before it
+  signals::LnavFrameSync frame_sync_;
+  signals::LnavDecoder decoder_;
+  std::array<std::int64_t, kHistory> code_periods_{};  // code period of each recent bit, by bit index
+  std::optional<TransmitTimeTag> tag_;
+  int polarity_ = 1;
+  bool new_ephemeris_ = false;
+};
+
+}  // namespace ultratrack::receiver

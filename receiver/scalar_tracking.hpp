@@ -1,0 +1,138 @@
+// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. FLL-assisted Costas
+// PLL pull-in, then Costas PLL (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
+// 1 ms epochs, then 20 ms coherent after bit sync; C/N0, phase-lock and C/N0 lock detectors; loss of lock is
+// a state (kLost), never silently tracked noise. Units: Hz, chips, cycles, seconds; C/N0 in dB-Hz at the edge.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "receiver/bit_sync.hpp"
+#include "receiver/correlation_epoch.hpp"
+#include "receiver/lock_detectors.hpp"
+#include "receiver/loop_filters.hpp"
+#include "receiver/nco_command.hpp"
+#include "receiver/tracking_channel.hpp"
+
+namespace ultratrack::receiver {
+
+// All scalar-tracking settings, with defaults for L1 C/A in a static or vehicle receiver. Check with
+// validation_error() at the edge (config file, command line) before constructing anything.
+struct ScalarTrackingOptions {
+  // Carrier loop
+  int pll_order = 3;                   // 2 or 3
+  double pll_bw_hz = 15.0;             // PLL noise bandwidth with 1 ms epochs; (0, 50]
+  double pll_bw_coherent_hz = 5.0;     // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
+                                       // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
+
+  // Pull-in: (1) a wide FLL alone on the two halves of each code period (range +-1 kHz, bit-edge safe); (2) a
+  // narrow FLL alone on successive 1 ms prompts (bit-tolerant atan, range +-250 Hz, 8x less noise); (3) the PLL
+  // assisted by the narrow FLL until the phase lock indicator holds; then the PLL alone.
+  double fll_bw_hz = 10.0;             // wide FLL; (0, 50]
+  double fll_wide_time_s = 0.25;       // stage (1) length; [0.01, 5]
+  double fll_narrow_bw_hz = 5.0;       // narrow FLL; (0, 20]
+  double fll_narrow_time_s = 0.2;      // stage (2) length; [0, 5]
+  double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
+  double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30]
+  // Code loop
+  double dll_bw_hz = 2.0;              // DLL noise bandwidth with 1 ms epochs; (0, 10]
+  double dll_bw_coherent_hz = 1.0;     // after bit sync; (0, 5]
+  double early_late_offset_chips = 0.5;  // E and L at +- this (E-L spacing twice it); (0, 0.5]; narrow: 0.1
+  bool very_early_late = false;          // extra VE/VL taps in the epochs
+  double very_early_late_offset_chips = 1.0;  // (early_late_offset_chips, 2]
+  // Integration
+  int coherent_ms = 20;                // coherent integration after bit sync, ms; 1, 2, 4, 5, 10 or 20
+  BitSyncOptions bit_sync;
+  // Lock detection
+  Cn0Method cn0_method = Cn0Method::kNoiseTap;  // kMoments works without the noise tap
+  double cn0_window_s = 0.2;           // C/N0 averaging window; [0.02, 5] (a multiple of the epoch length)
+  double cn0_loss_threshold_dbhz = 25.0;  // C/N0 below this counts toward loss of lock; [0, 45]
+  double pli_time_constant_s = 0.1;    // phase lock indicator low-pass; [0.005, 5]
+  double pli_lock_threshold = 0.7;     // PLI (cos 2 dphi) above this = phase locked; (0, 1)
+  double pli_loss_threshold = 0.3;     // PLI below this (after lock) counts toward loss; [-1, pli_lock_threshold)
+  double loss_of_lock_time_s = 0.3;    // continuous time with a loss condition before kLost; [0.02, 10]
+};
+
+// Empty when the options are valid, else a message naming the first bad field, its value and its range.
+std::string validation_error(const ScalarTrackingOptions& options);
+
+// The channel configuration these options need (correlator layout with the noise tap when kNoiseTap).
+ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz, int num_antennas = 1);
+
+enum class TrackingState {
+  kPullIn,       // FLL-assisted PLL, 1 ms epochs
+  kPhaseLocked,  // Costas PLL, 1 ms epochs, bit sync running
+  kBitSynced,    // 20 ms (coherent_ms) epochs, bits flowing
+  kLost,         // lock lost: the command only coasts; re-acquire
+};
+const char* to_string(TrackingState state);
+
+// What one loop update produced. The driver passes command (and set_coherent) to the channel.
+struct TrackingReport {
+  TrackingState state = TrackingState::kPullIn;
+  NcoCommand command;
+  bool set_coherent = false;  // ask the channel for coherent_periods-long epochs aligned to aligned_period
+  int coherent_periods = 1;
+  std::int64_t aligned_period = 0;
+  std::optional<double> cn0_dbhz;  // latest estimate (none before the first window)
+  double pli = 0.0;
+  bool phase_locked = false;
+  double phase_error_cycles = 0.0;   // discriminator outputs of this epoch
+  double frequency_error_hz = 0.0;
+  double code_error_chips = 0.0;
+  std::optional<NavBit> bit;         // a completed 20 ms navigation bit
+};
+
+class ScalarTracking final {
+ public:
+  // options must be valid (validation_error empty) or std::invalid_argument is thrown. initial: the command
+  // the channel started with (from acquisition).
+  ScalarTracking(const ScalarTrackingOptions& options, const NcoCommand& initial);
+
+  TrackingReport update(const CorrelationEpoch& epoch);
+  TrackingState state() const { return state_; }
+  std::optional<double> cn0_dbhz() const { return cn0_dbhz_; }
+  double pli() const { return pli_.value(); }
+  // Bit sync result (valid once state is kBitSynced or bit_synchronised()).
+  bool bit_synchronised() const { return bit_sync_.synchronised(); }
+  std::int64_t bit_edge_period() const { return bit_sync_.edge_period(); }
+
+ private:
+  ScalarTrackingOptions opt_;
+  TrackingState state_ = TrackingState::kPullIn;
+  CarrierLoopFilter carrier_;
+  NcoCommand command_;
+  PhaseLockIndicator pli_;
+  Cn0Estimator cn0_;
+  int cn0_epoch_periods_ = 1;
+  std::optional<double> cn0_dbhz_;
+  double noise_power_ = 0.0;  // low-passed |noise tap|^2 for the current epoch length
+  int noise_epoch_periods_ = 1;
+  BitSynchronizer bit_sync_;
+  std::optional<BitAssembler> bits_;
+  bool coherent_requested_ = false;
+  double time_s_ = 0.0, locked_time_s_ = 0.0, loss_time_s_ = 0.0;
+  bool ever_locked_ = false;
+  std::complex<float> previous_prompt_{};
+  double smoothed_frequency_hz_ = 0.0;  // NCO frequency low-passed over ~0.1 s while phase-locked at 1 ms
+  double previous_t_s_ = 0.0;
+};
+
+// Runs a channel under a scalar closure over one block: feeds samples, updates the loop at every epoch, passes
+// commands back, and calls on_epoch(const CorrelationEpoch&, const TrackingReport&) for each epoch.
+template <class OnEpoch>
+void track_block(TrackingChannel& channel, ScalarTracking& loop, const SampleBlockView& block, OnEpoch&& on_epoch) {
+  int offset = 0;
+  while (offset < block.num_samples) {
+    const auto r = channel.feed(block, offset);
+    offset += r.consumed;
+    if (!r.epoch_ready) continue;
+    const TrackingReport report = loop.update(channel.epoch());
+    channel.command(report.command);
+    if (report.set_coherent) channel.set_coherent_periods(report.coherent_periods, report.aligned_period);
+    on_epoch(channel.epoch(), report);
+  }
+}
+
+}  // namespace ultratrack::receiver

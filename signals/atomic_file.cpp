@@ -1,0 +1,33 @@
+#include "signals/atomic_file.hpp"
+
+#include <system_error>
+
+#include "signals/input_error.hpp"
+
+namespace ultratrack::signals {
+
+AtomicFile::AtomicFile(std::filesystem::path path, bool binary)
+    : path_(std::move(path)), partial_path_(path_.string() + ".partial") {
+  stream_.open(partial_path_, binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
+  if (!stream_) throw InputError(path_.string(), "cannot open for writing");
+}
+
+AtomicFile::~AtomicFile() {
+  if (committed_) return;
+  stream_.close();
+  std::error_code ignored;
+  std::filesystem::remove(partial_path_, ignored);
+}
+
+void AtomicFile::commit() {
+  stream_.flush();
+  const bool ok = static_cast<bool>(stream_);
+  stream_.close();
+  if (!ok) throw InputError(path_.string(), "write failed (disk full?)");
+  std::error_code ec;
+  std::filesystem::rename(partial_path_, path_, ec);
+  if (ec) throw InputError(path_.string(), "cannot rename the finished file into place: " + ec.message());
+  committed_ = true;
+}
+
+}  // namespace ultratrack::signals
