@@ -27,11 +27,14 @@ AntennaState TrajectoryMotion::antenna_state(int, double t_s) const {
   const double u = (t_s - a.t_s) / h;
   // Cubic Hermite basis on [0,1] and its derivative (divided by h for d/dt).
   const double u2 = u * u, u3 = u2 * u;
-  const double h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
-  const double d00 = 6 * u2 - 6 * u, d10 = 3 * u2 - 4 * u + 1, d01 = -6 * u2 + 6 * u, d11 = 3 * u2 - 2 * u;
+  // Written with the difference b - a (h00 = 1 - h01, d00 = -d01) so that ECEF magnitudes of 6e6 m do not
+  // cost precision.
+  const double h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
+  const double d10 = 3 * u2 - 4 * u + 1, d01 = -6 * u2 + 6 * u, d11 = 3 * u2 - 2 * u;
+  const Eigen::Vector3d dr = b.r_e_m - a.r_e_m;
   AntennaState s;
-  s.r_e_m = h00 * a.r_e_m + h10 * h * a.v_e_mps + h01 * b.r_e_m + h11 * h * b.v_e_mps;
-  s.v_e_mps = (d00 * a.r_e_m + d01 * b.r_e_m) / h + d10 * a.v_e_mps + d11 * b.v_e_mps;
+  s.r_e_m = a.r_e_m + h01 * dr + h * (h10 * a.v_e_mps + h11 * b.v_e_mps);
+  s.v_e_mps = (d01 / h) * dr + d10 * a.v_e_mps + d11 * b.v_e_mps;
   return s;
 }
 
