@@ -70,44 +70,84 @@ void add_code_carrier(std::complex<float>* out, std::size_t count, const float* 
   }
 }
 
-void GaussianNoise::pair(float& a, float& b) {
-  constexpr float kScale = 1.0f / 2147483648.0f;  // 2^-31: int32 -> [-1, 1)
+namespace {
+
+// Ziggurat tables for 128 layers (Marsaglia & Tsang 2000, "The ziggurat method for generating random
+// variables", J. Stat. Software 5(8)): kn thresholds, wn scales, fn densities at the layer edges.
+struct ZigguratTables {
+  std::array<std::int64_t, 128> kn{};
+  std::array<double, 128> wn{}, fn{};
+  ZigguratTables() {
+    constexpr double m1 = 2147483648.0;
+    constexpr double vn = 9.91256303526217e-3;
+    double dn = 3.442619855899, tn = dn;
+    const double q = vn / std::exp(-0.5 * dn * dn);
+    kn[0] = static_cast<std::int64_t>((dn / q) * m1);
+    kn[1] = 0;
+    wn[0] = q / m1;
+    wn[127] = dn / m1;
+    fn[0] = 1.0;
+    fn[127] = std::exp(-0.5 * dn * dn);
+    for (int i = 126; i >= 1; --i) {
+      dn = std::sqrt(-2.0 * std::log(vn / dn + std::exp(-0.5 * dn * dn)));
+      kn[i + 1] = static_cast<std::int64_t>((dn / tn) * m1);
+      tn = dn;
+      fn[i] = std::exp(-0.5 * dn * dn);
+      wn[i] = dn / m1;
+    }
+  }
+};
+
+const ZigguratTables& ziggurat() {
+  static const ZigguratTables tables;
+  return tables;
+}
+
+constexpr double kZigguratR = 3.442619855899;
+
+}  // namespace
+
+double GaussianNoise::uniform() {
+  return (static_cast<double>(rng_() >> 11) + 0.5) * (1.0 / 9007199254740992.0);  // 2^-53
+}
+
+double GaussianNoise::next() {
+  const auto& z = ziggurat();
+  const std::uint64_t u = rng_();
+  const int iz = static_cast<int>(u & 127u);
+  const auto hz = static_cast<std::int32_t>(static_cast<std::uint32_t>(u >> 32));
+  if (std::abs(static_cast<std::int64_t>(hz)) < z.kn[iz]) return hz * z.wn[iz];
+  return slow_path(hz, iz);
+}
+
+double GaussianNoise::slow_path(std::int32_t hz, int iz) {
+  const auto& z = ziggurat();
   for (;;) {
-    const std::uint64_t r = rng_();
-    const float u = static_cast<float>(static_cast<std::int32_t>(r & 0xffffffffu)) * kScale;
-    const float v = static_cast<float>(static_cast<std::int32_t>(r >> 32)) * kScale;
-    const float s = u * u + v * v;
-    if (s >= 1.0f || s == 0.0f) continue;
-    const float f = std::sqrt(-2.0f * std::log(s) / s);
-    a = u * f;
-    b = v * f;
-    return;
+    const double x = hz * z.wn[iz];
+    if (iz == 0) {  // the tail beyond r (Marsaglia's exact tail method)
+      double xt = 0.0, y = 0.0;
+      do {
+        xt = -std::log(uniform()) / kZigguratR;
+        y = -std::log(uniform());
+      } while (y + y < xt * xt);
+      return hz > 0 ? kZigguratR + xt : -kZigguratR - xt;
+    }
+    if (z.fn[iz] + uniform() * (z.fn[iz - 1] - z.fn[iz]) < std::exp(-0.5 * x * x)) return x;
+    const std::uint64_t u = rng_();
+    iz = static_cast<int>(u & 127u);
+    hz = static_cast<std::int32_t>(static_cast<std::uint32_t>(u >> 32));
+    if (std::abs(static_cast<std::int64_t>(hz)) < z.kn[iz]) return hz * z.wn[iz];
   }
 }
 
 void GaussianNoise::fill(std::complex<float>* out, std::size_t count, float sigma, bool real_output) {
-  float a = 0.0f, b = 0.0f;
   if (real_output) {
-    std::size_t i = 0;
-    if (has_spare_ && count > 0) {
-      out[i++] = {sigma * spare_, 0.0f};
-      has_spare_ = false;
-    }
-    for (; i + 1 < count; i += 2) {
-      pair(a, b);
-      out[i] = {sigma * a, 0.0f};
-      out[i + 1] = {sigma * b, 0.0f};
-    }
-    if (i < count) {
-      pair(a, b);
-      out[i] = {sigma * a, 0.0f};
-      spare_ = b;
-      has_spare_ = true;
-    }
+    for (std::size_t i = 0; i < count; ++i) out[i] = {sigma * static_cast<float>(next()), 0.0f};
   } else {
     for (std::size_t i = 0; i < count; ++i) {
-      pair(a, b);
-      out[i] = {sigma * a, sigma * b};
+      const auto x = static_cast<float>(next());
+      const auto y = static_cast<float>(next());
+      out[i] = {sigma * x, sigma * y};
     }
   }
 }

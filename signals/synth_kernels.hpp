@@ -21,19 +21,20 @@ void add_code_carrier(std::complex<float>* out, std::size_t count, const float* 
                       double code0_chips, double code_rate_chips_per_sample, double carrier0_cycles,
                       double carrier_rate_cycles_per_sample, bool real_output);
 
-// Independent N(0, 1) values from a seeded engine (Marsaglia's polar method, both values of each pair
-// used), so the sequence does not depend on how the samples are split into calls.
+// Independent N(0, 1) values from a seeded engine: Marsaglia and Tsang's ziggurat (128 layers, exact
+// tail and wedge sampling), one 64-bit draw per value with the layer and the value taken from separate
+// bits (Doornik's remark on the original). The sequence does not depend on how samples are split into calls.
 class GaussianNoise {
  public:
   GaussianNoise(std::uint64_t seed, std::uint64_t stream) : rng_(seeded_engine(seed, stream)) {}
   // out[i] = sigma * (x + j y); real output: y = 0.
   void fill(std::complex<float>* out, std::size_t count, float sigma, bool real_output);
+  double next();  // one N(0, 1) value
 
  private:
-  void pair(float& a, float& b);
+  double slow_path(std::int32_t hz, int iz);
+  double uniform();  // (0, 1)
   std::mt19937_64 rng_;
-  bool has_spare_ = false;
-  float spare_ = 0.0f;
 };
 
 }  // namespace ultratrack::signals::synth
