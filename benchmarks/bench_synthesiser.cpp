@@ -3,7 +3,6 @@
 #include <benchmark/benchmark.h>
 
 #include <GeographicLib/Geocentric.hpp>
-
 #include <cmath>
 #include <complex>
 #include <filesystem>
@@ -44,7 +43,8 @@ void BM_Synthesise4MHzI8(benchmark::State& state) {
   o.troposphere = true;
   Eigen::Vector3d r;
   GeographicLib::Geocentric::WGS84().Forward(35.27, 137.01, 100.0, r.x(), r.y(), r.z());
-  IfSynthesiser synth(o, satellites(o.start, static_cast<int>(state.range(0))), std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r}));
+  IfSynthesiser synth(o, satellites(o.start, static_cast<int>(state.range(0))),
+                      std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r}));
   const auto path = std::filesystem::temp_directory_path() / "ultratrack_bench_synth.i8";
   SampleWriter writer(path, SampleFormat::i8);
   std::vector<std::complex<float>> buf(400000);  // 100 ms

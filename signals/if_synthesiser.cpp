@@ -1,8 +1,7 @@
 #include "signals/if_synthesiser.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
 #include <Eigen/Geometry>
-
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,16 +20,16 @@ namespace {
 
 constexpr double kTwentyMs_s = 0.02;
 constexpr double kChipsPerBit = kCaChipRate_hz * kTwentyMs_s;  // 20460
-constexpr double kNodeInterval_s = 1e-3;                        // exact nodes every millisecond
-constexpr double kVisibilityInterval_s = 1.0;                   // elevation mask re-evaluated every second
+constexpr double kNodeInterval_s = 1e-3;                       // exact nodes every millisecond
+constexpr double kVisibilityInterval_s = 1.0;                  // elevation mask re-evaluated every second
 constexpr double kDopplerHalfStep_s = 0.5e-3;
 
 double floor_mod(double x, double m) { return x - m * std::floor(x / m); }
 
 // Receiver-side geometry of one antenna at one node.
 struct RxGeo {
-  double tau_s = 0.0;         // receiver time since sample 0
-  double t_r_s = 0.0;         // true GPS time since start
+  double tau_s = 0.0;  // receiver time since sample 0
+  double t_r_s = 0.0;  // true GPS time since start
   ReceiverClockState clock;
   AntennaState state;
   double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
@@ -77,11 +76,10 @@ struct IfSynthesiser::Impl {
   std::int64_t block_samples = 1;
   std::int64_t visibility_blocks = 1000;
   std::int64_t current_block = -1;
-  double frac20_s = 0.0;  // start.tow_s modulo 20 ms: aligns code epochs and data bits with GPS time
+  double frac20_s = 0.0;          // start.tow_s modulo 20 ms: aligns code epochs and data bits with GPS time
   std::vector<RxGeo> geo0, geo1;  // per antenna at the current block's two nodes
 
-  Impl(const SynthesiserOptions& o, const ReceiverMotion& m)
-      : opt(o), motion(m), clock(o.clock, o.seed) {}
+  Impl(const SynthesiserOptions& o, const ReceiverMotion& m) : opt(o), motion(m), clock(o.clock, o.seed) {}
 
   double tau_of(std::int64_t sample) const { return static_cast<double>(sample) / opt.sample_rate_hz; }
 
@@ -93,7 +91,7 @@ struct IfSynthesiser::Impl {
     g.state = motion.antenna_state(antenna, g.t_r_s);
     double lat_deg = 0, lon_deg = 0, h = 0;
     GeographicLib::Geocentric::WGS84().Reverse(g.state.r_e_m.x(), g.state.r_e_m.y(), g.state.r_e_m.z(), lat_deg,
-                                                 lon_deg, h);
+                                               lon_deg, h);
     g.lat_rad = lat_deg * M_PI / 180.0;
     g.lon_rad = lon_deg * M_PI / 180.0;
     g.height_m = h;
@@ -128,8 +126,7 @@ struct IfSynthesiser::Impl {
                                                   add_seconds(opt.start, rx.t_r_s).tow_s)
                               : 0.0;
       // The troposphere model is for satellites above the horizon; below it the signal is masked anyway.
-      tropo_m = opt.troposphere ? troposphere_delay_m(rx.lat_rad, rx.height_m, std::max(el, 2.0 * M_PI / 180.0))
-                                : 0.0;
+      tropo_m = opt.troposphere ? troposphere_delay_m(rx.lat_rad, rx.height_m, std::max(el, 2.0 * M_PI / 180.0)) : 0.0;
       const double next_d = iono_s + tropo_m / kSpeedOfLight_mps;
       const bool converged = std::abs(next_d - d) < 1e-15;
       d = next_d;
@@ -223,8 +220,7 @@ struct IfSynthesiser::Impl {
         data = static_cast<float>(tr.lnav->data_symbol_at(add_seconds(opt.start, t_sv)));
       }
       synth::add_code_carrier(out + done, seg, sats[k].chip_amplitude.data(), data,
-                              floor_mod(code, kCaCodeLength_chips), code_rate, carrier, carrier_rate,
-                              opt.real_output);
+                              floor_mod(code, kCaCodeLength_chips), code_rate, carrier, carrier_rate, opt.real_output);
       done += seg;
       code += static_cast<double>(seg) * code_rate;
       carrier += static_cast<double>(seg) * carrier_rate;
@@ -319,8 +315,8 @@ void IfSynthesiser::generate(std::span<const std::span<std::complex<float>>> out
     const std::int64_t block = next_sample_ / m.block_samples;
     if (block != m.current_block) m.enter_block(block);
     const std::int64_t block_end = (block + 1) * m.block_samples;
-    const std::size_t seg = static_cast<std::size_t>(std::min<std::int64_t>(
-        block_end - next_sample_, static_cast<std::int64_t>(count - done)));
+    const std::size_t seg = static_cast<std::size_t>(
+        std::min<std::int64_t>(block_end - next_sample_, static_cast<std::int64_t>(count - done)));
     for (std::size_t a = 0; a < out.size(); ++a) {
       std::complex<float>* dst = out[a].data() + done;
       if (options_.noise) {

@@ -42,23 +42,23 @@
 namespace ultratrack::signals {
 
 struct SynthesiserOptions {
-  double sample_rate_hz = 4e6;     // > 0
-  double if_hz = 0.0;              // output centre offset; |if_hz| < fs/2 (real output: 0 < if_hz < fs/2)
-  bool real_output = false;        // real samples: the real part of the signal at if_hz, real noise
-  double output_rms = 127.0 / 4.0; // expected RMS of each output component (I, Q or real), output units
-  GpsTime start;                   // true GPS time of sample 0
+  double sample_rate_hz = 4e6;      // > 0
+  double if_hz = 0.0;               // output centre offset; |if_hz| < fs/2 (real output: 0 < if_hz < fs/2)
+  bool real_output = false;         // real samples: the real part of the signal at if_hz, real noise
+  double output_rms = 127.0 / 4.0;  // expected RMS of each output component (I, Q or real), output units
+  GpsTime start;                    // true GPS time of sample 0
   double default_cn0_dbhz = 45.0;
-  std::map<int, double> cn0_dbhz_by_prn;  // per-PRN overrides
+  std::map<int, double> cn0_dbhz_by_prn;                             // per-PRN overrides
   double elevation_mask_rad = 5.0 * 3.14159265358979323846 / 180.0;  // seen from antenna 0
   bool include_unhealthy = false;  // transmit satellites whose ephemeris health is not 0
   bool ionosphere = true;          // Klobuchar with `klobuchar` (no delay when !klobuchar.valid)
   bool troposphere = false;        // standard troposphere (atmosphere.hpp)
   KlobucharParameters klobuchar;
-  UtcParameters utc;               // broadcast in the LNAV message
-  bool nav_data = true;            // modulate LNAV data bits (false: pure code, for tests)
-  bool noise = true;               // add the receiver noise (false: signals only, same gain)
+  UtcParameters utc;     // broadcast in the LNAV message
+  bool nav_data = true;  // modulate LNAV data bits (false: pure code, for tests)
+  bool noise = true;     // add the receiver noise (false: signals only, same gain)
   ReceiverClockModel clock;
-  std::uint64_t seed = 1;          // every random number comes from it
+  std::uint64_t seed = 1;  // every random number comes from it
 };
 
 // Empty when the options are usable; otherwise what is wrong (the caller names the file).
@@ -75,18 +75,18 @@ struct SatelliteView {
 
 // The exact (not interpolated) signal parameters of one satellite at one sample of one antenna.
 struct SignalTiming {
-  double receive_time_s = 0.0;       // true GPS time of the sample since start
-  double rx_clock_s = 0.0;           // receiver clock reading since start: b(0) + tau
-  double code_sv_time_s = 0.0;       // SV clock time of the code received, since start
-  double carrier_sv_time_s = 0.0;    // SV clock time of the carrier received, since start
-  double pseudorange_m = 0.0;        // c * (rx_clock_s - code_sv_time_s)
-  double geometric_range_m = 0.0;    // Sagnac-corrected, satellite at the code's true transmit time
-  double iono_delay_m = 0.0;         // group delay (the carrier is advanced by as much)
+  double receive_time_s = 0.0;     // true GPS time of the sample since start
+  double rx_clock_s = 0.0;         // receiver clock reading since start: b(0) + tau
+  double code_sv_time_s = 0.0;     // SV clock time of the code received, since start
+  double carrier_sv_time_s = 0.0;  // SV clock time of the carrier received, since start
+  double pseudorange_m = 0.0;      // c * (rx_clock_s - code_sv_time_s)
+  double geometric_range_m = 0.0;  // Sagnac-corrected, satellite at the code's true transmit time
+  double iono_delay_m = 0.0;       // group delay (the carrier is advanced by as much)
   double tropo_delay_m = 0.0;
-  double sv_clock_s = 0.0;           // dt_sv (af + relativistic - TGD)
-  double rx_clock_bias_s = 0.0;      // b
-  double code_phase_chips = 0.0;     // [0, 1023)
-  double carrier_phase_cycles = 0.0; // phase of the synthesised complex carrier (IF included), arbitrary origin
+  double sv_clock_s = 0.0;            // dt_sv (af + relativistic - TGD)
+  double rx_clock_bias_s = 0.0;       // b
+  double code_phase_chips = 0.0;      // [0, 1023)
+  double carrier_phase_cycles = 0.0;  // phase of the synthesised complex carrier (IF included), arbitrary origin
   double elevation_rad = 0.0, azimuth_rad = 0.0;
 };
 
@@ -115,9 +115,9 @@ class IfSynthesiser {
   const SynthesiserOptions& options() const { return options_; }
   const ReceiverMotion& motion() const { return *motion_; }
 
-  double gain() const { return gain_; }                // output units per unit noise sigma
-  double noise_sigma() const { return gain_; }         // per output component, output units
-  double amplitude(int prn) const;                     // signal amplitude in output units
+  double gain() const { return gain_; }         // output units per unit noise sigma
+  double noise_sigma() const { return gain_; }  // per output component, output units
+  double amplitude(int prn) const;              // signal amplitude in output units
 
  private:
   struct Impl;

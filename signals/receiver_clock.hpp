@@ -11,10 +11,10 @@
 namespace ultratrack::signals {
 
 struct ReceiverClockModel {
-  double bias_s = 0.0;                 // b at tau = 0
-  double drift_sps = 0.0;              // db/dtau at tau = 0 (s/s); +1e-6 = 1 ppm fast
-  double bias_noise_s_per_sqrt_s = 0.0;    // white frequency noise: b random walk, s/sqrt(s)
-  double drift_noise_sps_per_sqrt_s = 0.0; // random-walk frequency: drift random walk, (s/s)/sqrt(s)
+  double bias_s = 0.0;                      // b at tau = 0
+  double drift_sps = 0.0;                   // db/dtau at tau = 0 (s/s); +1e-6 = 1 ppm fast
+  double bias_noise_s_per_sqrt_s = 0.0;     // white frequency noise: b random walk, s/sqrt(s)
+  double drift_noise_sps_per_sqrt_s = 0.0;  // random-walk frequency: drift random walk, (s/s)/sqrt(s)
 };
 
 struct ReceiverClockState {

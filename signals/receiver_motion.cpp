@@ -67,7 +67,8 @@ std::vector<TrajectorySample> read_trajectory_csv(const std::filesystem::path& p
     if (!out.empty()) {
       const double dt = s.t_s - out.back().t_s;
       if (!(dt > 0)) throw InputError(name, "time does not increase", line_no);
-      if (dt > 0.1 + 1e-9) throw InputError(name, "gap of " + std::to_string(dt) + " s: at least 10 Hz is needed", line_no);
+      if (dt > 0.1 + 1e-9)
+        throw InputError(name, "gap of " + std::to_string(dt) + " s: at least 10 Hz is needed", line_no);
     }
     out.push_back(s);
   }

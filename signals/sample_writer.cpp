@@ -38,8 +38,7 @@ inline void put_le_f32(char* p, float v) {
 
 }  // namespace
 
-SampleWriter::SampleWriter(std::filesystem::path path, SampleFormat format)
-    : path_(std::move(path)), format_(format) {
+SampleWriter::SampleWriter(std::filesystem::path path, SampleFormat format) : path_(std::move(path)), format_(format) {
   temp_path_ = path_;
   temp_path_ += ".part";
   file_.open(temp_path_, std::ios::binary | std::ios::trunc);

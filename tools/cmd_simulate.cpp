@@ -1,8 +1,8 @@
 // `ultratrack simulate --scenario S.toml --out DIR`: synthesise IF samples and truth from a scenario
 // (tools/scenario.hpp for the keys, tools/simulation.hpp for the outputs).
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -24,8 +24,8 @@ void add_simulate_command(CLI::App& app) {
   cmd->callback([scenario_path, out_dir, quiet] {
     const Scenario scenario = read_scenario(*scenario_path);
     const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr);
-    fmt::print("simulate: {:.1f} s of {} at {:.3f} MHz ({} antenna{}) in {:.1f} s ({:.1f}x real time){}\n",
-               r.signal_s, signals::to_string(scenario.format), scenario.sample_rate_hz / 1e6, r.sample_files.size(),
+    fmt::print("simulate: {:.1f} s of {} at {:.3f} MHz ({} antenna{}) in {:.1f} s ({:.1f}x real time){}\n", r.signal_s,
+               signals::to_string(scenario.format), scenario.sample_rate_hz / 1e6, r.sample_files.size(),
                r.sample_files.size() == 1 ? "" : "s", r.wall_s, r.signal_s / std::max(r.wall_s, 1e-9),
                r.interrupted ? " - interrupted, files hold what was done" : "");
     fmt::print("satellites in view at the start (PRN  el deg  az deg  C/N0  Doppler Hz  code phase chips):\n");

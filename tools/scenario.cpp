@@ -124,7 +124,8 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
             const std::string prn_text(pk.str());
             int prn = 0;
             std::istringstream ss(prn_text);
-            if (!(ss >> prn) || !ss.eof() || prn < 1 || prn > 32) r.fail(pn, name + "." + prn_text, "PRN must be 1..32");
+            if (!(ss >> prn) || !ss.eof() || prn < 1 || prn > 32)
+              r.fail(pn, name + "." + prn_text, "PRN must be 1..32");
             const double cn0 = r.number(pn, name + "." + prn_text);
             check_range(r, pn, name + "." + prn_text, cn0 >= 0 && cn0 <= 80, "must be within 0..80 dB-Hz");
             s.cn0_dbhz_by_prn[prn] = cn0;
@@ -167,8 +168,9 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
       } else if (section == "receiver") {
         if (key == "llh_deg_m") {
           s.llh_deg_m = r.triple(n, name);
-          check_range(r, n, name, std::abs(s.llh_deg_m[0]) <= 90 && std::abs(s.llh_deg_m[1]) <= 360 &&
-                                      s.llh_deg_m[2] > -1e4 && s.llh_deg_m[2] < 1e7,
+          check_range(r, n, name,
+                      std::abs(s.llh_deg_m[0]) <= 90 && std::abs(s.llh_deg_m[1]) <= 360 && s.llh_deg_m[2] > -1e4 &&
+                          s.llh_deg_m[2] < 1e7,
                       "latitude must be within +-90 deg, longitude +-360 deg, height -10 km..10000 km");
           llh_given = true;
         } else if (key == "trajectory") {
@@ -220,9 +222,9 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
   if (rinex_given) s.constellation.clear();
   // Cross-key checks that need the whole scenario.
   const bool real = !signals::is_complex(s.format);
-  if (real && !(s.if_hz > 0)) throw InputError(file, "key signal.if_hz: real format " +
-                                                         std::string(signals::to_string(s.format)) +
-                                                         " needs an IF above 0 Hz");
+  if (real && !(s.if_hz > 0))
+    throw InputError(
+        file, "key signal.if_hz: real format " + std::string(signals::to_string(s.format)) + " needs an IF above 0 Hz");
   if (!(std::abs(s.if_hz) < 0.5 * s.sample_rate_hz))
     throw InputError(file, "key signal.if_hz: must be below half the sample rate");
   return s;

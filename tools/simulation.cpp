@@ -1,14 +1,14 @@
 #include "simulation.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include <GeographicLib/Geocentric.hpp>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <complex>
+#include <csignal>
 #include <numbers>
 #include <span>
 
@@ -99,8 +99,9 @@ std::shared_ptr<const signals::ReceiverMotion> make_motion(const Scenario& s) {
     const auto path = resolve_path(s, s.trajectory);
     auto samples = signals::read_trajectory_csv(path);
     if (samples.front().t_s > 1e-9 || samples.back().t_s < s.duration_s - 1e-9) {
-      throw InputError(path.string(), fmt::format("the trajectory covers t = {} .. {} s but the scenario needs 0 .. {} s",
-                                                  samples.front().t_s, samples.back().t_s, s.duration_s));
+      throw InputError(path.string(),
+                       fmt::format("the trajectory covers t = {} .. {} s but the scenario needs 0 .. {} s",
+                                   samples.front().t_s, samples.back().t_s, s.duration_s));
     }
     return std::make_shared<signals::TrajectoryMotion>(std::move(samples));
   }
@@ -180,10 +181,11 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
     GeographicLib::Geocentric::WGS84().Reverse(st.r_e_m.x(), st.r_e_m.y(), st.r_e_m.z(), lat, lon, h);
     const Eigen::Vector3d v_n = ned_from_ecef(lat * kDeg, lon * kDeg) * st.v_e_mps;
     const auto clk = synth.receiver_clock(n);
-    truth += fmt::format("{:.9f},{},{:.9f},{:.4f},{:.4f},{:.4f},{:.10f},{:.10f},{:.4f},{:.5f},{:.5f},{:.5f},{:.5f},{:.6f}\n",
-                         static_cast<double>(n) / s.sample_rate_hz, gps.week, gps.tow_s, st.r_e_m.x(), st.r_e_m.y(),
-                         st.r_e_m.z(), lat, lon, h, v_n.x(), v_n.y(), v_n.z(),
-                         clk.bias_s * signals::kSpeedOfLight_mps, clk.drift_sps * signals::kSpeedOfLight_mps);
+    truth +=
+        fmt::format("{:.9f},{},{:.9f},{:.4f},{:.4f},{:.4f},{:.10f},{:.10f},{:.4f},{:.5f},{:.5f},{:.5f},{:.5f},{:.6f}\n",
+                    static_cast<double>(n) / s.sample_rate_hz, gps.week, gps.tow_s, st.r_e_m.x(), st.r_e_m.y(),
+                    st.r_e_m.z(), lat, lon, h, v_n.x(), v_n.y(), v_n.z(), clk.bias_s * signals::kSpeedOfLight_mps,
+                    clk.drift_sps * signals::kSpeedOfLight_mps);
   };
 
   const std::size_t chunk = static_cast<std::size_t>(std::max(1.0, std::round(s.sample_rate_hz * 0.01)));  // 10 ms
@@ -210,8 +212,8 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
       last_decile = decile;
       const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
       const double done_s = static_cast<double>(n) / s.sample_rate_hz;
-      fmt::print(progress, "simulate: {:5.1f} / {:.1f} s of signal ({:3d}%), {:.1f}x real time\n", done_s,
-                 s.duration_s, decile * 10, done_s / std::max(wall, 1e-9));
+      fmt::print(progress, "simulate: {:5.1f} / {:.1f} s of signal ({:3d}%), {:.1f}x real time\n", done_s, s.duration_s,
+                 decile * 10, done_s / std::max(wall, 1e-9));
       std::fflush(progress);
     }
   }
@@ -221,8 +223,8 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
 
   std::string sats = "prn,elevation_deg,azimuth_deg,cn0_dbhz,doppler_hz,code_phase_chips\n";
   for (const auto& v : result.satellites) {
-    sats += fmt::format("{},{:.4f},{:.4f},{:.2f},{:.4f},{:.6f}\n", v.prn, v.elevation_rad / kDeg,
-                        v.azimuth_rad / kDeg, v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
+    sats += fmt::format("{},{:.4f},{:.4f},{:.2f},{:.4f},{:.6f}\n", v.prn, v.elevation_rad / kDeg, v.azimuth_rad / kDeg,
+                        v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
   }
   write_file_atomically(out_dir / "truth.csv", truth);
   write_file_atomically(out_dir / "satellites.csv", sats);
@@ -231,7 +233,8 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   std::string prns, files;
   for (const auto& v : result.satellites) prns += fmt::format("{}{}", prns.empty() ? "" : ", ", v.prn);
-  for (const auto& f : result.sample_files) files += fmt::format("{}\"{}\"", files.empty() ? "" : ", ", json_escape(f.filename().string()));
+  for (const auto& f : result.sample_files)
+    files += fmt::format("{}\"{}\"", files.empty() ? "" : ", ", json_escape(f.filename().string()));
   const std::string summary = fmt::format(
       "{{\n  \"command\": \"simulate\",\n  \"scenario\": \"{}\",\n  \"navigation\": \"{}\",\n"
       "  \"sample_rate_hz\": {},\n  \"if_hz\": {},\n  \"format\": \"{}\",\n  \"antennas\": {},\n"
@@ -239,9 +242,8 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
       "  \"satellites_in_view\": [{}],\n  \"noise_sigma_per_component\": {},\n  \"interrupted\": {},\n"
       "  \"wall_s\": {:.3f},\n  \"realtime_factor\": {:.3f}\n}}\n",
       json_escape(s.source.filename().string()), json_escape(std::filesystem::path(nav.name).filename().string()),
-      s.sample_rate_hz, s.if_hz,
-      signals::to_string(s.format), n_ant, files, result.samples, result.signal_s, prns, result.noise_sigma,
-      result.interrupted, result.wall_s, result.signal_s / std::max(result.wall_s, 1e-9));
+      s.sample_rate_hz, s.if_hz, signals::to_string(s.format), n_ant, files, result.samples, result.signal_s, prns,
+      result.noise_sigma, result.interrupted, result.wall_s, result.signal_s / std::max(result.wall_s, 1e-9));
   write_file_atomically(out_dir / "summary.json", summary);
   return result;
 }

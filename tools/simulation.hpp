@@ -43,7 +43,7 @@ struct SimulationResult {
   std::int64_t samples = 0;                        // per antenna
   double signal_s = 0.0;
   double wall_s = 0.0;
-  double noise_sigma = 0.0;                        // per output component, output units
+  double noise_sigma = 0.0;  // per output component, output units
   bool interrupted = false;
 };
 

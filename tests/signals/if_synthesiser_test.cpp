@@ -2,18 +2,19 @@
 // visible satellite at the Doppler, code phase and C/N0 the synthesiser states; noise and gain levels
 // follow the documented convention; the pseudorange implied by the synthesised code equals the
 // receiver-side model range + c (b - dt_sv) + I + T; synthesised samples follow the exact timing.
+#include "signals/if_synthesiser.hpp"
+
 #include <gtest/gtest.h>
 
 #include <numbers>
 #include <numeric>
 
 #include "signals/atmosphere.hpp"
-#include "signals/if_synthesiser.hpp"
 #include "signals/sample_reader.hpp"
 #include "signals/sample_writer.hpp"
 #include "signals/satellite_state.hpp"
-#include "support/test_data.hpp"
 #include "support/brute_force_acquisition.hpp"
+#include "support/test_data.hpp"
 
 namespace ultratrack::signals {
 namespace {
@@ -122,8 +123,8 @@ TEST(IfSynthesiser, RealIfOutputIsAcquiredAfterMixingDown) {
   auto x = via_file(synthesise(synth, 4096 * 110), SampleFormat::r8);
   for (std::size_t n = 0; n < x.size(); ++n) {
     EXPECT_EQ(x[n].imag(), 0.0f);
-    x[n] = x[n].real() * std::polar(1.0f, static_cast<float>(-2 * std::numbers::pi *
-                                                             std::fmod(o.if_hz * n / o.sample_rate_hz, 1.0)));
+    x[n] = x[n].real() *
+           std::polar(1.0f, static_cast<float>(-2 * std::numbers::pi * std::fmod(o.if_hz * n / o.sample_rate_hz, 1.0)));
   }
   BruteForceAcquisition acq(x, o.sample_rate_hz);
   for (const auto& v : views) {
@@ -160,8 +161,8 @@ TEST(IfSynthesiser, SingleSatelliteCn0MatchesWithinNoise) {
   IfSynthesiser synth(o, {eph[views[1].prn - 1]}, static_receiver());
   auto x = via_file(synthesise(synth, 4096 * 215), SampleFormat::r16);
   for (std::size_t n = 0; n < x.size(); ++n)
-    x[n] = x[n].real() * std::polar(1.0f, static_cast<float>(-2 * std::numbers::pi *
-                                                             std::fmod(o.if_hz * n / o.sample_rate_hz, 1.0)));
+    x[n] = x[n].real() *
+           std::polar(1.0f, static_cast<float>(-2 * std::numbers::pi * std::fmod(o.if_hz * n / o.sample_rate_hz, 1.0)));
   const auto r = BruteForceAcquisition(x, o.sample_rate_hz).acquire(views[1].prn, 200);
   ASSERT_TRUE(r.found);
   EXPECT_NEAR(r.cn0_dbhz, 44.0, 0.4);
@@ -282,14 +283,14 @@ TEST(IfSynthesiser, PseudorangeEqualsRangePlusClockTermsPlusDelays) {
       double az = std::atan2(u.dot(east), u.dot(north));
       if (az < 0) az += 2 * std::numbers::pi;
       const double iono_m = kSpeedOfLight_mps * klobuchar_delay_s(o.klobuchar, lat * kDeg, lon * kDeg, az, el,
-                                                                   add_seconds(t_rx_clock, -b).tow_s);
+                                                                  add_seconds(t_rx_clock, -b).tow_s);
       const double tropo_m = troposphere_delay_m(lat * kDeg, h, el);
       const double model = range + kSpeedOfLight_mps * (b - dt_sv) + iono_m + tropo_m;
       EXPECT_NEAR(rho - model, 0.0, 1e-4) << "PRN " << v.prn << " sample " << sample;
       EXPECT_NEAR(t.geometric_range_m, range, 1e-4);
       EXPECT_NEAR(t.iono_delay_m, iono_m, 1e-6);
       EXPECT_NEAR(t.tropo_delay_m, tropo_m, 1e-6);
-      EXPECT_GT(iono_m, 0.5);   // the delays are really in (Klobuchar at night: a few metres)
+      EXPECT_GT(iono_m, 0.5);  // the delays are really in (Klobuchar at night: a few metres)
       EXPECT_GT(tropo_m, 2.0);
     }
   }
@@ -309,8 +310,8 @@ TEST(IfSynthesiser, DopplerIsRangeRatePlusClockDrifts) {
     const SatelliteState st = satellite_state(eph, t_tx);
     const Eigen::Vector3d u = (rotate_to_receive_frame(st.r_e_m, 0.07) - r_rx).normalized();
     const double range_rate = u.dot(st.v_e_mps);
-    const double expected = -range_rate / kL1Wavelength_m - kL1Frequency_hz * o.clock.drift_sps +
-                            kL1Frequency_hz * st.clock_drift_sps;
+    const double expected =
+        -range_rate / kL1Wavelength_m - kL1Frequency_hz * o.clock.drift_sps + kL1Frequency_hz * st.clock_drift_sps;
     EXPECT_NEAR(v.doppler_hz, expected, 0.1) << "PRN " << v.prn;
   }
 }

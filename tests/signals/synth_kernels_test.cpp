@@ -1,12 +1,12 @@
 // The synthesiser's Gaussian noise against the normal distribution's closed forms: moments and tail
 // fractions P(|x| > k) = erfc(k / sqrt 2), from 4 million values; tolerances are 5 sigma of each estimate.
+#include "signals/synth_kernels.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <complex>
 #include <vector>
-
-#include "signals/synth_kernels.hpp"
 
 namespace ultratrack::signals::synth {
 namespace {

@@ -3,10 +3,9 @@
 // acquisition (radix-2 FFT code search, then direct correlations) written here from textbook formulas.
 #pragma once
 
-#include <GeographicLib/Geocentric.hpp>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -84,11 +83,11 @@ inline void fft_radix2(std::vector<cd>& a, bool inverse) {
 
 struct AcquisitionResult {
   int prn = 0;
-  bool found = false;               // coarse peak ratio above 4.5 and confirmed at >= 30 dB-Hz
-  double peak_ratio = 0.0;          // coarse peak over the mean of the search grid
-  double doppler_hz = 0.0;          // fine estimate
-  double code_phase_chips = 0.0;    // chip of the code at sample 0, fine estimate
-  double cn0_dbhz = 0.0;            // from 1 ms prompt power vs off-peak noise power
+  bool found = false;             // coarse peak ratio above 4.5 and confirmed at >= 30 dB-Hz
+  double peak_ratio = 0.0;        // coarse peak over the mean of the search grid
+  double doppler_hz = 0.0;        // fine estimate
+  double code_phase_chips = 0.0;  // chip of the code at sample 0, fine estimate
+  double cn0_dbhz = 0.0;          // from 1 ms prompt power vs off-peak noise power
 };
 
 // x: complex baseband samples from sample 0, fs with fs/1000 a power of two.

@@ -1,10 +1,11 @@
 // Scenario files: the keys parse to the stated values; unknown keys, wrong types and conflicting
 // keys are InputErrors naming the file, the key and the line; the echo (to_toml) reads back the same.
+#include "scenario.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "scenario.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {

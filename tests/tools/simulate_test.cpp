@@ -66,9 +66,9 @@ void expect_acquired_as_stated(const std::vector<std::complex<float>>& x, double
     SCOPED_TRACE("PRN " + std::to_string(row.prn));
     const auto r = acq.acquire(row.prn);
     ASSERT_TRUE(r.found) << "peak ratio " << r.peak_ratio;
-    EXPECT_NEAR(r.doppler_hz, row.doppler_hz, 25.0);       // FLL estimate, noise of a few Hz
+    EXPECT_NEAR(r.doppler_hz, row.doppler_hz, 25.0);  // FLL estimate, noise of a few Hz
     EXPECT_NEAR(wrap_chips(r.code_phase_chips - row.code_phase_chips), 0.0, 0.05);
-    EXPECT_NEAR(r.cn0_dbhz, row.cn0_dbhz, 1.5);            // floor includes other satellites' cross-correlation
+    EXPECT_NEAR(r.cn0_dbhz, row.cn0_dbhz, 1.5);  // floor includes other satellites' cross-correlation
     std::printf("PRN %2d: Doppler %8.1f / %8.1f Hz, code %8.3f / %8.3f chips, C/N0 %.1f / %.1f dB-Hz\n", row.prn,
                 r.doppler_hz, row.doppler_hz, r.code_phase_chips, row.code_phase_chips, r.cn0_dbhz, row.cn0_dbhz);
   }
@@ -97,9 +97,7 @@ clock_drift_mps = 90.0
 ionosphere = true
 troposphere = true
 )";
-  {
-    std::ofstream(dir / "s.toml") << text;
-  }
+  { std::ofstream(dir / "s.toml") << text; }
   const Scenario s = read_scenario(dir / "s.toml");
   const auto result = run_simulation(s, dir / "out");
   const auto out = dir / "out";
@@ -175,8 +173,8 @@ TEST(Simulate, TrajectoryFileDrivesTheReceiver) {
     for (int i = 0; i <= 3; ++i)
       f << 0.1 * i << "," << -3813409.3992 + 10.0 * 0.1 * i << ",3554350.1028,3662785.2375,10.0,0,0\n";
   }
-  Scenario s = parse_scenario("[signal]\nsample_rate_hz = 2e6\nduration_s = 0.3\n[receiver]\ntrajectory = \"motion.csv\"\n",
-                              dir / "s.toml");
+  Scenario s = parse_scenario(
+      "[signal]\nsample_rate_hz = 2e6\nduration_s = 0.3\n[receiver]\ntrajectory = \"motion.csv\"\n", dir / "s.toml");
   run_simulation(s, dir / "out");
   const auto truth = read_lines(dir / "out" / "truth.csv");
   ASSERT_EQ(truth.size(), 4u);  // t = 0, 0.1, 0.2 s (0.3 s is past the last sample)
