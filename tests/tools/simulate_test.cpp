@@ -145,6 +145,13 @@ TEST(Simulate, BroadcastEphemerisScenarioOfTheIssue) {
   for (int prn : {5, 13, 14, 15, 18, 23, 24}) EXPECT_TRUE(prns.count(prn)) << "PRN " << prn;
   EXPECT_FALSE(prns.count(28));
   expect_acquired_as_stated(read_samples(result.sample_files.at(0), signals::SampleFormat::i8), 2.048e6, rows);
+  // With include_unhealthy the flagged satellite is transmitted too.
+  s.include_unhealthy = true;
+  s.duration_s = 0.01;
+  const auto with_unhealthy = run_simulation(s, dir / "out_unhealthy");
+  bool has28 = false;
+  for (const auto& v : with_unhealthy.satellites) has28 = has28 || v.prn == 28;
+  EXPECT_TRUE(has28);
 }
 
 TEST(Simulate, SeveralAntennasGiveOneSynchronousFileEach) {
