@@ -6,7 +6,7 @@
 #include <fstream>
 #include <string>
 
-#include "ins/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "ins/csv_util.hpp"
 #include "ins/ins_error.hpp"
 
@@ -49,7 +49,7 @@ std::vector<ImuIncrement> read_imu_csv(const std::filesystem::path& file) {
   return out;
 }
 
-ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<AtomicFile>(file)) {
+ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<io::AtomicFile>(file)) {
   std::string h;
   for (const auto& n : imu_header()) h += (h.empty() ? "" : ",") + n;
   out_->write(h + "\n");
@@ -58,8 +58,8 @@ ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& file) : out_(std::make_u
 ImuCsvWriter::~ImuCsvWriter() = default;
 
 void ImuCsvWriter::write(const ImuIncrement& i) {
-  fmt::print(out_->handle(), "{},{},{},{},{},{},{}\n", i.t_s, i.dtheta_b.x(), i.dtheta_b.y(), i.dtheta_b.z(),
-             i.dv_b.x(), i.dv_b.y(), i.dv_b.z());
+  out_->write(fmt::format("{},{},{},{},{},{},{}\n", i.t_s, i.dtheta_b.x(), i.dtheta_b.y(), i.dtheta_b.z(),
+             i.dv_b.x(), i.dv_b.y(), i.dv_b.z()));
 }
 
 void ImuCsvWriter::commit() { out_->commit(); }

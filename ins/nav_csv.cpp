@@ -8,7 +8,7 @@
 #include <numbers>
 #include <string>
 
-#include "ins/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "ins/attitude.hpp"
 #include "ins/csv_util.hpp"
 #include "ins/ins_error.hpp"
@@ -64,7 +64,7 @@ std::vector<NavState> read_nav_csv(const std::filesystem::path& file) {
   return out;
 }
 
-NavCsvWriter::NavCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<AtomicFile>(file)) {
+NavCsvWriter::NavCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<io::AtomicFile>(file)) {
   std::string h;
   for (const auto& n : nav_header()) h += (h.empty() ? "" : ",") + n;
   out_->write(h + "\n");
@@ -74,8 +74,8 @@ NavCsvWriter::~NavCsvWriter() = default;
 
 void NavCsvWriter::write(const NavState& s) {
   const EulerAngles e = euler_from_quaternion(s.q_nb);
-  fmt::print(out_->handle(), "{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
-             s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
+             s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg));
 }
 
 void NavCsvWriter::commit() { out_->commit(); }

@@ -8,7 +8,7 @@
 
 #include "commands.hpp"
 #include "ins/ins_error.hpp"
-#include "signals/input_error.hpp"
+#include "io/input_error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"ultratrack: GPS L1 C/A software receiver with inertial aiding"};
@@ -23,10 +23,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
-  } catch (const ultratrack::signals::InputError& e) {
-    fmt::print(stderr, "ultratrack: error: {}\n", e.what());
-    return 2;
-  } catch (const ultratrack::ins::InputError& e) {
+  } catch (const ultratrack::io::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -12,7 +12,7 @@
 #include <numbers>
 #include <span>
 
-#include "atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/input_error.hpp"
@@ -226,9 +226,9 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
     sats += fmt::format("{},{:.4f},{:.4f},{:.2f},{:.4f},{:.6f}\n", v.prn, v.elevation_rad / kDeg, v.azimuth_rad / kDeg,
                         v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
   }
-  write_file_atomically(out_dir / "truth.csv", truth);
-  write_file_atomically(out_dir / "satellites.csv", sats);
-  write_file_atomically(out_dir / "scenario.toml", to_toml(s));
+  io::write_file_atomically(out_dir / "truth.csv", truth);
+  io::write_file_atomically(out_dir / "satellites.csv", sats);
+  io::write_file_atomically(out_dir / "scenario.toml", to_toml(s));
 
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   std::string prns, files;
@@ -244,7 +244,7 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
       json_escape(s.source.filename().string()), json_escape(std::filesystem::path(nav.name).filename().string()),
       s.sample_rate_hz, s.if_hz, signals::to_string(s.format), n_ant, files, result.samples, result.signal_s, prns,
       result.noise_sigma, result.interrupted, result.wall_s, result.signal_s / std::max(result.wall_s, 1e-9));
-  write_file_atomically(out_dir / "summary.json", summary);
+  io::write_file_atomically(out_dir / "summary.json", summary);
   return result;
 }
 
