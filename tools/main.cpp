@@ -7,6 +7,7 @@
 #include <exception>
 
 #include "commands.hpp"
+#include "ins/ins_error.hpp"
 #include "signals/input_error.hpp"
 
 int main(int argc, char** argv) {
@@ -16,11 +17,16 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_simulate_command(app);
   ultratrack::tools::add_demo_command(app);
   ultratrack::tools::add_acquire_command(app);
+  ultratrack::tools::add_ins_command(app);
+  ultratrack::tools::add_imusim_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const ultratrack::signals::InputError& e) {
+    fmt::print(stderr, "ultratrack: error: {}\n", e.what());
+    return 2;
+  } catch (const ultratrack::ins::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {
