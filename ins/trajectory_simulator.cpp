@@ -107,8 +107,7 @@ Eigen::Vector3d w_nb_b(const EulerAngles& e, const Eigen::Vector3d& rate) {
 
 TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State& y) const {
   const Commands u = commands(t);
-  const Kinematics k =
-      kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
+  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
   const double lat = y[2], h = y[4];
   const Eigen::Vector3d pos_rate = geodetic_rates(lat, h, k.v_n);
   const Eigen::Vector3d w_ie = earth_rate_n(lat);
@@ -133,8 +132,7 @@ TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State
 
 void TrajectoryGenerator::fill_truth(double t, const State& y, TruthSample& out) const {
   const Commands u = commands(t);
-  const Kinematics k =
-      kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
+  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
   out.t_s = t;
   out.lat_rad = y[2];
   out.lon_rad = y[3];

@@ -11,12 +11,12 @@
 
 #include "commands.hpp"
 #include "imu_simulation.hpp"
-#include "io/atomic_file.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
+#include "io/atomic_file.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -63,13 +63,13 @@ void run_imusim(const ImuSimOptions& o) {
   fs::create_directories(o.out_dir);
   ins::NavCsvWriter truth_out(fs::path(o.out_dir) / "truth.csv");
   std::vector<ins::TruthSample> truth_for_odometer;
-  const ImuSimulationResult r =
-      simulate_imu(spec, o.rate_hz, error_spec, o.seed, fs::path(o.out_dir) / "imu.csv",
-                   [&](const ins::TruthSample& t) {
-                     truth_out.write(t.nav());
-                     if (o.odometer) truth_for_odometer.push_back(t);
-                   },
-                   "imusim");
+  const ImuSimulationResult r = simulate_imu(
+      spec, o.rate_hz, error_spec, o.seed, fs::path(o.out_dir) / "imu.csv",
+      [&](const ins::TruthSample& t) {
+        truth_out.write(t.nav());
+        if (o.odometer) truth_for_odometer.push_back(t);
+      },
+      "imusim");
   truth_out.commit();
   if (o.odometer) write_odometer_csv(fs::path(o.out_dir) / "odometer.csv", truth_for_odometer, o.odometer_sf);
   const std::size_t rows = r.imu_rows;

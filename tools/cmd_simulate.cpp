@@ -30,9 +30,10 @@ void add_simulate_command(CLI::App& app) {
                           scenario.imu_preset, scenario.odometer ? "odometer.csv, " : "")
             : std::string();
     if (!scenario.signal) {
-      fmt::print("simulate: no [signal]: IMU and truth only in {:.1f} s\noutputs in {}: {}truth.csv, scenario.toml, "
-                 "summary.json\n",
-                 r.wall_s, *out_dir, inertial);
+      fmt::print(
+          "simulate: no [signal]: IMU and truth only in {:.1f} s\noutputs in {}: {}truth.csv, scenario.toml, "
+          "summary.json\n",
+          r.wall_s, *out_dir, inertial);
       return;
     }
     fmt::print("simulate: {:.1f} s of {} at {:.3f} MHz ({} antenna{}) in {:.1f} s ({:.1f}x real time){}\n", r.signal_s,

@@ -334,8 +334,10 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
     if (s.trajectory_file.empty() && start_state_given)
       fail_file("keys trajectory.speed_mps / heading_deg: only with a segment file");
     if (!s.trajectory.empty()) fail_file("key receiver.trajectory: not with a [trajectory] section");
-    if (offsets_given) fail_file("key receiver.antenna_offsets_enu_m: with [trajectory] use [[antenna]] lever_arm_body_m");
-    if (std::abs(s.llh_deg_m[0]) >= 89.0) fail_file("key receiver.llh_deg_m: latitude must be within +-89 deg with [trajectory]");
+    if (offsets_given)
+      fail_file("key receiver.antenna_offsets_enu_m: with [trajectory] use [[antenna]] lever_arm_body_m");
+    if (std::abs(s.llh_deg_m[0]) >= 89.0)
+      fail_file("key receiver.llh_deg_m: latitude must be within +-89 deg with [trajectory]");
     if (attitude_given && s.trajectory_profile != "static")
       fail_file("key receiver.attitude_deg: needs [trajectory] profile = \"static\"");
   } else {
@@ -375,9 +377,10 @@ std::string to_toml(const Scenario& s) {
   };
   std::string out = "# Scenario as run by `ultratrack simulate` (every key, defaults filled in).\n";
   if (s.signal) out += "\n[signal]\n";
-  if (s.signal) out += fmt::format("sample_rate_hz = {}\nif_hz = {}\nformat = \"{}\"\nduration_s = {}\ncn0_dbhz = {}\nseed = {}\n",
-                     toml_float(s.sample_rate_hz), toml_float(s.if_hz), signals::to_string(s.format),
-                     toml_float(s.duration_s), toml_float(s.cn0_dbhz), s.seed);
+  if (s.signal)
+    out += fmt::format("sample_rate_hz = {}\nif_hz = {}\nformat = \"{}\"\nduration_s = {}\ncn0_dbhz = {}\nseed = {}\n",
+                       toml_float(s.sample_rate_hz), toml_float(s.if_hz), signals::to_string(s.format),
+                       toml_float(s.duration_s), toml_float(s.cn0_dbhz), s.seed);
   if (s.signal) {
     out += "cn0_dbhz_by_prn = {";
     bool first = true;
@@ -435,10 +438,11 @@ std::string to_toml(const Scenario& s) {
     out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                        s.odometer, toml_float(s.odometer_scale_factor_error));
     out += fmt::format("\n[imu]\npreset = {}\nseed = {}\n", toml_string(s.imu_preset), s.imu_seed);
-    const std::pair<const char*, const std::optional<double>*> overrides[] = {{"gyro_bias_dph", &s.gyro_bias_dph},
-                                                                              {"accel_bias_mg", &s.accel_bias_mg},
-                                                                              {"gyro_arw_dpsh", &s.gyro_arw_dpsh},
-                                                                              {"accel_vrw_mpspsh", &s.accel_vrw_mpspsh}};
+    const std::pair<const char*, const std::optional<double>*> overrides[] = {
+        {"gyro_bias_dph", &s.gyro_bias_dph},
+        {"accel_bias_mg", &s.accel_bias_mg},
+        {"gyro_arw_dpsh", &s.gyro_arw_dpsh},
+        {"accel_vrw_mpspsh", &s.accel_vrw_mpspsh}};
     for (const auto& [key, value] : overrides)
       if (value->has_value()) out += fmt::format("{} = {}\n", key, toml_float(**value));
     for (const auto& l : s.lever_arms_body_m) {

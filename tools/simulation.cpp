@@ -133,9 +133,9 @@ ins::ImuErrorSpec imu_error_spec(const Scenario& s) {
   } catch (const InputError& err) {
     throw InputError(s.source.string(), std::string("[imu]: ") + err.what());
   }
-  constexpr double kDph = kDeg / 3600.0;           // deg/h -> rad/s
-  constexpr double kDpsh = kDeg / 60.0;            // deg/sqrt(h) -> rad/sqrt(s)
-  constexpr double kMg = 9.80665e-3;               // milli-g -> m/s^2
+  constexpr double kDph = kDeg / 3600.0;  // deg/h -> rad/s
+  constexpr double kDpsh = kDeg / 60.0;   // deg/sqrt(h) -> rad/sqrt(s)
+  constexpr double kMg = 9.80665e-3;      // milli-g -> m/s^2
   if (s.gyro_bias_dph) e.gyro.bias_sigma = *s.gyro_bias_dph * kDph;
   if (s.accel_bias_mg) e.accel.bias_sigma = *s.accel_bias_mg * kMg;
   if (s.gyro_arw_dpsh) e.gyro.random_walk = *s.gyro_arw_dpsh * kDpsh;
@@ -217,8 +217,9 @@ InertialRun run_inertial(const Scenario& s, const std::filesystem::path& out_dir
   std::vector<ins::TruthSample> samples;
   samples.reserve(static_cast<std::size_t>(std::llround(spec.duration_s() * s.imu_rate_hz)) + 1);
   InertialRun run;
-  run.imu = simulate_imu(spec, s.imu_rate_hz, imu_error_spec(s), s.imu_seed, out_dir / "imu.csv",
-                         [&](const ins::TruthSample& t) { samples.push_back(t); }, "simulate");
+  run.imu = simulate_imu(
+      spec, s.imu_rate_hz, imu_error_spec(s), s.imu_seed, out_dir / "imu.csv",
+      [&](const ins::TruthSample& t) { samples.push_back(t); }, "simulate");
   if (s.odometer) write_odometer_csv(out_dir / "odometer.csv", samples, s.odometer_scale_factor_error);
   run.duration_s = spec.duration_s();
   run.truth = std::make_shared<ins::TruthInterpolator>(std::move(samples));
@@ -236,8 +237,8 @@ std::string truth_row(double t_s, const signals::GpsTime& gps, const signals::An
   GeographicLib::Geocentric::WGS84().Reverse(st.r_e_m.x(), st.r_e_m.y(), st.r_e_m.z(), lat, lon, h);
   const Eigen::Vector3d v_n = ned_from_ecef(lat * kDeg, lon * kDeg) * st.v_e_mps;
   std::string row =
-      fmt::format("{:.9f},{},{:.9f},{:.4f},{:.4f},{:.4f},{:.10f},{:.10f},{:.4f},{:.5f},{:.5f},{:.5f},{:.5f},{:.6f}", t_s,
-                  gps.week, gps.tow_s, st.r_e_m.x(), st.r_e_m.y(), st.r_e_m.z(), lat, lon, h, v_n.x(), v_n.y(),
+      fmt::format("{:.9f},{},{:.9f},{:.4f},{:.4f},{:.4f},{:.10f},{:.10f},{:.4f},{:.5f},{:.5f},{:.5f},{:.5f},{:.6f}",
+                  t_s, gps.week, gps.tow_s, st.r_e_m.x(), st.r_e_m.y(), st.r_e_m.z(), lat, lon, h, v_n.x(), v_n.y(),
                   v_n.z(), clock_bias_m, clock_drift_mps);
   if (q_nb) {
     const ins::EulerAngles e = ins::euler_from_quaternion(*q_nb);
@@ -277,8 +278,8 @@ SimulationResult run_inertial_only(const Scenario& s, const std::filesystem::pat
   for (std::int64_t k = 0; k <= rows; ++k) {
     const double t = static_cast<double>(k) / s.truth_rate_hz;
     const Eigen::Quaterniond q = run.truth->attitude(t);
-    truth += truth_row(t, signals::add_seconds(start, t), imu_state(*run.truth, t), s.clock_bias_m + s.clock_drift_mps * t,
-                       s.clock_drift_mps, &q);
+    truth += truth_row(t, signals::add_seconds(start, t), imu_state(*run.truth, t),
+                       s.clock_bias_m + s.clock_drift_mps * t, s.clock_drift_mps, &q);
     ++result.truth_rows;
   }
   io::write_file_atomically(out_dir / "truth.csv", truth);
@@ -333,7 +334,8 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
     const double t_s = static_cast<double>(n) / s.sample_rate_hz;
     const auto gps = signals::add_seconds(options.start, t_r);
     const auto clk = synth.receiver_clock(n);
-    const double bias_m = clk.bias_s * signals::kSpeedOfLight_mps, drift_mps = clk.drift_sps * signals::kSpeedOfLight_mps;
+    const double bias_m = clk.bias_s * signals::kSpeedOfLight_mps,
+                 drift_mps = clk.drift_sps * signals::kSpeedOfLight_mps;
     if (inertial) {
       const Eigen::Quaterniond q = inertial->truth->attitude(t_r);
       truth += truth_row(t_s, gps, imu_state(*inertial->truth, t_r), bias_m, drift_mps, &q);

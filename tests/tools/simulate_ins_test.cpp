@@ -153,8 +153,8 @@ lever_arm_body_m = [-2.0, 1.0, -0.8]
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(row[9 + i], r.v_n[i], 2e-5);
     const Eigen::Matrix3d C = r.q_nb.toRotationMatrix();
     const double roll = std::atan2(C(2, 1), C(2, 2)), pitch = -std::asin(C(2, 0)), yaw = std::atan2(C(1, 0), C(0, 0));
-    worst_att = std::max({worst_att, std::abs(row[14] - roll / kDeg), std::abs(row[15] - pitch / kDeg),
-                          std::abs(row[16] - yaw / kDeg)});
+    worst_att = std::max(
+        {worst_att, std::abs(row[14] - roll / kDeg), std::abs(row[15] - pitch / kDeg), std::abs(row[16] - yaw / kDeg)});
   }
   std::printf("truth.csv vs independent trajectory: position %.2e m, attitude %.2e deg\n", worst_pos, worst_att);
   EXPECT_LT(worst_pos, 1e-3);
@@ -199,9 +199,9 @@ lever_arm_body_m = [-2.0, 1.0, -0.8]
   // still at the hand-built master position (code phase at one instant depends on position only).
   const auto sats = read_rows(out / "satellites.csv");
   ASSERT_EQ(sats.size(), views.size());
-  signals::IfSynthesiser still(synthesiser_options(s, nav), nav.ephemerides,
-                               std::make_shared<signals::StaticMotion>(
-                                   std::vector<Eigen::Vector3d>{antenna_by_hand(ref[0], levers[0])}));
+  signals::IfSynthesiser still(
+      synthesiser_options(s, nav), nav.ephemerides,
+      std::make_shared<signals::StaticMotion>(std::vector<Eigen::Vector3d>{antenna_by_hand(ref[0], levers[0])}));
   for (const auto& row : sats) {
     const double expected = still.timing(static_cast<int>(row[0]), 0, 0).code_phase_chips;
     double d = row[5] - expected;
@@ -316,7 +316,8 @@ preset = "ideal"
     const auto& row = truth[(i + 1) / 10];
     ASSERT_NEAR(ins.state().t_s, row[0], 1e-9);
     const auto& st = ins.state();
-    worst = std::max(worst, (ecef(st.lat_rad, st.lon_rad, st.height_m) - Eigen::Vector3d(row[3], row[4], row[5])).norm());
+    worst =
+        std::max(worst, (ecef(st.lat_rad, st.lon_rad, st.height_m) - Eigen::Vector3d(row[3], row[4], row[5])).norm());
     worst_att = std::max(worst_att, Eigen::AngleAxisd(st.q_nb.conjugate() * state_of(row).q_nb).angle() / kDeg);
   }
   std::printf("imu.csv (ideal) mechanised over 60 s of circle: position error %.3e m, attitude %.2e deg\n", worst,
@@ -367,9 +368,11 @@ std::string error_of(const std::string& text, bool run = false) {
 }
 
 TEST(SimulateIns, BadKeysAreInputErrorsNamingTheScenario) {
-  EXPECT_NE(error_of(scenario_head("") + "[trajectory]\nprofile = \"loop\"\nduration_s = 1.0\n").find("trajectory.profile"),
-            std::string::npos);
-  EXPECT_NE(error_of(scenario_head("") + "[trajectory]\nprofile = \"static\"\nduration_s = 1.0\n[imu]\npreset = \"tactical\"\n")
+  EXPECT_NE(
+      error_of(scenario_head("") + "[trajectory]\nprofile = \"loop\"\nduration_s = 1.0\n").find("trajectory.profile"),
+      std::string::npos);
+  EXPECT_NE(error_of(scenario_head("") +
+                     "[trajectory]\nprofile = \"static\"\nduration_s = 1.0\n[imu]\npreset = \"tactical\"\n")
                 .find("imu.preset"),
             std::string::npos);
   EXPECT_NE(error_of(scenario_head(kSignal) + "[trajectory]\nprofile = \"circle\"\nduration_s = 0.5\n", true)
@@ -381,10 +384,12 @@ TEST(SimulateIns, BadKeysAreInputErrorsNamingTheScenario) {
             std::string::npos);
   EXPECT_NE(error_of(scenario_head("") + "[[antenna]]\nlever_arm_body_m = [0, 0, 0]\n").find("[[antenna]]"),
             std::string::npos);
-  EXPECT_NE(error_of(scenario_head("", "attitude_deg = [0, 0, 10]\n") + "[trajectory]\nprofile = \"circle\"\nduration_s = 1.0\n")
+  EXPECT_NE(error_of(scenario_head("", "attitude_deg = [0, 0, 10]\n") +
+                     "[trajectory]\nprofile = \"circle\"\nduration_s = 1.0\n")
                 .find("attitude_deg"),
             std::string::npos);
-  EXPECT_NE(error_of(scenario_head("") + "[trajectory]\nprofile = \"static\"\nduration_s = 1.0\n[[antenna]]\nlever = [0, 0, 0]\n")
+  EXPECT_NE(error_of(scenario_head("") +
+                     "[trajectory]\nprofile = \"static\"\nduration_s = 1.0\n[[antenna]]\nlever = [0, 0, 0]\n")
                 .find("antenna.lever"),
             std::string::npos);
 }
