@@ -121,7 +121,11 @@ ins::TrajectorySpec trajectory_spec(const Scenario& s) {
     start.height0_m = h;
     start.speed0_mps = s.start_speed_mps;
     start.heading0_rad = s.start_heading_deg * kDeg;
-    spec = ins::read_segments_csv(resolve_path(s, s.trajectory_file), start);  // errors name the segment file
+    const auto file = resolve_path(s, s.trajectory_file);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+      throw InputError(s.source.string(), "key trajectory.file: no such segment file " + file.string());
+    spec = ins::read_segments_csv(file, start);  // errors in the file name it and the line
   }
   return spec;
 }

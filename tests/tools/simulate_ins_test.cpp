@@ -351,6 +351,34 @@ odometer = true
   EXPECT_NEAR(distance, path, 0.02 * path + 0.04);  // chords of 0.1 s vs arc; pulses of 2 cm
 }
 
+// A segment file (relative to the scenario) with its start speed and heading; the echo names it absolutely.
+TEST(SimulateIns, SegmentFileTrajectoryStartsAsGiven) {
+  const auto dir = test::scratch_dir();
+  std::ofstream(dir / "seg.csv")
+      << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n5,1,0,0,0\n5,0,3,0,0\n";
+  const std::string text = scenario_head("") + R"(
+[trajectory]
+file = "seg.csv"
+speed_mps = 10.0
+heading_deg = 30.0
+imu_rate_hz = 200.0
+)";
+  { std::ofstream(dir / "seg.toml") << text; }
+  const Scenario s = read_scenario(dir / "seg.toml");
+  const auto result = run_simulation(s, dir / "out");
+  EXPECT_EQ(result.imu_rows, 2000u);  // 10 s at 200 Hz
+  const auto truth = read_rows(dir / "out" / "truth.csv");
+  ASSERT_EQ(truth.size(), 101u);
+  EXPECT_NEAR(truth[0][9], 10.0 * std::cos(30.0 * kDeg), 1e-5);
+  EXPECT_NEAR(truth[0][10], 10.0 * std::sin(30.0 * kDeg), 1e-5);
+  EXPECT_NEAR(truth[0][16], 30.0, 1e-6);
+  // 1 m/s^2 for 5 s, blended in over the first 1 s (quintic: half of the ramp's acceleration is lost)
+  EXPECT_NEAR(std::hypot(truth[50][9], truth[50][10]), 10.0 + 4.5, 1e-4);
+  const std::string echo = to_toml(read_scenario(dir / "out" / "scenario.toml"));
+  EXPECT_EQ(echo, to_toml(s));
+  EXPECT_NE(echo.find((dir / "seg.csv").lexically_normal().string()), std::string::npos) << echo;
+}
+
 std::string error_of(const std::string& text, bool run = false) {
   const auto dir = test::scratch_dir();
   const auto path = dir / "bad.toml";
@@ -391,6 +419,10 @@ TEST(SimulateIns, BadKeysAreInputErrorsNamingTheScenario) {
   EXPECT_NE(error_of(scenario_head("") +
                      "[trajectory]\nprofile = \"static\"\nduration_s = 1.0\n[[antenna]]\nlever = [0, 0, 0]\n")
                 .find("antenna.lever"),
+            std::string::npos);
+  EXPECT_NE(error_of(scenario_head("") + "[trajectory]\nfile = \"seg.csv\"\nduration_s = 3.0\n").find("own duration"),
+            std::string::npos);
+  EXPECT_NE(error_of(scenario_head(kSignal) + "[trajectory]\nfile = \"absent.csv\"\n", true).find("absent.csv"),
             std::string::npos);
 }
 
