@@ -15,7 +15,7 @@ if ! command -v gnss-sdr >/dev/null; then
   echo "gnss_sdr_run.sh: gnss-sdr is not installed (apt-get install gnss-sdr): skipped"
   exit 0
 fi
-file=$(realpath "$1"); format=$2; fs=$3; out=$4; channels=${5:-8}; if_hz=${6:-0}
+file=$(realpath "$1"); format=$2; fs=$(printf "%.0f" "$3"); out=$4; channels=${5:-8}; if_hz=${6:-0}  # GNSS-SDR wants integer rates
 mkdir -p "$out"
 out=$(realpath "$out")
 case "$format" in
@@ -86,5 +86,5 @@ pos = [l for l in open(log, errors='replace') if 'Position at' in l]
 print(f"gnss-sdr: signal {duration:.1f} s, wall {secs:.1f} s, realtime factor {duration / secs:.2f}, "
       f"peak memory {int(peak_kb) / 1024:.0f} MB, fixes {len(pos)}")
 if pos:
-    print("gnss-sdr last fix:", pos[-1].strip())
+    print("gnss-sdr last fix:", re.sub(r"\x1b\[[0-9;]*m", "", pos[-1]).strip())
 PY
