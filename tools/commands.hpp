@@ -11,5 +11,6 @@ namespace ultratrack::tools {
 void add_simulate_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_acquire_command(CLI::App& app);
+void add_receive_command(CLI::App& app);
 
 }  // namespace ultratrack::tools

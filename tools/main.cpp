@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "command_exit.hpp"
 #include "commands.hpp"
 #include "signals/input_error.hpp"
 
@@ -16,10 +17,14 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_simulate_command(app);
   ultratrack::tools::add_demo_command(app);
   ultratrack::tools::add_acquire_command(app);
+  ultratrack::tools::add_receive_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const ultratrack::tools::CommandExit& e) {
+    fmt::print(stderr, "ultratrack: {}\n", e.what());
+    return e.code;
   } catch (const ultratrack::signals::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;
