@@ -31,7 +31,10 @@ bool same_set(const signals::Ephemeris& a, const signals::Ephemeris& b) {
 }  // namespace
 
 ReceiverEngine::ReceiverEngine(const ReceiverOptions& options, ReceiverObserver& observer)
-    : options_(checked(options)), observer_(observer), acquisition_(acquisition_options(options_)) {
+    : options_(checked(options)),
+      observer_(observer),
+      acquisition_(acquisition_options(options_)),
+      smoothing_(std::max(1, static_cast<int>(std::lround(options_.smoothing_window_s / options_.observation_interval_s)))) {
   channels_.resize(static_cast<std::size_t>(options_.channels));
   prns_ = options_.prns;
   if (prns_.empty())
@@ -234,6 +237,7 @@ void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::
 }
 
 void ReceiverEngine::observation_epoch(std::int64_t sample) {
+  ++epoch_index_;
   measured_.clear();
   for (auto& channel : channels_)
     if (channel)
@@ -266,6 +270,8 @@ void ReceiverEngine::observation_epoch(std::int64_t sample) {
     o.loss_of_lock = m.new_track;
     o.half_cycle_resolved = true;  // measure() needs frame sync, which fixes the polarity
     epoch_.observations.push_back(o);
+    const double smoothed = smoothing_.update(o.prn, epoch_index_, o.pseudorange_m, o.carrier_phase_cycles, o.loss_of_lock);
+    smoothed_m_[static_cast<std::size_t>(o.prn)] = options_.smoothing_window_s > 0.0 ? smoothed : o.pseudorange_m;
     auto& stats = stats_.satellites[static_cast<std::size_t>(m.prn)];
     ++stats.observations;
     stats.cn0_sum_dbhz += m.cn0_dbhz;
@@ -283,7 +289,7 @@ void ReceiverEngine::solve(const ObservationEpoch& epoch) {
     if (!eph) continue;
     SatelliteMeasurement m;
     m.prn = o.prn;
-    m.pseudorange_m = o.pseudorange_m;
+    m.pseudorange_m = smoothed_m_[static_cast<std::size_t>(o.prn)];
     m.doppler_hz = o.doppler_hz;
     m.has_doppler = true;
     m.cn0_dbhz = o.cn0_dbhz;
@@ -309,6 +315,7 @@ void ReceiverEngine::solve(const ObservationEpoch& epoch) {
   const double bias_s = fix.clock_bias_m / signals::kSpeedOfLight_mps;
   if (std::abs(bias_s) > options_.clock_jump_threshold_s) {
     clock_->correct(bias_s);
+    smoothing_.clock_jump(bias_s);
     ++stats_.clock_jumps;
   }
   last_fix_ = std::move(fix);

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "receiver/acquisition.hpp"
+#include "receiver/carrier_smoothing.hpp"
 #include "receiver/observables.hpp"
 #include "receiver/pvt.hpp"
 #include "receiver/receiver_channel.hpp"
@@ -124,6 +125,9 @@ class ReceiverEngine {
   signals::KlobucharParameters iono_;
   signals::UtcParameters utc_;
   std::optional<PvtSolution> last_fix_;
+  CarrierSmoothing smoothing_;
+  std::array<double, 33> smoothed_m_{};  // this epoch's smoothed pseudorange per PRN
+  std::int64_t epoch_index_ = 0;  // observation epochs since the start (for the smoothing's gap test)
 
   ObservationEpoch epoch_;                    // reused every epoch
   std::vector<ChannelMeasurement> measured_;  // reused

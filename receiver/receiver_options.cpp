@@ -23,6 +23,8 @@ std::string ReceiverOptions::validate() const {
   if (!(clock_jump_threshold_s > 0.0)) return "clock jump threshold must be positive";
   if (!(tracking_record_interval_s >= 0.001 && tracking_record_interval_s <= 60.0))
     return fmt::format("tracking record interval {} s outside [0.001, 60]", tracking_record_interval_s);
+  if (!(smoothing_window_s >= 0.0 && smoothing_window_s <= 1000.0))
+    return fmt::format("smoothing window {} s outside [0, 1000]", smoothing_window_s);
   AcquisitionOptions acq = acquisition;
   acq.fs_hz = fs_hz;
   std::string why;
