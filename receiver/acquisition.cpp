@@ -299,9 +299,8 @@ AcquisitionResult Acquisition::search(std::span<const std::complex<float>> sampl
   return search_grid(samples, prn, doppler_grid(assist), false);
 }
 
-std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<float>> samples,
-                                                   std::span<const int> prns) {
-  for (int prn : prns) check(samples, prn);
+std::vector<AcquisitionResult> Acquisition::search_each(std::span<const std::complex<float>> samples,
+                                                        std::span<const int> prns) {
   const std::vector<double> dopplers = doppler_grid(std::nullopt);
   const std::size_t spectra = dopplers.size() * static_cast<std::size_t>(options_.noncoherent);
   const bool cache = prns.size() > 1 && spectra * block_size_ * sizeof(std::complex<float>) <= memory_budget_bytes_;
@@ -319,6 +318,66 @@ std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<
   std::vector<AcquisitionResult> results;
   results.reserve(prns.size());
   for (int prn : prns) results.push_back(search_grid(samples, prn, dopplers, cache));
+  return results;
+}
+
+void Acquisition::cancel(std::span<std::complex<float>> samples, const AcquisitionResult& r) const {
+  // Least-squares fit of the replica's complex amplitude per millisecond (data bits and the carrier
+  // phase stay constant over one code period, near enough), then subtraction.
+  const auto& code = signals::ca_code(r.prn);
+  const double chips_per_sample = code_rate_hz(r.doppler_hz) / options_.fs_hz;
+  const double lag = -r.code_phase_chips / chips_per_sample;  // code phase at sample j: (j - lag) chips/sample
+  const std::complex<double> step = std::polar(1.0, kTwoPi * r.doppler_hz / options_.fs_hz);
+  const auto segment = static_cast<std::size_t>(std::llround(options_.fs_hz * 1e-3));
+  for (std::size_t first = 0; first < samples.size(); first += segment) {
+    const std::size_t count = std::min(segment, samples.size() - first);
+    const std::complex<double> start =
+        std::polar(1.0, kTwoPi * r.doppler_hz * static_cast<double>(first) / options_.fs_hz);
+    std::complex<double> replica_phase = start, sum;
+    for (std::size_t j = first; j < first + count; ++j) {
+      const double chip = chip_at(code, (static_cast<double>(j) - lag) * chips_per_sample);
+      sum += std::complex<double>(samples[j]) * std::conj(replica_phase) * chip;
+      replica_phase *= step;
+    }
+    const std::complex<double> amplitude = sum / static_cast<double>(count);
+    replica_phase = start;
+    for (std::size_t j = first; j < first + count; ++j) {
+      const double chip = chip_at(code, (static_cast<double>(j) - lag) * chips_per_sample);
+      samples[j] -= std::complex<float>(amplitude * replica_phase * chip);
+      replica_phase *= step;
+    }
+  }
+}
+
+std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<float>> samples,
+                                                   std::span<const int> prns) {
+  for (int prn : prns) check(samples, prn);
+  std::vector<AcquisitionResult> results = search_each(samples, prns);
+  if (!options_.cancel_cross_correlation) return results;
+
+  // Successive cancellation: confirm detections from the strongest down, each on the samples with the
+  // stronger confirmed signals removed, so that their cross-correlations (-21..-24 dB) cannot pass for
+  // weak satellites; then search the rest again on the cleaned samples. The threshold is unchanged.
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (results[i].detected) order.push_back(i);
+  if (order.empty()) return results;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return results[a].metric > results[b].metric; });
+  cleaned_.assign(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples_needed()));
+  for (std::size_t n = 0; n < order.size(); ++n) {
+    AcquisitionResult& r = results[order[n]];
+    if (n > 0) r = search_grid(cleaned_, r.prn, doppler_grid(std::nullopt), false);
+    if (r.detected) cancel(cleaned_, r);
+  }
+  std::vector<int> rest;
+  for (const auto& r : results)
+    if (std::find(order.begin(), order.end(), static_cast<std::size_t>(&r - results.data())) == order.end())
+      rest.push_back(r.prn);
+  const std::vector<AcquisitionResult> again = search_each(cleaned_, rest);
+  for (const auto& r : again)
+    for (auto& slot : results)
+      if (slot.prn == r.prn) slot = r;
   return results;
 }
 

@@ -53,6 +53,9 @@ struct AcquisitionOptions {
   double doppler_max_hz = 5000.0;  // search +-doppler_max_hz (unassisted), > 0, <= fs/4
   double doppler_step_hz = 0.0;    // 0: 2 / (3 T_coh); otherwise (0, 1 / T_coh]
   double pfa = 1e-3;               // false-alarm probability of one PRN search, (0, 0.5]
+  // Multi-PRN searches: confirm detections strongest first with the stronger signals cancelled, so that
+  // Gold-code cross-correlations of strong satellites are not reported as weak ones (about 2x the time).
+  bool cancel_cross_correlation = true;
 
   double coherent_s() const { return coherent_ms * 1e-3; }
   double step_hz() const { return doppler_step_hz > 0.0 ? doppler_step_hz : 2.0 / (3.0 * coherent_s()); }
@@ -99,7 +102,8 @@ class Acquisition {
   AcquisitionResult search(std::span<const std::complex<float>> samples, int prn,
                            std::optional<DopplerWindow> assist = std::nullopt);
   // Searches several PRNs over the same samples; the Doppler-shifted signal spectra are shared between
-  // them (cached when they fit in memory_budget_bytes).
+  // them (cached when they fit in memory_budget_bytes). With options.cancel_cross_correlation, detections
+  // are confirmed by successive cancellation (see AcquisitionOptions) and the rest searched again.
   std::vector<AcquisitionResult> search(std::span<const std::complex<float>> samples, std::span<const int> prns);
 
  private:
@@ -120,6 +124,9 @@ class Acquisition {
                                 const std::vector<double>& dopplers, bool cached);
   std::vector<double> doppler_grid(std::optional<DopplerWindow> assist) const;
   void check(std::span<const std::complex<float>> samples, int prn) const;
+  std::vector<AcquisitionResult> search_each(std::span<const std::complex<float>> samples, std::span<const int> prns);
+  // Removes a detected signal from samples (amplitude fitted per millisecond).
+  void cancel(std::span<std::complex<float>> samples, const AcquisitionResult& result) const;
 
   AcquisitionOptions options_;
   std::size_t block_size_;  // N = round(fs T_coh)
@@ -131,6 +138,7 @@ class Acquisition {
   std::vector<FftwBuffer> spectrum_cache_;               // [bin * K + k] for a multi-PRN search
   std::vector<float> row_, grid_;                        // one Doppler row; all rows [bin * lags + lag]
   std::vector<double> row_noise_;                        // noise cell mean per Doppler row
+  std::vector<std::complex<float>> cleaned_;             // samples with confirmed signals cancelled
   std::size_t memory_budget_bytes_ = std::size_t{256} << 20;
 };
 

@@ -43,10 +43,16 @@ void correlate_chunked(const std::int8_t* table, const double* offsets, std::spa
       carrier_sin[i] = s;
     }
     const double code0 = rep.code_phase_chips + rep.code_step_chips * start + 2 * kCodeLength;  // table origin
+    // Chip index = whole part of the chunk's start (exact, integer) + float offset within the chunk: the float
+    // part stays below ~kChunk * step chips, so its rounding is < 1e-5 chips and never accumulates.
+    const auto step_f = static_cast<float>(rep.code_step_chips);
     for (int t = 0; t < kTaps; ++t) {
       const double base = code0 + offsets[t];
+      const int whole = static_cast<int>(base);
+      const auto frac = static_cast<float>(base - whole);
+      const std::int8_t* __restrict chips = table + whole;
       float* __restrict out = code[t];
-      for (int i = 0; i < n; ++i) out[i] = table[static_cast<int>(base + rep.code_step_chips * i)];
+      for (int i = 0; i < n; ++i) out[i] = chips[static_cast<int>(frac + step_f * static_cast<float>(i))];
     }
     for (int a = 0; a < num_antennas; ++a) {
       const float* __restrict x = reinterpret_cast<const float*>(antennas[a] + start);

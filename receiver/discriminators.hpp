@@ -36,6 +36,16 @@ inline double fll_atan_hz(std::complex<float> first, std::complex<float> second,
   return std::atan(cross / dot) / (kTwoPi * dt_s);
 }
 
+// Cross and dot products of two successive sums (for FLLs that average them before the arctangent, which keeps
+// the discriminator's gain at low SNR): frequency = atan2(cross, dot) / (2 pi dt).
+struct CrossDot {
+  double cross = 0.0, dot = 0.0;
+};
+inline CrossDot cross_dot(std::complex<float> first, std::complex<float> second) {
+  return {static_cast<double>(first.real()) * second.imag() - static_cast<double>(second.real()) * first.imag(),
+          static_cast<double>(first.real()) * second.real() + static_cast<double>(first.imag()) * second.imag()};
+}
+
 // DLL normalised early-minus-late envelope for taps at +-offset chips (offset = half the E-L spacing):
 // (|E| - |L|) / (|E| + |L|) is tau / (1 - offset) for a triangle correlation with |tau| <= offset <= 0.5,
 // so it is multiplied by (1 - offset) to give tau in chips (tau = signal code phase - replica code phase).

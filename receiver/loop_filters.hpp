@@ -21,6 +21,11 @@ class CarrierLoopFilter final {
   CarrierLoopFilter(int order, double pll_bw_hz, double fll_bw_hz, double initial_frequency_hz);
 
   void set_bandwidths(double pll_bw_hz, double fll_bw_hz);
+  // Switches between 2nd and 3rd order keeping the frequency; the frequency-rate state restarts at 0.
+  void set_order(int order) {
+    order_ = order == 3 ? 3 : 2;
+    rate_hzps_ = 0.0;
+  }
   // Restarts the integrators (e.g. when the integration time changes and the old state is too noisy).
   void reset(double frequency_hz, double frequency_rate_hzps) {
     frequency_hz_ = frequency_hz;
@@ -29,6 +34,14 @@ class CarrierLoopFilter final {
   // One update with the phase error (cycles) and frequency error (Hz, ignored when the FLL is off) measured over
   // an integration of t_s seconds. Returns the NCO carrier frequency for the next integration, Hz.
   double update(double phase_error_cycles, double frequency_error_hz, double t_s);
+
+  // A first-order FLL alone (w0 = Bn / 0.25), used for pull-in before any phase is tracked; the frequency-rate
+  // state is cleared (it would otherwise random-walk on the FLL's noise). Returns the NCO frequency, Hz.
+  double update_fll_only(double frequency_error_hz, double fll_bw_hz, double t_s) {
+    rate_hzps_ = 0.0;
+    frequency_hz_ += t_s * fll_bw_hz / kFirstOrderBnPerW0 * frequency_error_hz;
+    return frequency_hz_;
+  }
 
   double frequency_hz() const { return frequency_hz_; }
   double frequency_rate_hzps() const { return rate_hzps_; }

@@ -17,6 +17,7 @@ bool SampleSourceOptions::IsValid(signals::SampleFormat format, std::string* err
   if (!std::isfinite(if_hz) || std::abs(if_hz) >= fs_hz / 2.0)
     return fail("intermediate frequency must lie within +-fs/2 (give the aliased IF for bandpass sampling)");
   if (start_sample < 0) return fail("start sample must not be negative");
+  if (!(int16_gain >= 0.0) || !std::isfinite(int16_gain)) return fail("int16 gain must be >= 0 (0: automatic)");
   if (!signals::is_complex(format)) {
     if (if_hz == 0.0) return fail("a real sample format needs a non-zero intermediate frequency (--if)");
     if (iq_swap) return fail("--iq-swap needs a complex (I/Q) sample format");
@@ -73,7 +74,8 @@ SampleSourceOptions checked(const std::filesystem::path& path, signals::SampleFo
   return options;
 }
 
-float gain_for(signals::SampleFormat format) {
+float gain_for(const std::filesystem::path& path, signals::SampleFormat format, const SampleSourceOptions& options) {
+  if (options.int16_gain > 0.0) return static_cast<float>(options.int16_gain);
   switch (format) {
     case signals::SampleFormat::i8:
     case signals::SampleFormat::r8:
@@ -82,9 +84,15 @@ float gain_for(signals::SampleFormat format) {
     case signals::SampleFormat::r16:
       return 0.25f;  // 32767 / 4 * sqrt(2) = 11585
     case signals::SampleFormat::f32:
-      return 1024.0f;
+      break;
   }
-  return 1.0f;
+  signals::SampleReader probe(path, format, 0);
+  std::vector<std::complex<float>> head(std::size_t{1} << 16);
+  const std::size_t n = probe.read(head);
+  double power = 0.0;
+  for (std::size_t i = 0; i < n; ++i) power += std::norm(head[i]);
+  const double rms = n > 0 ? std::sqrt(power / static_cast<double>(n)) : 0.0;
+  return rms > 0.0 && std::isfinite(rms) ? static_cast<float>(2048.0 / rms) : 1.0f;
 }
 
 }  // namespace
@@ -93,7 +101,7 @@ SampleSource::SampleSource(std::filesystem::path path, signals::SampleFormat for
     : options_(checked(path, format, options)),
       reader_(path, format, options.start_sample),
       converter_(options_, signals::is_complex(format)),
-      int16_gain_(gain_for(format)) {}
+      int16_gain_(gain_for(path, format, options_)) {}
 
 SampleBlock SampleSource::read(std::span<std::complex<float>> out) {
   const SampleBlock block{converter_.next_sample(), reader_.read(out)};

@@ -21,7 +21,16 @@ struct Checker {
   }
 };
 
+constexpr double kSmoothing_s = 0.1;
+
 int epochs_in(double window_s, double t_s) { return std::max(1, static_cast<int>(std::lround(window_s / t_s))); }
+
+// The moments method estimates the noise as a small difference of large moments at high SNR: it needs more
+// epochs per window than the noise-tap ratio (50 keeps its spread below ~0.5 dB at 45 dB-Hz, 20 ms).
+int cn0_window_epochs(Cn0Method method, double window_s, double t_s) {
+  const int n = epochs_in(window_s, t_s);
+  return method == Cn0Method::kMoments ? std::max(n, 50) : n;
+}
 
 }  // namespace
 
@@ -36,6 +45,12 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.fll_narrow_bw_hz > 0 && o.fll_narrow_bw_hz <= 20, "fll_narrow_bw_hz", o.fll_narrow_bw_hz, "(0, 20] Hz");
   c.check(o.pullin_lock_time_s >= 0.01 && o.pullin_lock_time_s <= 2, "pullin_lock_time_s", o.pullin_lock_time_s, "[0.01, 2] s");
   c.check(o.pullin_timeout_s >= 0.1 && o.pullin_timeout_s <= 30, "pullin_timeout_s", o.pullin_timeout_s, "[0.1, 30] s");
+  c.check(o.fll_fine_time_s >= 0 && o.fll_fine_time_s <= 5, "fll_fine_time_s", o.fll_fine_time_s, "[0, 5] s");
+  c.check(o.fll_fine_bw_hz > 0 && o.fll_fine_bw_hz <= 10, "fll_fine_bw_hz", o.fll_fine_bw_hz, "(0, 10] Hz");
+  const double pullin_min_s = o.fll_wide_time_s + o.fll_narrow_time_s + o.fll_fine_time_s + o.pli_time_constant_s +
+                              o.pullin_lock_time_s;
+  c.check(o.pullin_timeout_s > pullin_min_s, "pullin_timeout_s", o.pullin_timeout_s,
+          "(sum of the FLL stage times + pli_time_constant_s + pullin_lock_time_s, 30] s");
   c.check(o.dll_bw_hz > 0 && o.dll_bw_hz <= 10, "dll_bw_hz", o.dll_bw_hz, "(0, 10] Hz");
   c.check(o.dll_bw_coherent_hz > 0 && o.dll_bw_coherent_hz <= 5, "dll_bw_coherent_hz", o.dll_bw_coherent_hz, "(0, 5] Hz");
   c.check(o.early_late_offset_chips > 0 && o.early_late_offset_chips <= 0.5, "early_late_offset_chips",
@@ -90,13 +105,36 @@ const ScalarTrackingOptions& valid(const ScalarTrackingOptions& o) {
 
 ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCommand& initial)
     : opt_(valid(options)),
-      carrier_(options.pll_order, options.pll_bw_hz, options.fll_bw_hz, initial.carrier_frequency_hz),
+      // The PLL pulls in as 2nd order (a 3rd-order loop's rate state random-walks while cycles slip) and takes the
+      // configured order at phase lock.
+      carrier_(2, options.pll_bw_hz, 0.0, initial.carrier_frequency_hz),
       command_(initial),
       pli_(options.pli_time_constant_s),
-      cn0_(options.cn0_method, epochs_in(options.cn0_window_s, 1e-3)),
+      cn0_(options.cn0_method, cn0_window_epochs(options.cn0_method, options.cn0_window_s, 1e-3)),
       bit_sync_(options.bit_sync) {
   command_.code_phase_jump_chips = 0.0;
   command_.carrier_phase_jump_cycles = 0.0;
+}
+
+double ScalarTracking::fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz) {
+  constexpr int kFineSumEpochs = 5;  // 5 ms sums: +-50 Hz range, at most one bit edge inside (bit-tolerant)
+  fine_sum_ += std::complex<double>(prompt);
+  fine_time_s_ += t_s;
+  if (++fine_count_ < kFineSumEpochs) return carrier_.frequency_hz();
+  double frequency = carrier_.frequency_hz();
+  if (fine_have_previous_) {
+    const std::complex<float> a(fine_previous_), b(fine_sum_);
+    CrossDot cd = cross_dot(a, b);
+    if (cd.dot < 0.0) cd = {-cd.cross, -cd.dot};
+    *frequency_error_hz = std::atan2(cd.cross, cd.dot) / (kTwoPi * fine_time_s_);
+    frequency = carrier_.update_fll_only(*frequency_error_hz, opt_.fll_fine_bw_hz, fine_time_s_);
+  }
+  fine_previous_ = fine_sum_;
+  fine_have_previous_ = true;
+  fine_sum_ = {};
+  fine_count_ = 0;
+  fine_time_s_ = 0.0;
+  return frequency;
 }
 
 TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
@@ -108,7 +146,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   // Lock detectors. Their statistics depend on the epoch length: restart them when it changes.
   if (e.num_code_periods != cn0_epoch_periods_) {
     cn0_epoch_periods_ = e.num_code_periods;
-    cn0_ = Cn0Estimator(opt_.cn0_method, epochs_in(opt_.cn0_window_s, t));
+    cn0_ = Cn0Estimator(opt_.cn0_method, cn0_window_epochs(opt_.cn0_method, opt_.cn0_window_s, t));
     pli_.reset();
   }
   if (opt_.cn0_method == Cn0Method::kNoiseTap) {
@@ -126,9 +164,18 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
 
   r.phase_error_cycles = costas_atan_cycles(taps.prompt);
+  // Frequency error from cross and dot averaged over ~4 epochs: halves of this epoch in the wide stage, this and
+  // the previous prompt (dot sign removed: bit-tolerant) afterwards.
   const bool wide_fll = time_s_ <= opt_.fll_wide_time_s || previous_t_s_ == 0.0;
-  r.frequency_error_hz = wide_fll ? fll_atan2_hz(e.prompt_halves[0], e.prompt_halves[1], 0.5 * t)
-                                  : fll_atan_hz(previous_prompt_, taps.prompt, 0.5 * (previous_t_s_ + t));
+  if (wide_fll != wide_fll_) fll_average_ = {};
+  wide_fll_ = wide_fll;
+  CrossDot cd = wide_fll ? cross_dot(e.prompt_halves[0], e.prompt_halves[1]) : cross_dot(previous_prompt_, taps.prompt);
+  if (!wide_fll && cd.dot < 0.0) cd = {-cd.cross, -cd.dot};
+  constexpr double kFllAverage = 0.25;
+  fll_average_.cross += kFllAverage * (cd.cross - fll_average_.cross);
+  fll_average_.dot += kFllAverage * (cd.dot - fll_average_.dot);
+  const double fll_dt = wide_fll ? 0.5 * t : 0.5 * (previous_t_s_ + t);
+  r.frequency_error_hz = std::atan2(fll_average_.cross, fll_average_.dot) / (kTwoPi * fll_dt);
   previous_prompt_ = taps.prompt;
   previous_t_s_ = t;
   r.code_error_chips = dll_nelp_chips(taps.early, taps.late, opt_.early_late_offset_chips);
@@ -141,11 +188,16 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
 
   // State machine.
   if (state_ == TrackingState::kPullIn) {
-    locked_time_s_ = r.phase_locked ? locked_time_s_ + t : 0.0;
+    // Phase lock can only be judged once the PLL runs (after the FLL stages) and the PLI has settled on it.
+    const double pll_start_s = opt_.fll_wide_time_s + opt_.fll_narrow_time_s + opt_.fll_fine_time_s;
+    if (time_s_ > pll_start_s && time_s_ - t <= pll_start_s) pli_.reset();
+    const bool judged = time_s_ > pll_start_s + opt_.pli_time_constant_s;
+    locked_time_s_ = judged && r.phase_locked ? locked_time_s_ + t : 0.0;
     if (locked_time_s_ >= opt_.pullin_lock_time_s) {
       state_ = TrackingState::kPhaseLocked;
       ever_locked_ = true;
       carrier_.set_bandwidths(opt_.pll_bw_hz, 0.0);
+      carrier_.set_order(opt_.pll_order);
     } else if (time_s_ > opt_.pullin_timeout_s) {
       state_ = TrackingState::kLost;
     }
@@ -162,8 +214,9 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
     if (coherent_requested_ && e.num_code_periods == opt_.coherent_ms) {
       state_ = TrackingState::kBitSynced;
       carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
-      // The wide 1 ms loop's frequency (and more so its frequency rate) carries noise that would make the narrow
-      // loop ring for seconds: restart it from the smoothed frequency, and no rate (a static or vehicle receiver sees < ~10 Hz/s).
+      // The wide 1 ms loop's frequency, and much more its frequency rate, carry noise that would make the narrow
+      // loop ring for seconds: restart it from the smoothed frequency and no rate (a static receiver sees
+      // < 1 Hz/s, which the narrow loop then acquires within ~2 s).
       carrier_.reset(smoothed_frequency_hz_, 0.0);
     }
   }
@@ -181,16 +234,25 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   }
 
   // Loops.
-  if (state_ == TrackingState::kPullIn)
-    carrier_.set_bandwidths(opt_.pll_bw_hz, time_s_ <= opt_.fll_wide_time_s ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz);
-  const bool coherent = state_ == TrackingState::kBitSynced;
-  // The wide FLL runs alone: a PLL fed with the phase of a signal it does not yet follow only random-walks
-  // its integrators.
+  // Pull-in stages (see ScalarTrackingOptions): a first-order FLL alone, then the PLL alone.
+  const bool wide_stage = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s;
   const bool fll_only = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s;
-  const double f = carrier_.update(fll_only ? 0.0 : r.phase_error_cycles, r.frequency_error_hz, t);
+  const bool fine_stage = state_ == TrackingState::kPullIn && !fll_only &&
+                          time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s + opt_.fll_fine_time_s;
+  const bool coherent = state_ == TrackingState::kBitSynced;
+  double f = 0.0;
+  if (fll_only) {
+    f = carrier_.update_fll_only(r.frequency_error_hz, wide_stage ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz, t);
+  } else if (fine_stage) {
+    f = fine_fll(taps.prompt, t, &r.frequency_error_hz);
+  } else {
+    f = carrier_.update(r.phase_error_cycles, 0.0, t);
+  }
   const double dll_bw = coherent ? opt_.dll_bw_coherent_hz : opt_.dll_bw_hz;
-  if (state_ == TrackingState::kPhaseLocked) {
-    smoothed_frequency_hz_ = smoothed_frequency_hz_ == 0.0 ? f : smoothed_frequency_hz_ + std::min(1.0, t / 0.1) * (f - smoothed_frequency_hz_);
+  if (state_ == TrackingState::kPhaseLocked) {  // smoothed over kSmoothing_s for the switch to coherent epochs
+    if (!smoothing_started_) smoothed_frequency_hz_ = f;
+    smoothing_started_ = true;
+    smoothed_frequency_hz_ += std::min(1.0, t / kSmoothing_s) * (f - smoothed_frequency_hz_);
   }
   command_.carrier_frequency_hz = f;
   command_.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 + f / signals::kL1Frequency_hz) +

@@ -1,5 +1,5 @@
-// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. FLL-assisted Costas
-// PLL pull-in, then Costas PLL (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
+// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. FLL pull-in (wide,
+// narrow, fine stages) handing over to the Costas PLL (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
 // 1 ms epochs, then 20 ms coherent after bit sync; C/N0, phase-lock and C/N0 lock detectors; loss of lock is
 // a state (kLost), never silently tracked noise. Units: Hz, chips, cycles, seconds; C/N0 in dB-Hz at the edge.
 #pragma once
@@ -10,6 +10,7 @@
 
 #include "receiver/bit_sync.hpp"
 #include "receiver/correlation_epoch.hpp"
+#include "receiver/discriminators.hpp"
 #include "receiver/lock_detectors.hpp"
 #include "receiver/loop_filters.hpp"
 #include "receiver/nco_command.hpp"
@@ -25,16 +26,21 @@ struct ScalarTrackingOptions {
   double pll_bw_hz = 15.0;             // PLL noise bandwidth with 1 ms epochs; (0, 50]
   double pll_bw_coherent_hz = 5.0;     // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
                                        // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
-
   // Pull-in: (1) a wide FLL alone on the two halves of each code period (range +-1 kHz, bit-edge safe); (2) a
-  // narrow FLL alone on successive 1 ms prompts (bit-tolerant atan, range +-250 Hz, 8x less noise); (3) the PLL
-  // assisted by the narrow FLL until the phase lock indicator holds; then the PLL alone.
+  // narrow FLL alone on successive 1 ms prompts (bit-tolerant, range +-250 Hz, 8x less noise); (3) the PLL alone
+  // (2nd order while pulling in) until the phase lock indicator holds, then the PLL of pll_order. Both FLLs are
+  // first order and average cross and dot over ~4 epochs before the arctangent.
   double fll_bw_hz = 10.0;             // wide FLL; (0, 50]
   double fll_wide_time_s = 0.25;       // stage (1) length; [0.01, 5]
-  double fll_narrow_bw_hz = 5.0;       // narrow FLL; (0, 20]
-  double fll_narrow_time_s = 0.2;      // stage (2) length; [0, 5]
+  double fll_narrow_bw_hz = 2.0;       // narrow FLL; (0, 20]
+  double fll_narrow_time_s = 0.25;     // stage (2) length; [0, 5]
+  // (2b) a fine FLL on successive 5 ms prompt sums (bit-tolerant, range +-50 Hz, 5x the SNR per measurement):
+  // brings the frequency within the PLL's few-Hz lock-in range at low C/N0.
+  double fll_fine_bw_hz = 2.0;         // fine FLL; (0, 10]
+  double fll_fine_time_s = 0.3;        // stage (2b) length; [0, 5]
   double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
-  double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30]
+  double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30] and longer than
+                                       // the FLL stages plus pli_time_constant_s plus pullin_lock_time_s
   // Code loop
   double dll_bw_hz = 2.0;              // DLL noise bandwidth with 1 ms epochs; (0, 10]
   double dll_bw_coherent_hz = 1.0;     // after bit sync; (0, 5]
@@ -45,7 +51,7 @@ struct ScalarTrackingOptions {
   int coherent_ms = 20;                // coherent integration after bit sync, ms; 1, 2, 4, 5, 10 or 20
   BitSyncOptions bit_sync;
   // Lock detection
-  Cn0Method cn0_method = Cn0Method::kNoiseTap;  // kMoments works without the noise tap
+  Cn0Method cn0_method = Cn0Method::kNoiseTap;  // kMoments works without the noise tap (windows >= 50 epochs)
   double cn0_window_s = 0.2;           // C/N0 averaging window; [0.02, 5] (a multiple of the epoch length)
   double cn0_loss_threshold_dbhz = 25.0;  // C/N0 below this counts toward loss of lock; [0, 45]
   double pli_time_constant_s = 0.1;    // phase lock indicator low-pass; [0.005, 5]
@@ -61,7 +67,7 @@ std::string validation_error(const ScalarTrackingOptions& options);
 ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz, int num_antennas = 1);
 
 enum class TrackingState {
-  kPullIn,       // FLL-assisted PLL, 1 ms epochs
+  kPullIn,       // FLL stages, then the PLL until phase lock; 1 ms epochs
   kPhaseLocked,  // Costas PLL, 1 ms epochs, bit sync running
   kBitSynced,    // 20 ms (coherent_ms) epochs, bits flowing
   kLost,         // lock lost: the command only coasts; re-acquire
@@ -99,6 +105,8 @@ class ScalarTracking final {
   std::int64_t bit_edge_period() const { return bit_sync_.edge_period(); }
 
  private:
+  double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
+
   ScalarTrackingOptions opt_;
   TrackingState state_ = TrackingState::kPullIn;
   CarrierLoopFilter carrier_;
@@ -115,7 +123,14 @@ class ScalarTracking final {
   double time_s_ = 0.0, locked_time_s_ = 0.0, loss_time_s_ = 0.0;
   bool ever_locked_ = false;
   std::complex<float> previous_prompt_{};
-  double smoothed_frequency_hz_ = 0.0;  // NCO frequency low-passed over ~0.1 s while phase-locked at 1 ms
+  CrossDot fll_average_{};
+  std::complex<double> fine_sum_{}, fine_previous_{};
+  int fine_count_ = 0;
+  double fine_time_s_ = 0.0;
+  bool fine_have_previous_ = false;
+  bool wide_fll_ = true;
+  double smoothed_frequency_hz_ = 0.0;  // NCO frequency and rate low-passed while phase-locked at 1 ms
+  bool smoothing_started_ = false;
   double previous_t_s_ = 0.0;
 };
 

@@ -8,6 +8,7 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "ins/ins_error.hpp"
 #include "signals/input_error.hpp"
 
 int main(int argc, char** argv) {
@@ -18,6 +19,8 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_demo_command(app);
   ultratrack::tools::add_acquire_command(app);
   ultratrack::tools::add_receive_command(app);
+  ultratrack::tools::add_ins_command(app);
+  ultratrack::tools::add_imusim_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -26,6 +29,9 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "ultratrack: {}\n", e.what());
     return e.code;
   } catch (const ultratrack::signals::InputError& e) {
+    fmt::print(stderr, "ultratrack: error: {}\n", e.what());
+    return 2;
+  } catch (const ultratrack::ins::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {

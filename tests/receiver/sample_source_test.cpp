@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <random>
 
 #include "signals/input_error.hpp"
 #include "support/test_data.hpp"
@@ -161,4 +162,34 @@ TEST(SampleSource, BadOptionsAndFilesAreInputErrors) {
   } catch (const ultratrack::signals::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("x.r8"), std::string::npos);
   }
+}
+
+TEST(SampleSource, FloatFilesGetAnInt16ScaleFromTheirOwnLevel) {
+  // gr_complex files have no full scale (the CTTC capture has an RMS of 177): the int16 output must
+  // neither saturate nor vanish. Gaussian noise of RMS 177 must come out with RMS 2048.
+  const auto path = ultratrack::test::scratch_dir() / "noise.f32";
+  {
+    std::ofstream f(path, std::ios::binary);
+    std::mt19937 rng(4);
+    std::normal_distribution<float> normal(0.0f, 177.0f / std::sqrt(2.0f));
+    for (int i = 0; i < 100000; ++i) {
+      const float iq[2] = {normal(rng), normal(rng)};
+      f.write(reinterpret_cast<const char*>(iq), sizeof iq);
+    }
+  }
+  SampleSourceOptions o;
+  o.fs_hz = 4e6;
+  SampleSource source(path, SampleFormat::f32, o);
+  std::vector<std::complex<std::int16_t>> out(100000);
+  ASSERT_EQ(source.read(out).count, out.size());
+  double power = 0.0;
+  int saturated = 0;
+  for (const auto& v : out) {
+    power += double(v.real()) * v.real() + double(v.imag()) * v.imag();
+    saturated += (std::abs(v.real()) == 32767 || std::abs(v.imag()) == 32767) ? 1 : 0;
+  }
+  EXPECT_NEAR(std::sqrt(power / out.size()), 2048.0, 2048.0 * 0.01);  // 1e5 samples: 0.2 % (1 sigma)
+  EXPECT_EQ(saturated, 0);
+  o.int16_gain = 3.0;
+  EXPECT_FLOAT_EQ(SampleSource(path, SampleFormat::f32, o).int16_gain(), 3.0f);
 }

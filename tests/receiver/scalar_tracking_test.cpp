@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -107,6 +108,9 @@ TEST(ScalarTracking, DefaultOptionsAreValidAndBadOnesAreNamed) {
   o.coherent_ms = 3;
   EXPECT_NE(validation_error(o).find("coherent_ms"), std::string::npos);
   o = {};
+  o.pullin_timeout_s = 0.5;  // shorter than the FLL stages: could never lock
+  EXPECT_NE(validation_error(o).find("pullin_timeout_s"), std::string::npos);
+  o = {};
   o.pli_loss_threshold = 0.9;
   EXPECT_NE(validation_error(o).find("pli_loss_threshold"), std::string::npos);
   EXPECT_THROW(ScalarTracking(o, NcoCommand{}), std::invalid_argument);
@@ -115,7 +119,7 @@ TEST(ScalarTracking, DefaultOptionsAreValidAndBadOnesAreNamed) {
 TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   const auto sat = satellite(7, 45.0);
   ScalarTrackingOptions opt;
-  const auto recs = track(sat, opt, +230.0, 0.5, 5.0);
+  const auto recs = track(sat, opt, +240.0, 0.5, 6.0);
   double t_locked = -1, t_synced = -1;
   std::vector<double> code_err, phase_err, cn0;
   int bit_errors_plus = 0, bit_errors_minus = 0, bits = 0;
@@ -134,7 +138,7 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
       bit_errors_minus += r.report.bit->value != -truth;
       ++bits;
     }
-    if (r.t_s > 2.5) {
+    if (r.t_s > 3.5) {  // the narrow 20 ms loop settles within ~2 s of bit sync
       code_err.push_back(r.code_error_chips);
       phase_err.push_back(r.phase_error_cycles);
       if (r.report.cn0_dbhz) cn0.push_back(*r.report.cn0_dbhz);
@@ -142,8 +146,8 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   }
   ASSERT_GT(t_locked, 0.0);
   ASSERT_GT(t_synced, 0.0);
-  EXPECT_LT(t_locked, 1.0);
-  EXPECT_LT(t_synced, 2.0);
+  EXPECT_LT(t_locked, 1.5);  // FLL stages 0.65 s, then PLL lock judged over >= 0.2 s
+  EXPECT_LT(t_synced, 2.5);
   EXPECT_GE(bits, 100);
   EXPECT_EQ(std::min(bit_errors_plus, bit_errors_minus), 0);
   ASSERT_GT(code_err.size(), 50u);
@@ -151,7 +155,7 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   const double sigma_phase = pll_jitter_cycles(6.0, 45.0, 0.02);
   const double sigma_code = dll_jitter_chips(1.0, 2 * opt.early_late_offset_chips, 45.0, 0.02);
   const double code_rms = rms(code_err), phase_rms = rms(phase_err);
-  // Factors: 1.5 on the carrier (~100 independent samples in 2.5 s at 6 Hz: the RMS itself scatters ~10 %);
+  // Factors: 1.5 on the carrier (~30 independent samples in 2.5 s at 6 Hz: the RMS itself scatters ~13 %);
   // 2.5 on the code (a 1 Hz loop gives only ~10 independent samples, chi-square 99 % ~ 1.7, plus the sampled,
   // non-ideal triangle at 2.44 samples per chip).
   std::printf("45 dB-Hz: carrier RMS %.5f cycles (bound %.5f), code RMS %.5f chips (bound %.5f), lock %.3f s, "
@@ -164,10 +168,10 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   EXPECT_NEAR(mean_cn0, 45.0, 1.0);
 }
 
-TEST(ScalarTracking, PullsInFromNegativeDopplerErrorAndTracksAt35DbHz) {
+TEST(ScalarTracking, PullsInFrom240HzBelowAndTracksAt35DbHz) {
   const auto sat = satellite(23, 35.0);
   ScalarTrackingOptions opt;
-  const auto recs = track(sat, opt, -150.0, -0.4, 5.0, 7);
+  const auto recs = track(sat, opt, -240.0, -0.5, 6.0, 7);
   std::vector<double> cn0, phase_err;
   bool synced = false;
   for (const auto& r : recs) {
@@ -176,7 +180,7 @@ TEST(ScalarTracking, PullsInFromNegativeDopplerErrorAndTracksAt35DbHz) {
       synced = true;
       EXPECT_EQ(((r.true_period + sat.bit_offset_periods) % 20 + 20) % 20, 0);
     }
-    if (r.t_s > 3.0) {
+    if (r.t_s > 3.5) {
       if (r.report.cn0_dbhz) cn0.push_back(*r.report.cn0_dbhz);
       phase_err.push_back(r.phase_error_cycles);
     }
@@ -194,12 +198,16 @@ TEST(ScalarTracking, MomentsEstimatorWorksWithoutTheNoiseTap) {
   const auto sat = satellite(2, 45.0);
   ScalarTrackingOptions opt;
   opt.cn0_method = Cn0Method::kMoments;
-  const auto recs = track(sat, opt, 80.0, 0.2, 3.0, 9);
+  const auto recs = track(sat, opt, 80.0, 0.2, 4.0, 9);
   std::vector<double> cn0;
+  std::optional<double> last;
   for (const auto& r : recs) {
     ASSERT_NE(r.report.state, TrackingState::kLost);
-    if (r.t_s > 2.0 && r.report.cn0_dbhz) cn0.push_back(*r.report.cn0_dbhz);
+    // each new window's estimate once (the report repeats the latest one every epoch)
+    if (r.t_s > 1.0 && r.report.cn0_dbhz && r.report.cn0_dbhz != last) cn0.push_back(*r.report.cn0_dbhz);
+    last = r.report.cn0_dbhz;
   }
+  ASSERT_GE(cn0.size(), 5u);
   double mean_cn0 = 0.0;
   for (double c : cn0) mean_cn0 += c / static_cast<double>(cn0.size());
   EXPECT_NEAR(mean_cn0, 45.0, 1.0);
@@ -238,4 +246,18 @@ TEST(ScalarTracking, NarrowCorrelatorTracks) {
   const double bound = dll_jitter_chips(1.0, 0.2, 45.0, 0.02);
   std::printf("narrow (0.2 chip E-L): code RMS %.5f chips (bound %.5f)\n", rms(code_err), bound);
   EXPECT_LT(rms(code_err), 3.0 * bound);
+}
+
+TEST(ScalarTracking, PullsInAt32DbHzThroughTheFineFll) {
+  // Below the 1 ms FLLs' comfort: the 5 ms fine FLL must bring the frequency into the PLL's lock-in range.
+  const auto sat = satellite(5, 32.0);
+  ScalarTrackingOptions opt;
+  const auto recs = track(sat, opt, 60.0, 0.3, 3.0, 21);
+  bool locked = false;
+  for (const auto& r : recs) {
+    ASSERT_NE(r.report.state, TrackingState::kLost) << "t " << r.t_s;
+    locked = locked || r.report.state != TrackingState::kPullIn;
+  }
+  EXPECT_TRUE(locked);
+  EXPECT_LT(std::abs(recs.back().phase_error_cycles), 0.1);
 }

@@ -234,3 +234,42 @@ TEST(TrackingChannel, StartsFromAnAcquisitionCodeStart) {
   EXPECT_NEAR(epochs[0].first_sample, 1000 + samples_to_start, 1.0);
   EXPECT_NEAR(std::abs(epochs[0].master().prompt), epochs[0].num_samples, 1e-3 * epochs[0].num_samples);
 }
+
+TEST(TrackingChannel, VeryEarlyLateAndNoiseTapsLandInTheirFields) {
+  test::TestSatellite sat;
+  sat.prn = 25;
+  sat.doppler_hz = 700.0;
+  sat.code_phase_chips = 50.0;
+  const auto x = test::generate({sat}, {kFs, false, 1}, 0, 12000);
+  ChannelConfig cfg{25, kFs, 1, {}};
+  cfg.layout.early_late_offset_chips = 0.25;
+  cfg.layout.very_early_late = true;
+  cfg.layout.very_early_late_offset_chips = 0.75;
+  TrackingChannel ch(cfg, start_at_truth(sat, 0));
+  const auto epochs = run(ch, x, 0, 4000);
+  ASSERT_GE(epochs.size(), 2u);
+  const auto& t = epochs[1].master();
+  const double n = epochs[1].num_samples;
+  // On the triangle: |E| = |L| ~ 0.75 N, |VE| = |VL| ~ 0.25 N, noise tap ~ 0 (1 % sampling ripple).
+  EXPECT_NEAR(std::abs(t.early), 0.75 * n, 0.015 * n);
+  EXPECT_NEAR(std::abs(t.late), 0.75 * n, 0.015 * n);
+  EXPECT_NEAR(std::abs(t.very_early), 0.25 * n, 0.015 * n);
+  EXPECT_NEAR(std::abs(t.very_late), 0.25 * n, 0.015 * n);
+  EXPECT_LT(std::abs(t.noise), 0.01 * n);
+  // Without the noise tap the field reads zero.
+  cfg.layout.noise = false;
+  TrackingChannel quiet(cfg, start_at_truth(sat, 0));
+  EXPECT_EQ(run(quiet, x, 0, 4000)[1].master().noise, std::complex<float>{});
+}
+
+TEST(TrackingChannel, RejectsBadConfiguration) {
+  ChannelStart s;
+  EXPECT_THROW(TrackingChannel(ChannelConfig{0, kFs, 1, {}}, s), std::invalid_argument);
+  EXPECT_THROW(TrackingChannel(ChannelConfig{1, 1e5, 1, {}}, s), std::invalid_argument);
+  EXPECT_THROW(TrackingChannel(ChannelConfig{1, kFs, 5, {}}, s), std::invalid_argument);
+  ChannelConfig wide{1, kFs, 1, {}};
+  wide.layout.early_late_offset_chips = 1.5;
+  EXPECT_THROW(TrackingChannel(wide, s), std::invalid_argument);
+  s.code_phase_chips = 1023.0;
+  EXPECT_THROW(TrackingChannel(ChannelConfig{1, kFs, 1, {}}, s), std::invalid_argument);
+}

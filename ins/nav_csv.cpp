@@ -1,0 +1,89 @@
+#include "ins/nav_csv.hpp"
+
+#include <fmt/core.h>
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "ins/atomic_file.hpp"
+#include "ins/attitude.hpp"
+#include "ins/csv_util.hpp"
+#include "ins/ins_error.hpp"
+
+namespace ultratrack::ins {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+const std::vector<std::string>& nav_header() {
+  static const std::vector<std::string> h{"t_s",       "lat_deg",   "lon_deg",  "height_m",  "vel_n_mps",
+                                          "vel_e_mps", "vel_d_mps", "roll_deg", "pitch_deg", "yaw_deg"};
+  return h;
+}
+
+}  // namespace
+
+std::vector<NavState> read_nav_csv(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::ifstream in(file);
+  if (!in) throw InputError(name, "cannot open navigation file");
+  std::vector<NavState> out;
+  std::string line;
+  int line_no = 0;
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string_view t = trim(line);
+    if (t.empty()) continue;
+    if (!have_header) {
+      check_header(name, line_no, t, nav_header());
+      have_header = true;
+      continue;
+    }
+    std::array<double, 10> v{};
+    parse_row(name, line_no, t, v);
+    if (!out.empty() && !(v[0] > out.back().t_s))
+      throw InputError(name, "time does not increase (t_s " + fmt::format("{}", v[0]) + ")", line_no);
+    if (std::fabs(v[1]) > 90.0) throw InputError(name, "lat_deg outside [-90, 90]", line_no);
+    if (std::fabs(v[2]) > 360.0) throw InputError(name, "lon_deg outside [-360, 360]", line_no);
+    if (std::fabs(v[8]) > 90.0) throw InputError(name, "pitch_deg outside [-90, 90]", line_no);
+    NavState s;
+    s.t_s = v[0];
+    s.lat_rad = v[1] * kDeg;
+    s.lon_rad = v[2] * kDeg;
+    s.height_m = v[3];
+    s.v_n = {v[4], v[5], v[6]};
+    s.q_nb = quaternion_from_euler({v[7] * kDeg, v[8] * kDeg, v[9] * kDeg});
+    out.push_back(s);
+  }
+  if (!have_header) throw InputError(name, "empty file: missing header");
+  if (out.empty()) throw InputError(name, "no navigation rows");
+  return out;
+}
+
+NavCsvWriter::NavCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<AtomicFile>(file)) {
+  std::string h;
+  for (const auto& n : nav_header()) h += (h.empty() ? "" : ",") + n;
+  out_->write(h + "\n");
+}
+
+NavCsvWriter::~NavCsvWriter() = default;
+
+void NavCsvWriter::write(const NavState& s) {
+  const EulerAngles e = euler_from_quaternion(s.q_nb);
+  fmt::print(out_->handle(), "{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
+             s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+}
+
+void NavCsvWriter::commit() { out_->commit(); }
+
+void write_nav_csv(const std::filesystem::path& file, std::span<const NavState> states) {
+  NavCsvWriter w(file);
+  for (const auto& s : states) w.write(s);
+  w.commit();
+}
+
+}  // namespace ultratrack::ins
