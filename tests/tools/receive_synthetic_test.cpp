@@ -111,13 +111,14 @@ ionosphere = false
 troposphere = false
 )";
   const auto sim = dir / "sim";
-  try {
-    run("simulate", {"--scenario", scenario.string(), "--out", sim.string()});
-  } catch (const std::runtime_error& e) {
-    // Until the synthesiser (issue 2) is merged, `simulate` is a placeholder that says so.
-    if (std::string(e.what()).find("being built") != std::string::npos) GTEST_SKIP() << e.what();
-    throw;
+  {
+    // Until the synthesiser (issue 2) is merged, `simulate` is a placeholder without options.
+    CLI::App probe;
+    ultratrack::tools::add_simulate_command(probe);
+    if (probe.get_subcommand("simulate")->get_option_no_throw("--scenario") == nullptr)
+      GTEST_SKIP() << "ultratrack simulate is not merged yet";
   }
+  run("simulate", {"--scenario", scenario.string(), "--out", sim.string()});
   const auto out = dir / "rx";
   run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.6e6", "--out",
                   out.string(), "--reference-week", "2190", "--ionosphere", "off", "--troposphere", "off"});
@@ -158,17 +159,17 @@ troposphere = false
   std::ifstream in(pos);
   std::string line;
   int rows = 0;
-  double sum_r2 = 0.0;
+  double rtklib_r2 = 0.0;
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '%') continue;
     std::stringstream ss(line);
     double week = 0, tow = 0, x = 0, y = 0, z = 0;
     ss >> week >> tow >> x >> y >> z;
-    sum_r2 += (Eigen::Vector3d(x, y, z) - r_true).squaredNorm();
+    rtklib_r2 += (Eigen::Vector3d(x, y, z) - r_true).squaredNorm();
     ++rows;
   }
   ASSERT_GT(rows, 10);
-  const double rtklib_rms = std::sqrt(sum_r2 / rows);
+  const double rtklib_rms = std::sqrt(rtklib_r2 / rows);
   std::printf("rnx2rtkp on our RINEX: %d epochs, 3-D RMS %.2f m\n", rows, rtklib_rms);
   EXPECT_LE(rtklib_rms, 10.0);
 }
