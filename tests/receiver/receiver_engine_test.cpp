@@ -128,3 +128,36 @@ TEST(ReceiverOptions, ValidateNamesTheBadField) {
   o.tracking.pll_order = 5;
   EXPECT_NE(o.validate().find("tracking"), std::string::npos);
 }
+
+// A satellite that vanishes at 1.8 s and comes back at 3.5 s: the channel must declare loss of lock (C/N0 and
+// PLI tests over loss_of_lock_time_s = 0.3 s plus the 0.2 s C/N0 window), be released, and the PRN be found
+// again by a re-acquisition snapshot (every 1 s here) and tracked to phase lock by the end at 5.5 s.
+TEST(ReceiverEngine, ReleasesALostChannelAndReacquiresTheSatellite) {
+  test::TestSatellite first = satellite(9, 1800.0, 400.2);
+  first.stop_s = 1.8;
+  test::TestSatellite again = first;
+  again.start_s = 3.5;
+  again.stop_s = 1e30;
+  ReceiverOptions options;
+  options.fs_hz = kFs;
+  options.prns = {9};
+  options.reacquisition_interval_s = 1.0;
+  Recorder recorder;
+  ReceiverEngine engine(options, recorder);
+  const std::int64_t block = 130000, total = static_cast<std::int64_t>(5.5 * kFs);
+  std::int64_t released_at = -1;
+  for (std::int64_t first_sample = 0; first_sample < total; first_sample += block) {
+    const auto x = test::generate({first, again}, test::TestSignal{kFs, true, 5}, first_sample, block);
+    engine.process(x, first_sample);
+    if (released_at < 0 && engine.stats().satellites[9].losses > 0) released_at = first_sample + block;
+  }
+  const auto& stats = engine.stats().satellites[9];
+  EXPECT_EQ(stats.losses, 1);
+  EXPECT_EQ(stats.acquisitions, 2);
+  ASSERT_GT(released_at, 0);
+  EXPECT_LT(static_cast<double>(released_at) / kFs, 1.8 + 1.0);  // loss declared within a second of the outage
+  EXPECT_EQ(engine.channels_in_use(), 1);
+  const TrackingRecord& last = recorder.records.at(9).back();
+  EXPECT_TRUE(last.phase_locked);
+  EXPECT_NEAR(last.doppler_hz, test::true_doppler_hz(again, static_cast<double>(last.sample_index) / kFs), 5.0);
+}
