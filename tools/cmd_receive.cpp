@@ -36,11 +36,11 @@ namespace ultratrack::tools {
 namespace {
 
 volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void on_sigint(int) { g_interrupted = 1; }
+void stop_receiving(int) { g_interrupted = 1; }  // C++ linkage: no clash with other commands' handlers
 
 // Restores the previous SIGINT handler when the command leaves, however it leaves.
 struct SigintGuard {
-  SigintGuard() : previous(std::signal(SIGINT, on_sigint)) { g_interrupted = 0; }
+  SigintGuard() : previous(std::signal(SIGINT, stop_receiving)) { g_interrupted = 0; }
   ~SigintGuard() { std::signal(SIGINT, previous); }
   void (*previous)(int);
 };
