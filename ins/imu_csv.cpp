@@ -6,9 +6,9 @@
 #include <fstream>
 #include <string>
 
-#include "ins/atomic_file.hpp"
-#include "ins/csv_util.hpp"
 #include "ins/ins_error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/numeric_csv.hpp"
 
 namespace ultratrack::ins {
 namespace {
@@ -22,34 +22,16 @@ const std::vector<std::string>& imu_header() {
 }  // namespace
 
 std::vector<ImuIncrement> read_imu_csv(const std::filesystem::path& file) {
-  const std::string name = file.string();
-  std::ifstream in(file);
-  if (!in) throw InputError(name, "cannot open IMU file");
   std::vector<ImuIncrement> out;
-  std::string line;
-  int line_no = 0;
-  bool have_header = false;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string_view t = trim(line);
-    if (t.empty()) continue;
-    if (!have_header) {
-      check_header(name, line_no, t, imu_header());
-      have_header = true;
-      continue;
-    }
-    std::array<double, 7> v{};
-    parse_row(name, line_no, t, v);
+  io::read_numeric_csv(file, "IMU file", imu_header(), [&](int line, std::span<const double> v) {
     if (!out.empty() && !(v[0] > out.back().t_s))
-      throw InputError(name, "time does not increase (t_s " + fmt::format("{}", v[0]) + ")", line_no);
+      throw InputError(file.string(), fmt::format("time does not increase (t_s {})", v[0]), line);
     out.push_back({v[0], {v[1], v[2], v[3]}, {v[4], v[5], v[6]}});
-  }
-  if (!have_header) throw InputError(name, "empty file: missing header");
-  if (out.empty()) throw InputError(name, "no IMU rows");
+  });
   return out;
 }
 
-ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<AtomicFile>(file)) {
+ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<io::AtomicFile>(file)) {
   std::string h;
   for (const auto& n : imu_header()) h += (h.empty() ? "" : ",") + n;
   out_->write(h + "\n");
@@ -58,8 +40,8 @@ ImuCsvWriter::ImuCsvWriter(const std::filesystem::path& file) : out_(std::make_u
 ImuCsvWriter::~ImuCsvWriter() = default;
 
 void ImuCsvWriter::write(const ImuIncrement& i) {
-  fmt::print(out_->handle(), "{},{},{},{},{},{},{}\n", i.t_s, i.dtheta_b.x(), i.dtheta_b.y(), i.dtheta_b.z(),
-             i.dv_b.x(), i.dv_b.y(), i.dv_b.z());
+  out_->write(fmt::format("{},{},{},{},{},{},{}\n", i.t_s, i.dtheta_b.x(), i.dtheta_b.y(), i.dtheta_b.z(), i.dv_b.x(),
+                          i.dv_b.y(), i.dv_b.z()));
 }
 
 void ImuCsvWriter::commit() { out_->commit(); }

@@ -10,9 +10,12 @@
 
 #include "ins/nav_state.hpp"
 
+namespace ultratrack::io {
+class AtomicFile;
+}
+
 namespace ultratrack::ins {
 
-class AtomicFile;
 
 std::vector<ImuIncrement> read_imu_csv(const std::filesystem::path& file);
 
@@ -24,7 +27,7 @@ class ImuCsvWriter {
   void commit();
 
  private:
-  std::unique_ptr<AtomicFile> out_;
+  std::unique_ptr<io::AtomicFile> out_;
 };
 
 void write_imu_csv(const std::filesystem::path& file, std::span<const ImuIncrement> imu);

@@ -8,10 +8,10 @@
 #include <numbers>
 #include <string>
 
-#include "ins/atomic_file.hpp"
 #include "ins/attitude.hpp"
-#include "ins/csv_util.hpp"
 #include "ins/ins_error.hpp"
+#include "io/atomic_file.hpp"
+#include "io/numeric_csv.hpp"
 
 namespace ultratrack::ins {
 namespace {
@@ -27,29 +27,13 @@ const std::vector<std::string>& nav_header() {
 }  // namespace
 
 std::vector<NavState> read_nav_csv(const std::filesystem::path& file) {
-  const std::string name = file.string();
-  std::ifstream in(file);
-  if (!in) throw InputError(name, "cannot open navigation file");
   std::vector<NavState> out;
-  std::string line;
-  int line_no = 0;
-  bool have_header = false;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string_view t = trim(line);
-    if (t.empty()) continue;
-    if (!have_header) {
-      check_header(name, line_no, t, nav_header());
-      have_header = true;
-      continue;
-    }
-    std::array<double, 10> v{};
-    parse_row(name, line_no, t, v);
+  io::read_numeric_csv(file, "navigation file", nav_header(), [&](int line_no, std::span<const double> v) {
     if (!out.empty() && !(v[0] > out.back().t_s))
-      throw InputError(name, "time does not increase (t_s " + fmt::format("{}", v[0]) + ")", line_no);
-    if (std::fabs(v[1]) > 90.0) throw InputError(name, "lat_deg outside [-90, 90]", line_no);
-    if (std::fabs(v[2]) > 360.0) throw InputError(name, "lon_deg outside [-360, 360]", line_no);
-    if (std::fabs(v[8]) > 90.0) throw InputError(name, "pitch_deg outside [-90, 90]", line_no);
+      throw InputError(file.string(), fmt::format("time does not increase (t_s {})", v[0]), line_no);
+    if (std::fabs(v[1]) > 90.0) throw InputError(file.string(), "lat_deg outside [-90, 90]", line_no);
+    if (std::fabs(v[2]) > 360.0) throw InputError(file.string(), "lon_deg outside [-360, 360]", line_no);
+    if (std::fabs(v[8]) > 90.0) throw InputError(file.string(), "pitch_deg outside [-90, 90]", line_no);
     NavState s;
     s.t_s = v[0];
     s.lat_rad = v[1] * kDeg;
@@ -58,13 +42,11 @@ std::vector<NavState> read_nav_csv(const std::filesystem::path& file) {
     s.v_n = {v[4], v[5], v[6]};
     s.q_nb = quaternion_from_euler({v[7] * kDeg, v[8] * kDeg, v[9] * kDeg});
     out.push_back(s);
-  }
-  if (!have_header) throw InputError(name, "empty file: missing header");
-  if (out.empty()) throw InputError(name, "no navigation rows");
+  });
   return out;
 }
 
-NavCsvWriter::NavCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<AtomicFile>(file)) {
+NavCsvWriter::NavCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<io::AtomicFile>(file)) {
   std::string h;
   for (const auto& n : nav_header()) h += (h.empty() ? "" : ",") + n;
   out_->write(h + "\n");
@@ -74,8 +56,8 @@ NavCsvWriter::~NavCsvWriter() = default;
 
 void NavCsvWriter::write(const NavState& s) {
   const EulerAngles e = euler_from_quaternion(s.q_nb);
-  fmt::print(out_->handle(), "{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
-             s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
+                          s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg));
 }
 
 void NavCsvWriter::commit() { out_->commit(); }

@@ -11,9 +11,12 @@
 
 #include "ins/nav_state.hpp"
 
+namespace ultratrack::io {
+class AtomicFile;
+}
+
 namespace ultratrack::ins {
 
-class AtomicFile;
 
 std::vector<NavState> read_nav_csv(const std::filesystem::path& file);
 
@@ -25,7 +28,7 @@ class NavCsvWriter {
   void commit();
 
  private:
-  std::unique_ptr<AtomicFile> out_;
+  std::unique_ptr<io::AtomicFile> out_;
 };
 
 void write_nav_csv(const std::filesystem::path& file, std::span<const NavState> states);

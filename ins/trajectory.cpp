@@ -4,8 +4,8 @@
 #include <fstream>
 #include <numbers>
 
-#include "ins/csv_util.hpp"
 #include "ins/ins_error.hpp"
+#include "io/numeric_csv.hpp"
 
 namespace ultratrack::ins {
 namespace {
@@ -96,32 +96,14 @@ TrajectorySpec profile_spec(std::string_view name, double duration_s, double lat
 }
 
 TrajectorySpec read_segments_csv(const std::filesystem::path& file, const TrajectorySpec& start) {
-  std::ifstream in(file);
-  const std::string fname = file.string();
-  if (!in) throw InputError(fname, "cannot open segment file");
   TrajectorySpec spec = start;
   spec.segments.clear();
   const std::vector<std::string> header{"duration_s", "accel_mps2", "turn_rate_dps", "climb_rate_mps", "grade_deg"};
-  std::string line;
-  int line_no = 0;
-  bool have_header = false;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string_view t = trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    if (!have_header) {
-      check_header(fname, line_no, t, header);
-      have_header = true;
-      continue;
-    }
-    std::array<double, 5> v{};
-    parse_row(fname, line_no, t, v);
-    if (!(v[0] > 0.0)) throw InputError(fname, "segment duration must be positive", line_no);
-    if (std::fabs(v[4]) >= 80.0) throw InputError(fname, "grade must be within +-80 deg", line_no);
+  io::read_numeric_csv(file, "segment file", header, [&](int line, std::span<const double> v) {
+    if (!(v[0] > 0.0)) throw InputError(file.string(), "segment duration must be positive", line);
+    if (std::fabs(v[4]) >= 80.0) throw InputError(file.string(), "grade must be within +-80 deg", line);
     spec.segments.push_back({v[0], v[1], v[2] * kDeg, v[3], v[4] * kDeg});
-  }
-  if (!have_header) throw InputError(fname, "empty file: missing header");
-  if (spec.segments.empty()) throw InputError(fname, "no segments");
+  });
   return spec;
 }
 

@@ -79,13 +79,21 @@ Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) 
   if (!options_.IsValid(&why)) throw std::invalid_argument("acquisition options: " + why);
   block_size_ = static_cast<std::size_t>(std::llround(options_.fs_hz * options_.coherent_s()));
   samples_per_chip_ = options_.fs_hz / kChipRate_hz;
-  lags_ = std::min(block_size_, static_cast<std::size_t>(std::ceil(kCodeLength * samples_per_chip_)));
-  forward_ = FftwPlan(block_size_, FftwPlan::Direction::forward);
-  backward_ = FftwPlan(block_size_, FftwPlan::Direction::backward);
-  mixed_ = FftwBuffer(block_size_);
-  product_ = FftwBuffer(block_size_);
-  correlation_ = FftwBuffer(block_size_);
-  spectrum_scratch_ = FftwBuffer(block_size_);
+  // Folding: with a whole number P of samples per code period, a T_coh-long block (Doppler removed) summed
+  // period by period into P samples has exactly the same circular correlation with the one-period replica,
+  // so the FFTs are P points long whatever T_coh is. Otherwise the FFTs span the whole block.
+  const double period = kCodeLength * samples_per_chip_;
+  const auto whole_period = static_cast<std::size_t>(std::llround(period));
+  const bool fold = std::abs(period - static_cast<double>(whole_period)) < 1e-6 &&
+                    block_size_ == whole_period * static_cast<std::size_t>(options_.coherent_ms);
+  fft_size_ = fold ? whole_period : block_size_;
+  lags_ = std::min(fft_size_, static_cast<std::size_t>(std::ceil(period)));
+  forward_ = FftwPlan(fft_size_, FftwPlan::Direction::forward);
+  backward_ = FftwPlan(fft_size_, FftwPlan::Direction::backward);
+  mixed_ = FftwBuffer(fft_size_);
+  product_ = FftwBuffer(fft_size_);
+  correlation_ = FftwBuffer(fft_size_);
+  spectrum_scratch_ = FftwBuffer(fft_size_);
   code_spectra_.resize(signals::kMaxPrn);
   row_.resize(lags_);
 }
@@ -106,14 +114,14 @@ const FftwBuffer& Acquisition::code_spectrum(int prn) {
   auto& slot = code_spectra_[static_cast<std::size_t>(prn - 1)];
   if (!slot) {
     // Replica sampled at the actual rate (non-integer samples per chip), code phase 0 at sample 0,
-    // as conj(FFT) / N so that IFFT(X conj(C) / N) is the plain correlation sum.
+    // as conj(FFT) / F so that IFFT(X conj(C) / F) is the plain correlation sum.
     const auto& code = signals::ca_code(prn);
-    for (std::size_t m = 0; m < block_size_; ++m)
+    for (std::size_t m = 0; m < fft_size_; ++m)
       mixed_[m] = {chip_at(code, static_cast<double>(m) / samples_per_chip_), 0.0f};
-    FftwBuffer spectrum(block_size_);
+    FftwBuffer spectrum(fft_size_);
     forward_.execute(mixed_, spectrum);
-    const float scale = 1.0f / static_cast<float>(block_size_);
-    for (std::size_t i = 0; i < block_size_; ++i) spectrum[i] = std::conj(spectrum[i]) * scale;
+    const float scale = 1.0f / static_cast<float>(fft_size_);
+    for (std::size_t i = 0; i < fft_size_; ++i) spectrum[i] = std::conj(spectrum[i]) * scale;
     slot = std::move(spectrum);
   }
   return *slot;
@@ -121,14 +129,34 @@ const FftwBuffer& Acquisition::code_spectrum(int prn) {
 
 void Acquisition::doppler_spectrum(std::span<const std::complex<float>> samples, int block, double doppler_hz,
                                    FftwBuffer& out) {
+  // Carrier wipe-off as x[m] * base[m % 256] * anchor[m / 256]: 256 phasors from a double recursion, anchors
+  // exact in double, and a plain float inner loop (real arithmetic, no complex-multiply NaN path) that vectorises.
+  constexpr std::size_t kChunk = 256;
   const std::size_t first = static_cast<std::size_t>(block) * block_size_;
-  const std::complex<double> step = std::polar(1.0, -kTwoPi * doppler_hz / options_.fs_hz);
-  std::complex<double> nco(1.0, 0.0);
-  for (std::size_t m = 0; m < block_size_; ++m) {
-    const std::complex<float> x = samples[first + m];
-    const std::complex<double> y = std::complex<double>(x.real(), x.imag()) * nco;
-    mixed_[m] = {static_cast<float>(y.real()), static_cast<float>(y.imag())};
-    nco *= step;
+  const double cycles_per_sample = doppler_hz / options_.fs_hz;
+  const std::complex<double> step = std::polar(1.0, -kTwoPi * cycles_per_sample);
+  std::complex<double> p(1.0, 0.0);
+  for (std::size_t m = 0; m < kChunk; ++m, p *= step) {
+    base_re_[m] = static_cast<float>(p.real());
+    base_im_[m] = static_cast<float>(p.imag());
+  }
+  std::fill(mixed_.data(), mixed_.data() + fft_size_, std::complex<float>{});
+  auto* folded = reinterpret_cast<float*>(mixed_.data());
+  const auto* x = reinterpret_cast<const float*>(samples.data() + first);
+  std::size_t at = 0;  // index into the folded buffer
+  for (std::size_t chunk = 0; chunk * kChunk < block_size_; ++chunk) {
+    const double turns = cycles_per_sample * static_cast<double>(chunk * kChunk);
+    const std::complex<double> anchor = std::polar(1.0, -kTwoPi * (turns - std::floor(turns)));
+    const auto a_re = static_cast<float>(anchor.real()), a_im = static_cast<float>(anchor.imag());
+    const std::size_t count = std::min(kChunk, block_size_ - chunk * kChunk);
+    for (std::size_t m = 0; m < count; ++m) {
+      const float c_re = base_re_[m] * a_re - base_im_[m] * a_im;
+      const float c_im = base_re_[m] * a_im + base_im_[m] * a_re;
+      const float s_re = x[2 * (chunk * kChunk + m)], s_im = x[2 * (chunk * kChunk + m) + 1];
+      folded[2 * at] += s_re * c_re - s_im * c_im;
+      folded[2 * at + 1] += s_re * c_im + s_im * c_re;
+      if (++at == fft_size_) at = 0;
+    }
   }
   forward_.execute(mixed_, out);
 }
@@ -139,11 +167,11 @@ void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, co
   std::fill(row_.begin(), row_.end(), 0.0f);
   // Code-phase drift per block from the code Doppler (and from N not being a whole number of periods).
   const double period = kCodeLength * options_.fs_hz / code_rate_hz(doppler_hz);
-  const auto n = static_cast<std::ptrdiff_t>(block_size_);
+  const auto n = static_cast<std::ptrdiff_t>(fft_size_);
   for (int k = 0; k < options_.noncoherent; ++k) {
     const FftwBuffer* spectrum = cached ? cached + k : &spectrum_scratch_;
     if (!cached) doppler_spectrum(samples, k, doppler_hz, spectrum_scratch_);
-    for (std::size_t i = 0; i < block_size_; ++i) product_[i] = (*spectrum)[i] * code[i];
+    for (std::size_t i = 0; i < fft_size_; ++i) product_[i] = (*spectrum)[i] * code[i];
     backward_.execute(product_, correlation_);
     const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
     const auto shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period)));
@@ -303,12 +331,12 @@ std::vector<AcquisitionResult> Acquisition::search_each(std::span<const std::com
                                                         std::span<const int> prns) {
   const std::vector<double> dopplers = doppler_grid(std::nullopt);
   const std::size_t spectra = dopplers.size() * static_cast<std::size_t>(options_.noncoherent);
-  const bool cache = prns.size() > 1 && spectra * block_size_ * sizeof(std::complex<float>) <= memory_budget_bytes_;
+  const bool cache = prns.size() > 1 && spectra * fft_size_ * sizeof(std::complex<float>) <= memory_budget_bytes_;
   if (cache) {
     // One forward FFT per (Doppler bin, block), shared by every PRN.
     if (spectrum_cache_.size() != spectra) {
       spectrum_cache_.clear();
-      for (std::size_t i = 0; i < spectra; ++i) spectrum_cache_.emplace_back(block_size_);
+      for (std::size_t i = 0; i < spectra; ++i) spectrum_cache_.emplace_back(fft_size_);
     }
     const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
     for (std::size_t d = 0; d < dopplers.size(); ++d)

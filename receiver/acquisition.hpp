@@ -27,6 +27,10 @@
 // accept that loss: with T_coh <= 10 ms at most every second block holds a bit edge and the
 // non-coherent sum over K blocks keeps the others, so the average loss is <= 10*log10(1 - 1/6) = 0.8 dB.
 //
+// Folding: when a code period is a whole number P of samples (2.6, 4, 12, 38.192 MHz, ...), each Doppler-
+// wiped block is summed period by period into P samples before the FFT, which gives exactly the same
+// circular correlation with a one-period replica: FFTs of P points for any T_coh (10x cheaper at 10 ms).
+//
 // Code Doppler: block k is aligned on the code drift f_d / f_L1 before the non-coherent sum, so long
 // sums (K T_coh up to seconds) do not smear the peak. Refinement: the Doppler is refined by a fine
 // search (step/8 over +-1 coarse step, time-domain correlation at the peak's code phase) and a
@@ -130,6 +134,7 @@ class Acquisition {
 
   AcquisitionOptions options_;
   std::size_t block_size_;  // N = round(fs T_coh)
+  std::size_t fft_size_;    // F: one code period when it is a whole number of samples (folding), else N
   std::size_t lags_;        // code lags searched: one code period, min(N, ceil(1023 fs / f_chip))
   double samples_per_chip_;
   FftwPlan forward_, backward_;
@@ -138,6 +143,7 @@ class Acquisition {
   std::vector<FftwBuffer> spectrum_cache_;               // [bin * K + k] for a multi-PRN search
   std::vector<float> row_, grid_;                        // one Doppler row; all rows [bin * lags + lag]
   std::vector<double> row_noise_;                        // noise cell mean per Doppler row
+  std::array<float, 256> base_re_{}, base_im_{};         // carrier wipe-off phasors of one chunk
   std::vector<std::complex<float>> cleaned_;             // samples with confirmed signals cancelled
   std::size_t memory_budget_bytes_ = std::size_t{256} << 20;
 };

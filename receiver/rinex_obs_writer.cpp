@@ -51,7 +51,7 @@ void RinexObsWriter::write(const ObservationEpoch& epoch) {
 void RinexObsWriter::finish(const Eigen::Vector3d& approx_r_e_m) {
   body_.commit();
   const std::filesystem::path body_path = body_.path();
-  signals::AtomicFile file(path_);
+  io::AtomicFile file(path_);
   auto& out = file.stream();
   out << header_line(fmt::format("{:>9}{:11}{:<20}{:<20}", "3.04", "", "OBSERVATION DATA", "G (GPS)"),
                      "RINEX VERSION / TYPE");

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "receiver/observables.hpp"
-#include "signals/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace ultratrack::receiver {
 
@@ -31,7 +31,7 @@ class RinexObsWriter {
  private:
   std::filesystem::path path_;
   RinexObsHeaderInfo info_;
-  signals::AtomicFile body_;
+  io::AtomicFile body_;
   std::optional<signals::GpsTime> first_epoch_;
   int epochs_ = 0;
 };

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "receiver/pvt.hpp"
-#include "signals/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace ultratrack::receiver {
 
@@ -27,7 +27,7 @@ class SolutionCsvWriter {
   void finish() { file_.commit(); }
 
  private:
-  signals::AtomicFile file_;
+  io::AtomicFile file_;
 };
 
 class NmeaWriter {
@@ -37,7 +37,7 @@ class NmeaWriter {
   void finish() { file_.commit(); }
 
  private:
-  signals::AtomicFile file_;
+  io::AtomicFile file_;
   int leap_seconds_;
 };
 
@@ -51,7 +51,7 @@ class KmlWriter {
   void finish();
 
  private:
-  signals::AtomicFile file_;
+  io::AtomicFile file_;
   std::vector<std::string> coordinates_;  // "lon,lat,h" per fix (small: a few dozen bytes per fix)
   double sum_lat_deg_ = 0.0, sum_lon_deg_ = 0.0, sum_h_m_ = 0.0;
 };

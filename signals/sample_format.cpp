@@ -13,11 +13,16 @@ std::optional<SampleFormat> parse_sample_format(std::string_view name) {
 
 std::string_view to_string(SampleFormat format) {
   switch (format) {
-    case SampleFormat::i8: return "i8";
-    case SampleFormat::i16: return "i16";
-    case SampleFormat::f32: return "f32";
-    case SampleFormat::r8: return "r8";
-    case SampleFormat::r16: return "r16";
+    case SampleFormat::i8:
+      return "i8";
+    case SampleFormat::i16:
+      return "i16";
+    case SampleFormat::f32:
+      return "f32";
+    case SampleFormat::r8:
+      return "r8";
+    case SampleFormat::r16:
+      return "r16";
   }
   return "?";
 }
@@ -28,11 +33,16 @@ bool is_complex(SampleFormat format) {
 
 std::size_t bytes_per_sample(SampleFormat format) {
   switch (format) {
-    case SampleFormat::i8: return 2;
-    case SampleFormat::i16: return 4;
-    case SampleFormat::f32: return 8;
-    case SampleFormat::r8: return 1;
-    case SampleFormat::r16: return 2;
+    case SampleFormat::i8:
+      return 2;
+    case SampleFormat::i16:
+      return 4;
+    case SampleFormat::f32:
+      return 8;
+    case SampleFormat::r8:
+      return 1;
+    case SampleFormat::r16:
+      return 2;
   }
   return 1;
 }
@@ -40,10 +50,13 @@ std::size_t bytes_per_sample(SampleFormat format) {
 double full_scale(SampleFormat format) {
   switch (format) {
     case SampleFormat::i8:
-    case SampleFormat::r8: return 127.0;
+    case SampleFormat::r8:
+      return 127.0;
     case SampleFormat::i16:
-    case SampleFormat::r16: return 32767.0;
-    case SampleFormat::f32: return 1.0;
+    case SampleFormat::r16:
+      return 32767.0;
+    case SampleFormat::f32:
+      return 1.0;
   }
   return 1.0;
 }

@@ -61,14 +61,15 @@ std::size_t SampleReader::read(std::span<std::complex<float>> out) {
   raw_.resize(count * bps);
   file_.read(raw_.data(), static_cast<std::streamsize>(raw_.size()));
   if (file_.gcount() != static_cast<std::streamsize>(raw_.size())) {
-    throw InputError(path_.string(), "read failed at sample " + std::to_string(position_) +
-                                         " (the file changed while being read?)");
+    throw InputError(path_.string(),
+                     "read failed at sample " + std::to_string(position_) + " (the file changed while being read?)");
   }
   const char* p = raw_.data();
   switch (format_) {
     case SampleFormat::i8:
       for (std::size_t i = 0; i < count; ++i, p += 2)
-        out[i] = {static_cast<float>(static_cast<std::int8_t>(p[0])), static_cast<float>(static_cast<std::int8_t>(p[1]))};
+        out[i] = {static_cast<float>(static_cast<std::int8_t>(p[0])),
+                  static_cast<float>(static_cast<std::int8_t>(p[1]))};
       break;
     case SampleFormat::i16:
       for (std::size_t i = 0; i < count; ++i, p += 4)

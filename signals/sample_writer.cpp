@@ -19,9 +19,10 @@ template <typename Int>
 inline Int quantise(float x) {
   constexpr float lo = static_cast<float>(std::numeric_limits<Int>::min());
   constexpr float hi = static_cast<float>(std::numeric_limits<Int>::max());
-  if (!(x == x)) return 0;
-  const float r = x >= 0.0f ? x + 0.5f : x - 0.5f;
-  return static_cast<Int>(std::clamp(r, lo, hi));
+  // Branch-free so the loops vectorise: NaN -> 0, then round half away from zero, clamp, truncate.
+  const float v = (x == x) ? x : 0.0f;
+  const float r = std::clamp(v + std::copysign(0.5f, v), lo, hi);
+  return static_cast<Int>(r);
 }
 
 inline void put_le_i16(char* p, std::int16_t v) {
@@ -37,8 +38,7 @@ inline void put_le_f32(char* p, float v) {
 
 }  // namespace
 
-SampleWriter::SampleWriter(std::filesystem::path path, SampleFormat format)
-    : path_(std::move(path)), format_(format) {
+SampleWriter::SampleWriter(std::filesystem::path path, SampleFormat format) : path_(std::move(path)), format_(format) {
   temp_path_ = path_;
   temp_path_ += ".part";
   file_.open(temp_path_, std::ios::binary | std::ios::trunc);

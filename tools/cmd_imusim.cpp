@@ -10,7 +10,7 @@
 #include <string>
 
 #include "commands.hpp"
-#include "ins/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/ins_error.hpp"
@@ -86,7 +86,7 @@ void run_imusim(const ImuSimOptions& o) {
     ins::OdometerOptions odo;
     odo.scale_factor_error = o.odometer_sf;
     const auto samples = ins::simulate_odometer(truth_for_odometer, odo);
-    ins::AtomicFile f(fs::path(o.out_dir) / "odometer.csv");
+    io::AtomicFile f(fs::path(o.out_dir) / "odometer.csv");
     f.write("t_s,pulses,distance_m\n");
     for (const auto& s : samples) f.write(fmt::format("{},{},{}\n", s.t_s, s.pulses, s.distance_m));
     f.commit();
@@ -101,7 +101,7 @@ void run_imusim(const ImuSimOptions& o) {
   json += fmt::format("  \"accel_turn_on_bias_mps2\": [{:.6g}, {:.6g}, {:.6g}],\n", e.accel.bias.x(), e.accel.bias.y(),
                       e.accel.bias.z());
   json += fmt::format("  \"distance_m\": {:.3f}\n}}\n", gen.truth().distance_m);
-  ins::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
+  io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);
   summary.commit();
   fmt::print("imusim: {} IMU rows at {} Hz ({} s, preset {}, seed {}); wrote {}/imu.csv, truth.csv{}\n", rows,

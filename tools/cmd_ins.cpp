@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "ins/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 #include "ins/attitude.hpp"
 #include "ins/coarse_alignment.hpp"
 #include "ins/earth_model.hpp"
@@ -159,7 +159,7 @@ void run_ins(const InsOptions& o) {
         cmp.final_horizontal_m, cmp.final_vertical_m, cmp.final_attitude_deg);
   }
   json += fmt::format("  \"steps_per_second\": {:.0f}\n}}\n", wall_s > 0 ? steps / wall_s : 0.0);
-  ins::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
+  io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);
   summary.commit();
 

@@ -1,14 +1,41 @@
-#include <CLI/CLI.hpp>
+// `ultratrack simulate --scenario S.toml --out DIR`: synthesise IF samples and truth from a scenario
+// (tools/scenario.hpp for the keys, tools/simulation.hpp for the outputs).
+#include <fmt/core.h>
 
-#include <stdexcept>
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <memory>
+#include <string>
 
 #include "commands.hpp"
+#include "scenario.hpp"
+#include "simulation.hpp"
 
 namespace ultratrack::tools {
 
 void add_simulate_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("simulate", "Synthesise IF samples, truth and navigation data from a scenario");
-  cmd->callback([] { throw std::runtime_error("simulate: the synthesiser is being built (issue 2)"); });
+  auto scenario_path = std::make_shared<std::string>();
+  auto out_dir = std::make_shared<std::string>();
+  auto quiet = std::make_shared<bool>(false);
+  cmd->add_option("--scenario", *scenario_path, "Scenario file (TOML)")->required();
+  cmd->add_option("--out", *out_dir, "Output folder (created when missing)")->required();
+  cmd->add_flag("--quiet", *quiet, "No progress lines");
+  cmd->callback([scenario_path, out_dir, quiet] {
+    const Scenario scenario = read_scenario(*scenario_path);
+    const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr);
+    fmt::print("simulate: {:.1f} s of {} at {:.3f} MHz ({} antenna{}) in {:.1f} s ({:.1f}x real time){}\n", r.signal_s,
+               signals::to_string(scenario.format), scenario.sample_rate_hz / 1e6, r.sample_files.size(),
+               r.sample_files.size() == 1 ? "" : "s", r.wall_s, r.signal_s / std::max(r.wall_s, 1e-9),
+               r.interrupted ? " - interrupted, files hold what was done" : "");
+    fmt::print("satellites in view at the start (PRN  el deg  az deg  C/N0  Doppler Hz  code phase chips):\n");
+    for (const auto& v : r.satellites) {
+      fmt::print("  {:3d} {:6.1f} {:7.1f} {:5.1f} {:10.1f} {:9.3f}\n", v.prn, v.elevation_rad * 180.0 / M_PI,
+                 v.azimuth_rad * 180.0 / M_PI, v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
+    }
+    fmt::print("outputs in {}: {}, truth.csv, satellites.csv, scenario.toml, summary.json\n", *out_dir,
+               r.sample_files.front().filename().string());
+  });
 }
 
 }  // namespace ultratrack::tools

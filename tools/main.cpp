@@ -9,7 +9,7 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "ins/ins_error.hpp"
-#include "signals/input_error.hpp"
+#include "io/input_error.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"ultratrack: GPS L1 C/A software receiver with inertial aiding"};
@@ -28,10 +28,7 @@ int main(int argc, char** argv) {
   } catch (const ultratrack::tools::CommandExit& e) {
     fmt::print(stderr, "ultratrack: {}\n", e.what());
     return e.code;
-  } catch (const ultratrack::signals::InputError& e) {
-    fmt::print(stderr, "ultratrack: error: {}\n", e.what());
-    return 2;
-  } catch (const ultratrack::ins::InputError& e) {
+  } catch (const ultratrack::io::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;
   } catch (const std::exception& e) {

@@ -162,3 +162,62 @@ TEST(AcquisitionRealData, Cttc4MHzFloatWithFrontEndOffset) {
                 r.cn0_dbhz, r.metric, r.threshold);
   }
 }
+
+namespace {
+
+// Code phase change between two acquisitions `span_s` apart must be the code Doppler times the span,
+// 1023 * f_d / f_L1 chips per ms. A spectrum taken with the wrong sign (Q negated or the IF side
+// inverted) turns the carrier Doppler around but not the code drift, and fails by twice the drift.
+void check_code_drift(const std::filesystem::path& path, SampleFormat format, SampleSourceOptions source,
+                      const std::vector<int>& prns, double span_s) {
+  AcquisitionOptions ao;
+  ao.fs_hz = source.fs_hz;
+  ao.noncoherent = 5;
+  ao.cancel_cross_correlation = false;  // strong satellites only; saves the confirmation searches
+  Acquisition acquisition(ao);
+  std::vector<std::complex<float>> samples(acquisition.samples_needed());
+  SampleSource early(path, format, source);
+  ASSERT_EQ(early.read(samples).count, samples.size());
+  const auto first = acquisition.search(samples, prns);
+  source.start_sample = std::llround(span_s * source.fs_hz);
+  SampleSource late(path, format, source);
+  ASSERT_EQ(late.read(samples).count, samples.size());
+  const auto second = acquisition.search(samples, prns);
+  for (std::size_t i = 0; i < prns.size(); ++i) {
+    ASSERT_TRUE(first[i].detected && second[i].detected) << "PRN " << prns[i];
+    const double drift = std::remainder(second[i].code_phase_chips - first[i].code_phase_chips, 1023.0);
+    const double expected = 1.023e6 * first[i].doppler_hz / 1575.42e6 * span_s;
+    std::printf("  PRN %2d  Doppler %+7.1f Hz: code drift %+.3f chips in %.3f s, expected %+.3f\n", prns[i],
+                first[i].doppler_hz, drift, span_s, expected);
+    // Two code-phase estimates at 41-50 dB-Hz: a few hundredths of a chip each.
+    EXPECT_NEAR(drift, expected, 0.1) << "PRN " << prns[i];
+  }
+}
+
+}  // namespace
+
+TEST(AcquisitionRealData, PocketSdr4MHzCodeDriftAgreesWithDopplerOnlyWithQNegated) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(path, "pocketsdr_L1_4MHz_iq_2bit.bin");
+  SampleSourceOptions source;
+  source.fs_hz = 4e6;
+  source.q_negate = true;  // PocketSDR's convention; the README's Doppler list takes I + jQ literally
+  check_code_drift(path, SampleFormat::i8, source, {16, 29, 32}, 0.45);
+}
+
+TEST(AcquisitionRealData, Ugsdr38MHzCodeDriftAgreesWithDopplerWithoutInversion) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(path, "ugsdr_L1_38p192MHz_real_if9p55MHz.bin");
+  SampleSourceOptions source;
+  source.fs_hz = 38.192e6;
+  source.if_hz = 9.548e6;
+  check_code_drift(path, SampleFormat::r8, source, {6, 9, 29}, 0.09);
+}
+
+TEST(AcquisitionRealData, PocketSdr12MHzCodeDriftAgreesWithDopplerWithoutInversion) {
+  // Only up to 80 ms: the recording loses about 964 samples (80 us) near 85 ms, after which every PRN's code
+  // phase is 82.2 chips further on (measured: 568.66 -> 650.83 chips for PRN 2 between 5 ms blocks 17 and 18).
+  ULTRATRACK_REQUIRE_SHARED_FILE(path, "pocketsdr_L1_12MHz_real_if3MHz.bin");
+  SampleSourceOptions source;
+  source.fs_hz = 12e6;
+  source.if_hz = 3e6;
+  check_code_drift(path, SampleFormat::r8, source, {2, 11, 18}, 0.075);
+}

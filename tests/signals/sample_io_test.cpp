@@ -47,7 +47,8 @@ TEST(SampleFormat, ParsesNamesAndSizes) {
 TEST(SampleIo, RoundTripsEveryFormatInBlocks) {
   const auto dir = test::scratch_dir();
   std::vector<std::complex<float>> in;
-  for (int i = 0; i < 1000; ++i) in.emplace_back(static_cast<float>(i % 255 - 127), static_cast<float>(-(i % 201) + 100));
+  for (int i = 0; i < 1000; ++i)
+    in.emplace_back(static_cast<float>(i % 255 - 127), static_cast<float>(-(i % 201) + 100));
   for (auto format : kAllFormats) {
     const auto path = dir / ("rt." + std::string(to_string(format)));
     {

@@ -5,17 +5,19 @@
 
 #include <filesystem>
 #include <fstream>
+#include <string_view>
 
-namespace ultratrack::signals {
+namespace ultratrack::io {
 
 class AtomicFile {
  public:
-  explicit AtomicFile(std::filesystem::path path, bool binary = false);
+  explicit AtomicFile(std::filesystem::path path, bool binary = false);  // InputError if it cannot be created
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   std::ofstream& stream() { return stream_; }
+  void write(std::string_view text) { stream_.write(text.data(), static_cast<std::streamsize>(text.size())); }
   const std::filesystem::path& path() const { return path_; }
   // Flushes, closes and renames; throws InputError (naming the file) when any write failed.
   void commit();
@@ -26,4 +28,7 @@ class AtomicFile {
   bool committed_ = false;
 };
 
-}  // namespace ultratrack::signals
+// The whole content in one go, through an AtomicFile.
+void write_file_atomically(const std::filesystem::path& path, std::string_view content);
+
+}  // namespace ultratrack::io

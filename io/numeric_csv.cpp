@@ -1,11 +1,12 @@
-#include "ins/csv_util.hpp"
+#include "io/numeric_csv.hpp"
 
 #include <charconv>
 #include <cmath>
+#include <fstream>
 
-#include "ins/ins_error.hpp"
+#include "io/input_error.hpp"
 
-namespace ultratrack::ins {
+namespace ultratrack::io {
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -14,7 +15,7 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
-void check_header(const std::string& file, int line, std::string_view text, const std::vector<std::string>& names) {
+void check_csv_header(const std::string& file, int line, std::string_view text, const std::vector<std::string>& names) {
   std::size_t i = 0;
   std::string_view rest = text;
   while (true) {
@@ -36,7 +37,7 @@ void check_header(const std::string& file, int line, std::string_view text, cons
   }
 }
 
-void parse_row(const std::string& file, int line, std::string_view text, std::span<double> out) {
+void parse_numeric_row(const std::string& file, int line, std::string_view text, std::span<double> out) {
   std::string_view rest = text;
   for (std::size_t i = 0; i < out.size(); ++i) {
     const std::size_t comma = rest.find(',');
@@ -63,4 +64,31 @@ void parse_row(const std::string& file, int line, std::string_view text, std::sp
   }
 }
 
-}  // namespace ultratrack::ins
+int read_numeric_csv(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
+                     const NumericRowHandler& row) {
+  const std::string name = file.string();
+  std::ifstream in(file);
+  if (!in) throw InputError(name, "cannot open " + std::string(what));
+  std::vector<double> values(columns.size());
+  std::string line;
+  int line_no = 0, rows = 0;
+  bool have_header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string_view t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    if (!have_header) {
+      check_csv_header(name, line_no, t, columns);
+      have_header = true;
+      continue;
+    }
+    parse_numeric_row(name, line_no, t, values);
+    row(line_no, values);
+    ++rows;
+  }
+  if (!have_header) throw InputError(name, "empty " + std::string(what) + ": missing header");
+  if (rows == 0) throw InputError(name, std::string(what) + " has no data rows");
+  return rows;
+}
+
+}  // namespace ultratrack::io

@@ -1,10 +1,10 @@
-#include "signals/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 #include <system_error>
 
-#include "signals/input_error.hpp"
+#include "io/input_error.hpp"
 
-namespace ultratrack::signals {
+namespace ultratrack::io {
 
 AtomicFile::AtomicFile(std::filesystem::path path, bool binary)
     : path_(std::move(path)), partial_path_(path_.string() + ".partial") {
@@ -30,4 +30,10 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
-}  // namespace ultratrack::signals
+void write_file_atomically(const std::filesystem::path& path, std::string_view content) {
+  AtomicFile file(path);
+  file.write(content);
+  file.commit();
+}
+
+}  // namespace ultratrack::io

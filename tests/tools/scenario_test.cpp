@@ -1,0 +1,129 @@
+// Scenario files: the issue's keys parse to the stated values; unknown keys, wrong types and conflicting
+// keys are InputErrors naming the file, the key and the line; the echo (to_toml) reads back the same.
+#include "scenario.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "signals/input_error.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+const char* kIssueExample = R"(
+[signal]
+sample_rate_hz = 2.6e6
+if_hz = 0.0
+format = "i8"
+duration_s = 60.0
+cn0_dbhz = 45.0
+seed = 1
+[time]
+gps_week = 2190
+tow_s = 518400.0
+[navigation]
+rinex = "brdc0010.22n"          # relative to the scenario file
+[receiver]
+llh_deg_m = [35.274016, 137.013759, 100.0]
+[atmosphere]
+ionosphere = true
+troposphere = false
+)";
+
+std::string error_of(const std::string& text) {
+  try {
+    parse_scenario(text, "/data/s.toml");
+  } catch (const signals::InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Scenario, ParsesTheIssueExample) {
+  const Scenario s = parse_scenario(kIssueExample, "/data/run/s.toml");
+  EXPECT_EQ(s.sample_rate_hz, 2.6e6);
+  EXPECT_EQ(s.format, signals::SampleFormat::i8);
+  EXPECT_EQ(s.duration_s, 60.0);
+  EXPECT_EQ(s.seed, 1u);
+  EXPECT_EQ(s.gps_week, 2190);
+  EXPECT_EQ(s.tow_s, 518400.0);
+  EXPECT_EQ(s.rinex, "brdc0010.22n");
+  EXPECT_TRUE(s.constellation.empty());
+  EXPECT_EQ(s.llh_deg_m[0], 35.274016);
+  EXPECT_TRUE(s.ionosphere);
+  EXPECT_FALSE(s.troposphere);
+  EXPECT_EQ(resolve_path(s, s.rinex), std::filesystem::path("/data/run/brdc0010.22n"));
+  EXPECT_EQ(resolve_path(s, "/abs/x.csv"), std::filesystem::path("/abs/x.csv"));
+}
+
+TEST(Scenario, DefaultsWithoutNavigationUseTheNominalConstellation) {
+  const Scenario s = parse_scenario("[signal]\nduration_s = 2\n", "s.toml");
+  EXPECT_EQ(s.constellation, "nominal");
+  EXPECT_EQ(s.duration_s, 2.0);  // integers are accepted for numbers
+  EXPECT_EQ(s.sample_rate_hz, 2.6e6);
+  EXPECT_EQ(s.cn0_dbhz, 45.0);
+}
+
+TEST(Scenario, UnknownKeysWrongTypesAndConflictsNameFileKeyAndLine) {
+  auto e = error_of("[signal]\nsample_rate = 4e6\n");
+  EXPECT_NE(e.find("/data/s.toml:2"), std::string::npos) << e;
+  EXPECT_NE(e.find("signal.sample_rate"), std::string::npos) << e;
+  EXPECT_NE(e.find("unknown key"), std::string::npos) << e;
+  e = error_of("[signal]\nformat = 8\n");
+  EXPECT_NE(e.find("signal.format"), std::string::npos) << e;
+  EXPECT_NE(e.find("expected a string"), std::string::npos) << e;
+  e = error_of("[signal]\nformat = \"u4\"\n");
+  EXPECT_NE(e.find("unknown sample format"), std::string::npos) << e;
+  e = error_of("[time]\ngps_week = 2190.5\n");
+  EXPECT_NE(e.find("time.gps_week"), std::string::npos) << e;
+  e = error_of("[receiver]\nllh_deg_m = [1, 2]\n");
+  EXPECT_NE(e.find("receiver.llh_deg_m"), std::string::npos) << e;
+  e = error_of("[recever]\nx = 1\n");
+  EXPECT_NE(e.find("unknown section"), std::string::npos) << e;
+  e = error_of("[navigation]\nrinex = \"a.n\"\nconstellation = \"nominal\"\n");
+  EXPECT_NE(e.find("not both"), std::string::npos) << e;
+  e = error_of("[receiver]\nllh_deg_m = [1, 2, 3]\ntrajectory = \"m.csv\"\n");
+  EXPECT_NE(e.find("not both"), std::string::npos) << e;
+  e = error_of("[signal]\nformat = \"r8\"\n");
+  EXPECT_NE(e.find("needs an IF"), std::string::npos) << e;
+  e = error_of("[signal]\nduration_s = -1\n");
+  EXPECT_NE(e.find("signal.duration_s"), std::string::npos) << e;
+  e = error_of("[signal]\ncn0_dbhz_by_prn = { 40 = 45.0 }\n");
+  EXPECT_NE(e.find("PRN must be 1..32"), std::string::npos) << e;
+  e = error_of("[signal\nx = 1\n");
+  EXPECT_NE(e.find("/data/s.toml:1"), std::string::npos) << e;  // a syntax error, with its line
+}
+
+TEST(Scenario, EchoReadsBackTheSameScenario) {
+  Scenario s = parse_scenario(R"(
+[signal]
+format = "r16"
+if_hz = 1.5e6
+sample_rate_hz = 5e6
+cn0_dbhz_by_prn = { 5 = 40.5, 12 = 38.0 }
+seed = 77
+[receiver]
+llh_deg_m = [-33.9, 151.2, 42.25]
+antenna_offsets_enu_m = [[0, 0, 0], [1.5, 0, 0.1]]
+clock_drift_mps = 12.5
+[atmosphere]
+troposphere = true
+)",
+                              "/tmp/a/s.toml");
+  const std::string text = to_toml(s);
+  const Scenario back = parse_scenario(text, "/tmp/b/echo.toml");
+  EXPECT_EQ(to_toml(back), text);
+  EXPECT_EQ(back.format, signals::SampleFormat::r16);
+  EXPECT_EQ(back.if_hz, 1.5e6);
+  EXPECT_EQ(back.cn0_dbhz_by_prn, s.cn0_dbhz_by_prn);
+  EXPECT_EQ(back.seed, 77u);
+  EXPECT_EQ(back.llh_deg_m, s.llh_deg_m);
+  EXPECT_EQ(back.antenna_offsets_enu_m, s.antenna_offsets_enu_m);
+  EXPECT_EQ(back.clock_drift_mps, 12.5);
+  EXPECT_TRUE(back.troposphere);
+  EXPECT_EQ(back.constellation, "nominal");
+}
+
+}  // namespace
+}  // namespace ultratrack::tools

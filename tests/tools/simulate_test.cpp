@@ -1,0 +1,200 @@
+// `ultratrack simulate` end to end: the files it writes, and an independent brute-force acquisition
+// (tests/support) of the written samples that must find every satellite of satellites.csv at the stated
+// Doppler, code phase and C/N0, with the nominal constellation and (when shared data is present) the
+// broadcast ephemeris brdc0010.22n at the issue's position and time.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iomanip>
+#include <set>
+#include <sstream>
+
+#include "scenario.hpp"
+#include "signals/input_error.hpp"
+#include "signals/sample_reader.hpp"
+#include "simulation.hpp"
+#include "support/brute_force_acquisition.hpp"
+#include "support/test_data.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+using signals::test_support::BruteForceAcquisition;
+
+struct SatelliteRow {
+  int prn;
+  double elevation_deg, azimuth_deg, cn0_dbhz, doppler_hz, code_phase_chips;
+};
+
+std::vector<std::string> read_lines(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::vector<std::string> lines;
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+std::vector<SatelliteRow> read_satellites(const std::filesystem::path& p) {
+  const auto lines = read_lines(p);
+  EXPECT_EQ(lines.at(0), "prn,elevation_deg,azimuth_deg,cn0_dbhz,doppler_hz,code_phase_chips");
+  std::vector<SatelliteRow> rows;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    std::string l = lines[i];
+    std::replace(l.begin(), l.end(), ',', ' ');
+    std::istringstream ss(l);
+    SatelliteRow r{};
+    ss >> r.prn >> r.elevation_deg >> r.azimuth_deg >> r.cn0_dbhz >> r.doppler_hz >> r.code_phase_chips;
+    EXPECT_FALSE(ss.fail()) << lines[i];
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+std::vector<std::complex<float>> read_samples(const std::filesystem::path& p, signals::SampleFormat f) {
+  signals::SampleReader reader(p, f);
+  std::vector<std::complex<float>> x(static_cast<std::size_t>(reader.total_samples()));
+  EXPECT_EQ(reader.read(x), x.size());
+  return x;
+}
+
+double wrap_chips(double d) { return d - 1023.0 * std::round(d / 1023.0); }
+
+// Acquires every listed satellite independently and compares with the row.
+void expect_acquired_as_stated(const std::vector<std::complex<float>>& x, double fs,
+                               const std::vector<SatelliteRow>& rows) {
+  BruteForceAcquisition acq(x, fs);
+  for (const auto& row : rows) {
+    SCOPED_TRACE("PRN " + std::to_string(row.prn));
+    const auto r = acq.acquire(row.prn);
+    ASSERT_TRUE(r.found) << "peak ratio " << r.peak_ratio;
+    EXPECT_NEAR(r.doppler_hz, row.doppler_hz, 25.0);  // FLL estimate, noise of a few Hz
+    EXPECT_NEAR(wrap_chips(r.code_phase_chips - row.code_phase_chips), 0.0, 0.05);
+    EXPECT_NEAR(r.cn0_dbhz, row.cn0_dbhz, 1.5);  // floor includes other satellites' cross-correlation
+    std::printf("PRN %2d: Doppler %8.1f / %8.1f Hz, code %8.3f / %8.3f chips, C/N0 %.1f / %.1f dB-Hz\n", row.prn,
+                r.doppler_hz, row.doppler_hz, r.code_phase_chips, row.code_phase_chips, r.cn0_dbhz, row.cn0_dbhz);
+  }
+}
+
+TEST(Simulate, WritesAllOutputsAndTheSignalIsAcquiredAsStated) {
+  const auto dir = test::scratch_dir();
+  const std::string text = R"(
+[signal]
+sample_rate_hz = 2.048e6
+format = "i8"
+duration_s = 0.13
+cn0_dbhz = 45.0
+cn0_dbhz_by_prn = { 1 = 42.0 }
+seed = 7
+[time]
+gps_week = 2190
+tow_s = 518400.0
+[navigation]
+constellation = "nominal"
+[receiver]
+llh_deg_m = [35.274016, 137.013759, 100.0]
+clock_bias_m = 1500.0
+clock_drift_mps = 90.0
+[atmosphere]
+ionosphere = true
+troposphere = true
+)";
+  { std::ofstream(dir / "s.toml") << text; }
+  const Scenario s = read_scenario(dir / "s.toml");
+  const auto result = run_simulation(s, dir / "out");
+  const auto out = dir / "out";
+  for (const char* f : {"antenna0.i8.bin", "truth.csv", "satellites.csv", "scenario.toml", "summary.json"})
+    EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
+  for (const auto& e : std::filesystem::directory_iterator(out))
+    EXPECT_NE(e.path().extension(), ".part") << "temporary file left: " << e.path();
+  EXPECT_EQ(result.samples, 266240);
+  EXPECT_EQ(std::filesystem::file_size(out / "antenna0.i8.bin"), 266240u * 2);
+
+  // truth.csv: the header row of the issue, 10 Hz rows, the configured clock.
+  const auto truth = read_lines(out / "truth.csv");
+  EXPECT_EQ(truth.at(0),
+            "t_s,gps_week,tow_s,ecef_x_m,ecef_y_m,ecef_z_m,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,"
+            "clock_bias_m,clock_drift_mps");
+  ASSERT_EQ(truth.size(), 3u);  // t = 0.0 and 0.1 s
+  EXPECT_EQ(truth[1].rfind("0.000000000,2190,518400.000000000,", 0), 0u) << truth[1];
+  EXPECT_NE(truth[1].find("35.2740160000,137.0137590000,100.0000"), std::string::npos) << truth[1];
+  EXPECT_NE(truth[2].find(",1509.00000,90.000000"), std::string::npos) << truth[2];
+
+  // The echo reads back as the same scenario.
+  EXPECT_EQ(to_toml(read_scenario(out / "scenario.toml")), to_toml(s));
+
+  // satellites.csv against an independent acquisition of the written samples. The receiver clock drift
+  // of 90 m/s shifts every Doppler by -473 Hz, which the stated Doppler must include.
+  const auto rows = read_satellites(out / "satellites.csv");
+  ASSERT_GE(rows.size(), 5u);
+  ASSERT_EQ(rows.size(), result.satellites.size());
+  for (const auto& row : rows) EXPECT_GE(row.elevation_deg, 5.0);
+  expect_acquired_as_stated(read_samples(out / "antenna0.i8.bin", signals::SampleFormat::i8), 2.048e6, rows);
+}
+
+TEST(Simulate, BroadcastEphemerisScenarioOfTheIssue) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = test::scratch_dir();
+  Scenario s = parse_scenario("[signal]\nsample_rate_hz = 2.048e6\nduration_s = 0.13\n", dir / "s.toml");
+  s.constellation.clear();
+  s.rinex = brdc.string();
+  const auto result = run_simulation(s, dir / "out");
+  const auto rows = read_satellites(dir / "out" / "satellites.csv");
+  std::set<int> prns;
+  for (const auto& r : rows) prns.insert(r.prn);
+  // Healthy satellites above 10 deg at 2022-01-01 00:00 GPST from this position (shared/data README and
+  // the sky test); PRN 28 is in view but flagged unhealthy, so it is not transmitted.
+  for (int prn : {5, 13, 14, 15, 18, 23, 24}) EXPECT_TRUE(prns.count(prn)) << "PRN " << prn;
+  EXPECT_FALSE(prns.count(28));
+  expect_acquired_as_stated(read_samples(result.sample_files.at(0), signals::SampleFormat::i8), 2.048e6, rows);
+  // With include_unhealthy the flagged satellite is transmitted too.
+  s.include_unhealthy = true;
+  s.duration_s = 0.01;
+  const auto with_unhealthy = run_simulation(s, dir / "out_unhealthy");
+  bool has28 = false;
+  for (const auto& v : with_unhealthy.satellites) has28 = has28 || v.prn == 28;
+  EXPECT_TRUE(has28);
+}
+
+TEST(Simulate, SeveralAntennasGiveOneSynchronousFileEach) {
+  const auto dir = test::scratch_dir();
+  Scenario s = parse_scenario(
+      "[signal]\nsample_rate_hz = 2e6\nduration_s = 0.02\nformat = \"i16\"\n"
+      "[receiver]\nantenna_offsets_enu_m = [[0, 0, 0], [1.0, 0, 0], [0, 1.0, 0]]\n",
+      dir / "s.toml");
+  const auto result = run_simulation(s, dir / "out");
+  ASSERT_EQ(result.sample_files.size(), 3u);
+  for (int a = 0; a < 3; ++a) {
+    const auto p = dir / "out" / ("antenna" + std::to_string(a) + ".i16.bin");
+    EXPECT_TRUE(std::filesystem::exists(p));
+    EXPECT_EQ(std::filesystem::file_size(p), 40000u * 4);
+  }
+  // Independent receiver noise per antenna: the streams differ.
+  EXPECT_NE(read_samples(result.sample_files[0], signals::SampleFormat::i16),
+            read_samples(result.sample_files[1], signals::SampleFormat::i16));
+}
+
+TEST(Simulate, TrajectoryFileDrivesTheReceiver) {
+  const auto dir = test::scratch_dir();
+  {
+    std::ofstream f(dir / "motion.csv");
+    f << std::setprecision(12) << "t_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps\n";
+    for (int i = 0; i <= 3; ++i)
+      f << 0.1 * i << "," << -3813409.3992 + 10.0 * 0.1 * i << ",3554350.1028,3662785.2375,10.0,0,0\n";
+  }
+  Scenario s = parse_scenario(
+      "[signal]\nsample_rate_hz = 2e6\nduration_s = 0.3\n[receiver]\ntrajectory = \"motion.csv\"\n", dir / "s.toml");
+  run_simulation(s, dir / "out");
+  const auto truth = read_lines(dir / "out" / "truth.csv");
+  ASSERT_EQ(truth.size(), 4u);  // t = 0, 0.1, 0.2 s (0.3 s is past the last sample)
+  EXPECT_NE(truth[3].find("-3813407.3992,3554350.1028,3662785.2375"), std::string::npos) << truth[3];
+  // A trajectory shorter than the scenario is an error naming the trajectory file.
+  s.duration_s = 0.5;
+  try {
+    run_simulation(s, dir / "out2");
+    ADD_FAILURE() << "no error";
+  } catch (const signals::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("motion.csv"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace ultratrack::tools

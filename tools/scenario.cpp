@@ -1,0 +1,297 @@
+#include "scenario.hpp"
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "signals/input_error.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+using signals::InputError;
+
+// Strict readers of one key: the node must have the right type; errors name the file, line and key.
+class Reader {
+ public:
+  Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& problem) const {
+    throw InputError(file_, "key " + key + ": " + problem, static_cast<int>(node.source().begin.line));
+  }
+
+  double number(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_floating_point()) return v->get();
+    if (auto v = n.as_integer()) return static_cast<double>(v->get());
+    fail(n, key, "expected a number");
+  }
+  std::int64_t integer(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_integer()) return v->get();
+    fail(n, key, "expected an integer");
+  }
+  bool boolean(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_boolean()) return v->get();
+    fail(n, key, "expected true or false");
+  }
+  std::string string(const toml::node& n, const std::string& key) const {
+    if (auto v = n.as_string()) return v->get();
+    fail(n, key, "expected a string");
+  }
+  std::array<double, 3> triple(const toml::node& n, const std::string& key) const {
+    const auto* a = n.as_array();
+    if (!a || a->size() != 3) fail(n, key, "expected an array of 3 numbers");
+    std::array<double, 3> out{};
+    for (std::size_t i = 0; i < 3; ++i) out[i] = number(*a->get(i), key);
+    return out;
+  }
+  const std::string& file() const { return file_; }
+
+ private:
+  std::string file_;
+};
+
+void check_range(const Reader& r, const toml::node& n, const std::string& key, bool ok, const std::string& what) {
+  if (!ok) r.fail(n, key, what);
+}
+
+std::string toml_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// Shortest round-trip text of a double, always with a decimal point or exponent (a TOML float).
+std::string toml_float(double v) {
+  std::string s = fmt::format("{}", v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+}  // namespace
+
+Scenario parse_scenario(std::string_view text, const std::filesystem::path& source) {
+  const std::string file = source.string();
+  toml::table root;
+  try {
+    root = toml::parse(text, file);
+  } catch (const toml::parse_error& e) {
+    throw InputError(file, std::string(e.description()), static_cast<int>(e.source().begin.line));
+  }
+  Reader r(file);
+  Scenario s;
+  s.source = source;
+  bool llh_given = false, rinex_given = false, constellation_given = false, offsets_given = false;
+
+  for (auto&& [section_key, section_node] : root) {
+    const std::string section(section_key.str());
+    const auto* tbl = section_node.as_table();
+    if (!tbl) r.fail(section_node, section, "expected a table [" + section + "]");
+    for (auto&& [k, n] : *tbl) {
+      const std::string key(k.str());
+      const std::string name = section + "." + key;
+      if (section == "signal") {
+        if (key == "sample_rate_hz") {
+          s.sample_rate_hz = r.number(n, name);
+          check_range(r, n, name, s.sample_rate_hz >= 1e5 && s.sample_rate_hz <= 1e9, "must be within 100 kHz..1 GHz");
+        } else if (key == "if_hz") {
+          s.if_hz = r.number(n, name);
+        } else if (key == "format") {
+          const auto f = signals::parse_sample_format(r.string(n, name));
+          if (!f) r.fail(n, name, "unknown sample format (i8, i16, f32, r8, r16)");
+          s.format = *f;
+        } else if (key == "duration_s") {
+          s.duration_s = r.number(n, name);
+          check_range(r, n, name, s.duration_s > 0 && s.duration_s <= 86400, "must be within (0, 86400] s");
+        } else if (key == "cn0_dbhz") {
+          s.cn0_dbhz = r.number(n, name);
+          check_range(r, n, name, s.cn0_dbhz >= 0 && s.cn0_dbhz <= 80, "must be within 0..80 dB-Hz");
+        } else if (key == "seed") {
+          const auto v = r.integer(n, name);
+          check_range(r, n, name, v >= 0, "must be >= 0");
+          s.seed = static_cast<std::uint64_t>(v);
+        } else if (key == "cn0_dbhz_by_prn") {
+          const auto* t = n.as_table();
+          if (!t) r.fail(n, name, "expected a table of PRN = C/N0 (dB-Hz), e.g. { 5 = 40.0 }");
+          for (auto&& [pk, pn] : *t) {
+            const std::string prn_text(pk.str());
+            int prn = 0;
+            std::istringstream ss(prn_text);
+            if (!(ss >> prn) || !ss.eof() || prn < 1 || prn > 32)
+              r.fail(pn, name + "." + prn_text, "PRN must be 1..32");
+            const double cn0 = r.number(pn, name + "." + prn_text);
+            check_range(r, pn, name + "." + prn_text, cn0 >= 0 && cn0 <= 80, "must be within 0..80 dB-Hz");
+            s.cn0_dbhz_by_prn[prn] = cn0;
+          }
+        } else if (key == "nav_data") {
+          s.nav_data = r.boolean(n, name);
+        } else if (key == "noise") {
+          s.noise = r.boolean(n, name);
+        } else {
+          r.fail(n, name, "unknown key in [signal]");
+        }
+      } else if (section == "time") {
+        if (key == "gps_week") {
+          const auto v = r.integer(n, name);
+          check_range(r, n, name, v >= 0 && v < 100000, "must be a full GPS week >= 0");
+          s.gps_week = static_cast<int>(v);
+        } else if (key == "tow_s") {
+          s.tow_s = r.number(n, name);
+          check_range(r, n, name, s.tow_s >= 0 && s.tow_s < 604800, "must be within [0, 604800) s");
+        } else {
+          r.fail(n, name, "unknown key in [time]");
+        }
+      } else if (section == "navigation") {
+        if (key == "rinex") {
+          s.rinex = r.string(n, name);
+          rinex_given = true;
+        } else if (key == "constellation") {
+          s.constellation = r.string(n, name);
+          if (s.constellation != "nominal") r.fail(n, name, "unknown constellation (only \"nominal\")");
+          constellation_given = true;
+        } else if (key == "elevation_mask_deg") {
+          s.elevation_mask_deg = r.number(n, name);
+          check_range(r, n, name, s.elevation_mask_deg >= -90 && s.elevation_mask_deg <= 90, "must be within -90..90");
+        } else if (key == "include_unhealthy") {
+          s.include_unhealthy = r.boolean(n, name);
+        } else {
+          r.fail(n, name, "unknown key in [navigation]");
+        }
+        if (rinex_given && constellation_given) r.fail(n, name, "give either rinex or constellation, not both");
+      } else if (section == "receiver") {
+        if (key == "llh_deg_m") {
+          s.llh_deg_m = r.triple(n, name);
+          check_range(r, n, name,
+                      std::abs(s.llh_deg_m[0]) <= 90 && std::abs(s.llh_deg_m[1]) <= 360 && s.llh_deg_m[2] > -1e4 &&
+                          s.llh_deg_m[2] < 1e7,
+                      "latitude must be within +-90 deg, longitude +-360 deg, height -10 km..10000 km");
+          llh_given = true;
+        } else if (key == "trajectory") {
+          s.trajectory = r.string(n, name);
+        } else if (key == "antenna_offsets_enu_m") {
+          const auto* a = n.as_array();
+          if (!a || a->empty()) r.fail(n, name, "expected an array of [east, north, up] offsets in metres");
+          s.antenna_offsets_enu_m.clear();
+          for (const auto& e : *a) s.antenna_offsets_enu_m.push_back(r.triple(e, name));
+          offsets_given = true;
+        } else if (key == "clock_bias_m") {
+          s.clock_bias_m = r.number(n, name);
+          check_range(r, n, name, std::abs(s.clock_bias_m) < 3e8, "must be below 1 light-second");
+        } else if (key == "clock_drift_mps") {
+          s.clock_drift_mps = r.number(n, name);
+          check_range(r, n, name, std::abs(s.clock_drift_mps) < 3e5, "must be below 3e5 m/s (1e-3 s/s)");
+        } else if (key == "clock_bias_noise_m_per_sqrt_s") {
+          s.clock_bias_noise_m_per_sqrt_s = r.number(n, name);
+          check_range(r, n, name, s.clock_bias_noise_m_per_sqrt_s >= 0, "must be >= 0");
+        } else if (key == "clock_drift_noise_mps_per_sqrt_s") {
+          s.clock_drift_noise_mps_per_sqrt_s = r.number(n, name);
+          check_range(r, n, name, s.clock_drift_noise_mps_per_sqrt_s >= 0, "must be >= 0");
+        } else {
+          r.fail(n, name, "unknown key in [receiver]");
+        }
+        if (llh_given && !s.trajectory.empty()) r.fail(n, name, "give either llh_deg_m or trajectory, not both");
+        if (offsets_given && !s.trajectory.empty())
+          r.fail(n, name, "antenna_offsets_enu_m needs a static receiver (llh_deg_m), not a trajectory");
+      } else if (section == "atmosphere") {
+        if (key == "ionosphere") {
+          s.ionosphere = r.boolean(n, name);
+        } else if (key == "troposphere") {
+          s.troposphere = r.boolean(n, name);
+        } else {
+          r.fail(n, name, "unknown key in [atmosphere]");
+        }
+      } else if (section == "output") {
+        if (key == "truth_rate_hz") {
+          s.truth_rate_hz = r.number(n, name);
+          check_range(r, n, name, s.truth_rate_hz > 0 && s.truth_rate_hz <= 1000, "must be within (0, 1000] Hz");
+        } else {
+          r.fail(n, name, "unknown key in [output]");
+        }
+      } else {
+        r.fail(section_node, section, "unknown section (signal, time, navigation, receiver, atmosphere, output)");
+      }
+    }
+  }
+  if (rinex_given) s.constellation.clear();
+  // Cross-key checks that need the whole scenario.
+  const bool real = !signals::is_complex(s.format);
+  if (real && !(s.if_hz > 0))
+    throw InputError(
+        file, "key signal.if_hz: real format " + std::string(signals::to_string(s.format)) + " needs an IF above 0 Hz");
+  if (!(std::abs(s.if_hz) < 0.5 * s.sample_rate_hz))
+    throw InputError(file, "key signal.if_hz: must be below half the sample rate");
+  return s;
+}
+
+Scenario read_scenario(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string(), "cannot open the scenario file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse_scenario(ss.str(), path);
+}
+
+std::filesystem::path resolve_path(const Scenario& scenario, const std::string& path) {
+  std::filesystem::path p(path);
+  if (p.is_absolute() || scenario.source.empty()) return p;
+  return scenario.source.parent_path() / p;
+}
+
+std::string to_toml(const Scenario& s) {
+  auto abs = [&](const std::string& p) {
+    std::error_code ec;
+    const auto a = std::filesystem::absolute(resolve_path(s, p), ec);
+    return toml_string(ec ? p : a.lexically_normal().string());
+  };
+  std::string out = "# Scenario as run by `ultratrack simulate` (every key, defaults filled in).\n\n[signal]\n";
+  out += fmt::format("sample_rate_hz = {}\nif_hz = {}\nformat = \"{}\"\nduration_s = {}\ncn0_dbhz = {}\nseed = {}\n",
+                     toml_float(s.sample_rate_hz), toml_float(s.if_hz), signals::to_string(s.format),
+                     toml_float(s.duration_s), toml_float(s.cn0_dbhz), s.seed);
+  out += "cn0_dbhz_by_prn = {";
+  bool first = true;
+  for (const auto& [prn, cn0] : s.cn0_dbhz_by_prn) {
+    out += fmt::format("{} {} = {}", first ? "" : ",", prn, toml_float(cn0));
+    first = false;
+  }
+  out += first ? "}\n" : " }\n";
+  out += fmt::format("nav_data = {}\nnoise = {}\n", s.nav_data, s.noise);
+  out += fmt::format("\n[time]\ngps_week = {}\ntow_s = {}\n", s.gps_week, toml_float(s.tow_s));
+  out += "\n[navigation]\n";
+  if (!s.rinex.empty()) {
+    out += "rinex = " + abs(s.rinex) + "\n";
+  } else {
+    out += "constellation = " + toml_string(s.constellation) + "\n";
+  }
+  out += fmt::format("elevation_mask_deg = {}\ninclude_unhealthy = {}\n", toml_float(s.elevation_mask_deg),
+                     s.include_unhealthy);
+  out += "\n[receiver]\n";
+  if (!s.trajectory.empty()) {
+    out += "trajectory = " + abs(s.trajectory) + "\n";
+  } else {
+    out += fmt::format("llh_deg_m = [{}, {}, {}]\n", toml_float(s.llh_deg_m[0]), toml_float(s.llh_deg_m[1]),
+                       toml_float(s.llh_deg_m[2]));
+    out += "antenna_offsets_enu_m = [";
+    for (std::size_t i = 0; i < s.antenna_offsets_enu_m.size(); ++i) {
+      const auto& o = s.antenna_offsets_enu_m[i];
+      out += fmt::format("{}[{}, {}, {}]", i ? ", " : "", toml_float(o[0]), toml_float(o[1]), toml_float(o[2]));
+    }
+    out += "]\n";
+  }
+  out += fmt::format(
+      "clock_bias_m = {}\nclock_drift_mps = {}\nclock_bias_noise_m_per_sqrt_s = {}\n"
+      "clock_drift_noise_mps_per_sqrt_s = {}\n",
+      toml_float(s.clock_bias_m), toml_float(s.clock_drift_mps), toml_float(s.clock_bias_noise_m_per_sqrt_s),
+      toml_float(s.clock_drift_noise_mps_per_sqrt_s));
+  out += fmt::format("\n[atmosphere]\nionosphere = {}\ntroposphere = {}\n", s.ionosphere, s.troposphere);
+  out += fmt::format("\n[output]\ntruth_rate_hz = {}\n", toml_float(s.truth_rate_hz));
+  return out;
+}
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,251 @@
+#include "simulation.hpp"
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include <GeographicLib/Geocentric.hpp>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <csignal>
+#include <numbers>
+#include <span>
+
+#include "io/atomic_file.hpp"
+#include "signals/ephemeris_selection.hpp"
+#include "signals/gps_constants.hpp"
+#include "signals/input_error.hpp"
+#include "signals/nominal_constellation.hpp"
+#include "signals/rinex_nav.hpp"
+#include "signals/sample_writer.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+using signals::InputError;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_sigint(int) { g_interrupted = 1; }
+
+// Installs the Ctrl-C handler for the lifetime of a run and restores the previous one.
+class SigintGuard {
+ public:
+  SigintGuard() {
+    g_interrupted = 0;
+    previous_ = std::signal(SIGINT, on_sigint);
+  }
+  ~SigintGuard() { std::signal(SIGINT, previous_ == SIG_ERR ? SIG_DFL : previous_); }
+
+ private:
+  void (*previous_)(int) = SIG_DFL;
+};
+
+// Rows of ECEF -> local frame rotations at a geodetic position.
+Eigen::Matrix3d ned_from_ecef(double lat_rad, double lon_rad) {
+  const double sl = std::sin(lat_rad), cl = std::cos(lat_rad), so = std::sin(lon_rad), co = std::cos(lon_rad);
+  Eigen::Matrix3d C;
+  C << -sl * co, -sl * so, cl, -so, co, 0.0, -cl * co, -cl * so, -sl;
+  return C;
+}
+
+std::string json_escape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+NavigationSource load_navigation(const Scenario& s) {
+  NavigationSource nav;
+  const signals::GpsTime start{s.gps_week, s.tow_s};
+  std::vector<signals::Ephemeris> sets;
+  if (!s.rinex.empty()) {
+    const auto path = resolve_path(s, s.rinex);
+    auto data = signals::read_rinex_nav(path);
+    nav.name = path.string();
+    sets = std::move(data.ephemerides);
+    nav.klobuchar = data.klobuchar;
+    nav.utc = data.utc;
+  } else {
+    auto c = signals::nominal_constellation(start);
+    nav.name = "nominal";
+    sets = std::move(c.ephemerides);
+    nav.klobuchar = c.klobuchar;
+    nav.utc = c.utc;
+  }
+  signals::EphemerisSelectionOptions opt;
+  opt.include_unhealthy = s.include_unhealthy;
+  for (int prn = signals::kMinPrn; prn <= signals::kMaxPrn; ++prn)
+    if (auto e = signals::select_ephemeris(sets, prn, start, opt)) nav.ephemerides.push_back(*e);
+  if (nav.ephemerides.empty()) {
+    throw InputError(nav.name, fmt::format("no ephemeris is valid at GPS week {} tow {} s (scenario {})", s.gps_week,
+                                           s.tow_s, s.source.string()));
+  }
+  return nav;
+}
+
+std::shared_ptr<const signals::ReceiverMotion> make_motion(const Scenario& s) {
+  if (!s.trajectory.empty()) {
+    const auto path = resolve_path(s, s.trajectory);
+    auto samples = signals::read_trajectory_csv(path);
+    if (samples.front().t_s > 1e-9 || samples.back().t_s < s.duration_s - 1e-9) {
+      throw InputError(path.string(),
+                       fmt::format("the trajectory covers t = {} .. {} s but the scenario needs 0 .. {} s",
+                                   samples.front().t_s, samples.back().t_s, s.duration_s));
+    }
+    return std::make_shared<signals::TrajectoryMotion>(std::move(samples));
+  }
+  Eigen::Vector3d r0;
+  GeographicLib::Geocentric::WGS84().Forward(s.llh_deg_m[0], s.llh_deg_m[1], s.llh_deg_m[2], r0.x(), r0.y(), r0.z());
+  const Eigen::Matrix3d C_ned_e = ned_from_ecef(s.llh_deg_m[0] * kDeg, s.llh_deg_m[1] * kDeg);
+  std::vector<Eigen::Vector3d> antennas;
+  for (const auto& o : s.antenna_offsets_enu_m) {
+    const Eigen::Vector3d d_ned(o[1], o[0], -o[2]);
+    antennas.push_back(r0 + C_ned_e.transpose() * d_ned);
+  }
+  return std::make_shared<signals::StaticMotion>(std::move(antennas));
+}
+
+signals::SynthesiserOptions synthesiser_options(const Scenario& s, const NavigationSource& nav) {
+  signals::SynthesiserOptions o;
+  o.sample_rate_hz = s.sample_rate_hz;
+  o.if_hz = s.if_hz;
+  o.real_output = !signals::is_complex(s.format);
+  // Automatic gain: noise plus signals at RMS = full scale / 4 per component (clipping beyond 4 sigma).
+  o.output_rms = signals::full_scale(s.format) / 4.0;
+  o.start = {s.gps_week, s.tow_s};
+  o.default_cn0_dbhz = s.cn0_dbhz;
+  o.cn0_dbhz_by_prn = s.cn0_dbhz_by_prn;
+  o.elevation_mask_rad = s.elevation_mask_deg * kDeg;
+  o.include_unhealthy = s.include_unhealthy;
+  o.ionosphere = s.ionosphere;
+  o.troposphere = s.troposphere;
+  o.klobuchar = nav.klobuchar;
+  o.utc = nav.utc;
+  o.nav_data = s.nav_data;
+  o.noise = s.noise;
+  o.clock.bias_s = s.clock_bias_m / signals::kSpeedOfLight_mps;
+  o.clock.drift_sps = s.clock_drift_mps / signals::kSpeedOfLight_mps;
+  o.clock.bias_noise_s_per_sqrt_s = s.clock_bias_noise_m_per_sqrt_s / signals::kSpeedOfLight_mps;
+  o.clock.drift_noise_sps_per_sqrt_s = s.clock_drift_noise_mps_per_sqrt_s / signals::kSpeedOfLight_mps;
+  o.seed = s.seed;
+  if (const auto err = signals::validate(o); !err.empty()) throw InputError(s.source.string(), err);
+  return o;
+}
+
+SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& out_dir, std::FILE* progress) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const NavigationSource nav = load_navigation(s);
+  auto motion = make_motion(s);
+  const auto options = synthesiser_options(s, nav);
+  signals::IfSynthesiser synth(options, nav.ephemerides, motion);
+
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) throw InputError(out_dir.string(), "cannot create the output folder: " + ec.message());
+
+  SimulationResult result;
+  const int n_ant = synth.antenna_count();
+  std::vector<std::unique_ptr<signals::SampleWriter>> writers;
+  for (int a = 0; a < n_ant; ++a) {
+    const auto path = out_dir / fmt::format("antenna{}.{}.bin", a, signals::to_string(s.format));
+    writers.push_back(std::make_unique<signals::SampleWriter>(path, s.format));
+    result.sample_files.push_back(path);
+  }
+  result.satellites = synth.visible_satellites(0);
+  result.noise_sigma = synth.noise_sigma();
+
+  // Truth rows at receiver times k / truth_rate (sample-exact), CSV built in memory (small).
+  std::string truth =
+      "t_s,gps_week,tow_s,ecef_x_m,ecef_y_m,ecef_z_m,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,"
+      "clock_bias_m,clock_drift_mps\n";
+  const auto total = static_cast<std::int64_t>(std::llround(s.duration_s * s.sample_rate_hz));
+  const auto truth_sample = [&](std::int64_t k) {
+    return static_cast<std::int64_t>(std::llround(static_cast<double>(k) * s.sample_rate_hz / s.truth_rate_hz));
+  };
+  const auto add_truth_row = [&](std::int64_t n) {
+    const double t_r = synth.receive_time_s(n);
+    const auto gps = signals::add_seconds(options.start, t_r);
+    const auto st = motion->antenna_state(0, t_r);
+    double lat = 0, lon = 0, h = 0;
+    GeographicLib::Geocentric::WGS84().Reverse(st.r_e_m.x(), st.r_e_m.y(), st.r_e_m.z(), lat, lon, h);
+    const Eigen::Vector3d v_n = ned_from_ecef(lat * kDeg, lon * kDeg) * st.v_e_mps;
+    const auto clk = synth.receiver_clock(n);
+    truth +=
+        fmt::format("{:.9f},{},{:.9f},{:.4f},{:.4f},{:.4f},{:.10f},{:.10f},{:.4f},{:.5f},{:.5f},{:.5f},{:.5f},{:.6f}\n",
+                    static_cast<double>(n) / s.sample_rate_hz, gps.week, gps.tow_s, st.r_e_m.x(), st.r_e_m.y(),
+                    st.r_e_m.z(), lat, lon, h, v_n.x(), v_n.y(), v_n.z(), clk.bias_s * signals::kSpeedOfLight_mps,
+                    clk.drift_sps * signals::kSpeedOfLight_mps);
+  };
+
+  const std::size_t chunk = static_cast<std::size_t>(std::max(1.0, std::round(s.sample_rate_hz * 0.01)));  // 10 ms
+  std::vector<std::vector<std::complex<float>>> buffers(n_ant, std::vector<std::complex<float>>(chunk));
+  std::vector<std::span<std::complex<float>>> spans(n_ant);
+  SigintGuard sigint;
+  std::int64_t next_truth = 0;
+  int last_decile = 0;
+  std::int64_t n = 0;
+  while (n < total) {
+    while (truth_sample(next_truth) <= n && truth_sample(next_truth) < total) add_truth_row(truth_sample(next_truth++));
+    if (g_interrupted) {
+      result.interrupted = true;
+      break;
+    }
+    const auto count = static_cast<std::size_t>(std::min<std::int64_t>(
+        {static_cast<std::int64_t>(chunk), total - n, std::max<std::int64_t>(1, truth_sample(next_truth) - n)}));
+    for (int a = 0; a < n_ant; ++a) spans[a] = std::span(buffers[a].data(), count);
+    synth.generate(spans);
+    for (int a = 0; a < n_ant; ++a) writers[a]->write(spans[a]);
+    n += static_cast<std::int64_t>(count);
+    const int decile = static_cast<int>(10 * n / total);
+    if (progress && decile > last_decile) {
+      last_decile = decile;
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      const double done_s = static_cast<double>(n) / s.sample_rate_hz;
+      fmt::print(progress, "simulate: {:5.1f} / {:.1f} s of signal ({:3d}%), {:.1f}x real time\n", done_s, s.duration_s,
+                 decile * 10, done_s / std::max(wall, 1e-9));
+      std::fflush(progress);
+    }
+  }
+  for (auto& w : writers) w->finish();
+  result.samples = n;
+  result.signal_s = static_cast<double>(n) / s.sample_rate_hz;
+
+  std::string sats = "prn,elevation_deg,azimuth_deg,cn0_dbhz,doppler_hz,code_phase_chips\n";
+  for (const auto& v : result.satellites) {
+    sats += fmt::format("{},{:.4f},{:.4f},{:.2f},{:.4f},{:.6f}\n", v.prn, v.elevation_rad / kDeg, v.azimuth_rad / kDeg,
+                        v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
+  }
+  io::write_file_atomically(out_dir / "truth.csv", truth);
+  io::write_file_atomically(out_dir / "satellites.csv", sats);
+  io::write_file_atomically(out_dir / "scenario.toml", to_toml(s));
+
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  std::string prns, files;
+  for (const auto& v : result.satellites) prns += fmt::format("{}{}", prns.empty() ? "" : ", ", v.prn);
+  for (const auto& f : result.sample_files)
+    files += fmt::format("{}\"{}\"", files.empty() ? "" : ", ", json_escape(f.filename().string()));
+  const std::string summary = fmt::format(
+      "{{\n  \"command\": \"simulate\",\n  \"scenario\": \"{}\",\n  \"navigation\": \"{}\",\n"
+      "  \"sample_rate_hz\": {},\n  \"if_hz\": {},\n  \"format\": \"{}\",\n  \"antennas\": {},\n"
+      "  \"sample_files\": [{}],\n  \"samples_per_antenna\": {},\n  \"signal_s\": {},\n"
+      "  \"satellites_in_view\": [{}],\n  \"noise_sigma_per_component\": {},\n  \"interrupted\": {},\n"
+      "  \"wall_s\": {:.3f},\n  \"realtime_factor\": {:.3f}\n}}\n",
+      json_escape(s.source.filename().string()), json_escape(std::filesystem::path(nav.name).filename().string()),
+      s.sample_rate_hz, s.if_hz, signals::to_string(s.format), n_ant, files, result.samples, result.signal_s, prns,
+      result.noise_sigma, result.interrupted, result.wall_s, result.signal_s / std::max(result.wall_s, 1e-9));
+  io::write_file_atomically(out_dir / "summary.json", summary);
+  return result;
+}
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,54 @@
+// Runs a scenario through the IF synthesiser and writes the outputs of `ultratrack simulate` into a folder:
+// antenna<k>.<format>.bin (one per antenna, sample-synchronous), truth.csv (receiver truth at the truth
+// rate), satellites.csv (what the receiver should find at the first sample), scenario.toml (as run) and
+// summary.json. Every file is written under a temporary name and renamed when complete; Ctrl-C stops the
+// run early and still finishes the files (summary.json says "interrupted": true).
+//
+// truth.csv: t_s is receiver time (sample index / fs); gps_week, tow_s the true GPS time of that sample;
+// position/velocity of antenna 0 (ECEF and geodetic, NED velocity); clock_bias_m = c * (receiver clock -
+// GPS time), clock_drift_mps its rate. satellites.csv: doppler_hz as the receiver sees it (receiver
+// clock drift included, IF removed), code_phase_chips the chip received at sample 0, in [0, 1023).
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scenario.hpp"
+#include "signals/ephemeris.hpp"
+#include "signals/if_synthesiser.hpp"
+#include "signals/receiver_motion.hpp"
+
+namespace ultratrack::tools {
+
+// Broadcast data for a scenario: one ephemeris per PRN selected for the start time (healthy only unless
+// the scenario includes unhealthy ones), ionosphere and UTC parameters.
+struct NavigationSource {
+  std::string name;  // the RINEX file or "nominal"
+  std::vector<signals::Ephemeris> ephemerides;
+  signals::KlobucharParameters klobuchar;
+  signals::UtcParameters utc;
+};
+
+NavigationSource load_navigation(const Scenario& scenario);
+std::shared_ptr<const signals::ReceiverMotion> make_motion(const Scenario& scenario);
+// Throws InputError naming the scenario file when the options are not usable.
+signals::SynthesiserOptions synthesiser_options(const Scenario& scenario, const NavigationSource& nav);
+
+struct SimulationResult {
+  std::vector<std::filesystem::path> sample_files;
+  std::vector<signals::SatelliteView> satellites;  // in view at the first sample
+  std::int64_t samples = 0;                        // per antenna
+  double signal_s = 0.0;
+  double wall_s = 0.0;
+  double noise_sigma = 0.0;  // per output component, output units
+  bool interrupted = false;
+};
+
+// progress: where to print progress lines (nullptr: silent).
+SimulationResult run_simulation(const Scenario& scenario, const std::filesystem::path& out_dir,
+                                std::FILE* progress = nullptr);
+
+}  // namespace ultratrack::tools
