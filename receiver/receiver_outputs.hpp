@@ -13,7 +13,7 @@
 #include "receiver/receiver_summary.hpp"
 #include "receiver/rinex_obs_writer.hpp"
 #include "receiver/solution_writer.hpp"
-#include "signals/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace ultratrack::receiver {
 
@@ -37,7 +37,7 @@ class ReceiverOutputs final : public ReceiverObserver {
   std::optional<NmeaWriter> nmea_;  // made at the first fix, when the leap-second count is known
   KmlWriter kml_;
   RinexObsWriter obs_;
-  signals::AtomicFile tracking_;
+  io::AtomicFile tracking_;
   Eigen::Vector3d sum_r_e_m_ = Eigen::Vector3d::Zero();
   int fixes_ = 0;
 };

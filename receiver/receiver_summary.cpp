@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "signals/atomic_file.hpp"
+#include "io/atomic_file.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -53,7 +53,7 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
     if (engine.tracked_time_s(prn) > 0.0) tracked.push_back(prn);
     if (sat.used_in_fixes > 0) used.push_back(prn);
   }
-  signals::AtomicFile file(path);
+  io::AtomicFile file(path);
   auto& out = file.stream();
   fmt::print(out, "{{\n  \"input\": {{\"file\": {}, \"format\": {}, \"fs_hz\": {}, \"if_hz\": {}, \"skip_s\": {}}},\n",
              json_string(run.input), json_string(run.format), run.fs_hz, run.if_hz, run.skip_s);
