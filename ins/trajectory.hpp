@@ -27,6 +27,8 @@ struct TrajectorySpec {
   double heading0_rad = 0.0;
   bool coordinated_turns = false;  // bank into turns (roll = atan(speed * turn_rate / g0)), aircraft-like
   double ramp_s = 1.0;             // command blend time at each segment start (capped at half the segment)
+  double roll0_rad = 0.0;          // constant roll and pitch added to the attitude (a vehicle parked on a
+  double pitch0_rad = 0.0;         // slope, an IMU mounted tilted); |pitch| well below 90 deg
   std::vector<Segment> segments;
 
   double duration_s() const;

@@ -72,7 +72,8 @@ struct Kinematics {
 };
 
 Kinematics kinematics(double s, double psi, double a, double r, double c, double gr, double dr, double dc, double dgr,
-                      bool coordinated) {
+                      const TrajectorySpec& spec) {
+  const bool coordinated = spec.coordinated_turns;
   Kinematics k;
   const double cp = std::cos(psi), sp = std::sin(psi);
   const double tg = std::tan(gr), sec2 = 1.0 + tg * tg;
@@ -82,7 +83,7 @@ Kinematics kinematics(double s, double psi, double a, double r, double c, double
   // pitch: road grade plus the flight-path angle of the climb (speed softened near rest)
   const double w = std::sqrt(s * s + 1.0);
   const double dw = s * a / w;
-  k.e.pitch_rad = gr + std::atan2(c, w);
+  k.e.pitch_rad = gr + std::atan2(c, w) + spec.pitch0_rad;
   const double dpitch = dgr + (w * dc - c * dw) / (c * c + w * w);
   double roll = 0.0, droll = 0.0;
   if (coordinated) {
@@ -90,7 +91,7 @@ Kinematics kinematics(double s, double psi, double a, double r, double c, double
     roll = std::atan(u);
     droll = (a * r + s * dr) / kG0 / (1.0 + u * u);
   }
-  k.e.roll_rad = roll;
+  k.e.roll_rad = roll + spec.roll0_rad;
   k.e.yaw_rad = psi;
   k.euler_rate = {droll, dpitch, r};
   return k;
@@ -106,8 +107,7 @@ Eigen::Vector3d w_nb_b(const EulerAngles& e, const Eigen::Vector3d& rate) {
 
 TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State& y) const {
   const Commands u = commands(t);
-  const Kinematics k =
-      kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_.coordinated_turns);
+  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
   const double lat = y[2], h = y[4];
   const Eigen::Vector3d pos_rate = geodetic_rates(lat, h, k.v_n);
   const Eigen::Vector3d w_ie = earth_rate_n(lat);
@@ -132,8 +132,7 @@ TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State
 
 void TrajectoryGenerator::fill_truth(double t, const State& y, TruthSample& out) const {
   const Commands u = commands(t);
-  const Kinematics k =
-      kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_.coordinated_turns);
+  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
   out.t_s = t;
   out.lat_rad = y[2];
   out.lon_rad = y[3];

@@ -10,14 +10,13 @@
 #include <string>
 
 #include "commands.hpp"
-#include "io/atomic_file.hpp"
-#include "ins/imu_csv.hpp"
+#include "imu_simulation.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
-#include "ins/odometer.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
+#include "io/atomic_file.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -62,45 +61,24 @@ void run_imusim(const ImuSimOptions& o) {
   const ins::ImuErrorSpec error_spec = ins::imu_preset(o.preset);
 
   fs::create_directories(o.out_dir);
-  ins::TrajectoryGenerator gen(spec, o.rate_hz);
-  ins::ImuErrorModel errors(error_spec, o.seed);
-  ins::ImuCsvWriter imu_out(fs::path(o.out_dir) / "imu.csv");
   ins::NavCsvWriter truth_out(fs::path(o.out_dir) / "truth.csv");
   std::vector<ins::TruthSample> truth_for_odometer;
-  truth_out.write(gen.truth().nav());
-  if (o.odometer) truth_for_odometer.push_back(gen.truth());
-  std::size_t rows = 0;
-  const auto total = static_cast<std::size_t>(std::llround(spec.duration_s() * o.rate_hz));
-  const bool show_progress = total >= 500000;  // long runs report every 10 % on stderr
-  while (!gen.done()) {
-    if (show_progress && rows % (total / 10) == 0 && rows > 0) fmt::print(stderr, "imusim: {}%\n", 100 * rows / total);
-    const ins::ImuIncrement ideal = gen.advance();
-    imu_out.write(errors.apply(ideal, gen.dt_s()));
-    truth_out.write(gen.truth().nav());
-    if (o.odometer) truth_for_odometer.push_back(gen.truth());
-    ++rows;
-  }
-  imu_out.commit();
+  const ImuSimulationResult r = simulate_imu(
+      spec, o.rate_hz, error_spec, o.seed, fs::path(o.out_dir) / "imu.csv",
+      [&](const ins::TruthSample& t) {
+        truth_out.write(t.nav());
+        if (o.odometer) truth_for_odometer.push_back(t);
+      },
+      "imusim");
   truth_out.commit();
-  if (o.odometer) {
-    ins::OdometerOptions odo;
-    odo.scale_factor_error = o.odometer_sf;
-    const auto samples = ins::simulate_odometer(truth_for_odometer, odo);
-    io::AtomicFile f(fs::path(o.out_dir) / "odometer.csv");
-    f.write("t_s,pulses,distance_m\n");
-    for (const auto& s : samples) f.write(fmt::format("{},{},{}\n", s.t_s, s.pulses, s.distance_m));
-    f.commit();
-  }
-  const auto& e = errors.turn_on_errors();
+  if (o.odometer) write_odometer_csv(fs::path(o.out_dir) / "odometer.csv", truth_for_odometer, o.odometer_sf);
+  const std::size_t rows = r.imu_rows;
   std::string json = "{\n";
   json += fmt::format("  \"trajectory\": \"{}\",\n  \"duration_s\": {},\n  \"imu_rate_hz\": {},\n  \"imu_rows\": {},\n",
                       o.profile.empty() ? o.segments_file : o.profile, spec.duration_s(), o.rate_hz, rows);
   json += fmt::format("  \"preset\": \"{}\",\n  \"seed\": {},\n", o.preset, o.seed);
-  json += fmt::format("  \"gyro_turn_on_bias_dph\": [{:.6g}, {:.6g}, {:.6g}],\n", e.gyro.bias.x() / kDeg * 3600,
-                      e.gyro.bias.y() / kDeg * 3600, e.gyro.bias.z() / kDeg * 3600);
-  json += fmt::format("  \"accel_turn_on_bias_mps2\": [{:.6g}, {:.6g}, {:.6g}],\n", e.accel.bias.x(), e.accel.bias.y(),
-                      e.accel.bias.z());
-  json += fmt::format("  \"distance_m\": {:.3f}\n}}\n", gen.truth().distance_m);
+  json += turn_on_bias_json(r.turn_on);
+  json += fmt::format("  \"distance_m\": {:.3f}\n}}\n", r.distance_m);
   io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);
   summary.commit();

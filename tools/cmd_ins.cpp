@@ -14,7 +14,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "io/atomic_file.hpp"
 #include "ins/attitude.hpp"
 #include "ins/coarse_alignment.hpp"
 #include "ins/earth_model.hpp"
@@ -22,6 +21,8 @@
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
 #include "ins/strapdown.hpp"
+#include "io/atomic_file.hpp"
+#include "truth_csv.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -78,7 +79,7 @@ void run_ins(const InsOptions& o) {
   if (o.decimate < 1) throw InputError("command line", "--decimate must be at least 1");
   const std::vector<ins::ImuIncrement> imu = ins::read_imu_csv(o.imu_file);
   std::vector<ins::NavState> truth;
-  if (!o.init_file.empty()) truth = ins::read_nav_csv(o.init_file);
+  if (!o.init_file.empty()) truth = read_truth_csv(o.init_file);
 
   ins::NavState init;
   std::size_t first = 0;  // first IMU row to navigate with
@@ -186,7 +187,8 @@ void add_ins_command(CLI::App& app) {
   cmd->add_option("--imu", opts->imu_file, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps)")
       ->required()
       ->check(CLI::ExistingFile);
-  cmd->add_option("--init", opts->init_file, "truth/nav CSV: first row is the initial state; later rows are compared")
+  cmd->add_option("--init", opts->init_file,
+                  "truth/nav CSV (or simulate's truth.csv): first row is the initial state; later rows are compared")
       ->check(CLI::ExistingFile);
   cmd->add_option("--align", opts->align_s, "coarse alignment over the first SECONDS of stationary data");
   cmd->add_option("--position", opts->position, "LAT_DEG LON_DEG HEIGHT_M (with --align and no --init)")->expected(3);

@@ -14,7 +14,7 @@
 namespace ultratrack::tools {
 
 void add_simulate_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("simulate", "Synthesise IF samples, truth and navigation data from a scenario");
+  auto* cmd = app.add_subcommand("simulate", "Synthesise IF samples, IMU data and truth from a scenario");
   auto scenario_path = std::make_shared<std::string>();
   auto out_dir = std::make_shared<std::string>();
   auto quiet = std::make_shared<bool>(false);
@@ -24,6 +24,18 @@ void add_simulate_command(CLI::App& app) {
   cmd->callback([scenario_path, out_dir, quiet] {
     const Scenario scenario = read_scenario(*scenario_path);
     const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr);
+    const std::string inertial =
+        scenario.trajectory_enabled()
+            ? fmt::format("imu.csv ({} rows at {} Hz, preset {}), {}", r.imu_rows, scenario.imu_rate_hz,
+                          scenario.imu_preset, scenario.odometer ? "odometer.csv, " : "")
+            : std::string();
+    if (!scenario.signal) {
+      fmt::print(
+          "simulate: no [signal]: IMU and truth only in {:.1f} s\noutputs in {}: {}truth.csv, scenario.toml, "
+          "summary.json\n",
+          r.wall_s, *out_dir, inertial);
+      return;
+    }
     fmt::print("simulate: {:.1f} s of {} at {:.3f} MHz ({} antenna{}) in {:.1f} s ({:.1f}x real time){}\n", r.signal_s,
                signals::to_string(scenario.format), scenario.sample_rate_hz / 1e6, r.sample_files.size(),
                r.sample_files.size() == 1 ? "" : "s", r.wall_s, r.signal_s / std::max(r.wall_s, 1e-9),
@@ -33,8 +45,9 @@ void add_simulate_command(CLI::App& app) {
       fmt::print("  {:3d} {:6.1f} {:7.1f} {:5.1f} {:10.1f} {:9.3f}\n", v.prn, v.elevation_rad * 180.0 / M_PI,
                  v.azimuth_rad * 180.0 / M_PI, v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
     }
-    fmt::print("outputs in {}: {}, truth.csv, satellites.csv, scenario.toml, summary.json\n", *out_dir,
-               r.sample_files.front().filename().string());
+    fmt::print("outputs in {}: {}, {}truth.csv, {}satellites.csv, scenario.toml, summary.json\n", *out_dir,
+               r.sample_files.front().filename().string(), inertial,
+               scenario.trajectory_enabled() ? "antenna_truth.csv, " : "");
   });
 }
 

@@ -4,11 +4,14 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
 
+#include "ins/imu_error_model.hpp"
+#include "ins/trajectory.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {
@@ -89,14 +92,47 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
   Scenario s;
   s.source = source;
   bool llh_given = false, rinex_given = false, constellation_given = false, offsets_given = false;
+  bool signal_given = false, trajectory_given = false, antennas_given = false, attitude_given = false;
+  bool duration_given = false, start_state_given = false;
+  auto in_list = [](const std::vector<std::string>& names, const std::string& v) {
+    return std::find(names.begin(), names.end(), v) != names.end();
+  };
+  auto joined = [](const std::vector<std::string>& names) {
+    std::string out;
+    for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+  };
 
   for (auto&& [section_key, section_node] : root) {
     const std::string section(section_key.str());
+    if (section == "antenna") {
+      const auto* arr = section_node.as_array();
+      if (!arr || arr->empty() || !arr->is_array_of_tables())
+        r.fail(section_node, section, "expected [[antenna]] tables with lever_arm_body_m = [x, y, z]");
+      s.lever_arms_body_m.clear();
+      for (const auto& e : *arr) {
+        const auto& t = *e.as_table();
+        const toml::node* lever = nullptr;
+        for (auto&& [k, n] : t) {
+          if (k.str() != "lever_arm_body_m") r.fail(n, "antenna." + std::string(k.str()), "unknown key in [[antenna]]");
+          lever = &n;
+        }
+        if (!lever) r.fail(e, "antenna.lever_arm_body_m", "missing in an [[antenna]] table");
+        const auto l = r.triple(*lever, "antenna.lever_arm_body_m");
+        check_range(r, *lever, "antenna.lever_arm_body_m",
+                    std::abs(l[0]) <= 1000 && std::abs(l[1]) <= 1000 && std::abs(l[2]) <= 1000,
+                    "each component must be within +-1000 m");
+        s.lever_arms_body_m.push_back(l);
+      }
+      antennas_given = true;
+      continue;
+    }
     const auto* tbl = section_node.as_table();
     if (!tbl) r.fail(section_node, section, "expected a table [" + section + "]");
     for (auto&& [k, n] : *tbl) {
       const std::string key(k.str());
       const std::string name = section + "." + key;
+      if (section == "signal") signal_given = true;
       if (section == "signal") {
         if (key == "sample_rate_hz") {
           s.sample_rate_hz = r.number(n, name);
@@ -181,6 +217,13 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
           s.antenna_offsets_enu_m.clear();
           for (const auto& e : *a) s.antenna_offsets_enu_m.push_back(r.triple(e, name));
           offsets_given = true;
+        } else if (key == "attitude_deg") {
+          s.attitude_deg = r.triple(n, name);
+          check_range(r, n, name,
+                      std::abs(s.attitude_deg[0]) <= 180 && std::abs(s.attitude_deg[1]) <= 80 &&
+                          std::abs(s.attitude_deg[2]) <= 360,
+                      "roll must be within +-180 deg, pitch +-80 deg, yaw +-360 deg");
+          attitude_given = true;
         } else if (key == "clock_bias_m") {
           s.clock_bias_m = r.number(n, name);
           check_range(r, n, name, std::abs(s.clock_bias_m) < 3e8, "must be below 1 light-second");
@@ -207,6 +250,65 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
         } else {
           r.fail(n, name, "unknown key in [atmosphere]");
         }
+      } else if (section == "trajectory") {
+        trajectory_given = true;
+        if (key == "profile") {
+          s.trajectory_profile = r.string(n, name);
+          if (!in_list(ins::profile_names(), s.trajectory_profile))
+            r.fail(n, name, "unknown profile (" + joined(ins::profile_names()) + ")");
+        } else if (key == "file") {
+          s.trajectory_file = r.string(n, name);
+          if (s.trajectory_file.empty()) r.fail(n, name, "must name a segment CSV file");
+        } else if (key == "duration_s") {
+          s.trajectory_duration_s = r.number(n, name);
+          check_range(r, n, name, s.trajectory_duration_s > 0 && s.trajectory_duration_s <= 86400,
+                      "must be within (0, 86400] s");
+          duration_given = true;
+        } else if (key == "imu_rate_hz") {
+          s.imu_rate_hz = r.number(n, name);
+          check_range(r, n, name, s.imu_rate_hz >= 50 && s.imu_rate_hz <= 1000, "must be within 50..1000 Hz");
+        } else if (key == "speed_mps") {
+          s.start_speed_mps = r.number(n, name);
+          check_range(r, n, name, s.start_speed_mps >= 0 && s.start_speed_mps < 3000, "must be within 0..3000 m/s");
+          start_state_given = true;
+        } else if (key == "heading_deg") {
+          s.start_heading_deg = r.number(n, name);
+          check_range(r, n, name, std::abs(s.start_heading_deg) <= 360, "must be within +-360 deg");
+          start_state_given = true;
+        } else if (key == "odometer") {
+          s.odometer = r.boolean(n, name);
+        } else if (key == "odometer_scale_factor_error") {
+          s.odometer_scale_factor_error = r.number(n, name);
+          check_range(r, n, name, std::abs(s.odometer_scale_factor_error) < 0.5, "must be within +-0.5");
+        } else {
+          r.fail(n, name, "unknown key in [trajectory]");
+        }
+        if (!s.trajectory_profile.empty() && !s.trajectory_file.empty())
+          r.fail(n, name, "give either profile or file, not both");
+      } else if (section == "imu") {
+        auto override_value = [&](std::optional<double>& v, double max) {
+          v = r.number(n, name);
+          check_range(r, n, name, *v >= 0 && *v <= max, fmt::format("must be within 0..{}", max));
+        };
+        if (key == "preset") {
+          s.imu_preset = r.string(n, name);
+          if (!in_list(ins::imu_preset_names(), s.imu_preset))
+            r.fail(n, name, "unknown preset (" + joined(ins::imu_preset_names()) + ")");
+        } else if (key == "seed") {
+          const auto v = r.integer(n, name);
+          check_range(r, n, name, v >= 0, "must be >= 0");
+          s.imu_seed = static_cast<std::uint64_t>(v);
+        } else if (key == "gyro_bias_dph") {
+          override_value(s.gyro_bias_dph, 1e5);
+        } else if (key == "accel_bias_mg") {
+          override_value(s.accel_bias_mg, 1e3);
+        } else if (key == "gyro_arw_dpsh") {
+          override_value(s.gyro_arw_dpsh, 1e3);
+        } else if (key == "accel_vrw_mpspsh") {
+          override_value(s.accel_vrw_mpspsh, 1e3);
+        } else {
+          r.fail(n, name, "unknown key in [imu]");
+        }
       } else if (section == "output") {
         if (key == "truth_rate_hz") {
           s.truth_rate_hz = r.number(n, name);
@@ -215,11 +317,34 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
           r.fail(n, name, "unknown key in [output]");
         }
       } else {
-        r.fail(section_node, section, "unknown section (signal, time, navigation, receiver, atmosphere, output)");
+        r.fail(section_node, section,
+               "unknown section (signal, time, navigation, receiver, atmosphere, output, trajectory, imu, "
+               "[[antenna]])");
       }
     }
   }
   if (rinex_given) s.constellation.clear();
+  // Inertial scenarios.
+  const auto fail_file = [&](const std::string& problem) { throw InputError(file, problem); };
+  if (trajectory_given) {
+    if (!s.trajectory_enabled()) fail_file("[trajectory] needs profile = \"NAME\" or file = \"segments.csv\"");
+    if (!s.trajectory_profile.empty() && !duration_given) fail_file("key trajectory.duration_s: missing (profiles)");
+    if (!s.trajectory_file.empty() && duration_given)
+      fail_file("key trajectory.duration_s: a segment file sets its own duration");
+    if (s.trajectory_file.empty() && start_state_given)
+      fail_file("keys trajectory.speed_mps / heading_deg: only with a segment file");
+    if (!s.trajectory.empty()) fail_file("key receiver.trajectory: not with a [trajectory] section");
+    if (offsets_given)
+      fail_file("key receiver.antenna_offsets_enu_m: with [trajectory] use [[antenna]] lever_arm_body_m");
+    if (std::abs(s.llh_deg_m[0]) >= 89.0)
+      fail_file("key receiver.llh_deg_m: latitude must be within +-89 deg with [trajectory]");
+    if (attitude_given && s.trajectory_profile != "static")
+      fail_file("key receiver.attitude_deg: needs [trajectory] profile = \"static\"");
+  } else {
+    if (antennas_given) fail_file("[[antenna]] needs a [trajectory] section (static receivers: antenna_offsets_enu_m)");
+    if (attitude_given) fail_file("key receiver.attitude_deg: needs [trajectory] profile = \"static\"");
+  }
+  s.signal = signal_given || !trajectory_given;
   // Cross-key checks that need the whole scenario.
   const bool real = !signals::is_complex(s.format);
   if (real && !(s.if_hz > 0))
@@ -250,18 +375,22 @@ std::string to_toml(const Scenario& s) {
     const auto a = std::filesystem::absolute(resolve_path(s, p), ec);
     return toml_string(ec ? p : a.lexically_normal().string());
   };
-  std::string out = "# Scenario as run by `ultratrack simulate` (every key, defaults filled in).\n\n[signal]\n";
-  out += fmt::format("sample_rate_hz = {}\nif_hz = {}\nformat = \"{}\"\nduration_s = {}\ncn0_dbhz = {}\nseed = {}\n",
-                     toml_float(s.sample_rate_hz), toml_float(s.if_hz), signals::to_string(s.format),
-                     toml_float(s.duration_s), toml_float(s.cn0_dbhz), s.seed);
-  out += "cn0_dbhz_by_prn = {";
-  bool first = true;
-  for (const auto& [prn, cn0] : s.cn0_dbhz_by_prn) {
-    out += fmt::format("{} {} = {}", first ? "" : ",", prn, toml_float(cn0));
-    first = false;
+  std::string out = "# Scenario as run by `ultratrack simulate` (every key, defaults filled in).\n";
+  if (s.signal) out += "\n[signal]\n";
+  if (s.signal)
+    out += fmt::format("sample_rate_hz = {}\nif_hz = {}\nformat = \"{}\"\nduration_s = {}\ncn0_dbhz = {}\nseed = {}\n",
+                       toml_float(s.sample_rate_hz), toml_float(s.if_hz), signals::to_string(s.format),
+                       toml_float(s.duration_s), toml_float(s.cn0_dbhz), s.seed);
+  if (s.signal) {
+    out += "cn0_dbhz_by_prn = {";
+    bool first = true;
+    for (const auto& [prn, cn0] : s.cn0_dbhz_by_prn) {
+      out += fmt::format("{} {} = {}", first ? "" : ",", prn, toml_float(cn0));
+      first = false;
+    }
+    out += first ? "}\n" : " }\n";
+    out += fmt::format("nav_data = {}\nnoise = {}\n", s.nav_data, s.noise);
   }
-  out += first ? "}\n" : " }\n";
-  out += fmt::format("nav_data = {}\nnoise = {}\n", s.nav_data, s.noise);
   out += fmt::format("\n[time]\ngps_week = {}\ntow_s = {}\n", s.gps_week, toml_float(s.tow_s));
   out += "\n[navigation]\n";
   if (!s.rinex.empty()) {
@@ -277,6 +406,12 @@ std::string to_toml(const Scenario& s) {
   } else {
     out += fmt::format("llh_deg_m = [{}, {}, {}]\n", toml_float(s.llh_deg_m[0]), toml_float(s.llh_deg_m[1]),
                        toml_float(s.llh_deg_m[2]));
+  }
+  if (s.trajectory_profile == "static") {
+    out += fmt::format("attitude_deg = [{}, {}, {}]\n", toml_float(s.attitude_deg[0]), toml_float(s.attitude_deg[1]),
+                       toml_float(s.attitude_deg[2]));
+  }
+  if (s.trajectory.empty() && !s.trajectory_enabled()) {
     out += "antenna_offsets_enu_m = [";
     for (std::size_t i = 0; i < s.antenna_offsets_enu_m.size(); ++i) {
       const auto& o = s.antenna_offsets_enu_m[i];
@@ -291,6 +426,30 @@ std::string to_toml(const Scenario& s) {
       toml_float(s.clock_drift_noise_mps_per_sqrt_s));
   out += fmt::format("\n[atmosphere]\nionosphere = {}\ntroposphere = {}\n", s.ionosphere, s.troposphere);
   out += fmt::format("\n[output]\ntruth_rate_hz = {}\n", toml_float(s.truth_rate_hz));
+  if (s.trajectory_enabled()) {
+    out += "\n[trajectory]\n";
+    if (!s.trajectory_profile.empty()) {
+      out += fmt::format("profile = {}\nduration_s = {}\n", toml_string(s.trajectory_profile),
+                         toml_float(s.trajectory_duration_s));
+    } else {
+      out += fmt::format("file = {}\nspeed_mps = {}\nheading_deg = {}\n", abs(s.trajectory_file),
+                         toml_float(s.start_speed_mps), toml_float(s.start_heading_deg));
+    }
+    out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
+                       s.odometer, toml_float(s.odometer_scale_factor_error));
+    out += fmt::format("\n[imu]\npreset = {}\nseed = {}\n", toml_string(s.imu_preset), s.imu_seed);
+    const std::pair<const char*, const std::optional<double>*> overrides[] = {
+        {"gyro_bias_dph", &s.gyro_bias_dph},
+        {"accel_bias_mg", &s.accel_bias_mg},
+        {"gyro_arw_dpsh", &s.gyro_arw_dpsh},
+        {"accel_vrw_mpspsh", &s.accel_vrw_mpspsh}};
+    for (const auto& [key, value] : overrides)
+      if (value->has_value()) out += fmt::format("{} = {}\n", key, toml_float(**value));
+    for (const auto& l : s.lever_arms_body_m) {
+      out += fmt::format("\n[[antenna]]\nlever_arm_body_m = [{}, {}, {}]\n", toml_float(l[0]), toml_float(l[1]),
+                         toml_float(l[2]));
+    }
+  }
   return out;
 }
 

@@ -13,12 +13,31 @@
 //                 clock_bias_noise_m_per_sqrt_s = 0.0  clock_drift_noise_mps_per_sqrt_s = 0.0
 //   [atmosphere]  ionosphere = true  troposphere = false
 //   [output]      truth_rate_hz = 10.0
+//
+// Inertial scenarios (one trajectory drives the IMU data, the truth and the IF synthesiser's antennas):
+//   [trajectory]  profile = "circle"  (static, straight, circle, s, spiral, land)  or  file = "segments.csv"
+//                 (ins/trajectory.hpp's segment CSV, relative to the scenario; then speed_mps = 0.0 and
+//                 heading_deg = 0.0 give the start state and the file sets the duration)
+//                 duration_s = 120.0 (profiles; must cover [signal] duration_s)  imu_rate_hz = 100.0 (50..1000)
+//                 odometer = false  odometer_scale_factor_error = 0.0   (odometer.csv; the land profile's use)
+//                 The start position is [receiver] llh_deg_m; t = 0 of the trajectory is the [time] start.
+//   [imu]         preset = "ideal" (ideal, hg1700ae, dmu6x, navigation, mems)  seed = 1
+//                 overrides of the preset's 1-sigma values (only when given):
+//                 gyro_bias_dph (turn-on bias, deg/h)  accel_bias_mg (turn-on bias, milli-g of 9.80665 m/s^2)
+//                 gyro_arw_dpsh (angle random walk, deg/sqrt(h))  accel_vrw_mpspsh (velocity random walk,
+//                 m/s/sqrt(h))
+//   [[antenna]]   lever_arm_body_m = [x, y, z]   one table per antenna, body axes (x forward, y right,
+//                 z down) from the IMU; the first is the master (antenna0); default one antenna at the IMU
+//   [receiver]    attitude_deg = [roll, pitch, yaw]   with profile = "static": the parked body's attitude
+// With [trajectory], [receiver] takes neither trajectory nor antenna_offsets_enu_m, and [signal] is optional:
+// without it only the IMU and truth files are written. [[antenna]] and attitude_deg need [trajectory].
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -66,6 +85,30 @@ struct Scenario {
 
   // [output]
   double truth_rate_hz = 10.0;
+
+  // Whether IF samples are synthesised: [signal] present, or no [trajectory] (the classic scenario).
+  bool signal = true;
+
+  // [trajectory]: exactly one of profile / file when the section is present (trajectory_enabled())
+  std::string trajectory_profile;
+  std::string trajectory_file;
+  double trajectory_duration_s = 0.0;  // profiles only
+  double imu_rate_hz = 100.0;
+  double start_speed_mps = 0.0;    // segment files only
+  double start_heading_deg = 0.0;  // segment files only
+  bool odometer = false;
+  double odometer_scale_factor_error = 0.0;
+
+  // [imu]
+  std::string imu_preset = "ideal";
+  std::uint64_t imu_seed = 1;
+  std::optional<double> gyro_bias_dph, accel_bias_mg, gyro_arw_dpsh, accel_vrw_mpspsh;
+
+  // [[antenna]] and [receiver] attitude_deg (inertial scenarios)
+  std::vector<std::array<double, 3>> lever_arms_body_m = {{0.0, 0.0, 0.0}};
+  std::array<double, 3> attitude_deg = {0.0, 0.0, 0.0};
+
+  bool trajectory_enabled() const { return !trajectory_profile.empty() || !trajectory_file.empty(); }
 };
 
 // Parses scenario text; `source` names it in errors and anchors relative paths. Throws InputError.

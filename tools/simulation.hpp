@@ -8,6 +8,15 @@
 // position/velocity of antenna 0 (ECEF and geodetic, NED velocity); clock_bias_m = c * (receiver clock -
 // GPS time), clock_drift_mps its rate. satellites.csv: doppler_hz as the receiver sees it (receiver
 // clock drift included, IF removed), code_phase_chips the chip received at sample 0, in [0, 1023).
+//
+// With [trajectory] (an inertial scenario) one trajectory drives everything: DIR/imu.csv (ins/imu_csv.hpp
+// columns, increments ending at t_s, trajectory time = true GPS time since the [time] start, errors from
+// the [imu] preset and seed), the antennas (InsTruthMotion: IMU position + C_en C_nb lever arm) and
+// truth.csv, whose position and velocity are then the IMU's (body origin, not an antenna) and which gains
+// roll_deg,pitch_deg,yaw_deg (body to NED, z-y-x). antenna_truth.csv: t_s, antenna, ECEF position and
+// velocity of every antenna at the truth rows. DIR/odometer.csv when [trajectory] odometer = true.
+// Without [signal] there is no receiver: truth.csv's t_s is the GPS time since the start, its clock columns
+// the deterministic clock model (bias + drift t), and no sample, satellite or antenna file is written.
 #pragma once
 
 #include <cstdio>
@@ -16,6 +25,9 @@
 #include <string>
 #include <vector>
 
+#include "ins/imu_error_model.hpp"
+#include "ins/trajectory.hpp"
+#include "ins/truth_interpolator.hpp"
 #include "scenario.hpp"
 #include "signals/ephemeris.hpp"
 #include "signals/if_synthesiser.hpp"
@@ -33,7 +45,13 @@ struct NavigationSource {
 };
 
 NavigationSource load_navigation(const Scenario& scenario);
-std::shared_ptr<const signals::ReceiverMotion> make_motion(const Scenario& scenario);
+// The antennas' motion: InsTruthMotion on `truth` with the scenario's lever arms for an inertial scenario
+// (truth required then), else the static position(s) or the trajectory file.
+std::shared_ptr<const signals::ReceiverMotion> make_motion(
+    const Scenario& scenario, std::shared_ptr<const ins::TruthInterpolator> truth = nullptr);
+// The trajectory and IMU errors of an inertial scenario (InputError naming the scenario file).
+ins::TrajectorySpec trajectory_spec(const Scenario& scenario);
+ins::ImuErrorSpec imu_error_spec(const Scenario& scenario);
 // Throws InputError naming the scenario file when the options are not usable.
 signals::SynthesiserOptions synthesiser_options(const Scenario& scenario, const NavigationSource& nav);
 
@@ -45,6 +63,8 @@ struct SimulationResult {
   double wall_s = 0.0;
   double noise_sigma = 0.0;  // per output component, output units
   bool interrupted = false;
+  std::size_t imu_rows = 0;  // inertial scenarios
+  std::size_t truth_rows = 0;
 };
 
 // progress: where to print progress lines (nullptr: silent).

@@ -30,8 +30,11 @@ double position_error_m(const NavState& a, const TruthSample& b) {
       .norm();
 }
 
-Errors run_profile(const std::string& name, double duration_s, double rate_hz) {
-  const TrajectorySpec spec = profile_spec(name, duration_s, 36.37 * kDeg, 127.36 * kDeg, 100.0);
+Errors run_profile(const std::string& name, double duration_s, double rate_hz, double roll0_rad = 0.0,
+                   double pitch0_rad = 0.0) {
+  TrajectorySpec spec = profile_spec(name, duration_s, 36.37 * kDeg, 127.36 * kDeg, 100.0);
+  spec.roll0_rad = roll0_rad;
+  spec.pitch0_rad = pitch0_rad;
   TrajectoryGenerator gen(spec, rate_hz);
   Strapdown ins(gen.truth().nav());
   Errors e;
@@ -73,4 +76,22 @@ TEST(ProfileConsistency, HoldsAt50HzAnd400Hz) {
     EXPECT_LT(e.max_pos_m, 1.0) << rate;
     EXPECT_LT(e.max_att_deg, 1e-4) << rate;
   }
+}
+
+// Constant roll/pitch offsets (a parked, tilted body; an IMU mounted tilted on a moving vehicle) keep the
+// increments consistent with the attitude, and the attitude carries the offsets.
+TEST(ProfileConsistency, HoldsWithRollAndPitchOffsets) {
+  for (const char* name : {"static", "land"}) {
+    const Errors e = run_profile(name, 600.0, 100.0, 12.0 * kDeg, -7.0 * kDeg);
+    EXPECT_LT(e.max_pos_m, 1.0) << name;
+    EXPECT_LT(e.max_att_deg, 1e-4) << name;
+  }
+  TrajectorySpec spec = profile_spec("static", 1.0, 36.37 * kDeg, 127.36 * kDeg, 100.0);
+  spec.roll0_rad = 12.0 * kDeg;
+  spec.pitch0_rad = -7.0 * kDeg;
+  spec.heading0_rad = 63.0 * kDeg;
+  const EulerAngles a = euler_from_quaternion(simulate(spec, 100.0).truth.back().q_nb);
+  EXPECT_NEAR(a.roll_rad / kDeg, 12.0, 1e-9);
+  EXPECT_NEAR(a.pitch_rad / kDeg, -7.0, 1e-9);
+  EXPECT_NEAR(a.yaw_rad / kDeg, 63.0, 1e-9);
 }

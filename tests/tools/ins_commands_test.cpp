@@ -25,6 +25,7 @@ void run(std::vector<std::string> args) {
   app.require_subcommand(1);
   ultratrack::tools::add_ins_command(app);
   ultratrack::tools::add_imusim_command(app);
+  ultratrack::tools::add_simulate_command(app);
   std::vector<std::string> rev(args.rbegin(), args.rend());  // CLI11 parses a reversed vector
   app.parse(rev);
 }
@@ -55,6 +56,22 @@ TEST(InsCommands, SimulatedSpiralNavigatesOntoItsTruth) {
   EXPECT_LT(json_number(summary, "max_vertical_error_m"), 1.0);
   EXPECT_LT(json_number(summary, "max_attitude_error_deg"), 1e-4);
   EXPECT_EQ(ultratrack::ins::read_nav_csv(dir / "nav/nav.csv").size(), 12001u);
+}
+
+// The truth.csv of an inertial `simulate` scenario (IMU only) initialises `ins` and is compared on GPS time.
+TEST(InsCommands, SimulateScenarioImuNavigatesOntoItsTruth) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "s.toml") << "[time]\ngps_week = 2190\ntow_s = 604790.0\n"  // crosses the week
+                                   "[receiver]\nllh_deg_m = [36.37, 127.36, 300.0]\n"
+                                   "[trajectory]\nprofile = \"spiral\"\nduration_s = 60.0\n[imu]\npreset = \"ideal\"\n";
+  run({"simulate", "--scenario", (dir / "s.toml").string(), "--out", (dir / "sim").string(), "--quiet"});
+  run({"ins", "--imu", (dir / "sim/imu.csv").string(), "--init", (dir / "sim/truth.csv").string(), "--out",
+       (dir / "nav").string()});
+  const fs::path summary = dir / "nav/summary.json";
+  EXPECT_EQ(json_number(summary, "rows_matched"), 601);  // every 10 Hz truth row
+  EXPECT_LT(json_number(summary, "max_horizontal_error_m"), 1.0);
+  EXPECT_LT(json_number(summary, "max_vertical_error_m"), 1.0);
+  EXPECT_LT(json_number(summary, "max_attitude_error_deg"), 1e-4);
 }
 
 TEST(InsCommands, AlignModeLevelsFromStationaryData) {

@@ -1,0 +1,72 @@
+#include "truth_csv.hpp"
+
+#include <fmt/core.h>
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "ins/attitude.hpp"
+#include "ins/csv_util.hpp"
+#include "ins/ins_error.hpp"
+#include "ins/nav_csv.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+const std::vector<std::string>& simulate_truth_header() {
+  static const std::vector<std::string> h{"t_s",       "gps_week",  "tow_s",        "ecef_x_m",        "ecef_y_m",
+                                          "ecef_z_m",  "lat_deg",   "lon_deg",      "height_m",        "vel_n_mps",
+                                          "vel_e_mps", "vel_d_mps", "clock_bias_m", "clock_drift_mps", "roll_deg",
+                                          "pitch_deg", "yaw_deg"};
+  return h;
+}
+
+}  // namespace
+
+std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::ifstream in(file);
+  if (!in) throw ins::InputError(name, "cannot open the truth file");
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line) && ins::trim(line).empty()) ++line_no;
+  ++line_no;
+  if (ins::trim(line).rfind("t_s,gps_week,", 0) != 0) return ins::read_nav_csv(file);
+
+  ins::check_header(name, line_no, ins::trim(line), simulate_truth_header());
+  std::vector<ins::NavState> out;
+  double week0 = 0.0, tow0 = 0.0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const std::string_view t = ins::trim(line);
+    if (t.empty()) continue;
+    std::array<double, 17> v{};
+    ins::parse_row(name, line_no, t, v);
+    if (out.empty()) {
+      week0 = v[1];
+      tow0 = v[2];
+    }
+    const double t_s = (v[1] - week0) * 604800.0 + (v[2] - tow0);
+    if (!out.empty() && !(t_s > out.back().t_s))
+      throw ins::InputError(name, fmt::format("GPS time does not increase (tow_s {})", v[2]), line_no);
+    if (std::fabs(v[6]) > 90.0) throw ins::InputError(name, "lat_deg outside [-90, 90]", line_no);
+    if (std::fabs(v[15]) > 90.0) throw ins::InputError(name, "pitch_deg outside [-90, 90]", line_no);
+    ins::NavState s;
+    s.t_s = t_s;
+    s.lat_rad = v[6] * kDeg;
+    s.lon_rad = v[7] * kDeg;
+    s.height_m = v[8];
+    s.v_n = {v[9], v[10], v[11]};
+    s.q_nb = ins::quaternion_from_euler({v[14] * kDeg, v[15] * kDeg, v[16] * kDeg});
+    out.push_back(s);
+  }
+  if (out.empty()) throw ins::InputError(name, "no truth rows");
+  return out;
+}
+
+}  // namespace ultratrack::tools
