@@ -9,7 +9,8 @@
 #include <string>
 
 #include "ins/attitude.hpp"
-#include "ins/csv_util.hpp"
+#include "io/input_error.hpp"
+#include "io/numeric_csv.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
 
@@ -30,32 +31,27 @@ const std::vector<std::string>& simulate_truth_header() {
 
 std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
-  std::ifstream in(file);
-  if (!in) throw ins::InputError(name, "cannot open the truth file");
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line) && ins::trim(line).empty()) ++line_no;
-  ++line_no;
-  if (ins::trim(line).rfind("t_s,gps_week,", 0) != 0) return ins::read_nav_csv(file);
-
-  ins::check_header(name, line_no, ins::trim(line), simulate_truth_header());
+  {
+    // The first non-blank line tells the format: simulate's truth.csv or a plain nav CSV.
+    std::ifstream in(file);
+    if (!in) throw io::InputError(name, "cannot open the truth file");
+    std::string line;
+    while (std::getline(in, line) && io::trim(line).empty()) {
+    }
+    if (io::trim(line).rfind("t_s,gps_week,", 0) != 0) return ins::read_nav_csv(file);
+  }
   std::vector<ins::NavState> out;
   double week0 = 0.0, tow0 = 0.0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string_view t = ins::trim(line);
-    if (t.empty()) continue;
-    std::array<double, 17> v{};
-    ins::parse_row(name, line_no, t, v);
+  io::read_numeric_csv(file, "truth file", simulate_truth_header(), [&](int line_no, std::span<const double> v) {
     if (out.empty()) {
       week0 = v[1];
       tow0 = v[2];
     }
     const double t_s = (v[1] - week0) * 604800.0 + (v[2] - tow0);
     if (!out.empty() && !(t_s > out.back().t_s))
-      throw ins::InputError(name, fmt::format("GPS time does not increase (tow_s {})", v[2]), line_no);
-    if (std::fabs(v[6]) > 90.0) throw ins::InputError(name, "lat_deg outside [-90, 90]", line_no);
-    if (std::fabs(v[15]) > 90.0) throw ins::InputError(name, "pitch_deg outside [-90, 90]", line_no);
+      throw io::InputError(name, fmt::format("GPS time does not increase (tow_s {})", v[2]), line_no);
+    if (std::fabs(v[6]) > 90.0) throw io::InputError(name, "lat_deg outside [-90, 90]", line_no);
+    if (std::fabs(v[15]) > 90.0) throw io::InputError(name, "pitch_deg outside [-90, 90]", line_no);
     ins::NavState s;
     s.t_s = t_s;
     s.lat_rad = v[6] * kDeg;
@@ -64,8 +60,7 @@ std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file) {
     s.v_n = {v[9], v[10], v[11]};
     s.q_nb = ins::quaternion_from_euler({v[14] * kDeg, v[15] * kDeg, v[16] * kDeg});
     out.push_back(s);
-  }
-  if (out.empty()) throw ins::InputError(name, "no truth rows");
+  });
   return out;
 }
 
