@@ -12,7 +12,7 @@ namespace ultratrack::receiver {
 struct Observation {
   int prn = 0;
   double pseudorange_m = 0.0;          // c * (receive time by the receiver clock - transmit time)
-  double carrier_phase_cycles = 0.0;   // accumulated, continuous while locked (RINEX sign: grows as range shrinks)
+  double carrier_phase_cycles = 0.0;   // accumulated, continuous while locked (RINEX sign: grows with the range, like the pseudorange)
   double doppler_hz = 0.0;             // positive when the range shrinks
   double cn0_dbhz = 0.0;
   double lock_time_s = 0.0;            // time since carrier lock was (re)gained

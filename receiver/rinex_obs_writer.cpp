@@ -77,7 +77,7 @@ void RinexObsWriter::finish(const Eigen::Vector3d& approx_r_e_m) {
   out << header_line("", "END OF HEADER");
   {
     std::ifstream body(body_path);
-    out << body.rdbuf();
+    if (epochs_ > 0) out << body.rdbuf();  // inserting an empty streambuf would set failbit
   }
   file.commit();
   std::filesystem::remove(body_path);

@@ -84,6 +84,17 @@ TrackingChannel::TrackingChannel(const ChannelConfig& config, const ChannelStart
   epoch_.num_antennas = config.num_antennas;
 }
 
+ReplicaState TrackingChannel::replica() const {
+  const Int128 raw = code_.raw();
+  const Int128 period = floor_div(raw, kPeriodRaw);
+  ReplicaState r;
+  r.sample_index = nco_sample_;
+  r.code_period = static_cast<std::int64_t>(period);
+  r.code_phase_chips = static_cast<double>(raw - period * kPeriodRaw) * 0x1p-52;
+  r.carrier_phase_cycles = carrier_.value();
+  return r;
+}
+
 void TrackingChannel::apply(const NcoCommand& cmd) {
   current_ = cmd;
   current_.code_phase_jump_chips = 0.0;

@@ -49,6 +49,15 @@ struct ChannelStart {
 ChannelStart start_from_code_start(std::int64_t first_sample, double samples_to_code_start, double doppler_hz,
                                    double sample_rate_hz);
 
+// The replica at a sample: which code period (the channel's count, as in CorrelationEpoch::first_code_period) and
+// how far into it, and the carrier phase accumulated since the channel's start. What observables are built from.
+struct ReplicaState {
+  std::int64_t sample_index = 0;
+  std::int64_t code_period = 0;
+  double code_phase_chips = 0.0;  // [0, 1023) into code_period
+  double carrier_phase_cycles = 0.0;
+};
+
 // Views on one block of samples (one pointer per antenna, same length, same receiver sample indices).
 struct SampleBlockView {
   std::int64_t first_sample = 0;
@@ -86,6 +95,8 @@ class TrackingChannel final {
   const CorrelatorLayout& layout() const { return config_.layout; }
   // Sample index the NCO state refers to (the next sample the channel expects).
   std::int64_t next_sample() const { return nco_sample_; }
+  // The replica's exact NCO state at next_sample() (a pending command is not yet applied).
+  ReplicaState replica() const;
 
  private:
   void apply(const NcoCommand& cmd);

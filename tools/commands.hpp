@@ -11,6 +11,7 @@ namespace ultratrack::tools {
 void add_simulate_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
 void add_acquire_command(CLI::App& app);
+void add_receive_command(CLI::App& app);
 void add_ins_command(CLI::App& app);
 void add_imusim_command(CLI::App& app);
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "command_exit.hpp"
 #include "commands.hpp"
 #include "ins/ins_error.hpp"
 #include "io/input_error.hpp"
@@ -17,12 +18,16 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_simulate_command(app);
   ultratrack::tools::add_demo_command(app);
   ultratrack::tools::add_acquire_command(app);
+  ultratrack::tools::add_receive_command(app);
   ultratrack::tools::add_ins_command(app);
   ultratrack::tools::add_imusim_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const ultratrack::tools::CommandExit& e) {
+    fmt::print(stderr, "ultratrack: {}\n", e.what());
+    return e.code;
   } catch (const ultratrack::io::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;

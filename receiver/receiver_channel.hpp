@@ -1,0 +1,108 @@
+// One receiver channel: a satellite's TrackingChannel closed by ScalarTracking (which assembles the 20 ms
+// navigation bits) and its NavigationDataChannel (frame sync, LNAV decoding, transmit-time tag). At any
+// sample the channel has reached it gives the observables' raw material: the transmit time of the replica
+// (time tag + whole code periods + code phase / chip rate) and the carrier phase with the Costas half cycle
+// resolved by the frame polarity. Units: seconds, chips, cycles, Hz; sample indices on the receiver's clock.
+#pragma once
+
+#include <cmath>
+#include <complex>
+#include <cstdint>
+#include <optional>
+
+#include "receiver/acquisition.hpp"
+#include "receiver/navigation_data_channel.hpp"
+#include "receiver/scalar_tracking.hpp"
+#include "receiver/tracking_channel.hpp"
+#include "signals/gps_time.hpp"
+
+namespace ultratrack::receiver {
+
+// Where a satellite's replica starts when acquisition searched samples from snapshot_first_sample on but
+// tracking begins later, at start_sample: the code phase is carried forward at the Doppler-scaled chip rate
+// 1.023 MHz (1 + f_d / f_L1) over the samples in between (the carrier phase restarts at 0: it is arbitrary).
+ChannelStart channel_start_from_acquisition(const AcquisitionResult& result, std::int64_t snapshot_first_sample,
+                                            std::int64_t start_sample, double fs_hz);
+
+// One tracking.csv row: the prompt and loop state of a channel at the start of an epoch.
+struct TrackingRecord {
+  int prn = 0;
+  std::int64_t sample_index = 0;  // first sample of the epoch
+  std::complex<float> prompt{};   // unnormalised correlator sum
+  int integration_ms = 1;
+  double cn0_dbhz = NAN;          // NaN before the first estimate
+  double doppler_hz = 0.0;        // replica carrier frequency at baseband
+  double code_phase_chips = 0.0;  // replica code phase into the period at the epoch start
+  TrackingState state = TrackingState::kPullIn;
+  double pli = 0.0;
+  bool phase_locked = false;
+  bool frame_synced = false;
+};
+
+// What a synchronised channel measures at the sample it has reached.
+struct ChannelMeasurement {
+  int prn = 0;
+  signals::GpsTime tag_time;          // transmit time of the tagged subframe start
+  double since_tag_s = 0.0;           // replica's transmit time - tag_time (code periods + code phase)
+  double carrier_phase_cycles = 0.0;  // RINEX sense (grows with range), half cycle resolved
+  double doppler_hz = 0.0;            // positive when approaching
+  double cn0_dbhz = 0.0;
+  double lock_time_s = 0.0;
+  bool new_track = false;             // first measurement of this track (RINEX loss of lock)
+};
+
+class ReceiverChannel {
+ public:
+  ReceiverChannel(int prn, const ChannelStart& start, double fs_hz, const ScalarTrackingOptions& options,
+                  int reference_week, int record_periods);
+
+  // Consumes a block (samples before next_sample() are skipped); calls on_record(const TrackingRecord&) once
+  // every record_periods code periods. Allocates nothing.
+  template <class OnRecord>
+  void feed(const SampleBlockView& block, OnRecord&& on_record) {
+    int offset = 0;
+    while (offset < block.num_samples) {
+      const auto r = channel_.feed(block, offset);
+      offset += r.consumed;
+      if (r.epoch_ready) {
+        const CorrelationEpoch& e = channel_.epoch();
+        const TrackingReport report = loop_.update(e);
+        channel_.command(report.command);
+        if (report.set_coherent) channel_.set_coherent_periods(report.coherent_periods, report.aligned_period);
+        after_epoch(e, report);
+        const std::int64_t p0 = e.first_code_period;
+        if (floor_div(p0 + e.num_code_periods - 1, record_periods_) != floor_div(p0 - 1, record_periods_))
+          on_record(record(e, report));
+      }
+    }
+  }
+
+  int prn() const { return channel_.prn(); }
+  TrackingState state() const { return loop_.state(); }
+  bool lost() const { return loop_.state() == TrackingState::kLost; }
+  std::int64_t next_sample() const { return channel_.next_sample(); }
+  std::optional<double> cn0_dbhz() const { return loop_.cn0_dbhz(); }
+  // Synchronised: bit sync, frame sync and a transmit-time tag; measurement() is then available.
+  bool synchronised() const { return loop_.state() == TrackingState::kBitSynced && nav_.synchronised(); }
+  // The measurement at next_sample(); nothing unless synchronised(). Marks the track as reported.
+  std::optional<ChannelMeasurement> measure();
+  NavigationDataChannel& navigation() { return nav_; }
+  const NavigationDataChannel& navigation() const { return nav_; }
+  double tracked_time_s() const { return tracked_s_; }
+
+ private:
+  static std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+  void after_epoch(const CorrelationEpoch& e, const TrackingReport& report);
+  TrackingRecord record(const CorrelationEpoch& e, const TrackingReport& report) const;
+
+  double fs_hz_;
+  TrackingChannel channel_;
+  ScalarTracking loop_;
+  NavigationDataChannel nav_;
+  int record_periods_;
+  std::optional<std::int64_t> lock_start_sample_;
+  bool reported_ = false;
+  double tracked_s_ = 0.0;
+};
+
+}  // namespace ultratrack::receiver

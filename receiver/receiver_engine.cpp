@@ -1,0 +1,324 @@
+#include "receiver/receiver_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "signals/ephemeris_selection.hpp"
+#include "signals/gps_constants.hpp"
+#include "signals/look_angles.hpp"
+#include "signals/satellite_state.hpp"
+
+namespace ultratrack::receiver {
+namespace {
+
+const ReceiverOptions& checked(const ReceiverOptions& o) {
+  const std::string why = o.validate();
+  if (!why.empty()) throw std::invalid_argument("ReceiverEngine: " + why);
+  return o;
+}
+
+AcquisitionOptions acquisition_options(const ReceiverOptions& o) {
+  AcquisitionOptions a = o.acquisition;
+  a.fs_hz = o.fs_hz;
+  return a;
+}
+
+bool same_set(const signals::Ephemeris& a, const signals::Ephemeris& b) {
+  return a.prn == b.prn && a.iode == b.iode && a.iodc == b.iodc && a.week == b.week && a.toe_s == b.toe_s;
+}
+
+}  // namespace
+
+ReceiverEngine::ReceiverEngine(const ReceiverOptions& options, ReceiverObserver& observer)
+    : options_(checked(options)),
+      observer_(observer),
+      acquisition_(acquisition_options(options_)),
+      smoothing_(std::max(1, static_cast<int>(std::lround(options_.smoothing_window_s / options_.observation_interval_s)))) {
+  channels_.resize(static_cast<std::size_t>(options_.channels));
+  prns_ = options_.prns;
+  if (prns_.empty())
+    for (int prn = 1; prn <= 32; ++prn) prns_.push_back(prn);
+  observation_step_ = std::max<std::int64_t>(1, std::llround(options_.observation_interval_s * options_.fs_hz));
+  record_periods_ = std::max(1, static_cast<int>(std::lround(options_.tracking_record_interval_s * 1e3)));
+  snapshot_.resize(acquisition_.samples_needed());
+  epoch_.observations.reserve(32);
+  measured_.reserve(32);
+  pvt_input_.reserve(32);
+}
+
+ReceiverEngine::~ReceiverEngine() = default;
+
+void ReceiverEngine::add_navigation(const std::vector<signals::Ephemeris>& ephemerides,
+                                    const signals::KlobucharParameters& iono, const signals::UtcParameters& utc) {
+  ephemerides_.insert(ephemerides_.end(), ephemerides.begin(), ephemerides.end());
+  if (iono.valid) iono_ = iono;
+  if (utc.valid) utc_ = utc;
+}
+
+int ReceiverEngine::channels_in_use() const {
+  return static_cast<int>(std::count_if(channels_.begin(), channels_.end(), [](const auto& c) { return c != nullptr; }));
+}
+
+int ReceiverEngine::channels_synchronised() const {
+  return static_cast<int>(
+      std::count_if(channels_.begin(), channels_.end(), [](const auto& c) { return c && c->synchronised(); }));
+}
+
+double ReceiverEngine::tracked_time_s(int prn) const {
+  double t = stats_.satellites[static_cast<std::size_t>(prn)].tracked_s;
+  for (const auto& c : channels_)
+    if (c && c->prn() == prn) t += c->tracked_time_s();
+  return t;
+}
+
+std::vector<int> ReceiverEngine::tracked_prns() const {
+  std::vector<int> out;
+  for (const auto& c : channels_)
+    if (c) out.push_back(c->prn());
+  return out;
+}
+
+void ReceiverEngine::begin_snapshot(std::int64_t sample) {
+  snapshot_active_ = true;
+  snapshot_have_ = 0;
+  snapshot_first_ = sample;
+}
+
+std::vector<int> ReceiverEngine::missing_prns() const {
+  std::vector<int> out;
+  for (int prn : prns_) {
+    const bool tracked =
+        std::any_of(channels_.begin(), channels_.end(), [prn](const auto& c) { return c && c->prn() == prn; });
+    if (!tracked) out.push_back(prn);
+  }
+  return out;
+}
+
+// Predicted Doppler from the last fix (position, clock drift), the receiver clock and an ephemeris.
+std::optional<DopplerWindow> ReceiverEngine::assistance(int prn, const signals::GpsTime& t, bool* below_horizon) const {
+  *below_horizon = false;
+  if (!last_fix_) return std::nullopt;
+  const auto eph = signals::select_ephemeris(ephemerides_, prn, t, {.include_unhealthy = true});
+  if (!eph) return std::nullopt;
+  const auto sat = signals::satellite_state(*eph, signals::add_seconds(t, -0.075));
+  const Eigen::Vector3d& r_rx = last_fix_->r_e_m;
+  const auto look = signals::look_angles(r_rx, sat.r_e_m);
+  if (look.elevation_rad < options_.assisted_elevation_min_deg * signals::kPi / 180.0) {
+    *below_horizon = true;
+    return std::nullopt;
+  }
+  const Eigen::Vector3d los = (sat.r_e_m - r_rx).normalized();
+  const double range_rate = los.dot(sat.v_e_mps - last_fix_->v_e_mps);
+  const double c = signals::kSpeedOfLight_mps;
+  const double doppler = -(range_rate + last_fix_->clock_drift_mps - c * sat.clock_drift_sps) / signals::kL1Wavelength_m;
+  return DopplerWindow{doppler, options_.assisted_doppler_half_width_hz};
+}
+
+void ReceiverEngine::acquire(std::int64_t start_sample) {
+  snapshot_active_ = false;
+  next_reacquisition_ = start_sample + std::llround(options_.reacquisition_interval_s * options_.fs_hz);
+  const std::span<const std::complex<float>> samples(snapshot_.data(), snapshot_.size());
+  std::vector<int> blind;
+  std::vector<AcquisitionResult> results;
+  const bool can_assist = last_fix_ && clock_;
+  for (int prn : missing_prns()) {
+    if (!can_assist) {
+      blind.push_back(prn);
+      continue;
+    }
+    bool below = false;
+    const auto window = assistance(prn, clock_->time_at(snapshot_first_), &below);
+    if (below) continue;
+    if (window)
+      results.push_back(acquisition_.search(samples, prn, window));
+    else
+      blind.push_back(prn);
+  }
+  if (!blind.empty()) {
+    auto more = acquisition_.search(samples, blind);
+    results.insert(results.end(), more.begin(), more.end());
+  }
+  observer_.on_acquisition(snapshot_first_, results);
+  std::vector<const AcquisitionResult*> detected;
+  for (const auto& r : results)
+    if (r.detected) detected.push_back(&r);
+  std::sort(detected.begin(), detected.end(), [](auto* a, auto* b) { return a->metric > b->metric; });
+  for (const AcquisitionResult* r : detected) {
+    auto free = std::find(channels_.begin(), channels_.end(), nullptr);
+    if (free == channels_.end()) break;
+    const ChannelStart start = channel_start_from_acquisition(*r, snapshot_first_, start_sample, options_.fs_hz);
+    *free = std::make_unique<ReceiverChannel>(r->prn, start, options_.fs_hz, options_.tracking, options_.reference_week,
+                                              record_periods_);
+    ++stats_.satellites[static_cast<std::size_t>(r->prn)].acquisitions;
+  }
+}
+
+void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
+  SampleBlockView view;
+  view.first_sample = first_sample;
+  view.num_samples = static_cast<int>(samples.size());
+  view.num_antennas = 1;
+  view.antenna[0] = samples.data();
+  for (auto& channel : channels_) {
+    if (!channel) continue;
+    channel->feed(view, [this](const TrackingRecord& r) {
+      if (!std::isnan(r.cn0_dbhz) && r.state != TrackingState::kLost) {
+        auto& stats = stats_.satellites[static_cast<std::size_t>(r.prn)];
+        stats.tracking_cn0_sum_dbhz += r.cn0_dbhz;
+        ++stats.tracking_cn0_count;
+      }
+      observer_.on_tracking(r);
+    });
+    collect_navigation(*channel);
+  }
+}
+
+void ReceiverEngine::collect_navigation(ReceiverChannel& channel) {
+  NavigationDataChannel& nav = channel.navigation();
+  auto& stats = stats_.satellites[static_cast<std::size_t>(channel.prn())];
+  if (nav.synchronised()) stats.frame_synced = true;
+  if (!nav.take_new_ephemeris()) return;
+  const auto& decoder = nav.decoder();
+  if (decoder.klobuchar().valid) iono_ = decoder.klobuchar();
+  if (decoder.utc().valid) utc_ = decoder.utc();
+  if (!decoder.ephemeris()) return;
+  const signals::Ephemeris& eph = *decoder.ephemeris();
+  stats.ephemeris_decoded = true;
+  if (std::none_of(decoded_.begin(), decoded_.end(), [&](const auto& e) { return same_set(e, eph); }))
+    decoded_.push_back(eph);
+  if (std::none_of(ephemerides_.begin(), ephemerides_.end(), [&](const auto& e) { return same_set(e, eph); }))
+    ephemerides_.push_back(eph);
+}
+
+void ReceiverEngine::release_lost_channels() {
+  for (auto& channel : channels_) {
+    if (!channel || !channel->lost()) continue;
+    auto& stats = stats_.satellites[static_cast<std::size_t>(channel->prn())];
+    ++stats.losses;
+    stats.tracked_s += channel->tracked_time_s();
+    channel.reset();
+  }
+}
+
+void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
+  if (!started_) {
+    started_ = true;
+    stats_.first_sample = first_sample;
+    next_sample_ = first_sample;
+    next_observation_ = first_sample + observation_step_;
+    begin_snapshot(first_sample);
+  }
+  if (first_sample != next_sample_ && snapshot_active_) begin_snapshot(first_sample);  // a gap: restart it
+  const std::int64_t end = first_sample + static_cast<std::int64_t>(samples.size());
+  std::int64_t s = first_sample;
+  while (s < end) {
+    std::int64_t stop = std::min(end, next_observation_);
+    if (snapshot_active_) stop = std::min(stop, s + static_cast<std::int64_t>(snapshot_.size() - snapshot_have_));
+    const auto part = samples.subspan(static_cast<std::size_t>(s - first_sample), static_cast<std::size_t>(stop - s));
+    if (snapshot_active_) {
+      std::copy(part.begin(), part.end(), snapshot_.begin() + static_cast<std::ptrdiff_t>(snapshot_have_));
+      snapshot_have_ += part.size();
+    }
+    feed_channels(part, s);
+    s = stop;
+    if (snapshot_active_ && snapshot_have_ == snapshot_.size()) acquire(s);
+    if (s == next_observation_) {
+      observation_epoch(s);
+      next_observation_ += observation_step_;
+    }
+    release_lost_channels();
+    if (!snapshot_active_ && s >= next_reacquisition_ && channels_in_use() < options_.channels &&
+        !missing_prns().empty())
+      begin_snapshot(s);
+  }
+  next_sample_ = end;
+  stats_.samples_processed += static_cast<std::int64_t>(samples.size());
+}
+
+void ReceiverEngine::observation_epoch(std::int64_t sample) {
+  ++epoch_index_;
+  measured_.clear();
+  for (auto& channel : channels_)
+    if (channel)
+      if (auto m = channel->measure()) measured_.push_back(*m);
+  if (measured_.empty()) return;
+  if (!clock_) {
+    // The latest transmit time plus a nominal travel time: the clock starts within ~20 ms of GPS time.
+    auto latest = std::max_element(measured_.begin(), measured_.end(), [](const auto& a, const auto& b) {
+      return signals::seconds_between(a.tag_time, b.tag_time) + a.since_tag_s - b.since_tag_s < 0.0;
+    });
+    clock_.emplace(signals::add_seconds(latest->tag_time, latest->since_tag_s + options_.initial_travel_time_s), sample,
+                   options_.fs_hz);
+  }
+  const double since_base = clock_->seconds_since_base(sample);
+  epoch_.receive_time = clock_->time_at(sample);
+  epoch_.sample_index = sample;
+  epoch_.observations.clear();
+  for (const ChannelMeasurement& m : measured_) {
+    const double travel = signals::seconds_between(clock_->base(), m.tag_time) + since_base - m.since_tag_s;
+    // Travel times are 64-90 ms; a clock off by up to ~30 ms before the first fix widens that. Anything
+    // outside is a wrong time tag (e.g. a bad week or a bit slip), never a measurement.
+    if (!(travel > 0.02 && travel < 0.2)) continue;
+    Observation o;
+    o.prn = m.prn;
+    o.pseudorange_m = signals::kSpeedOfLight_mps * travel;
+    o.carrier_phase_cycles = m.carrier_phase_cycles;
+    o.doppler_hz = m.doppler_hz;
+    o.cn0_dbhz = m.cn0_dbhz;
+    o.lock_time_s = m.lock_time_s;
+    o.loss_of_lock = m.new_track;
+    o.half_cycle_resolved = true;  // measure() needs frame sync, which fixes the polarity
+    epoch_.observations.push_back(o);
+    const double smoothed = smoothing_.update(o.prn, epoch_index_, o.pseudorange_m, o.carrier_phase_cycles, o.loss_of_lock);
+    smoothed_m_[static_cast<std::size_t>(o.prn)] = options_.smoothing_window_s > 0.0 ? smoothed : o.pseudorange_m;
+    auto& stats = stats_.satellites[static_cast<std::size_t>(m.prn)];
+    ++stats.observations;
+    stats.cn0_sum_dbhz += m.cn0_dbhz;
+  }
+  if (epoch_.observations.empty()) return;
+  ++stats_.observation_epochs;
+  observer_.on_observations(epoch_);
+  solve(epoch_);
+}
+
+void ReceiverEngine::solve(const ObservationEpoch& epoch) {
+  pvt_input_.clear();
+  for (const Observation& o : epoch.observations) {
+    const auto eph = signals::select_ephemeris(ephemerides_, o.prn, epoch.receive_time, {.include_unhealthy = true});
+    if (!eph) continue;
+    SatelliteMeasurement m;
+    m.prn = o.prn;
+    m.pseudorange_m = smoothed_m_[static_cast<std::size_t>(o.prn)];
+    m.doppler_hz = o.doppler_hz;
+    m.has_doppler = true;
+    m.cn0_dbhz = o.cn0_dbhz;
+    m.ephemeris = *eph;
+    pvt_input_.push_back(m);
+  }
+  if (pvt_input_.size() < 4) return;
+  PvtOptions pvt = options_.pvt;
+  pvt.ionosphere = pvt.ionosphere && iono_.valid;
+  const Eigen::Vector3d initial = last_fix_ ? last_fix_->r_e_m : Eigen::Vector3d::Zero();
+  PvtSolution fix = solve_pvt(pvt_input_, epoch.receive_time, iono_, pvt, initial);
+  if (!fix.valid) return;
+  if (!stats_.first_fix_sample) stats_.first_fix_sample = epoch.sample_index;
+  ++stats_.fixes;
+  stats_.sum_r_e_m += fix.r_e_m;
+  stats_.sum_lat_rad += fix.lat_rad;
+  stats_.sum_lon_rad += fix.lon_rad;
+  stats_.sum_height_m += fix.height_m;
+  for (int prn : fix.used_prns) ++stats_.satellites[static_cast<std::size_t>(prn)].used_in_fixes;
+  observer_.on_fix(fix, epoch);
+  // Keep the receiver clock within clock_jump_threshold_s of GPS time: a jump, as RINEX allows (the
+  // pseudoranges of later epochs drop by c * bias; carrier phases are unaffected).
+  const double bias_s = fix.clock_bias_m / signals::kSpeedOfLight_mps;
+  if (std::abs(bias_s) > options_.clock_jump_threshold_s) {
+    clock_->correct(bias_s);
+    smoothing_.clock_jump(bias_s);
+    ++stats_.clock_jumps;
+  }
+  last_fix_ = std::move(fix);
+}
+
+}  // namespace ultratrack::receiver

@@ -1,0 +1,138 @@
+// The scalar receiver as a processing object: fed with contiguous blocks of complex baseband samples (any
+// size), it acquires satellites on a snapshot of the first samples (assisted by ephemeris and the last fix once
+// they exist), allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh
+// snapshots, forms observables at common receive epochs (every observation_interval_s, in samples), and solves
+// PVT from them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
+// The receiver clock is a GpsTime tied to a sample index (ReceiverClock); pseudorange = c (t_rx - t_tx).
+// Units: samples, seconds, metres, Hz.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <complex>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "receiver/acquisition.hpp"
+#include "receiver/carrier_smoothing.hpp"
+#include "receiver/observables.hpp"
+#include "receiver/pvt.hpp"
+#include "receiver/receiver_channel.hpp"
+#include "receiver/receiver_clock.hpp"
+#include "receiver/receiver_options.hpp"
+#include "signals/ephemeris.hpp"
+
+namespace ultratrack::receiver {
+
+// Receives what the engine produces, synchronously, from process(). Default: ignore.
+class ReceiverObserver {
+ public:
+  virtual ~ReceiverObserver() = default;
+  virtual void on_tracking(const TrackingRecord&) {}
+  virtual void on_acquisition(std::int64_t /*snapshot_first_sample*/, const std::vector<AcquisitionResult>&) {}
+  virtual void on_observations(const ObservationEpoch&) {}
+  virtual void on_fix(const PvtSolution&, const ObservationEpoch&) {}
+};
+
+// Per-satellite counts over the run (index = PRN).
+struct SatelliteStats {
+  int acquisitions = 0;          // times detected and given a channel
+  int losses = 0;                // times its channel lost lock and was released
+  double tracked_s = 0.0;        // time phase-locked
+  double cn0_sum_dbhz = 0.0;     // over observation epochs
+  double tracking_cn0_sum_dbhz = 0.0;  // over tracking records with an estimate (every 20 ms)
+  int tracking_cn0_count = 0;
+  int observations = 0;          // observation epochs with a pseudorange
+  int used_in_fixes = 0;
+  bool frame_synced = false;
+  bool ephemeris_decoded = false;
+};
+
+struct ReceiverStats {
+  std::int64_t first_sample = 0;        // first sample processed
+  std::int64_t samples_processed = 0;
+  std::optional<std::int64_t> first_fix_sample;
+  int fixes = 0;
+  int observation_epochs = 0;
+  int clock_jumps = 0;
+  Eigen::Vector3d sum_r_e_m = Eigen::Vector3d::Zero();  // for the mean fix
+  double sum_lat_rad = 0.0, sum_lon_rad = 0.0, sum_height_m = 0.0;
+  std::array<SatelliteStats, 33> satellites{};
+};
+
+class ReceiverEngine {
+ public:
+  // options must validate (std::invalid_argument otherwise). The observer must outlive the engine.
+  ReceiverEngine(const ReceiverOptions& options, ReceiverObserver& observer);
+  ~ReceiverEngine();
+
+  // Hot start: ephemerides (and Klobuchar/UTC when valid) known before decoding any.
+  void add_navigation(const std::vector<signals::Ephemeris>& ephemerides, const signals::KlobucharParameters& iono,
+                      const signals::UtcParameters& utc);
+
+  // Processes samples[0..n) whose first sample has receiver index first_sample. Blocks should be contiguous;
+  // a gap is bridged by the channels (dead reckoning) and restarts a pending acquisition snapshot.
+  void process(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+
+  const ReceiverStats& stats() const { return stats_; }
+  const std::optional<PvtSolution>& last_fix() const { return last_fix_; }
+  int channels_in_use() const;
+  int channels_synchronised() const;
+  // Ephemerides decoded from the signal (each new set once), and the broadcast Klobuchar/UTC parameters.
+  const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return decoded_; }
+  const signals::KlobucharParameters& klobuchar() const { return iono_; }
+  const signals::UtcParameters& utc() const { return utc_; }
+  const ReceiverOptions& options() const { return options_; }
+  // Time phase-locked on a PRN so far (released channels and the one tracking it now).
+  double tracked_time_s(int prn) const;
+  // PRNs in channels now, and of those the synchronised ones (for progress displays).
+  std::vector<int> tracked_prns() const;
+
+ private:
+  void begin_snapshot(std::int64_t sample);
+  void acquire(std::int64_t start_sample);
+  std::vector<int> missing_prns() const;
+  std::optional<DopplerWindow> assistance(int prn, const signals::GpsTime& t, bool* below_horizon) const;
+  void feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+  void collect_navigation(ReceiverChannel& channel);
+  void release_lost_channels();
+  void observation_epoch(std::int64_t sample);
+  void solve(const ObservationEpoch& epoch);
+
+  ReceiverOptions options_;
+  ReceiverObserver& observer_;
+  Acquisition acquisition_;
+  std::vector<std::unique_ptr<ReceiverChannel>> channels_;  // nullptr = free
+  std::vector<int> prns_;
+
+  bool started_ = false;
+  std::int64_t next_sample_ = 0;  // expected first sample of the next block
+  std::int64_t observation_step_ = 0, next_observation_ = 0;
+  std::int64_t next_reacquisition_ = 0;
+  int record_periods_ = 20;
+
+  std::vector<std::complex<float>> snapshot_;
+  std::size_t snapshot_have_ = 0;
+  bool snapshot_active_ = false;
+  std::int64_t snapshot_first_ = 0;
+
+  std::optional<ReceiverClock> clock_;
+  std::vector<signals::Ephemeris> ephemerides_;  // all known: supplied + decoded
+  std::vector<signals::Ephemeris> decoded_;
+  signals::KlobucharParameters iono_;
+  signals::UtcParameters utc_;
+  std::optional<PvtSolution> last_fix_;
+  CarrierSmoothing smoothing_;
+  std::array<double, 33> smoothed_m_{};  // this epoch's smoothed pseudorange per PRN
+  std::int64_t epoch_index_ = 0;  // observation epochs since the start (for the smoothing's gap test)
+
+  ObservationEpoch epoch_;                    // reused every epoch
+  std::vector<ChannelMeasurement> measured_;  // reused
+  std::vector<SatelliteMeasurement> pvt_input_;
+  ReceiverStats stats_;
+};
+
+}  // namespace ultratrack::receiver

@@ -1,0 +1,101 @@
+#include "receiver/receiver_summary.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+#include <cmath>
+
+#include "io/atomic_file.hpp"
+
+namespace ultratrack::receiver {
+namespace {
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string prn_list(const std::vector<int>& prns) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < prns.size(); ++i) out += (i ? ", " : "") + std::to_string(prns[i]);
+  return out + "]";
+}
+
+}  // namespace
+
+double processed_seconds(const ReceiverEngine& engine) {
+  return static_cast<double>(engine.stats().samples_processed) / engine.options().fs_hz;
+}
+
+double ttff_seconds(const ReceiverEngine& engine) {
+  const auto& s = engine.stats();
+  if (!s.first_fix_sample) return -1.0;
+  return static_cast<double>(*s.first_fix_sample - s.first_sample) / engine.options().fs_hz;
+}
+
+void write_summary_json(const std::filesystem::path& path, const ReceiverEngine& engine, const RunDescription& run) {
+  const ReceiverStats& s = engine.stats();
+  const double duration = processed_seconds(engine);
+  std::vector<int> acquired, tracked, used;
+  for (int prn = 1; prn <= 32; ++prn) {
+    const SatelliteStats& sat = s.satellites[static_cast<std::size_t>(prn)];
+    if (sat.acquisitions > 0) acquired.push_back(prn);
+    if (engine.tracked_time_s(prn) > 0.0) tracked.push_back(prn);
+    if (sat.used_in_fixes > 0) used.push_back(prn);
+  }
+  io::AtomicFile file(path);
+  auto& out = file.stream();
+  fmt::print(out, "{{\n  \"input\": {{\"file\": {}, \"format\": {}, \"fs_hz\": {}, \"if_hz\": {}, \"skip_s\": {}}},\n",
+             json_string(run.input), json_string(run.format), run.fs_hz, run.if_hz, run.skip_s);
+  fmt::print(out, "  \"duration_s\": {:.6f},\n  \"wall_time_s\": {:.3f},\n  \"realtime_factor\": {:.3f},\n", duration,
+             run.wall_time_s, run.wall_time_s > 0.0 ? duration / run.wall_time_s : 0.0);
+  fmt::print(out, "  \"interrupted\": {},\n", run.interrupted);
+  const bool fix = s.fixes > 0;
+  fmt::print(out, "  \"fix\": {},\n  \"ttff_s\": {},\n", fix, fix ? fmt::format("{:.3f}", ttff_seconds(engine)) : "null");
+  fmt::print(out, "  \"fixes\": {},\n  \"observation_epochs\": {},\n  \"clock_jumps\": {},\n", s.fixes,
+             s.observation_epochs, s.clock_jumps);
+  fmt::print(out, "  \"satellites_acquired\": {},\n  \"satellites_tracked\": {},\n  \"satellites_used\": {},\n",
+             prn_list(acquired), prn_list(tracked), prn_list(used));
+  if (fix) {
+    const double n = s.fixes;
+    const double kDeg = 180.0 / 3.14159265358979323846;
+    fmt::print(out,
+               "  \"mean_llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n"
+               "  \"mean_ecef_m\": [{:.3f}, {:.3f}, {:.3f}],\n",
+               s.sum_lat_rad / n * kDeg, s.sum_lon_rad / n * kDeg, s.sum_height_m / n, s.sum_r_e_m.x() / n,
+               s.sum_r_e_m.y() / n, s.sum_r_e_m.z() / n);
+  } else {
+    fmt::print(out, "  \"mean_llh\": null,\n  \"mean_ecef_m\": null,\n");
+  }
+  fmt::print(out, "  \"ephemerides_decoded\": {},\n", engine.decoded_ephemerides().size());
+  fmt::print(out, "  \"per_satellite\": [");
+  bool first = true;
+  for (int prn = 1; prn <= 32; ++prn) {
+    const SatelliteStats& sat = s.satellites[static_cast<std::size_t>(prn)];
+    if (sat.acquisitions == 0) continue;
+    fmt::print(out,
+               "{}\n    {{\"prn\": {}, \"acquisitions\": {}, \"losses\": {}, \"tracked_s\": {:.3f}, "
+               "\"mean_cn0_dbhz\": {}, \"tracking_cn0_dbhz\": {}, \"observations\": {}, \"used_in_fixes\": {}, \"frame_synced\": {}, "
+               "\"ephemeris_decoded\": {}}}",
+               first ? "" : ",", prn, sat.acquisitions, sat.losses, engine.tracked_time_s(prn),
+               sat.observations ? fmt::format("{:.2f}", sat.cn0_sum_dbhz / sat.observations) : "null",
+               sat.tracking_cn0_count ? fmt::format("{:.2f}", sat.tracking_cn0_sum_dbhz / sat.tracking_cn0_count)
+                                      : "null",
+               sat.observations, sat.used_in_fixes, sat.frame_synced, sat.ephemeris_decoded);
+    first = false;
+  }
+  fmt::print(out, "\n  ]\n}}\n");
+  file.commit();
+}
+
+}  // namespace ultratrack::receiver
