@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "commands.hpp"
 #include "receiver/acquisition.hpp"
 #include "receiver/sample_source.hpp"
@@ -21,7 +22,7 @@ namespace ultratrack::tools {
 
 namespace {
 
-// Numbers are taken as text and parsed here so that a malformed one is an InputError like any other.
+// Numbers are taken as text and parsed by cli_parse.hpp so that a malformed one is an InputError like any other.
 struct AcquireArgs {
   std::string input, format, fs = "", if_hz = "0", ms = "1", noncoh = "10", prns = "1-32";
   std::string doppler_max = "5000", doppler_step = "0", pfa = "1e-3";
@@ -32,63 +33,23 @@ signals::InputError bad_option(const std::string& option, const std::string& pro
   return signals::InputError("command line", option + ": " + problem);
 }
 
-double parse_double(const std::string& option, const std::string& text) {
-  double value = 0.0;
-  std::size_t used = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
-    throw bad_option(option, "'" + text + "' is not a number");
-  return value;
-}
-
-int parse_int(const std::string& option, const std::string& text) {
-  int value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size())
-    throw bad_option(option, "'" + text + "' is not an integer");
-  return value;
-}
-
-// "1-32", "3,7,12-15": PRNs 1..32 in the order given, without repeats.
-std::vector<int> parse_prn_list(const std::string& text) {
-  std::vector<int> prns;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
-    const std::size_t dash = item.find('-');
-    const int first = parse_int("--prn", item.substr(0, dash));
-    const int last = dash == std::string::npos ? first : parse_int("--prn", item.substr(dash + 1));
-    if (first < 1 || last > 32 || first > last)
-      throw bad_option("--prn", "'" + item + "' is not a PRN range within 1-32");
-    for (int prn = first; prn <= last; ++prn)
-      if (std::find(prns.begin(), prns.end(), prn) == prns.end()) prns.push_back(prn);
-    start = comma + 1;
-  }
-  return prns;
-}
-
 void run_acquire(const AcquireArgs& args) {
   const auto format = signals::parse_sample_format(args.format);
   if (!format) throw bad_option("--format", "unknown sample format '" + args.format + "' (i8, i16, f32, r8, r16)");
   receiver::SampleSourceOptions source_options;
-  source_options.fs_hz = parse_double("--fs", args.fs);
-  source_options.if_hz = parse_double("--if", args.if_hz);
+  source_options.fs_hz = parse_double_option("--fs", args.fs);
+  source_options.if_hz = parse_double_option("--if", args.if_hz);
   source_options.iq_swap = args.iq_swap;
   source_options.q_negate = args.q_negate;
 
   receiver::AcquisitionOptions options;
   options.fs_hz = source_options.fs_hz;
-  options.coherent_ms = parse_int("--ms", args.ms);
-  options.noncoherent = parse_int("--noncoh", args.noncoh);
-  options.doppler_max_hz = parse_double("--doppler-max", args.doppler_max);
-  options.doppler_step_hz = parse_double("--doppler-step", args.doppler_step);
-  options.pfa = parse_double("--pfa", args.pfa);
-  const std::vector<int> prns = parse_prn_list(args.prns);
+  options.coherent_ms = parse_int_option("--ms", args.ms);
+  options.noncoherent = parse_int_option("--noncoh", args.noncoh);
+  options.doppler_max_hz = parse_double_option("--doppler-max", args.doppler_max);
+  options.doppler_step_hz = parse_double_option("--doppler-step", args.doppler_step);
+  options.pfa = parse_double_option("--pfa", args.pfa);
+  const std::vector<int> prns = parse_prn_list_option("--prn", args.prns);
   std::string why;
   if (!options.IsValid(&why)) throw signals::InputError("command line", why);
 
