@@ -9,6 +9,8 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-dev libcli11-dev
           libtomlplusplus-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev)
+# The test suite also runs RTKLIB (convbin, rnx2rtkp) on our RINEX output as an independent reader.
+[[ "${1:-build}" == test ]] && packages+=(rtklib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
