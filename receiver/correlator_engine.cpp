@@ -37,16 +37,18 @@ ULTRATRACK_ALWAYS_INLINE void sincos_q32(std::uint32_t phase, float& c_out, floa
 
 // Code chips of one tap over a chunk: out[i] = chips[int(frac + step * i)], frac in [0, 1). The float
 // expression is the contract: every instruction-set copy evaluates it identically (no FMA), so the chips agree.
+// The baseline fill is also the AVX2 copy's fallback, hence noinline (no contraction inside an AVX2 caller).
 using CodeFill = void (*)(const float* chips, float frac, float step, int n, float* out);
 
-void fill_code_baseline(const float* __restrict chips, float frac, float step, int n, float* __restrict out) {
+__attribute__((noinline)) void fill_code_baseline(const float* __restrict chips, float frac, float step, int n, float* __restrict out) {
   for (int i = 0; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
 }
 
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
 // Below one chip per sample (any sample rate above the chip rate), 8 consecutive samples read at most 8
 // consecutive chips: one unaligned load of those chips and a lane permutation replace an 8-way gather.
-__attribute__((target("avx2,fma"))) void fill_code_avx2(const float* __restrict chips, float frac, float step, int n,
+// fp-contract=off and noinline: no fused multiply-add, so the chip indices are those of the baseline copy.
+__attribute__((target("avx2,fma"), optimize("fp-contract=off"), noinline)) void fill_code_avx2(const float* __restrict chips, float frac, float step, int n,
                                                          float* __restrict out) {
   if (!(step <= 0.99f)) {  // margin for the float rounding of frac + step * i (< 1e-4 chips)
     fill_code_baseline(chips, frac, step, n, out);
@@ -57,10 +59,11 @@ __attribute__((target("avx2,fma"))) void fill_code_avx2(const float* __restrict 
   const __m256 vstep = _mm256_set1_ps(step);
   int i = 0;
   for (; i + 8 <= n; i += 8) {
-    const int first = static_cast<int>(frac + step * static_cast<float>(i));
-    const __m256 window = _mm256_loadu_ps(chips + first);
     const __m256 x = _mm256_add_ps(vfrac, _mm256_mul_ps(vstep, _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(i), lane))));
-    const __m256i rel = _mm256_sub_epi32(_mm256_cvttps_epi32(x), _mm256_set1_epi32(first));
+    const __m256i index = _mm256_cvttps_epi32(x);
+    const int first = _mm256_cvtsi256_si32(index);  // lane 0: the window starts at this sample's chip
+    const __m256 window = _mm256_loadu_ps(chips + first);
+    const __m256i rel = _mm256_sub_epi32(index, _mm256_set1_epi32(first));
     _mm256_storeu_ps(out + i, _mm256_permutevar8x32_ps(window, rel));
   }
   for (; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
@@ -146,8 +149,9 @@ ULTRATRACK_ALWAYS_INLINE void correlate_chunked(const float* table, const double
   }
 }
 
-// One copy of the kernel per instruction set. Explicit lanes fix the summation order, and no FMA contraction
-// happens (ISO mode: -ffp-contract=off), so both copies give bit-identical sums.
+// One copy of the kernel per instruction set. Explicit lanes fix the summation order and the chip indices are
+// identical; the AVX2 copy fuses multiply-adds (GCC's default -ffp-contract=fast), so the sums differ from the
+// baseline copy's by float rounding only (~1e-7 relative).
 template <int kTaps>
 void correlate_baseline(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
                         int num_samples, const ReplicaSegment& rep, std::span<TapSums> sums) {
