@@ -1,10 +1,16 @@
 #include "receiver/correlator_engine.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
 #include "signals/ca_code.hpp"
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define ULTRATRACK_HAVE_AVX2_KERNEL 1
+#include <immintrin.h>
+#endif
 
 namespace ultratrack::receiver {
 namespace {
@@ -13,8 +19,12 @@ constexpr int kCodeLength = signals::kCaCodeLength_chips;
 constexpr int kChunk = 256;  // samples per inner pass: the replica buffers stay in L1
 constexpr int kLanes = 8;    // independent partial sums, so the compiler can vectorise without reassociation
 
+// Force-inlined helpers: the kernel body below is compiled once per instruction set (see the wrappers), and only
+// code inlined into a target("avx2,fma") wrapper is vectorised with AVX2.
+#define ULTRATRACK_ALWAYS_INLINE inline __attribute__((always_inline))
+
 // Quadrant rotation by integer arithmetic, then Taylor series on |theta| <= pi/4 (truncation < 3e-8).
-inline void sincos_q32(std::uint32_t phase, float& c_out, float& s_out) {
+ULTRATRACK_ALWAYS_INLINE void sincos_q32(std::uint32_t phase, float& c_out, float& s_out) {
   const std::uint32_t quadrant = ((phase + (1u << 29)) >> 30) & 3u;
   const auto residual = static_cast<std::int32_t>(phase - (quadrant << 30));  // [-2^29, 2^29)
   const float theta = static_cast<float>(residual) * static_cast<float>(2.0 * 3.14159265358979323846 / 4294967296.0);
@@ -25,22 +35,70 @@ inline void sincos_q32(std::uint32_t phase, float& c_out, float& s_out) {
   s_out = quadrant == 0 ? s : quadrant == 1 ? c : quadrant == 2 ? -s : -c;
 }
 
-template <int kTaps>
-void correlate_chunked(const std::int8_t* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
+// Code chips of one tap over a chunk: out[i] = chips[int(frac + step * i)], frac in [0, 1). The float
+// expression is the contract: every instruction-set copy evaluates it identically (no FMA), so the chips agree.
+// The baseline fill is also the AVX2 copy's fallback, hence noinline (no contraction inside an AVX2 caller).
+using CodeFill = void (*)(const float* chips, float frac, float step, int n, float* out);
+
+__attribute__((noinline)) void fill_code_baseline(const float* __restrict chips, float frac, float step, int n, float* __restrict out) {
+  for (int i = 0; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
+}
+
+#ifdef ULTRATRACK_HAVE_AVX2_KERNEL
+// Below one chip per sample (any sample rate above the chip rate), 8 consecutive samples read at most 8
+// consecutive chips: one unaligned load of those chips and a lane permutation replace an 8-way gather.
+// fp-contract=off and noinline: no fused multiply-add, so the chip indices are those of the baseline copy.
+__attribute__((target("avx2,fma"), optimize("fp-contract=off"), noinline)) void fill_code_avx2(const float* __restrict chips, float frac, float step, int n,
+                                                         float* __restrict out) {
+  if (!(step <= 0.99f)) {  // margin for the float rounding of frac + step * i (< 1e-4 chips)
+    fill_code_baseline(chips, frac, step, n, out);
+    return;
+  }
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256 vfrac = _mm256_set1_ps(frac);
+  const __m256 vstep = _mm256_set1_ps(step);
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256 x = _mm256_add_ps(vfrac, _mm256_mul_ps(vstep, _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(i), lane))));
+    const __m256i index = _mm256_cvttps_epi32(x);
+    const int first = _mm256_cvtsi256_si32(index);  // lane 0: the window starts at this sample's chip
+    const __m256 window = _mm256_loadu_ps(chips + first);
+    const __m256i rel = _mm256_sub_epi32(index, _mm256_set1_epi32(first));
+    _mm256_storeu_ps(out + i, _mm256_permutevar8x32_ps(window, rel));
+  }
+  for (; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
+}
+#endif
+
+template <int kTaps, CodeFill kFill>
+ULTRATRACK_ALWAYS_INLINE void correlate_chunked(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
                        int num_samples, const ReplicaSegment& rep, std::span<TapSums> sums) {
   alignas(64) float carrier_cos[kChunk];
   alignas(64) float carrier_sin[kChunk];
   alignas(64) float code[kTaps][kChunk];
   const int num_antennas = static_cast<int>(antennas.size());
 
+  // The carrier over a chunk is its exact first-sample phasor (fixed point, so nothing accumulates across
+  // chunks) times a rotation table that every chunk of this call shares: one complex product per sample
+  // instead of a polynomial sin/cos. Error < 3e-6 (two sin/cos errors plus float rounding).
+  alignas(64) float rotation_cos[kChunk];
+  alignas(64) float rotation_sin[kChunk];
+  const int table_n = num_samples < kChunk ? num_samples : kChunk;
+  for (int i = 0; i < table_n; ++i) {
+    float c, s;
+    sincos_q32(rep.carrier_step_q32 * static_cast<std::uint32_t>(i), c, s);
+    rotation_cos[i] = c;
+    rotation_sin[i] = s;
+  }
+
   for (int start = 0; start < num_samples; start += kChunk) {
     const int n = num_samples - start < kChunk ? num_samples - start : kChunk;
     const std::uint32_t phase0 = rep.carrier_phase_q32 + rep.carrier_step_q32 * static_cast<std::uint32_t>(start);
+    float c0, s0;
+    sincos_q32(phase0, c0, s0);
     for (int i = 0; i < n; ++i) {
-      float c, s;
-      sincos_q32(phase0 + rep.carrier_step_q32 * static_cast<std::uint32_t>(i), c, s);
-      carrier_cos[i] = c;
-      carrier_sin[i] = s;
+      carrier_cos[i] = c0 * rotation_cos[i] - s0 * rotation_sin[i];
+      carrier_sin[i] = s0 * rotation_cos[i] + c0 * rotation_sin[i];
     }
     const double code0 = rep.code_phase_chips + rep.code_step_chips * start + 2 * kCodeLength;  // table origin
     // Chip index = whole part of the chunk's start (exact, integer) + float offset within the chunk: the float
@@ -50,9 +108,7 @@ void correlate_chunked(const std::int8_t* table, const double* offsets, std::spa
       const double base = code0 + offsets[t];
       const int whole = static_cast<int>(base);
       const auto frac = static_cast<float>(base - whole);
-      const std::int8_t* __restrict chips = table + whole;
-      float* __restrict out = code[t];
-      for (int i = 0; i < n; ++i) out[i] = chips[static_cast<int>(frac + step_f * static_cast<float>(i))];
+      kFill(table + whole, frac, step_f, n, code[t]);
     }
     for (int a = 0; a < num_antennas; ++a) {
       const float* __restrict x = reinterpret_cast<const float*>(antennas[a] + start);
@@ -93,6 +149,49 @@ void correlate_chunked(const std::int8_t* table, const double* offsets, std::spa
   }
 }
 
+// One copy of the kernel per instruction set. Explicit lanes fix the summation order and the chip indices are
+// identical; the AVX2 copy fuses multiply-adds (GCC's default -ffp-contract=fast), so the sums differ from the
+// baseline copy's by float rounding only (~1e-7 relative).
+template <int kTaps>
+void correlate_baseline(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
+                        int num_samples, const ReplicaSegment& rep, std::span<TapSums> sums) {
+  correlate_chunked<kTaps, fill_code_baseline>(table, offsets, antennas, num_samples, rep, sums);
+}
+
+#ifdef ULTRATRACK_HAVE_AVX2_KERNEL
+template <int kTaps>
+__attribute__((target("avx2,fma"))) void correlate_avx2(const float* table, const double* offsets,
+                                                         std::span<const std::complex<float>* const> antennas,
+                                                         int num_samples, const ReplicaSegment& rep,
+                                                         std::span<TapSums> sums) {
+  correlate_chunked<kTaps, fill_code_avx2>(table, offsets, antennas, num_samples, rep, sums);
+}
+#endif
+
+// The instruction set is chosen once per process from the running CPU (the build targets baseline x86-64);
+// ULTRATRACK_CORRELATOR_ISA=baseline forces the portable copy (tests and benchmarks of both).
+bool use_avx2() {
+#ifdef ULTRATRACK_HAVE_AVX2_KERNEL
+  static const bool chosen = [] {
+    const char* forced = std::getenv("ULTRATRACK_CORRELATOR_ISA");
+    if (forced != nullptr && std::string(forced) == "baseline") return false;
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  }();
+  return chosen;
+#else
+  return false;
+#endif
+}
+
+template <int kTaps>
+CorrelatorEngine::Kernel select_kernel() {
+#ifdef ULTRATRACK_HAVE_AVX2_KERNEL
+  if (use_avx2()) return &correlate_avx2<kTaps>;
+#endif
+  return &correlate_baseline<kTaps>;
+}
+
 }  // namespace
 
 CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips)
@@ -106,21 +205,20 @@ CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_
   }
   const auto& chips = signals::ca_code(prn);  // throws std::out_of_range for a bad PRN
   table_.resize(5 * kCodeLength + 8);
-  for (int i = 0; i < static_cast<int>(table_.size()); ++i) table_[i] = chips[i % kCodeLength];
+  for (int i = 0; i < static_cast<int>(table_.size()); ++i) table_[i] = static_cast<float>(chips[i % kCodeLength]);
+  switch (num_taps_) {
+    case 1: kernel_ = select_kernel<1>(); break;
+    case 2: kernel_ = select_kernel<2>(); break;
+    case 3: kernel_ = select_kernel<3>(); break;
+    case 4: kernel_ = select_kernel<4>(); break;
+    case 5: kernel_ = select_kernel<5>(); break;
+    default: kernel_ = select_kernel<6>(); break;
+  }
 }
 
 void CorrelatorEngine::correlate(std::span<const std::complex<float>* const> antennas, int num_samples,
                                  const ReplicaSegment& replica, std::span<TapSums> sums) const {
-  const std::int8_t* table = table_.data();
-  const double* off = offsets_.data();
-  switch (num_taps_) {
-    case 1: correlate_chunked<1>(table, off, antennas, num_samples, replica, sums); break;
-    case 2: correlate_chunked<2>(table, off, antennas, num_samples, replica, sums); break;
-    case 3: correlate_chunked<3>(table, off, antennas, num_samples, replica, sums); break;
-    case 4: correlate_chunked<4>(table, off, antennas, num_samples, replica, sums); break;
-    case 5: correlate_chunked<5>(table, off, antennas, num_samples, replica, sums); break;
-    default: correlate_chunked<6>(table, off, antennas, num_samples, replica, sums); break;
-  }
+  kernel_(table_.data(), offsets_.data(), antennas, num_samples, replica, sums);
 }
 
 double noise_tap_offset_chips(int prn) {

@@ -2,7 +2,8 @@
 // early, early, prompt, late, very late, noise: any set of code offsets in chips) over one block of complex
 // baseband samples, for 1..kMaxAntennas antennas against one replica in one pass. Code chips come from a table
 // built once per PRN; the carrier from a 32-bit fixed-point phase and a polynomial sin/cos (|error| < 1e-6).
-// No allocation, no exceptions per call. Scalar C++ written for auto-vectorisation; SIMD arrives behind this API.
+// No allocation, no exceptions per call. Scalar C++ written for auto-vectorisation, compiled twice (baseline
+// x86-64 and AVX2+FMA) with the copy chosen once at run time from the CPU's features.
 #pragma once
 
 #include <array>
@@ -44,11 +45,17 @@ class CorrelatorEngine final {
   void correlate(std::span<const std::complex<float>* const> antennas, int num_samples, const ReplicaSegment& replica,
                  std::span<TapSums> sums) const;
 
+ public:
+  // One instruction-set-specific copy of the kernel for this engine's tap count, picked at construction.
+  using Kernel = void (*)(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
+                          int num_samples, const ReplicaSegment& replica, std::span<TapSums> sums);
+
  private:
   int prn_;
   int num_taps_;
   std::array<double, kMaxTaps> offsets_{};
-  std::vector<std::int8_t> table_;  // 5 code periods of +1/-1 chips: index = chip + 2046
+  std::vector<float> table_;  // 5 code periods of +1/-1 chips (float: no conversion per sample): index = chip + 2046
+  Kernel kernel_ = nullptr;
 };
 
 // A lag (chips, -723..-300: the noise replica lags prompt) where this PRN's periodic autocorrelation is -1/1023 at that lag and its two neighbours
