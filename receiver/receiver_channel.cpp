@@ -22,8 +22,9 @@ ChannelStart channel_start_from_acquisition(const AcquisitionResult& result, std
 }
 
 ReceiverChannel::ReceiverChannel(int prn, const ChannelStart& start, double fs_hz, const ScalarTrackingOptions& options,
-                                 int reference_week, int record_periods)
+                                 int reference_week, bool reference_week_is_signal_week, int record_periods)
     : fs_hz_(fs_hz),
+      week_trusted_(reference_week_is_signal_week),
       channel_(channel_config(options, prn, fs_hz), start),
       loop_(options, channel_.current_command()),
       nav_(prn, reference_week),
@@ -54,7 +55,7 @@ TrackingRecord ReceiverChannel::record(const CorrelationEpoch& e, const Tracking
 }
 
 std::optional<ChannelMeasurement> ReceiverChannel::measure() {
-  if (!synchronised()) return std::nullopt;
+  if (!synchronised() || !(week_trusted_ || nav_.decoder().week_known())) return std::nullopt;
   const TransmitTimeTag& tag = *nav_.time_tag();
   const ReplicaState replica = channel_.replica();
   ChannelMeasurement m;

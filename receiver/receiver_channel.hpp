@@ -53,8 +53,10 @@ struct ChannelMeasurement {
 
 class ReceiverChannel {
  public:
+  // reference_week_is_signal_week: the reference week is known to be the signal's (see ReceiverOptions);
+  // otherwise measure() waits until this channel's subframe 1 has given the week.
   ReceiverChannel(int prn, const ChannelStart& start, double fs_hz, const ScalarTrackingOptions& options,
-                  int reference_week, int record_periods);
+                  int reference_week, bool reference_week_is_signal_week, int record_periods);
 
   // Consumes a block (samples before next_sample() are skipped); calls on_record(const TrackingRecord&) once
   // every record_periods code periods. Allocates nothing.
@@ -84,7 +86,8 @@ class ReceiverChannel {
   std::optional<double> cn0_dbhz() const { return loop_.cn0_dbhz(); }
   // Synchronised: bit sync, frame sync and a transmit-time tag; measurement() is then available.
   bool synchronised() const { return loop_.state() == TrackingState::kBitSynced && nav_.synchronised(); }
-  // The measurement at next_sample(); nothing unless synchronised(). Marks the track as reported.
+  // The measurement at next_sample(); nothing unless synchronised() and the time tag's week is known.
+  // Marks the track as reported.
   std::optional<ChannelMeasurement> measure();
   NavigationDataChannel& navigation() { return nav_; }
   const NavigationDataChannel& navigation() const { return nav_; }
@@ -96,6 +99,7 @@ class ReceiverChannel {
   TrackingRecord record(const CorrelationEpoch& e, const TrackingReport& report) const;
 
   double fs_hz_;
+  bool week_trusted_;  // the reference week is the signal's: time tags usable before subframe 1
   TrackingChannel channel_;
   ScalarTracking loop_;
   NavigationDataChannel nav_;

@@ -149,7 +149,7 @@ void ReceiverEngine::acquire(std::int64_t start_sample) {
     if (free == channels_.end()) break;
     const ChannelStart start = channel_start_from_acquisition(*r, snapshot_first_, start_sample, options_.fs_hz);
     *free = std::make_unique<ReceiverChannel>(r->prn, start, options_.fs_hz, options_.tracking, options_.reference_week,
-                                              record_periods_);
+                                              options_.reference_week_is_signal_week, record_periods_);
     ++stats_.satellites[static_cast<std::size_t>(r->prn)].acquisitions;
   }
 }

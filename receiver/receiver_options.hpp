@@ -16,6 +16,10 @@ struct ReceiverOptions {
   int channels = 12;                       // tracking channels, 1..32
   std::vector<int> prns;                   // PRNs to search; empty = 1..32
   int reference_week = 0;                  // full GPS week within +-512 weeks of the signal (10-bit WN)
+  // True when reference_week IS the signal's week (from a nav file, the user or a scenario): time tags are
+  // then usable before subframe 1 gives the week. False for a guess such as the build date: a channel's
+  // measurements wait for its subframe 1.
+  bool reference_week_is_signal_week = false;
   double observation_interval_s = 0.1;     // common receive epochs (observables, PVT), rounded to samples
   double reacquisition_interval_s = 5.0;   // a fresh snapshot for missing PRNs this often (with free channels)
   double assisted_doppler_half_width_hz = 600.0;  // assisted search window around the predicted Doppler

@@ -73,7 +73,10 @@ LnavUpdate LnavDecoder::add(const LnavSubframe& sf) {
   const double start_tow = sf.start_tow_s();
   // Time of week running backwards by more than half a week: the stream crossed a week boundary.
   if (last_start_ && start_tow < last_start_->tow_s - kSecondsPerWeek / 2) ++week_;
-  if (sf.subframe_id == 1) week_ = resolve_week_rollover(static_cast<int>(get(sf.words, kWeek)), week_);
+  if (sf.subframe_id == 1) {
+    week_ = resolve_week_rollover(static_cast<int>(get(sf.words, kWeek)), week_);
+    week_known_ = true;
+  }
   last_start_ = GpsTime{week_, start_tow};
   last_tow_count_ = sf.tow_count;
 

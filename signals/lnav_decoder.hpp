@@ -66,6 +66,9 @@ class LnavDecoder {
   // GPS time at which the last accepted subframe's first bit left the satellite, and its HOW TOW count.
   // The week is the last subframe 1 WN (resolved), or the reference week before one has been read.
   std::optional<GpsTime> last_subframe_start() const { return last_start_; }
+  // True once a subframe 1 has given the week: until then last_subframe_start()'s week is only the
+  // caller's reference week, which may be hundreds of weeks from the signal's.
+  bool week_known() const { return week_known_; }
   std::optional<int> last_tow_count() const { return last_tow_count_; }
   const Counters& counters() const { return counters_; }
   int prn() const { return prn_; }
@@ -76,6 +79,7 @@ class LnavDecoder {
 
   int prn_;
   int week_;                           // current full week of transmission
+  bool week_known_ = false;
   std::optional<LnavSubframe> sf_[3];  // latest subframes 1, 2, 3
   int sf1_week_ = 0;                   // full transmission week of the stored subframe 1
   std::optional<Ephemeris> ephemeris_;

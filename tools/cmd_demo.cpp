@@ -86,6 +86,7 @@ void receive_and_compare(const fs::path& samples, const Scenario& scenario, cons
   receiver::ReceiverOptions options;
   options.fs_hz = scenario.sample_rate_hz;
   options.reference_week = scenario.gps_week;
+  options.reference_week_is_signal_week = true;
   options.pvt.troposphere = scenario.troposphere;
   options.pvt.ionosphere = scenario.ionosphere;
   receiver::SampleSource source(samples, scenario.format, source_options);

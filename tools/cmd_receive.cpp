@@ -128,10 +128,14 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   signals::RinexNavData nav;
   if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
-  if (!args.reference_week.empty())
+  if (!args.reference_week.empty()) {
     options.reference_week = parse_int_option("--reference-week", args.reference_week);
-  else if (options.reference_week == 0)
+    options.reference_week_is_signal_week = true;
+  } else if (options.reference_week == 0) {
+    // A nav file dates the recording; the build date only bounds it (+-512 weeks for the 10-bit WN).
     options.reference_week = nav.ephemerides.empty() ? build_week() : nav.ephemerides.front().week;
+    options.reference_week_is_signal_week = !nav.ephemerides.empty();
+  }
   const double duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
   if (duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
   if (args.out.empty()) throw signals::InputError("command line", "--out: an output folder is required");

@@ -44,7 +44,7 @@ const std::map<std::string, Table>& sections() {
            o.prns.clear();
            for (const auto& item : *array) o.prns.push_back(Setter{v.file, v.key, item}.integer());
          }},
-        {"reference_week", [](const Setter& v, O& o) { o.reference_week = v.integer(); }},
+        {"reference_week", [](const Setter& v, O& o) { o.reference_week = v.integer(); o.reference_week_is_signal_week = true; }},
         {"observation_interval_s", [](const Setter& v, O& o) { o.observation_interval_s = v.number(); }},
         {"reacquisition_interval_s", [](const Setter& v, O& o) { o.reacquisition_interval_s = v.number(); }},
         {"assisted_doppler_half_width_hz", [](const Setter& v, O& o) { o.assisted_doppler_half_width_hz = v.number(); }},

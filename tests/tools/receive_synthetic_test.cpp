@@ -173,3 +173,43 @@ troposphere = false
   std::printf("rnx2rtkp on our RINEX: %d epochs, 3-D RMS %.2f m\n", rows, rtklib_rms);
   EXPECT_LE(rtklib_rms, 10.0);
 }
+
+// An undated recording: without --reference-week (or --nav) the receiver only knows the build date's week,
+// hundreds of weeks after the signal's 2190. The scenario starts at tow 518388, so the first whole subframe
+// a channel decodes is subframe 5 (518394): its time tag has a TOW but not yet a week. Measurements must wait
+// for subframe 1 (518400) instead of starting the receiver clock in the wrong week (which once rejected every
+// later measurement). Subframes 1-3 end at 518418 + ~70 ms of travel = 30.07 s into the file.
+TEST(ReceiveSynthetic, UndatedRecordingTakesTheWeekFromSubframeOne) {
+  const auto dir = ultratrack::test::scratch_dir();
+  const auto scenario = dir / "undated.toml";
+  std::ofstream(scenario) << R"([signal]
+sample_rate_hz = 2.6e6
+format = "i8"
+duration_s = 31.0
+cn0_dbhz = 45.0
+seed = 11
+[time]
+gps_week = 2190
+tow_s = 518388.0
+[navigation]
+constellation = "nominal"
+[receiver]
+llh_deg_m = [35.274016, 137.013759, 100.0]
+[atmosphere]
+ionosphere = false
+troposphere = false
+)";
+  const auto sim = dir / "sim";
+  run("simulate", {"--scenario", scenario.string(), "--out", sim.string()});
+  const auto out = dir / "rx";
+  try {
+    run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.6e6", "--out",
+                    out.string(), "--ionosphere", "off", "--troposphere", "off"});
+  } catch (const ultratrack::tools::CommandExit& e) {
+    FAIL() << "no fix from an undated recording (exit " << e.code << "): " << e.what();
+  }
+  const double ttff = json_number(read(out / "summary.json"), "ttff_s");
+  EXPECT_GE(ttff, 30.07);
+  EXPECT_LE(ttff, 30.3);
+  EXPECT_GE(columns(out / "solution.csv", {"ecef_x_m"}).size(), 5u);
+}
