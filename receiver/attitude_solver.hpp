@@ -21,9 +21,9 @@
 namespace ultratrack::receiver {
 
 struct AntennaArray {
-  // Phase centre of each antenna in the body frame, m; [0] is the master. 2..kMaxAntennas entries, the baselines
-  // (lever_arm_body_m[k] - lever_arm_body_m[0]) at least 0.1 m long, and at least two of them not collinear (an
-  // array of two antennas gives yaw and pitch only: roll is then reported with an infinite variance).
+  // Phase centre of each antenna in the body frame, m; [0] is the master. 3..kMaxAntennas entries, the baselines
+  // (lever_arm_body_m[k] - lever_arm_body_m[0]) at least 0.1 m long and at least two of them not collinear (a full
+  // attitude needs two directions).
   std::vector<Eigen::Vector3d> lever_arm_body_m;
 };
 
@@ -32,8 +32,12 @@ struct AttitudeSolverOptions {
   double phase_sigma_m = 0.003;       // carrier noise of one antenna's phase (1 sigma, uniform over elevation), m
   double elevation_mask_rad = 0.17453292519943295;  // 10 deg; satellites below it are left out
   int min_satellites = 5;             // satellites (reference included) needed on a baseline to resolve
-  // Validation of a new fix: second-best / best constrained cost (Euler & Schaffrin / Verhagen ratio test, > 1).
+  // Validation of a new fix, both tests on the rigid-fit chi-square of the best and second-best candidates: ratio
+  // test J2 / J1 >= ratio_threshold (Euler & Schaffrin 1991) and difference test J2 - J1 >= difference_threshold
+  // (Tiberius & de Jonge 1995). The difference test is what keeps wrong fixes rare at 5 satellites, where a wrong
+  // candidate can fit almost as well as the right one (15: no wrong fix in 12000 simulated 5-satellite epochs).
   double ratio_threshold = 2.0;
+  double difference_threshold = 15.0;
   // true: per-baseline LAMBDA candidates filtered by the baseline lengths, then pairs by the angle between
   // baselines and ranked by the rigid-array fit of all DDs (the constrained method). false: plain LAMBDA on each
   // baseline's float (weak length prior only), best candidate + ratio test: kept to measure what constraints buy.
@@ -99,11 +103,11 @@ class AttitudeSolver {
  private:
   AttitudeSolverOptions options_;
   std::vector<SdAmbiguity> fixed_;             // carried SD ambiguities
-  std::vector<double> bias_sum_, bias_sum_sq_; // running line-bias calibration per antenna
+  std::vector<double> bias_mean_, bias_m2_;    // running line-bias calibration per antenna (Welford)
   std::vector<int> bias_count_;
   double last_ratio_ = 0.0;
   bool have_attitude_ = false;
-  Eigen::Matrix3d last_C_nb_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d last_R_eb_ = Eigen::Matrix3d::Identity();
 };
 
 }  // namespace ultratrack::receiver
