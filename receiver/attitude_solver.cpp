@@ -89,6 +89,13 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
   sol.line_bias_cycles.assign(lever.size(), std::numeric_limits<double>::quiet_NaN());
   sol.line_bias_sigma_cycles.assign(lever.size(), std::numeric_limits<double>::quiet_NaN());
   sol.line_bias_cycles[0] = sol.line_bias_sigma_cycles[0] = 0.0;
+  for (int k = 1; k < na; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    if (bias_count_[ku] == 0) continue;
+    sol.line_bias_cycles[ku] = wrap_half(bias_mean_[ku]);
+    sol.line_bias_sigma_cycles[ku] = bias_count_[ku] >= 2 ? std::sqrt(bias_m2_[ku] / (bias_count_[ku] - 1) / bias_count_[ku])
+                                                          : std::numeric_limits<double>::quiet_NaN();
+  }
 
   std::vector<const AntennaPhaseObservation*> sats;
   for (const AntennaPhaseObservation& o : epoch.satellites) {
@@ -128,9 +135,18 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
   const Eigen::Matrix3d C_en = ned_to_ecef_rotation(epoch.master_position_e);
   const double pfa = options_.residual_test_pfa;
   auto passes = [&](const ArrayFit& f) { return f.ok && f.dof >= 1 && f.chi2 <= chi_square_quantile(f.dof, pfa); };
+  // Carried DDs: the satellites with a kept ambiguity, on the baselines that keep at least 4 of them (3 DDs).
   auto carried_dd = [&]() {
+    std::vector<int> kept_sats(lever.size(), 0);
+    for (std::size_t s = 0; s < sats.size(); ++s) {
+      for (int k = 1; k < na; ++k) {
+        kept_sats[static_cast<std::size_t>(k)] +=
+            usable(s, k) && find_ambiguity(fixed_, k, sats[s]->prn) != nullptr ? 1 : 0;
+      }
+    }
     return form_double_differences(sats, na, sigma_cycles, [&](std::size_t s, int k) {
-      return usable(s, k) && find_ambiguity(fixed_, k, sats[s]->prn) != nullptr;
+      return kept_sats[static_cast<std::size_t>(k)] >= 4 && usable(s, k) &&
+             find_ambiguity(fixed_, k, sats[s]->prn) != nullptr;
     });
   };
   auto carried_integers = [&](const DoubleDifferences& dd) {
@@ -142,11 +158,16 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
     }
     return z;
   };
-  auto every_baseline_has = [&](const DoubleDifferences& dd, int rows) {
-    for (int k = 1; k < na; ++k) {
-      if (dd.baseline_count[static_cast<std::size_t>(k)] < rows) return false;
-    }
-    return true;
+  auto baselines_in = [&](const DoubleDifferences& dd) {
+    int n = 0;
+    for (int k = 1; k < na; ++k) n += dd.baseline_count[static_cast<std::size_t>(k)] > 0 ? 1 : 0;
+    return n;
+  };
+  // The rigid fit from the previous attitude, and from Wahba's start when that fails (a long gap, a fast turn).
+  auto carried_fit = [&](const ArrayFitter& fitter, const Eigen::VectorXd& z, const Eigen::Matrix3d* start) {
+    ArrayFit f = fitter.fit(z, start);
+    if (!passes(f) && start != nullptr) f = fitter.fit(z, nullptr);
+    return f;
   };
 
   // Writes the solution from a validated fit and updates the line-bias calibration.
@@ -171,6 +192,7 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
     sol.num_sats = static_cast<int>(used_sats.size());
     for (int k = 1; k < na; ++k) {
       const auto ku = static_cast<std::size_t>(k);
+      if (dd.baseline_count[ku] == 0) continue;  // this antenna's ambiguities took no part in the fit
       const Eigen::Vector3d b_e = fit.R_eb * body[ku];
       double sum = 0.0;
       int n = 0;
@@ -202,9 +224,9 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
   // 2. Carried ambiguities: rigid fit and residual check; then satellites without one join by rounding.
   if (!fixed_.empty()) {
     const DoubleDifferences dd = carried_dd();
-    if (every_baseline_has(dd, 3)) {
+    if (baselines_in(dd) >= 2) {
       const ArrayFitter fitter(dd, body);
-      const ArrayFit fit = fitter.fit(carried_integers(dd), have_attitude_ ? &last_R_eb_ : nullptr);
+      const ArrayFit fit = carried_fit(fitter, carried_integers(dd), have_attitude_ ? &last_R_eb_ : nullptr);
       if (!passes(fit)) {
         for (const SdAmbiguity& a : fixed_) slipped.insert(a.prn);
         fixed_.clear();
@@ -225,7 +247,7 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
           fixed_.insert(fixed_.end(), added.begin(), added.end());
           const DoubleDifferences dd2 = carried_dd();
           const ArrayFitter fitter2(dd2, body);
-          const ArrayFit fit2 = fitter2.fit(carried_integers(dd2), &fit.R_eb);
+          const ArrayFit fit2 = carried_fit(fitter2, carried_integers(dd2), &fit.R_eb);
           if (passes(fit2)) {
             emit(dd2, fit2, false);
             return sol;
@@ -247,11 +269,6 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
   const DoubleDifferences dd = form_double_differences(sats, na, sigma_cycles, [&](std::size_t s, int k) {
     return usable(s, k) && count[static_cast<std::size_t>(k)] >= options_.min_satellites;
   });
-  for (int k = 1; k < na; ++k) {
-    if (bias_count_[static_cast<std::size_t>(k)] > 0) {
-      sol.line_bias_cycles[static_cast<std::size_t>(k)] = wrap_half(bias_mean_[static_cast<std::size_t>(k)]);
-    }
-  }
   sol.slipped_prns.assign(slipped.begin(), slipped.end());
   if (dd.rows.empty()) return sol;
   const ArrayFitter fitter(dd, body);

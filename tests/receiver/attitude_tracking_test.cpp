@@ -184,3 +184,30 @@ TEST(AttitudeTracking, LineBiasCalibrationMatchesTheSimulatedBias) {
     EXPECT_LE(std::abs(err), 5.0 * s.line_bias_sigma_cycles[static_cast<std::size_t>(k)] + 1e-4);
   }
 }
+
+TEST(AttitudeTracking, FourAntennasKeepTheAttitudeWhileOneIsBlocked) {
+  std::vector<Eigen::Vector3d> lever = testsim::seed_lever_arms();
+  lever.push_back(Eigen::Vector3d(1.0, 1.025, 0.0));
+  PhaseSimulator sim(lever, 24);
+  AttitudeSolverOptions o;
+  o.array.lever_arm_body_m = lever;
+  AttitudeSolver solver(o);
+  const double roll = -5 * kDeg, pitch = 2 * kDeg, yaw = 42 * kDeg;
+  const double kT0 = start_with_eight(sim, 20);
+  for (int i = 0; i < 20; ++i) {
+    const auto sky = sim.nominal_sky({2300, kT0 + i});
+    std::vector<bool> blocked(4, false);
+    blocked[3] = i >= 5 && i < 10;
+    if (i == 10) {
+      for (const auto& s : sky) sim.ambiguity(3, s.prn) -= 500 + 3 * s.prn;
+    }
+    AntennaPhaseEpoch e = sim.epoch(sky, testsim::dcm_nb(roll, pitch, yaw), kT0 + i, blocked);
+    for (auto& ob : e.satellites) ob.slip[3] = i == 10;
+    const AttitudeSolution s = solver.update(e);
+    ASSERT_TRUE(s.valid) << i;
+    EXPECT_EQ(s.new_fix, i == 0) << i;
+    expect_right(s, sim, roll, pitch, yaw, i);
+    EXPECT_EQ(has_ambiguity(s, 3, sky[0].prn), !(i >= 5 && i < 10)) << i;
+    EXPECT_EQ(s.baseline_n_m.size(), 3u);
+  }
+}
