@@ -97,6 +97,8 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
                                                           : std::numeric_limits<double>::quiet_NaN();
   }
 
+  if (!epoch.master_position_e.allFinite() || epoch.master_position_e.norm() < 1.0e6) return sol;
+
   std::vector<const AntennaPhaseObservation*> sats;
   for (const AntennaPhaseObservation& o : epoch.satellites) {
     if (o.elevation_rad >= options_.elevation_mask_rad && o.usable[0] && o.los_e.allFinite() &&

@@ -68,7 +68,9 @@ struct AttitudeSolution {
   bool valid = false;     // an attitude is given (only from validated integer ambiguities)
   bool fixed = false;     // the ambiguities used this epoch are fixed and passed this epoch's checks
   bool new_fix = false;   // resolved from scratch this epoch (false: carried from earlier epochs)
-  double ratio = 0.0;     // ratio test value of the fix in use (from the epoch it was resolved); 0 if none
+  // Ratio test value (J2 / J1) of the fix in use, from the epoch it was resolved; 1e9 when no rival candidate passed
+  // the constraints; when not fixed, the value that failed (0 if no candidate at all).
+  double ratio = 0.0;
   int num_sats = 0;       // satellites in the attitude fit (reference included)
   double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;  // yaw in [0, 2 pi)
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();  // (roll, pitch, yaw), from the DD covariance
@@ -94,6 +96,8 @@ class AttitudeSolver {
   // Throws std::invalid_argument when validation_error(options) is not empty.
   explicit AttitudeSolver(AttitudeSolverOptions options);
 
+  // An epoch without a usable master position (not finite, or nearer the geocentre than 1000 km) has no NED frame:
+  // valid = false, and the ambiguities are kept for the next epoch.
   AttitudeSolution update(const AntennaPhaseEpoch& epoch);
   // Forget every fixed ambiguity and the line-bias calibration.
   void reset();
