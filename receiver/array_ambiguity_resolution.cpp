@@ -1,9 +1,12 @@
 #include "receiver/array_ambiguity_resolution.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 
 #include "receiver/chi_square.hpp"
 #include "receiver/lambda.hpp"
