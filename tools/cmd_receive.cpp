@@ -211,8 +211,9 @@ void run_receive(const ReceiveArgs& args) {
   fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", tracked, used, stats.fixes,
              engine.decoded_ephemerides().size());
   if (stats.fixes == 0)
-    throw CommandExit(3, fmt::format("no position fix in {:.1f} s of signal (outputs up to the end are in {})", t,
-                                     args.out));
+    throw CommandExit(3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} "
+                                     "ephemerides decoded; --nav gives a hot start); outputs up to the end are in {}",
+                                     args.input, t, tracked, engine.decoded_ephemerides().size(), args.out));
   const auto& s = stats;
   fmt::print("receive: first fix after {:.2f} s; mean position {:.7f} deg, {:.7f} deg, {:.2f} m; outputs in {}\n",
              receiver::ttff_seconds(engine), s.sum_lat_rad / s.fixes * 180.0 / M_PI,

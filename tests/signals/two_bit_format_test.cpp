@@ -250,3 +250,40 @@ TEST(TwoBitFormat, BadFilesAreInputErrorsNamingTheFile) {
 
 }  // namespace
 }  // namespace ultratrack::signals
+
+namespace ultratrack::signals {
+namespace {
+
+// PocketSDR's 4 MHz recording holds MAX2771 2-bit samples expanded to int8 (+-1, +-3) by PocketSDR's
+// sign-magnitude table. Packed back by hand with that table (I0 bits 1:0, Q0 3:2, I1 5:4, Q1 7:6), our i2
+// reader with sign-magnitude / lsb-first must give every sample of the int8 file back.
+TEST(TwoBitFormat, RepackedPocketSdrRecordingReadsBackExactly) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(path, "pocketsdr_L1_4MHz_iq_2bit.bin");
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(raw.size() % 4, 0u);
+  auto code = [](signed char v) -> unsigned char {
+    switch (v) {
+      case 1: return 0b00;
+      case 3: return 0b01;
+      case -1: return 0b10;
+      case -3: return 0b11;
+    }
+    ADD_FAILURE() << "value " << int(v) << " is not 2-bit";
+    return 0;
+  };
+  std::vector<unsigned char> packed(raw.size() / 4);
+  for (std::size_t i = 0; i < packed.size(); ++i)
+    for (std::size_t k = 0; k < 4; ++k)
+      packed[i] = static_cast<unsigned char>(packed[i] | code(static_cast<signed char>(raw[4 * i + k])) << (2 * k));
+  const auto dir = test::scratch_dir();
+  write_raw(dir / "pocket.i2", packed);
+  const auto want = read_all(path, SampleFormat::i8, {}, 0, 4096);
+  const auto got =
+      read_all(dir / "pocket.i2", SampleFormat::i2, {TwoBitCoding::sign_magnitude, BitOrder::lsb_first}, 0, 4093);
+  ASSERT_EQ(got.size(), want.size());
+  EXPECT_TRUE(got == want);
+}
+
+}  // namespace
+}  // namespace ultratrack::signals
