@@ -19,6 +19,8 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "scenario.hpp"
+#include "signals/input_error.hpp"
 #include "signals/nominal_constellation.hpp"
 #include "signals/rinex_nav.hpp"
 #include "support/test_data.hpp"
@@ -168,4 +170,26 @@ TEST(FormatsMatrix, TwoBitFileFixesWithAHotStart) {
   const double rms = std::sqrt(sum2 / static_cast<double>(fixes.size()));
   std::printf("i2 4 MHz hot start: %zu fixes, 3-D RMS %.2f m\n", fixes.size(), rms);
   EXPECT_LE(rms, 3.0);
+}
+
+// The scenario keys of the 2-bit packing: parsed, echoed by to_toml (so that scenario.toml re-runs the same
+// file), and an unknown name is an InputError naming the key.
+TEST(FormatsMatrix, ScenarioTwoBitKeysParseAndEcho) {
+  using ultratrack::tools::parse_scenario;
+  const auto s = parse_scenario(
+      "[signal]\nformat = \"r2\"\nif_hz = 4.092e6\nsample_rate_hz = 16.368e6\n"
+      "two_bit_coding = \"offset-binary\"\ntwo_bit_order = \"msb-first\"\n",
+      "/tmp/a/s.toml");
+  EXPECT_EQ(s.format, ultratrack::signals::SampleFormat::r2);
+  EXPECT_EQ(s.two_bit.coding, ultratrack::signals::TwoBitCoding::offset_binary);
+  EXPECT_EQ(s.two_bit.order, ultratrack::signals::BitOrder::msb_first);
+  const auto back = parse_scenario(ultratrack::tools::to_toml(s), "/tmp/b/echo.toml");
+  EXPECT_EQ(back.two_bit.coding, s.two_bit.coding);
+  EXPECT_EQ(back.two_bit.order, s.two_bit.order);
+  try {
+    parse_scenario("[signal]\nformat = \"i2\"\ntwo_bit_coding = \"gray\"\n", "/tmp/a/bad.toml");
+    FAIL() << "unknown coding accepted";
+  } catch (const ultratrack::signals::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("signal.two_bit_coding"), std::string::npos) << e.what();
+  }
 }
