@@ -32,8 +32,8 @@ std::string_view to_string(SampleFormat format) {
 std::string_view sample_format_names() { return "i8, i16, f32, r8, r16, r2, i2"; }
 
 std::optional<TwoBitCoding> parse_two_bit_coding(std::string_view name) {
-  for (auto c : {TwoBitCoding::twos_complement, TwoBitCoding::sign_magnitude, TwoBitCoding::offset_binary,
-                 TwoBitCoding::nt1065})
+  for (auto c :
+       {TwoBitCoding::twos_complement, TwoBitCoding::sign_magnitude, TwoBitCoding::offset_binary, TwoBitCoding::nt1065})
     if (name == to_string(c)) return c;
   return std::nullopt;
 }

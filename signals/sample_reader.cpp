@@ -110,7 +110,8 @@ std::size_t SampleReader::read_packed(std::span<std::complex<float>> out) {
     raw_.resize(bytes);
     file_.read(raw_.data(), static_cast<std::streamsize>(bytes));
     if (file_.gcount() != static_cast<std::streamsize>(bytes)) {
-      throw InputError(path_.string(), "read failed at sample " + std::to_string(position_ + static_cast<std::int64_t>(n)) +
+      throw InputError(path_.string(), "read failed at sample " +
+                                           std::to_string(position_ + static_cast<std::int64_t>(n)) +
                                            " (the file changed while being read?)");
     }
     const std::size_t whole = rest / per_byte_;

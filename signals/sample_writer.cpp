@@ -41,8 +41,10 @@ inline void put_le_f32(char* p, float v) {
 SampleWriter::SampleWriter(std::filesystem::path path, SampleFormat format, TwoBitLayout layout)
     : path_(std::move(path)), format_(format) {
   const auto levels = two_bit_levels(layout.coding);
-  for (std::size_t c = 0; c < 4; ++c) code_[static_cast<std::size_t>((levels[c] + 3) / 2)] = static_cast<std::uint8_t>(c);
-  for (int j = 0; j < 4; ++j) shift_[static_cast<std::size_t>(j)] = 2 * (layout.order == BitOrder::lsb_first ? j : 3 - j);
+  for (std::size_t c = 0; c < 4; ++c)
+    code_[static_cast<std::size_t>((levels[c] + 3) / 2)] = static_cast<std::uint8_t>(c);
+  for (int j = 0; j < 4; ++j)
+    shift_[static_cast<std::size_t>(j)] = 2 * (layout.order == BitOrder::lsb_first ? j : 3 - j);
   temp_path_ = path_;
   temp_path_ += ".part";
   file_.open(temp_path_, std::ios::binary | std::ios::trunc);
@@ -62,8 +64,8 @@ inline void SampleWriter::pack(float x, char*& p) {
   // Level index 0..3 for -3, -1, +1, +3: thresholds -2, 0, +2 (NaN counts as 0, i.e. +1).
   const float v = (x == x) ? x : 0.0f;
   const int index = (v >= -2.0f) + (v >= 0.0f) + (v >= 2.0f);
-  pending_ = static_cast<std::uint8_t>(pending_ | (code_[static_cast<std::size_t>(index)]
-                                                   << shift_[static_cast<std::size_t>(pending_fields_)]));
+  pending_ = static_cast<std::uint8_t>(
+      pending_ | (code_[static_cast<std::size_t>(index)] << shift_[static_cast<std::size_t>(pending_fields_)]));
   if (++pending_fields_ == 4) {
     *p++ = static_cast<char>(pending_);
     pending_ = 0;

@@ -10,8 +10,8 @@
 #pragma once
 
 #include <array>
-#include <cstdint>
 #include <complex>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <span>

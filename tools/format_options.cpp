@@ -10,10 +10,11 @@ void add_format_options(CLI::App* cmd, FormatArgs& args) {
                   "int16 LE), r2 (real 2-bit packed, 4 samples per byte), i2 (2-bit packed I/Q, 2 pairs per byte, "
                   "I first; --iq-swap for Q first)")
       ->required();
-  cmd->add_option("--2bit-coding", args.coding,
-                  "r2/i2: codes 00 01 10 11 stand for: twos = +1 +3 -3 -1 (GNSS-SDR Two_Bit_Packed, MAX2769 two's "
-                  "complement), sign-magnitude = +1 +3 -1 -3 (MAX2769/MAX2771, PocketSDR), offset-binary = -3 -1 +1 +3, "
-                  "nt1065 = -1 +1 -3 +3")
+  cmd->add_option(
+         "--2bit-coding", args.coding,
+         "r2/i2: codes 00 01 10 11 stand for: twos = +1 +3 -3 -1 (GNSS-SDR Two_Bit_Packed, MAX2769 two's "
+         "complement), sign-magnitude = +1 +3 -1 -3 (MAX2769/MAX2771, PocketSDR), offset-binary = -3 -1 +1 +3, "
+         "nt1065 = -1 +1 -3 +3")
       ->capture_default_str();
   cmd->add_option("--2bit-order", args.order,
                   "r2/i2: first sample of a byte in bits 1:0 (lsb-first, GNSS-SDR default) or in bits 7:6 "

@@ -54,8 +54,8 @@ TEST(TwoBitFormat, NamesAndSizes) {
   EXPECT_EQ(bytes_per_sample(SampleFormat::r2), 0u);
   EXPECT_EQ(full_scale(SampleFormat::i2), 3.0);
   EXPECT_EQ(nominal_rms(SampleFormat::r2), 2.0);
-  for (auto c : {TwoBitCoding::twos_complement, TwoBitCoding::sign_magnitude, TwoBitCoding::offset_binary,
-                 TwoBitCoding::nt1065})
+  for (auto c :
+       {TwoBitCoding::twos_complement, TwoBitCoding::sign_magnitude, TwoBitCoding::offset_binary, TwoBitCoding::nt1065})
     EXPECT_EQ(parse_two_bit_coding(to_string(c)), c);
   EXPECT_EQ(parse_bit_order("msb-first"), BitOrder::msb_first);
   EXPECT_FALSE(parse_two_bit_coding("ones").has_value());
@@ -98,7 +98,7 @@ TEST(TwoBitFormat, DecodesEveryByteAsThePeersDo) {
   for (int b = 0; b < 256; ++b) bytes.push_back(static_cast<unsigned char>(b));
   write_raw(path, bytes);
   auto field = [](int b, int j) { return (b >> (2 * j)) & 3; };
-  auto twos = [](int f) { return 2 * (f >= 2 ? f - 4 : f) + 1; };             // GNSS-SDR: 2 * signed(f) + 1
+  auto twos = [](int f) { return 2 * (f >= 2 ? f - 4 : f) + 1; };               // GNSS-SDR: 2 * signed(f) + 1
   auto signmag = [](int f) { return ((f & 2) ? -1 : 1) * ((f & 1) ? 3 : 1); };  // PocketSDR {+1, +3, -1, -3}
   auto nt = [](int f) { return ((f & 1) ? 1 : -1) * ((f & 2) ? 3 : 1); };       // NTLab: M = bit 1, S = bit 0
   const auto tw = reals(read_all(path, SampleFormat::r2, {TwoBitCoding::twos_complement, BitOrder::lsb_first}));
@@ -264,10 +264,14 @@ TEST(TwoBitFormat, RepackedPocketSdrRecordingReadsBackExactly) {
   ASSERT_EQ(raw.size() % 4, 0u);
   auto code = [](signed char v) -> unsigned char {
     switch (v) {
-      case 1: return 0b00;
-      case 3: return 0b01;
-      case -1: return 0b10;
-      case -3: return 0b11;
+      case 1:
+        return 0b00;
+      case 3:
+        return 0b01;
+      case -1:
+        return 0b10;
+      case -3:
+        return 0b11;
     }
     ADD_FAILURE() << "value " << int(v) << " is not 2-bit";
     return 0;

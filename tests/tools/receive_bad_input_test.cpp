@@ -1,7 +1,8 @@
 // `ultratrack receive` on a synthetic file read with wrong flags (issue 3's bad input, without ../shared/data):
 // a wrong format, a wrong rate and a 2-bit file read as 8-bit find no satellite (InputError naming the file,
-// no outputs), a wrong 2-bit order fails with a message naming the file; the right flags on a file too short for a fix give exit 3 with a message naming the file and
-// every output written up to the end. (Empty, truncated and unknown-format files: cmd_receive_test.cpp.)
+// no outputs), a wrong 2-bit order fails with a message naming the file; the right flags on a file too short for a fix
+// give exit 3 with a message naming the file and every output written up to the end. (Empty, truncated and
+// unknown-format files: cmd_receive_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
@@ -59,9 +60,9 @@ TEST(ReceiveBadInput, WrongFormatOrRateFindsNoSatelliteAndNamesTheFile) {
   const auto dir = ultratrack::test::scratch_dir();
   const auto i8 = simulate(dir, "i8");
   const auto i2 = simulate(dir, "i2");
-  expect_no_satellite(i8, {"--format", "i16", "--fs", "4e6"}, dir / "out1");    // wrong format
-  expect_no_satellite(i8, {"--format", "i8", "--fs", "2.6e6"}, dir / "out2");   // wrong rate
-  expect_no_satellite(i2, {"--format", "i8", "--fs", "4e6"}, dir / "out3");     // 2-bit read as 8-bit
+  expect_no_satellite(i8, {"--format", "i16", "--fs", "4e6"}, dir / "out1");   // wrong format
+  expect_no_satellite(i8, {"--format", "i8", "--fs", "2.6e6"}, dir / "out2");  // wrong rate
+  expect_no_satellite(i2, {"--format", "i8", "--fs", "4e6"}, dir / "out3");    // 2-bit read as 8-bit
   // The wrong bit order turns each byte's (I0, Q0, I1, Q1) into (Q1, I1, Q0, I0): acquisition may still find
   // mirrored peaks, tracking cannot hold them; either way a non-zero exit whose message names the file.
   try {
