@@ -326,7 +326,8 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
   }
   result.satellites = synth.visible_satellites(0);
   // 2-bit quantiser threshold (2 in file units, sample_writer.hpp) at 1 sigma of the noise alone, the
-  // minimum-loss setting; the signals (a few % of the power at GPS C/N0) do not move it.
+  // minimum-loss setting, set from the noise because the signals (up to ~10 % of the power with ten
+  // satellites at 45 dB-Hz and a few MHz) are not what the threshold should scale with.
   const float to_file = signals::is_two_bit(s.format) ? static_cast<float>(2.0 / synth.noise_sigma()) : 1.0f;
   result.noise_sigma = synth.noise_sigma() * to_file;
 
