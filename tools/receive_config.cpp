@@ -74,6 +74,7 @@ const std::map<std::string, Table>& sections() {
         {"coherent_ms", [](const Setter& v, O& o) { o.tracking.coherent_ms = v.integer(); }},
         {"cn0_window_s", [](const Setter& v, O& o) { o.tracking.cn0_window_s = v.number(); }},
         {"cn0_loss_threshold_dbhz", [](const Setter& v, O& o) { o.tracking.cn0_loss_threshold_dbhz = v.number(); }},
+        {"pli_time_constant_s", [](const Setter& v, O& o) { o.tracking.pli_time_constant_s = v.number(); }},
         {"pli_lock_threshold", [](const Setter& v, O& o) { o.tracking.pli_lock_threshold = v.number(); }},
         {"pli_loss_threshold", [](const Setter& v, O& o) { o.tracking.pli_loss_threshold = v.number(); }},
         {"loss_of_lock_time_s", [](const Setter& v, O& o) { o.tracking.loss_of_lock_time_s = v.number(); }}}},
