@@ -10,9 +10,10 @@
 #   lost          locked once, then a lost record, a gap or an unlocked record;
 #   never locked  acquired (a channel got it) but not locked by LOCK_DEADLINE_S;
 #   not acquired  no channel ever (an acquisition miss; reported, left out of the fraction).
-# fraction kept = kept / (kept + lost + never locked), with its Wilson 68 % interval; the 90 % threshold is
-# interpolated linearly in C/N0 between the levels whose fractions bracket 0.9 (and so are its bounds, from the
-# interval curves).
+# fraction kept = kept / (kept + lost + never locked) (the headline: pull-in included), and kept / (kept + lost)
+# (lock kept once locked), each with its Wilson 68 % interval; a 90 % threshold is the lowest C/N0 above which
+# the fraction stays >= 0.9, interpolated linearly between the bracketing levels (its bounds likewise from the
+# interval curves). The report can be redone from runs.csv: --report-only DIR.
 #
 # Acquisition is not what is measured: the receiver searches only the PRNs the file holds, +-4.5 kHz, with a
 # long snapshot (10 ms coherent x 25: it finds every satellite of a 26 dB-Hz file); a lost satellite is not
@@ -30,7 +31,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
 levels="24 26 28 30 32"; files=4; duration=60; fs=2.6e6; seed0=100; out=/tmp/ultratrack_threshold
 ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$root/../shared/data/brdc0010.22n
-lock_deadline_s=5; extra_config=""
+lock_deadline_s=5; extra_config=""; report_only=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --levels) levels=$2; shift 2 ;;
@@ -45,6 +46,7 @@ while [ $# -gt 0 ]; do
     --lock-deadline) lock_deadline_s=$2; shift 2 ;;
     --config-extra) extra_config=$(realpath "$2"); shift 2 ;;
     --keep) keep=1; shift ;;
+    --report-only) report_only=1; out=$2; shift 2 ;;
     -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -71,7 +73,7 @@ TOML
 [ -z "$extra_config" ] || cat "$extra_config" >> "$acq_config"
 
 runs=$out/runs.csv
-echo "cn0_dbhz,file,prn,outcome,first_lock_s,lock_end_s" > "$runs"
+if [ "$report_only" = 1 ]; then levels=""; else echo "cn0_dbhz,file,prn,outcome,first_lock_s,lock_end_s" > "$runs"; fi
 for level in $levels; do
   for ((k = 0; k < files; ++k)); do
     seed=$((seed0 + k))
@@ -155,8 +157,8 @@ def wilson(k, n, z=1.0):
     c = (p + z * z / (2 * n)) / d
     h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
     return (max(0.0, c - h), min(1.0, c + h))
-table = []
-print("cn0_dbhz  runs  kept  lost  never_locked  not_acquired  fraction_kept  wilson68")
+table, table_locked = [], []
+print("cn0_dbhz  runs  kept  lost  never_locked  not_acquired  fraction_kept  wilson68        kept_of_locked  wilson68")
 for L in levels:
     rs = [r for r in runs if float(r["cn0_dbhz"]) == L]
     count = {o: sum(r["outcome"] == o for r in rs) for o in ("kept", "lost", "never_locked", "not_acquired")}
@@ -164,8 +166,12 @@ for L in levels:
     f = count["kept"] / n if n else float("nan")
     lo, hi = wilson(count["kept"], n)
     table.append((L, f, lo, hi))
+    m = count["kept"] + count["lost"]
+    g = count["kept"] / m if m else 0.0
+    glo, ghi = wilson(count["kept"], m)
+    table_locked.append((L, g, glo, ghi))
     print(f"{L:8.1f}  {len(rs):4d}  {count['kept']:4d}  {count['lost']:4d}  {count['never_locked']:12d}  "
-          f"{count['not_acquired']:12d}  {f:13.3f}  [{lo:.3f}, {hi:.3f}]")
+          f"{count['not_acquired']:12d}  {f:13.3f}  [{lo:.3f}, {hi:.3f}]  {g:14.3f}  [{glo:.3f}, {ghi:.3f}]")
 def crossing(values):
     # lowest C/N0 above which the curve stays >= 0.9, interpolated between the bracketing levels
     pts = [(L, v) for L, v in values]
@@ -177,7 +183,7 @@ def crossing(values):
         return f"<= {pts[0][0]:.1f}"
     (L0, v0), (L1, v1) = pts[i - 1], pts[i]
     return f"{L0 + (0.9 - v0) * (L1 - L0) / (v1 - v0):.2f}"
-print("90 % tracking threshold (dB-Hz):", crossing([(L, f) for L, f, _, _ in table]),
-      " range from the 68 % intervals:", crossing([(L, hi) for L, _, _, hi in table]), "..",
-      crossing([(L, lo) for L, _, lo, _ in table]))
+for label, t in (("of acquired satellites (pull-in included)", table), ("of locked satellites (lock kept)", table_locked)):
+    print(f"90 % threshold, {label}: {crossing([(L, f) for L, f, _, _ in t])} dB-Hz; from the 68 % intervals: "
+          f"{crossing([(L, hi) for L, _, _, hi in t])} .. {crossing([(L, lo) for L, _, lo, _ in t])}")
 PY
