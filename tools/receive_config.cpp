@@ -66,6 +66,8 @@ const std::map<std::string, Table>& sections() {
         {"fll_wide_time_s", [](const Setter& v, O& o) { o.tracking.fll_wide_time_s = v.number(); }},
         {"fll_narrow_bw_hz", [](const Setter& v, O& o) { o.tracking.fll_narrow_bw_hz = v.number(); }},
         {"fll_narrow_time_s", [](const Setter& v, O& o) { o.tracking.fll_narrow_time_s = v.number(); }},
+        {"fll_fine_bw_hz", [](const Setter& v, O& o) { o.tracking.fll_fine_bw_hz = v.number(); }},
+        {"fll_fine_time_s", [](const Setter& v, O& o) { o.tracking.fll_fine_time_s = v.number(); }},
         {"pullin_lock_time_s", [](const Setter& v, O& o) { o.tracking.pullin_lock_time_s = v.number(); }},
         {"pullin_timeout_s", [](const Setter& v, O& o) { o.tracking.pullin_timeout_s = v.number(); }},
         {"dll_bw_hz", [](const Setter& v, O& o) { o.tracking.dll_bw_hz = v.number(); }},
