@@ -51,13 +51,13 @@ while [ $# -gt 0 ]; do
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-if [ ! -f "$nav" ]; then
+if [ "$report_only" = 0 ] && [ ! -f "$nav" ]; then
   echo "tracking_threshold.sh: $nav not found (../shared/data/brdc0010.22n): skipped"
   exit 0
 fi
 [ -x "$ultratrack" ] || { echo "tracking_threshold.sh: $ultratrack not built" >&2; exit 2; }
 command -v python3 >/dev/null || { echo "tracking_threshold.sh: python3 is needed for the report" >&2; exit 2; }
-nav=$(realpath "$nav")
+[ "$report_only" = 1 ] || nav=$(realpath "$nav")
 mkdir -p "$out"
 out=$(realpath "$out")
 
