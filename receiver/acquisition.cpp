@@ -171,15 +171,26 @@ void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, co
   for (int k = 0; k < options_.noncoherent; ++k) {
     const FftwBuffer* spectrum = cached ? cached + k : &spectrum_scratch_;
     if (!cached) doppler_spectrum(samples, k, doppler_hz, spectrum_scratch_);
-    for (std::size_t i = 0; i < fft_size_; ++i) product_[i] = (*spectrum)[i] * code[i];
+    // X * C in real arithmetic: std::complex's operator* carries a NaN-recovery branch that stops vectorisation.
+    const float* x = reinterpret_cast<const float*>(spectrum->data());
+    const float* c = reinterpret_cast<const float*>(code.data());
+    float* p = reinterpret_cast<float*>(product_.data());
+    for (std::size_t i = 0; i < fft_size_; ++i) {
+      const float xr = x[2 * i], xi = x[2 * i + 1], cr = c[2 * i], ci = c[2 * i + 1];
+      p[2 * i] = xr * cr - xi * ci;
+      p[2 * i + 1] = xr * ci + xi * cr;
+    }
     backward_.execute(product_, correlation_);
     const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
-    const auto shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period)));
-    for (std::size_t lag = 0; lag < lags_; ++lag) {
-      std::ptrdiff_t index = (static_cast<std::ptrdiff_t>(lag) + shift) % n;
-      if (index < 0) index += n;
-      row_[lag] += std::norm(correlation_[static_cast<std::size_t>(index)]);
-    }
+    std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
+    if (shift < 0) shift += n;
+    // row[lag] += |corr[(lag + shift) mod n]|^2, in the two unwrapped runs.
+    const auto* y = reinterpret_cast<const float*>(correlation_.data());
+    const auto first_run = static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(lags_), n - shift));
+    const float* a = y + 2 * shift;
+    for (std::size_t lag = 0; lag < first_run; ++lag) row_[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
+    const float* b = y - 2 * static_cast<std::ptrdiff_t>(first_run);
+    for (std::size_t lag = first_run; lag < lags_; ++lag) row_[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
   }
 }
 
