@@ -12,7 +12,7 @@
 # scenario's start, first fix ~36 s in, simulator elevation mask 9 deg; 12 satellites: 70 N 90 W from tow 518398,
 # 2 s before a frame, first fix ~20 s in, one satellite below the receiver's 10 deg mask). 60 s of signal, 40 s
 # at 16 MHz (2.6 GB for i16). Defaults: build/, ${ULTRATRACK_BENCH_DIR:-/tmp/ultratrack_bench}, 3 runs,
-# --threads 2 (the issue's 2 cores). Needs python3 and /usr/bin/time (Debian package `time`).
+# --threads 2 (the issue's 2 cores; --threads none for builds without the option). Needs python3 and /usr/bin/time (Debian package `time`).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=$here/build; scratch=${ULTRATRACK_BENCH_DIR:-/tmp/ultratrack_bench}; runs=3; threads=2; only=.
@@ -33,6 +33,8 @@ brdc=${ULTRATRACK_BRDC:-$here/../shared/data/brdc0010.22n}
 [[ -f $brdc ]] || { echo "receiver_throughput.sh: $brdc missing (set ULTRATRACK_BRDC)" >&2; exit 2; }
 brdc=$(realpath "$brdc")
 mkdir -p "$scratch"
+threads_flag=(--threads "$threads")
+[[ $threads == none ]] && threads_flag=()  # builds from before --threads existed
 
 # name sats fs format duration
 set_list() {
@@ -93,7 +95,7 @@ while read -r name sats fs fmt duration; do
     out=$scratch/$name/rx
     rm -rf "$out"
     /usr/bin/time -v -o "$scratch/$name/time.txt" "$ut" receive --input "$input" --format "$fmt" --fs "$fs" \
-      --out "$out" --quiet --threads "$threads" --reference-week 2190 --troposphere off >/dev/null
+      --out "$out" --quiet ${threads_flag[@]+"${threads_flag[@]}"} --reference-week 2190 --troposphere off >/dev/null
     read -r rt cpu kb e < <(python3 - "$out" "$scratch/$name/time.txt" "$scratch/$name/sim/truth.csv" <<'PY'
 import csv, json, math, sys
 out, timing, truth = sys.argv[1:]
