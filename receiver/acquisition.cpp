@@ -200,15 +200,23 @@ std::complex<double> Acquisition::correlate_time(std::span<const std::complex<fl
   const std::size_t first = static_cast<std::size_t>(block) * block_size_;
   const double chips_per_sample = code_rate_hz(doppler_hz) / options_.fs_hz;
   const std::complex<double> step = std::polar(1.0, -kTwoPi * doppler_hz / options_.fs_hz);
-  std::complex<double> nco(1.0, 0.0), sum(0.0, 0.0);
+  // The complex products written out in real arithmetic (the same operations as std::complex's, without its
+  // NaN-recovery branches, which cost more than the arithmetic).
+  const double step_re = step.real(), step_im = step.imag();
+  double nco_re = 1.0, nco_im = 0.0, sum_re = 0.0, sum_im = 0.0;
   double phase = (static_cast<double>(first) - lag_samples) * chips_per_sample;
+  const auto* x = reinterpret_cast<const float*>(samples.data() + first);
   for (std::size_t m = 0; m < block_size_; ++m) {
-    const std::complex<float> x = samples[first + m];
-    sum += std::complex<double>(x.real(), x.imag()) * nco * static_cast<double>(chip_at(code, phase));
-    nco *= step;
+    const double xr = x[2 * m], xi = x[2 * m + 1];
+    const double chip = chip_at(code, phase);
+    sum_re += (xr * nco_re - xi * nco_im) * chip;
+    sum_im += (xr * nco_im + xi * nco_re) * chip;
+    const double next_re = nco_re * step_re - nco_im * step_im;
+    nco_im = nco_re * step_im + nco_im * step_re;
+    nco_re = next_re;
     phase += chips_per_sample;
   }
-  return sum;
+  return {sum_re, sum_im};
 }
 
 double Acquisition::power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz,
