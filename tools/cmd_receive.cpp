@@ -48,7 +48,7 @@ struct SigintGuard {
 
 struct ReceiveArgs {
   std::string input, fs, if_hz = "0", config, nav, out;
-  std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week;
+  std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
   FormatArgs format;
   bool iq_swap = false, q_negate = false, quiet = false;
 };
@@ -127,6 +127,7 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.troposphere.empty()) options.pvt.troposphere = on_off("--troposphere", args.troposphere, "on", "off");
   if (!args.ionosphere.empty()) options.pvt.ionosphere = on_off("--ionosphere", args.ionosphere, "broadcast", "off");
   if (!args.channels.empty()) options.channels = parse_int_option("--channels", args.channels);
+  if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   signals::RinexNavData nav;
   if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
@@ -201,8 +202,8 @@ void run_receive(const ReceiveArgs& args) {
   outputs.finish(engine, run);
 
   const double t = receiver::processed_seconds(engine);
-  fmt::print("receive: {:.1f} s of signal in {:.1f} s ({:.1f}x real time){}\n", t, wall_s, wall_s > 0 ? t / wall_s : 0.0,
-             run.interrupted ? ", interrupted" : "");
+  fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
+             wall_s > 0 ? t / wall_s : 0.0, engine.threads(), run.interrupted ? ", interrupted" : "");
   int used = 0, tracked = 0;
   for (int prn = 1; prn <= 32; ++prn) {
     used += stats.satellites[static_cast<std::size_t>(prn)].used_in_fixes > 0;
@@ -236,6 +237,7 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--troposphere", args->troposphere, "on|off (default on)");
   cmd->add_option("--ionosphere", args->ionosphere, "broadcast|off (default broadcast)");
   cmd->add_option("--channels", args->channels, "tracking channels (default 12)");
+  cmd->add_option("--threads", args->threads, "worker threads including the main one (default: all cores)");
   cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15 (default all)");
   cmd->add_option("--duration", args->duration, "seconds of signal to process (default: to the end)");
   cmd->add_option("--skip", args->skip, "seconds of signal to skip at the start");
