@@ -3,7 +3,8 @@
 // one clock), the line of sight, and the slip flags. Units: cycles of L1, metres, dB-Hz; frames in the names.
 //
 // Between two antennas of one satellite the receiver clock, the satellite clock, the atmosphere and the navigation
-// bit cancel: carrier_phase_cycles[k] - carrier_phase_cycles[0] = (b_k . los) / lambda + N_k + line bias + noise,
+// bit cancel: carrier_phase_cycles[k] - carrier_phase_cycles[0] = -(b_k . los) / lambda + N_k + line bias + noise
+// (RINEX sense: antenna k, nearer the satellite by b_k . los, reads fewer cycles),
 // with b_k the ECEF baseline from the master to antenna k and N_k an integer that stays fixed while no slip flag
 // is raised for antenna k.
 #pragma once

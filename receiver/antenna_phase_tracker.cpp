@@ -51,6 +51,7 @@ void AntennaPhaseTracker::update(const CorrelationEpoch& e, bool master_locked, 
       s.noise_power += a * (noise_k - s.noise_power);
       s.master_power += a * (power0 - s.master_power);
     }
+    s.cn0_dbhz = NAN;
     if (s.noise_power > 0.0) {
       const double snr = std::max(1e-3, s.signal_power / s.noise_power - 1.0);
       s.cn0_dbhz = 10.0 * std::log10(snr / dt);
@@ -103,7 +104,9 @@ AntennaPhaseSample AntennaPhaseTracker::peek(int k, std::int64_t sample_index, d
   const State& s = state_[static_cast<std::size_t>(k)];
   AntennaPhaseSample out;
   out.cn0_dbhz = s.cn0_dbhz;
-  out.usable = master_locked_ && s.started && !s.faded && s.cn0_dbhz >= options_.min_cn0_dbhz;
+  out.power_ratio = s.master_power > 0.0 ? s.signal_power / s.master_power : 0.0;
+  // Without a noise tap the fade test (power ratio) alone decides.
+  out.usable = master_locked_ && s.started && !s.faded && !(s.cn0_dbhz < options_.min_cn0_dbhz);
   out.phase_cycles = s.phase_cycles + s.rate_hz * (static_cast<double>(sample_index) - s.sample_mid) / fs_hz;
   out.slip = s.slip_pending;
   return out;
@@ -131,7 +134,7 @@ AntennaPhaseObservation make_antenna_observation(AntennaPhaseTracker& tracker, i
     const AntennaPhaseSample a = tracker.report(k, sample_index, fs_hz);
     const auto i = static_cast<std::size_t>(k);
     o.carrier_phase_cycles[i] = master_phase_cycles + a.phase_cycles;
-    o.cn0_dbhz[i] = a.cn0_dbhz;
+    o.cn0_dbhz[i] = std::isnan(a.cn0_dbhz) ? master_cn0_dbhz + 10.0 * std::log10(std::max(a.power_ratio, 1e-6)) : a.cn0_dbhz;
     o.usable[i] = a.usable;
     // A new master track restarts the between-antenna trackers too (a new channel), so its slip covers all.
     o.slip[i] = a.slip || master_slip;

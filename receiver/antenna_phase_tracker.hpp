@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 
@@ -36,7 +37,8 @@ struct AntennaPhaseTrackerOptions {
 // The state of antenna k's between-antenna phase at one sample.
 struct AntennaPhaseSample {
   double phase_cycles = 0.0;  // phase_k - phase_0, cycles, RINEX sense, extrapolated to the sample
-  double cn0_dbhz = 0.0;
+  double cn0_dbhz = NAN;     // from antenna k's prompt and noise tap; NaN without a noise tap (or no noise)
+  double power_ratio = 0.0;  // smoothed |P_k|^2 / |P_0|^2
   bool usable = false;
   bool slip = false;  // continuity was lost since the previous usable report (cleared by report())
 };
@@ -66,7 +68,7 @@ class AntennaPhaseTracker {
     double sample_mid = 0.0;
     double signal_power = 0.0, noise_power = 0.0, master_power = 0.0;  // smoothed |P_k|^2, |noise_k|^2, |P_0|^2
     bool have_power = false;
-    double cn0_dbhz = 0.0;
+    double cn0_dbhz = NAN;
   };
   void restart(State& s);
 
