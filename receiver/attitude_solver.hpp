@@ -21,9 +21,9 @@
 namespace ultratrack::receiver {
 
 struct AntennaArray {
-  // Phase centre of each antenna in the body frame, m; [0] is the master. 2..kMaxAntennas entries, the baselines
-  // (lever_arm_body_m[k] - lever_arm_body_m[0]) at least 0.1 m long, and at least two of them not collinear (an
-  // array of two antennas gives yaw and pitch only: roll is then reported with an infinite variance).
+  // Phase centre of each antenna in the body frame, m; [0] is the master. 3..kMaxAntennas entries, the baselines
+  // (lever_arm_body_m[k] - lever_arm_body_m[0]) at least 0.1 m long and at least two of them not collinear (a full
+  // attitude needs two directions).
   std::vector<Eigen::Vector3d> lever_arm_body_m;
 };
 
@@ -32,8 +32,12 @@ struct AttitudeSolverOptions {
   double phase_sigma_m = 0.003;       // carrier noise of one antenna's phase (1 sigma, uniform over elevation), m
   double elevation_mask_rad = 0.17453292519943295;  // 10 deg; satellites below it are left out
   int min_satellites = 5;             // satellites (reference included) needed on a baseline to resolve
-  // Validation of a new fix: second-best / best constrained cost (Euler & Schaffrin / Verhagen ratio test, > 1).
+  // Validation of a new fix, both tests on the rigid-fit chi-square of the best and second-best candidates: ratio
+  // test J2 / J1 >= ratio_threshold (Euler & Schaffrin 1991) and difference test J2 - J1 >= difference_threshold
+  // (Tiberius & de Jonge 1995). The difference test is what keeps wrong fixes rare at 5 satellites, where a wrong
+  // candidate can fit almost as well as the right one (15: no wrong fix in 12000 simulated 5-satellite epochs).
   double ratio_threshold = 2.0;
+  double difference_threshold = 15.0;
   // true: per-baseline LAMBDA candidates filtered by the baseline lengths, then pairs by the angle between
   // baselines and ranked by the rigid-array fit of all DDs (the constrained method). false: plain LAMBDA on each
   // baseline's float (weak length prior only), best candidate + ratio test: kept to measure what constraints buy.
@@ -64,7 +68,9 @@ struct AttitudeSolution {
   bool valid = false;     // an attitude is given (only from validated integer ambiguities)
   bool fixed = false;     // the ambiguities used this epoch are fixed and passed this epoch's checks
   bool new_fix = false;   // resolved from scratch this epoch (false: carried from earlier epochs)
-  double ratio = 0.0;     // ratio test value of the fix in use (from the epoch it was resolved); 0 if none
+  // Ratio test value (J2 / J1) of the fix in use, from the epoch it was resolved; 1e9 when no rival candidate passed
+  // the constraints; when not fixed, the value that failed (0 if no candidate at all).
+  double ratio = 0.0;
   int num_sats = 0;       // satellites in the attitude fit (reference included)
   double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;  // yaw in [0, 2 pi)
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();  // (roll, pitch, yaw), from the DD covariance
@@ -90,6 +96,8 @@ class AttitudeSolver {
   // Throws std::invalid_argument when validation_error(options) is not empty.
   explicit AttitudeSolver(AttitudeSolverOptions options);
 
+  // An epoch without a usable master position (not finite, or nearer the geocentre than 1000 km) has no NED frame:
+  // valid = false, and the ambiguities are kept for the next epoch.
   AttitudeSolution update(const AntennaPhaseEpoch& epoch);
   // Forget every fixed ambiguity and the line-bias calibration.
   void reset();
@@ -99,11 +107,11 @@ class AttitudeSolver {
  private:
   AttitudeSolverOptions options_;
   std::vector<SdAmbiguity> fixed_;             // carried SD ambiguities
-  std::vector<double> bias_sum_, bias_sum_sq_; // running line-bias calibration per antenna
+  std::vector<double> bias_mean_, bias_m2_;    // running line-bias calibration per antenna (Welford)
   std::vector<int> bias_count_;
   double last_ratio_ = 0.0;
   bool have_attitude_ = false;
-  Eigen::Matrix3d last_C_nb_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d last_R_eb_ = Eigen::Matrix3d::Identity();
 };
 
 }  // namespace ultratrack::receiver
