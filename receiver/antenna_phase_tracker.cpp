@@ -108,7 +108,7 @@ AntennaPhaseSample AntennaPhaseTracker::peek(int k, std::int64_t sample_index, d
   // Without a noise tap the fade test (power ratio) alone decides.
   out.usable = master_locked_ && s.started && !s.faded && !(s.cn0_dbhz < options_.min_cn0_dbhz);
   out.phase_cycles = s.phase_cycles + s.rate_hz * (static_cast<double>(sample_index) - s.sample_mid) / fs_hz;
-  out.slip = s.slip_pending;
+  out.slip = s.slip_pending && out.usable;  // given with the first usable phase after the break
   return out;
 }
 

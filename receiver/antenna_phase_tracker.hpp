@@ -40,7 +40,9 @@ struct AntennaPhaseSample {
   double cn0_dbhz = NAN;     // from antenna k's prompt and noise tap; NaN without a noise tap (or no noise)
   double power_ratio = 0.0;  // smoothed |P_k|^2 / |P_0|^2
   bool usable = false;
-  bool slip = false;  // continuity was lost since the previous usable report (cleared by report())
+  // Continuity was lost since the previous usable report: raised with the first usable phase after the break
+  // (never while unusable), cleared by report().
+  bool slip = false;
 };
 
 class AntennaPhaseTracker {
