@@ -40,7 +40,7 @@ struct SigintGuard {
 
 struct AttitudeArgs {
   std::vector<std::string> inputs;
-  std::string format, fs, if_hz = "0", antennas, nav, out, duration, reference_week, interval;
+  std::string format, fs, if_hz = "0", antennas, nav, out, duration, reference_week, interval, prns;
   bool quiet = false;
 };
 
@@ -59,6 +59,7 @@ void run_attitude(const AttitudeArgs& args) {
   receiver::ReceiverOptions options;
   options.fs_hz = source_options.fs_hz;
   options.num_antennas = static_cast<int>(n_ant);
+  if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   if (!args.interval.empty()) options.observation_interval_s = parse_double_option("--interval", args.interval);
   signals::RinexNavData nav;
   if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
@@ -145,6 +146,7 @@ void add_attitude_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "output folder (created when missing)")->required();
   cmd->add_option("--duration", args->duration, "seconds of signal to process (default: to the end)");
   cmd->add_option("--interval", args->interval, "attitude epoch interval, s (default 0.1)");
+  cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15 (default all)");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
   cmd->callback([args] { run_attitude(*args); });
 }
