@@ -305,8 +305,9 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
   if (const auto err = validate(options_); !err.empty()) throw std::invalid_argument(err);
   if (!motion_ || motion_->antenna_count() < 1) throw std::invalid_argument("the receiver needs at least one antenna");
   const int antennas = motion_->antenna_count();
-  if (static_cast<int>(options_.antenna_impairments.size()) > antennas)
-    throw std::invalid_argument("more antenna impairments than antennas");
+  for (std::size_t a = static_cast<std::size_t>(antennas); a < options_.antenna_impairments.size(); ++a)
+    if (options_.antenna_impairments[a].line_bias_cycles != 0.0 || options_.antenna_impairments[a].phase_noise_m != 0.0)
+      throw std::invalid_argument("impairments for antenna " + std::to_string(a) + ": no such antenna");
   for (const auto& e : options_.cycle_slips)
     if (e.antenna >= antennas) throw std::invalid_argument("cycle slip on antenna " + std::to_string(e.antenna) + ": no such antenna");
   for (const auto& b : options_.blockages)

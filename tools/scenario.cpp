@@ -527,7 +527,9 @@ std::string to_toml(const Scenario& s) {
       const auto& l = s.lever_arms_body_m[i];
       out += fmt::format("\n[[antenna]]\nlever_arm_body_m = [{}, {}, {}]\n", toml_float(l[0]), toml_float(l[1]),
                          toml_float(l[2]));
-      if (i < s.antenna_impairments.size())
+      // Written only when set, so that the echo of a scenario without them stays as it was.
+      if (i < s.antenna_impairments.size() &&
+          (s.antenna_impairments[i].line_bias_cycles != 0.0 || s.antenna_impairments[i].phase_noise_m != 0.0))
         out += fmt::format("line_bias_cycles = {}\nphase_noise_m = {}\n", toml_float(s.antenna_impairments[i].line_bias_cycles),
                            toml_float(s.antenna_impairments[i].phase_noise_m));
     }
