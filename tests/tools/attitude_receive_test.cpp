@@ -44,7 +44,7 @@ tools::Scenario attitude_scenario() {
   s.cn0_dbhz = 45.0;
   s.seed = 5;
   s.gps_week = 2190;
-  s.tow_s = 518396.0;  // 4 s before a subframe start: frame sync (the time tag) after ~4 s
+  s.tow_s = 518396.0;  // the first time tag at ~10 s, when the subframe 518400-518406 completes
   s.constellation = "nominal";
   s.ionosphere = false;
   // Master, 1 m at azimuth 35 deg, 1.025 m at azimuth 125 deg (the seed array turned by 35 deg of yaw).
