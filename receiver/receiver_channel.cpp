@@ -22,16 +22,21 @@ ChannelStart channel_start_from_acquisition(const AcquisitionResult& result, std
 }
 
 ReceiverChannel::ReceiverChannel(int prn, const ChannelStart& start, double fs_hz, const ScalarTrackingOptions& options,
-                                 int reference_week, bool reference_week_is_signal_week, int record_periods)
+                                 int reference_week, bool reference_week_is_signal_week, int record_periods,
+                                 int num_antennas)
     : fs_hz_(fs_hz),
       week_trusted_(reference_week_is_signal_week),
-      channel_(channel_config(options, prn, fs_hz), start),
+      channel_(channel_config(options, prn, fs_hz, num_antennas), start),
       loop_(options, channel_.current_command()),
       nav_(prn, reference_week),
-      record_periods_(record_periods < 1 ? 1 : record_periods) {}
+      record_periods_(record_periods < 1 ? 1 : record_periods) {
+  if (num_antennas > 1) antenna_phases_.emplace(num_antennas);
+}
 
 void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingReport& report) {
-  if (report.state == TrackingState::kPhaseLocked || report.state == TrackingState::kBitSynced) {
+  const bool locked = report.state == TrackingState::kPhaseLocked || report.state == TrackingState::kBitSynced;
+  if (antenna_phases_) antenna_phases_->update(e, locked, fs_hz_);
+  if (locked) {
     if (!lock_start_sample_) lock_start_sample_ = e.first_sample;
     tracked_s_ += e.integration_time_s;
   }

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "receiver/acquisition.hpp"
+#include "receiver/antenna_phase_tracker.hpp"
 #include "receiver/navigation_data_channel.hpp"
 #include "receiver/scalar_tracking.hpp"
 #include "receiver/tracking_channel.hpp"
@@ -55,8 +56,10 @@ class ReceiverChannel {
  public:
   // reference_week_is_signal_week: the reference week is known to be the signal's (see ReceiverOptions);
   // otherwise measure() waits until this channel's subframe 1 has given the week.
+  // num_antennas > 1: every antenna is correlated against the master's replica and an AntennaPhaseTracker
+  // follows each one's phase against the master.
   ReceiverChannel(int prn, const ChannelStart& start, double fs_hz, const ScalarTrackingOptions& options,
-                  int reference_week, bool reference_week_is_signal_week, int record_periods);
+                  int reference_week, bool reference_week_is_signal_week, int record_periods, int num_antennas = 1);
 
   // Consumes a block (samples before next_sample() are skipped); calls on_record(const TrackingRecord&) once
   // every record_periods code periods. Allocates nothing.
@@ -92,6 +95,8 @@ class ReceiverChannel {
   NavigationDataChannel& navigation() { return nav_; }
   const NavigationDataChannel& navigation() const { return nav_; }
   double tracked_time_s() const { return tracked_s_; }
+  // The between-antenna phases (nullptr with one antenna).
+  AntennaPhaseTracker* antenna_phases() { return antenna_phases_ ? &*antenna_phases_ : nullptr; }
 
  private:
   static std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
@@ -107,6 +112,7 @@ class ReceiverChannel {
   std::optional<std::int64_t> lock_start_sample_;
   bool reported_ = false;
   double tracked_s_ = 0.0;
+  std::optional<AntennaPhaseTracker> antenna_phases_;
 };
 
 }  // namespace ultratrack::receiver

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "receiver/antenna_phase_tracker.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/look_angles.hpp"
@@ -190,7 +191,8 @@ void ReceiverEngine::finish_acquisition(std::int64_t start_sample) {
     if (free == channels_.end()) break;
     const ChannelStart start = channel_start_from_acquisition(*r, snapshot_first_, start_sample, options_.fs_hz);
     *free = std::make_unique<ReceiverChannel>(r->prn, start, options_.fs_hz, options_.tracking, options_.reference_week,
-                                              options_.reference_week_is_signal_week, record_periods_);
+                                              options_.reference_week_is_signal_week, record_periods_,
+                                              options_.num_antennas);
     ++stats_.satellites[static_cast<std::size_t>(r->prn)].acquisitions;
   }
 }
@@ -206,8 +208,10 @@ void ReceiverEngine::feed_channel(int slot) {
 void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
   view_.first_sample = first_sample;
   view_.num_samples = static_cast<int>(samples.size());
-  view_.num_antennas = 1;
+  view_.num_antennas = options_.num_antennas;
   view_.antenna[0] = samples.data();
+  for (int a = 1; a < options_.num_antennas; ++a)
+    view_.antenna[static_cast<std::size_t>(a)] = antenna_block_[static_cast<std::size_t>(a)] + (first_sample - antenna_block_first_);
   // Channels are independent given the block: each job touches only its own channel and record buffer.
   auto job = [this](int slot) { feed_channel(slot); };
   pool_.parallel_for(static_cast<int>(channels_.size()), job);
@@ -254,6 +258,21 @@ void ReceiverEngine::release_lost_channels() {
 }
 
 void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
+  if (options_.num_antennas != 1) throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
+  process_master(samples, first_sample);
+}
+
+void ReceiverEngine::process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample) {
+  if (antennas.size() != static_cast<std::size_t>(options_.num_antennas))
+    throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
+  for (const auto& a : antennas)
+    if (a.size() != antennas[0].size()) throw std::invalid_argument("ReceiverEngine: antenna blocks differ in size");
+  for (std::size_t a = 0; a < antennas.size(); ++a) antenna_block_[a] = antennas[a].data();
+  antenna_block_first_ = first_sample;
+  process_master(antennas[0], first_sample);
+}
+
+void ReceiverEngine::process_master(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
   if (!started_) {
     started_ = true;
     stats_.first_sample = first_sample;
@@ -335,6 +354,26 @@ void ReceiverEngine::observation_epoch(std::int64_t sample) {
   ++stats_.observation_epochs;
   observer_.on_observations(epoch_);
   solve(epoch_);
+  if (options_.num_antennas > 1) antenna_phases(sample);
+}
+
+// Every antenna's phase for the satellites of this epoch, with the line of sight from this epoch's fix.
+void ReceiverEngine::antenna_phases(std::int64_t sample) {
+  if (!last_fix_ || std::abs(signals::seconds_between(last_fix_->time, epoch_.receive_time)) > 0.05) return;
+  antenna_epoch_.receive_time = epoch_.receive_time;
+  antenna_epoch_.sample_index = sample;
+  antenna_epoch_.master_position_e = last_fix_->r_e_m;
+  antenna_epoch_.satellites.clear();
+  for (const Observation& o : epoch_.observations) {
+    auto channel = std::find_if(channels_.begin(), channels_.end(), [&](const auto& c) { return c && c->prn() == o.prn; });
+    if (channel == channels_.end() || !(*channel)->antenna_phases()) continue;
+    const auto eph = signals::select_ephemeris(ephemerides_, o.prn, epoch_.receive_time, {.include_unhealthy = true});
+    if (!eph) continue;
+    antenna_epoch_.satellites.push_back(make_antenna_observation(
+        *(*channel)->antenna_phases(), o.prn, o.carrier_phase_cycles, o.cn0_dbhz, o.loss_of_lock, o.pseudorange_m, *eph,
+        epoch_.receive_time, last_fix_->clock_bias_m, last_fix_->r_e_m, sample, options_.fs_hz));
+  }
+  observer_.on_antenna_phases(antenna_epoch_);
 }
 
 void ReceiverEngine::solve(const ObservationEpoch& epoch) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "receiver/acquisition.hpp"
+#include "receiver/antenna_phase.hpp"
 #include "receiver/carrier_smoothing.hpp"
 #include "receiver/observables.hpp"
 #include "receiver/pvt.hpp"
@@ -41,6 +42,8 @@ class ReceiverObserver {
   virtual void on_acquisition(std::int64_t /*snapshot_first_sample*/, const std::vector<AcquisitionResult>&) {}
   virtual void on_observations(const ObservationEpoch&) {}
   virtual void on_fix(const PvtSolution&, const ObservationEpoch&) {}
+  // Multi-antenna receivers (num_antennas > 1): every antenna's phase per satellite, after each epoch's fix.
+  virtual void on_antenna_phases(const AntennaPhaseEpoch&) {}
 };
 
 // Per-satellite counts over the run (index = PRN).
@@ -82,6 +85,9 @@ class ReceiverEngine {
   // Processes samples[0..n) whose first sample has receiver index first_sample. Blocks should be contiguous;
   // a gap is bridged by the channels (dead reckoning) and restarts a pending acquisition snapshot.
   void process(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+  // num_antennas > 1: one span per antenna, all the same size and on the same sample indices; antenna 0 (the
+  // master) is the one acquired on. Throws std::invalid_argument when the spans do not match the options.
+  void process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample);
 
   const ReceiverStats& stats() const { return stats_; }
   const std::optional<PvtSolution>& last_fix() const { return last_fix_; }
@@ -112,6 +118,8 @@ class ReceiverEngine {
     void run() override;
   };
 
+  void process_master(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+  void antenna_phases(std::int64_t sample);
   void begin_snapshot(std::int64_t sample);
   void start_acquisition(std::int64_t end_sample);
   void finish_acquisition(std::int64_t start_sample);
@@ -160,6 +168,10 @@ class ReceiverEngine {
   std::vector<ChannelMeasurement> measured_;  // reused
   std::vector<SatelliteMeasurement> pvt_input_;
   ReceiverStats stats_;
+  // Multi-antenna: the other antennas' samples of the block being processed, and the phases of each epoch.
+  std::array<const std::complex<float>*, kMaxAntennas> antenna_block_{};
+  std::int64_t antenna_block_first_ = 0;
+  AntennaPhaseEpoch antenna_epoch_;
 };
 
 }  // namespace ultratrack::receiver

@@ -11,6 +11,8 @@ std::string ReceiverOptions::validate() const {
   if (channels < 1 || channels > 32) return fmt::format("channels = {}: must be within 1..32", channels);
   for (int prn : prns)
     if (prn < 1 || prn > 32) return fmt::format("PRN {} outside 1..32", prn);
+  if (num_antennas < 1 || num_antennas > kMaxAntennas)
+    return fmt::format("num_antennas = {}: must be within 1..{}", num_antennas, kMaxAntennas);
   if (reference_week < 0) return fmt::format("reference week {} is negative", reference_week);
   if (!(observation_interval_s >= 0.001 && observation_interval_s <= 60.0))
     return fmt::format("observation interval {} s outside [0.001, 60]", observation_interval_s);

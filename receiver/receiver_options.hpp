@@ -36,6 +36,7 @@ struct ReceiverOptions {
   double initial_travel_time_s = 0.068;    // receiver clock set to (latest transmit time + this) at first sync
   double clock_jump_threshold_s = 1e-3;    // after a fix, a receiver clock error above this is removed (a jump)
   double tracking_record_interval_s = 0.02;  // tracking.csv rows per channel
+  int num_antennas = 1;                    // antennas on one clock (1..kMaxAntennas); antenna 0 is acquired on
   double smoothing_window_s = 10.0;        // Hatch filter for the PVT's pseudoranges; 0 = off (raw)
   AcquisitionOptions acquisition;          // fs_hz is taken from fs_hz above
   ScalarTrackingOptions tracking;

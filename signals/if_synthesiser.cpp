@@ -65,6 +65,10 @@ struct IfSynthesiser::Impl {
     double travel_guess_s = 0.075;
     double d_guess_s = 0.0;
     std::unique_ptr<LnavTransmitter> lnav;
+    // Extra phase noise (Gauss-Markov state, metres) and its generator.
+    double noise_m = 0.0;
+    bool noise_started = false;
+    std::mt19937_64 rng;
   };
 
   const SynthesiserOptions& opt;
@@ -166,7 +170,41 @@ struct IfSynthesiser::Impl {
     const Solution s = solve(sats[k], rx, tr.travel_guess_s, tr.d_guess_s);
     tr.travel_guess_s = s.travel_s;
     tr.d_guess_s = s.d_code_s;
-    return {sample, s.code_chips, s.carrier_cycles};
+    return {sample, s.code_chips, s.carrier_cycles - carrier_offset_cycles(tr, sats[k].eph.prn, antenna, sample)};
+  }
+
+  // Line bias + slips + extra noise of a track at a node, cycles, RINEX sense (the synthesised phase falls
+  // with range, so the caller subtracts it).
+  double carrier_offset_cycles(Track& tr, int prn, int antenna, std::int64_t sample) {
+    double cycles = 0.0;
+    if (antenna < static_cast<int>(opt.antenna_impairments.size())) {
+      const AntennaImpairment& imp = opt.antenna_impairments[static_cast<std::size_t>(antenna)];
+      cycles += imp.line_bias_cycles;
+      if (imp.phase_noise_m > 0.0) {
+        std::normal_distribution<double> gauss;
+        if (!tr.noise_started) {
+          tr.noise_m = imp.phase_noise_m * gauss(tr.rng);
+          tr.noise_started = true;
+        } else {
+          const double phi = std::exp(-kNodeInterval_s / opt.phase_noise_correlation_s);
+          tr.noise_m = phi * tr.noise_m + std::sqrt(1.0 - phi * phi) * imp.phase_noise_m * gauss(tr.rng);
+        }
+        cycles += tr.noise_m / kL1Wavelength_m;
+      }
+    }
+    const double tau = tau_of(sample);
+    for (const CycleSlipEvent& e : opt.cycle_slips)
+      if (e.antenna == antenna && e.prn == prn && tau >= e.time_s) cycles += e.cycles;
+    return cycles;
+  }
+
+  // Whether satellite prn's signal is absent at antenna a at receiver time tau (blockage or a slip's fade).
+  bool absent(int prn, int antenna, double tau) const {
+    for (const BlockageEvent& b : opt.blockages)
+      if (b.antenna == antenna && tau >= b.start_s && tau < b.start_s + b.duration_s) return true;
+    for (const CycleSlipEvent& e : opt.cycle_slips)
+      if (e.antenna == antenna && e.prn == prn && tau >= e.time_s && tau < e.time_s + e.fade_s) return true;
+    return false;
   }
 
   void update_visibility(std::int64_t sample) {
@@ -245,6 +283,19 @@ std::string validate(const SynthesiserOptions& o) {
     return "clock noise densities must be >= 0";
   if (!(std::abs(o.clock.drift_sps) < 1e-3)) return "clock drift must be below 1e-3 s/s (300 km/s)";
   if (!std::isfinite(o.clock.bias_s) || std::abs(o.clock.bias_s) > 1.0) return "clock bias must be below 1 s";
+  if (!(o.phase_noise_correlation_s > 0.0)) return "phase noise correlation time must be positive";
+  for (const auto& imp : o.antenna_impairments) {
+    if (!std::isfinite(imp.line_bias_cycles)) return "line bias must be finite";
+    if (!(imp.phase_noise_m >= 0.0 && imp.phase_noise_m < 1.0)) return "phase noise must be within [0, 1) m";
+  }
+  for (const auto& e : o.cycle_slips) {
+    if (e.prn < kMinPrn || e.prn > kMaxPrn) return "cycle slip: PRN must be 1..32";
+    if (e.antenna < 0 || !(e.time_s >= 0.0) || !std::isfinite(e.cycles) || !(e.fade_s >= 0.0))
+      return "cycle slip: antenna >= 0, time_s >= 0, finite cycles and fade_s >= 0 are needed";
+  }
+  for (const auto& b : o.blockages)
+    if (b.antenna < 0 || !(b.start_s >= 0.0) || !(b.duration_s > 0.0))
+      return "blockage: antenna >= 0, start_s >= 0 and duration_s > 0 are needed";
   return {};
 }
 
@@ -253,6 +304,14 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
     : options_(std::move(options)), motion_(std::move(motion)) {
   if (const auto err = validate(options_); !err.empty()) throw std::invalid_argument(err);
   if (!motion_ || motion_->antenna_count() < 1) throw std::invalid_argument("the receiver needs at least one antenna");
+  const int antennas = motion_->antenna_count();
+  for (std::size_t a = static_cast<std::size_t>(antennas); a < options_.antenna_impairments.size(); ++a)
+    if (options_.antenna_impairments[a].line_bias_cycles != 0.0 || options_.antenna_impairments[a].phase_noise_m != 0.0)
+      throw std::invalid_argument("impairments for antenna " + std::to_string(a) + ": no such antenna");
+  for (const auto& e : options_.cycle_slips)
+    if (e.antenna >= antennas) throw std::invalid_argument("cycle slip on antenna " + std::to_string(e.antenna) + ": no such antenna");
+  for (const auto& b : options_.blockages)
+    if (b.antenna >= antennas) throw std::invalid_argument("blockage of antenna " + std::to_string(b.antenna) + ": no such antenna");
   impl_ = std::make_unique<Impl>(options_, *motion_);
   Impl& m = *impl_;
   m.block_samples = std::max<std::int64_t>(1, std::llround(options_.sample_rate_hz * kNodeInterval_s));
@@ -282,6 +341,8 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
     m.noise.emplace_back(options_.seed, 1000 + static_cast<std::uint64_t>(a));
     for (std::size_t k = 0; k < m.sats.size(); ++k) {
       auto& tr = m.tracks[static_cast<std::size_t>(a) * m.sats.size() + k];
+      tr.rng.seed(options_.seed * 1000003ULL + 7919ULL * static_cast<std::uint64_t>(a) +
+                  static_cast<std::uint64_t>(m.sats[k].eph.prn));
       if (options_.nav_data)
         tr.lnav = std::make_unique<LnavTransmitter>(m.sats[k].eph, options_.klobuchar, options_.utc, ephemerides);
     }
@@ -324,8 +385,10 @@ void IfSynthesiser::generate(std::span<const std::span<std::complex<float>>> out
       } else {
         std::fill(dst, dst + seg, std::complex<float>(0.0f, 0.0f));
       }
+      const double tau = m.tau_of(next_sample_);
       for (std::size_t k = 0; k < m.sats.size(); ++k)
-        if (m.sats[k].active) m.add_satellite(k, static_cast<int>(a), next_sample_, dst, seg);
+        if (m.sats[k].active && !m.absent(m.sats[k].eph.prn, static_cast<int>(a), tau))
+          m.add_satellite(k, static_cast<int>(a), next_sample_, dst, seg);
     }
     done += seg;
     next_sample_ += static_cast<std::int64_t>(seg);

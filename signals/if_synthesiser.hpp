@@ -41,6 +41,35 @@
 
 namespace ultratrack::signals {
 
+// Carrier impairments of one antenna (SynthesiserOptions::antenna_impairments[a]; missing entries are zero).
+struct AntennaImpairment {
+  // Constant offset of the antenna's carrier phase, cycles, RINEX sense (a longer cable reads more cycles).
+  double line_bias_cycles = 0.0;
+  // Extra carrier phase noise per satellite, 1 sigma, metres: a first-order Gauss-Markov process with
+  // SynthesiserOptions::phase_noise_correlation_s, drawn at the 1 ms nodes (multipath/cable-like, on top of the
+  // thermal noise the C/N0 gives).
+  double phase_noise_m = 0.0;
+};
+
+// A phase step of `cycles` (RINEX sense) on one satellite's signal at one antenna from time_s on (receiver
+// time since sample 0), with that signal absent for fade_s from time_s (a short fade, the usual cause of a
+// slip). A whole number of cycles changes nothing a receiver can see once the signal is back: only the
+// fade and the fractional part are observable; the receiver must flag the break in continuity.
+struct CycleSlipEvent {
+  int antenna = 0;
+  int prn = 1;
+  double time_s = 0.0;
+  double cycles = 0.0;
+  double fade_s = 0.1;
+};
+
+// Every satellite's signal absent at one antenna (noise only) for [start_s, start_s + duration_s).
+struct BlockageEvent {
+  int antenna = 0;
+  double start_s = 0.0;
+  double duration_s = 0.0;
+};
+
 struct SynthesiserOptions {
   double sample_rate_hz = 4e6;      // > 0
   double if_hz = 0.0;               // output centre offset; |if_hz| < fs/2 (real output: 0 < if_hz < fs/2)
@@ -59,6 +88,11 @@ struct SynthesiserOptions {
   bool noise = true;     // add the receiver noise (false: signals only, same gain)
   ReceiverClockModel clock;
   std::uint64_t seed = 1;  // every random number comes from it
+  // Multi-antenna impairments. Event times are resolved to the 1 ms synthesis blocks.
+  std::vector<AntennaImpairment> antenna_impairments;  // index = antenna
+  double phase_noise_correlation_s = 0.1;              // > 0
+  std::vector<CycleSlipEvent> cycle_slips;
+  std::vector<BlockageEvent> blockages;
 };
 
 // Empty when the options are usable; otherwise what is wrong (the caller names the file).

@@ -15,5 +15,6 @@ void add_receive_command(CLI::App& app);
 void add_ins_command(CLI::App& app);
 void add_imusim_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
+void add_attitude_command(CLI::App& app);
 
 }  // namespace ultratrack::tools

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_ins_command(app);
   ultratrack::tools::add_imusim_command(app);
   ultratrack::tools::add_compare_command(app);
+  ultratrack::tools::add_attitude_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -110,13 +111,27 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
       if (!arr || arr->empty() || !arr->is_array_of_tables())
         r.fail(section_node, section, "expected [[antenna]] tables with lever_arm_body_m = [x, y, z]");
       s.lever_arms_body_m.clear();
+      s.antenna_impairments.clear();
       for (const auto& e : *arr) {
         const auto& t = *e.as_table();
         const toml::node* lever = nullptr;
+        signals::AntennaImpairment imp;
         for (auto&& [k, n] : t) {
-          if (k.str() != "lever_arm_body_m") r.fail(n, "antenna." + std::string(k.str()), "unknown key in [[antenna]]");
-          lever = &n;
+          const std::string key(k.str());
+          if (key == "line_bias_cycles") {
+            imp.line_bias_cycles = r.number(n, "antenna.line_bias_cycles");
+            check_range(r, n, "antenna.line_bias_cycles", std::abs(imp.line_bias_cycles) <= 1e6, "must be within +-1e6");
+          } else if (key == "phase_noise_m") {
+            imp.phase_noise_m = r.number(n, "antenna.phase_noise_m");
+            check_range(r, n, "antenna.phase_noise_m", imp.phase_noise_m >= 0 && imp.phase_noise_m < 1,
+                        "must be within [0, 1) m");
+          } else if (key == "lever_arm_body_m") {
+            lever = &n;
+          } else {
+            r.fail(n, "antenna." + key, "unknown key in [[antenna]]");
+          }
         }
+        s.antenna_impairments.push_back(imp);
         if (!lever) r.fail(e, "antenna.lever_arm_body_m", "missing in an [[antenna]] table");
         const auto l = r.triple(*lever, "antenna.lever_arm_body_m");
         check_range(r, *lever, "antenna.lever_arm_body_m",
@@ -125,6 +140,60 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
         s.lever_arms_body_m.push_back(l);
       }
       antennas_given = true;
+      continue;
+    }
+    if (section == "cycle_slip" || section == "blockage") {
+      const auto* arr = section_node.as_array();
+      if (!arr || arr->empty() || !arr->is_array_of_tables()) r.fail(section_node, section, "expected [[" + section + "]] tables");
+      for (const auto& e : *arr) {
+        std::map<std::string, const toml::node*> keys;
+        for (auto&& [k, n] : *e.as_table()) keys[std::string(k.str())] = &n;
+        const std::vector<std::string> allowed = section == "cycle_slip"
+                                                     ? std::vector<std::string>{"antenna", "prn", "time_s", "cycles", "fade_s"}
+                                                     : std::vector<std::string>{"antenna", "start_s", "duration_s"};
+        for (const auto& [k, n] : keys)
+          if (!in_list(allowed, k)) r.fail(*n, section + "." + k, "unknown key in [[" + section + "]]");
+        auto get = [&](const std::string& k, bool required) -> const toml::node* {
+          auto it = keys.find(k);
+          if (it == keys.end()) {
+            if (required) r.fail(e, section + "." + k, "missing in a [[" + section + "]] table");
+            return nullptr;
+          }
+          return it->second;
+        };
+        const toml::node* ant = get("antenna", true);
+        const auto antenna = r.integer(*ant, section + ".antenna");
+        check_range(r, *ant, section + ".antenna", antenna >= 0 && antenna < 4, "must be 0..3");
+        if (section == "cycle_slip") {
+          signals::CycleSlipEvent ev;
+          ev.antenna = static_cast<int>(antenna);
+          const toml::node* p = get("prn", true);
+          const auto prn = r.integer(*p, "cycle_slip.prn");
+          check_range(r, *p, "cycle_slip.prn", prn >= 1 && prn <= 32, "PRN must be 1..32");
+          ev.prn = static_cast<int>(prn);
+          const toml::node* t = get("time_s", true);
+          ev.time_s = r.number(*t, "cycle_slip.time_s");
+          check_range(r, *t, "cycle_slip.time_s", ev.time_s >= 0, "must be >= 0");
+          const toml::node* c = get("cycles", true);
+          ev.cycles = r.number(*c, "cycle_slip.cycles");
+          check_range(r, *c, "cycle_slip.cycles", std::abs(ev.cycles) <= 1e6, "must be within +-1e6");
+          if (const toml::node* f = get("fade_s", false)) {
+            ev.fade_s = r.number(*f, "cycle_slip.fade_s");
+            check_range(r, *f, "cycle_slip.fade_s", ev.fade_s >= 0 && ev.fade_s <= 60, "must be within 0..60 s");
+          }
+          s.cycle_slips.push_back(ev);
+        } else {
+          signals::BlockageEvent ev;
+          ev.antenna = static_cast<int>(antenna);
+          const toml::node* t = get("start_s", true);
+          ev.start_s = r.number(*t, "blockage.start_s");
+          check_range(r, *t, "blockage.start_s", ev.start_s >= 0, "must be >= 0");
+          const toml::node* d = get("duration_s", true);
+          ev.duration_s = r.number(*d, "blockage.duration_s");
+          check_range(r, *d, "blockage.duration_s", ev.duration_s > 0 && ev.duration_s <= 86400, "must be within (0, 86400] s");
+          s.blockages.push_back(ev);
+        }
+      }
       continue;
     }
     const auto* tbl = section_node.as_table();
@@ -327,7 +396,7 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
       } else {
         r.fail(section_node, section,
                "unknown section (signal, time, navigation, receiver, atmosphere, output, trajectory, imu, "
-               "[[antenna]])");
+               "[[antenna]], [[cycle_slip]], [[blockage]])");
       }
     }
   }
@@ -353,6 +422,15 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
     if (attitude_given) fail_file("key receiver.attitude_deg: needs [trajectory] profile = \"static\"");
   }
   s.signal = signal_given || !trajectory_given;
+  const std::size_t n_antennas = s.trajectory_enabled() ? s.lever_arms_body_m.size() : s.antenna_offsets_enu_m.size();
+  if ((!s.cycle_slips.empty() || !s.blockages.empty()) && !s.signal)
+    fail_file("[[cycle_slip]] and [[blockage]] need a [signal] section");
+  for (const auto& e : s.cycle_slips)
+    if (static_cast<std::size_t>(e.antenna) >= n_antennas)
+      fail_file(fmt::format("key cycle_slip.antenna: antenna {} does not exist ({} antennas)", e.antenna, n_antennas));
+  for (const auto& b : s.blockages)
+    if (static_cast<std::size_t>(b.antenna) >= n_antennas)
+      fail_file(fmt::format("key blockage.antenna: antenna {} does not exist ({} antennas)", b.antenna, n_antennas));
   // Cross-key checks that need the whole scenario.
   const bool real = !signals::is_complex(s.format);
   if (real && !(s.if_hz > 0))
@@ -456,11 +534,23 @@ std::string to_toml(const Scenario& s) {
         {"accel_vrw_mpspsh", &s.accel_vrw_mpspsh}};
     for (const auto& [key, value] : overrides)
       if (value->has_value()) out += fmt::format("{} = {}\n", key, toml_float(**value));
-    for (const auto& l : s.lever_arms_body_m) {
+    for (std::size_t i = 0; i < s.lever_arms_body_m.size(); ++i) {
+      const auto& l = s.lever_arms_body_m[i];
       out += fmt::format("\n[[antenna]]\nlever_arm_body_m = [{}, {}, {}]\n", toml_float(l[0]), toml_float(l[1]),
                          toml_float(l[2]));
+      // Written only when set, so that the echo of a scenario without them stays as it was.
+      if (i < s.antenna_impairments.size() &&
+          (s.antenna_impairments[i].line_bias_cycles != 0.0 || s.antenna_impairments[i].phase_noise_m != 0.0))
+        out += fmt::format("line_bias_cycles = {}\nphase_noise_m = {}\n", toml_float(s.antenna_impairments[i].line_bias_cycles),
+                           toml_float(s.antenna_impairments[i].phase_noise_m));
     }
   }
+  for (const auto& e : s.cycle_slips)
+    out += fmt::format("\n[[cycle_slip]]\nantenna = {}\nprn = {}\ntime_s = {}\ncycles = {}\nfade_s = {}\n", e.antenna,
+                       e.prn, toml_float(e.time_s), toml_float(e.cycles), toml_float(e.fade_s));
+  for (const auto& b : s.blockages)
+    out += fmt::format("\n[[blockage]]\nantenna = {}\nstart_s = {}\nduration_s = {}\n", b.antenna, toml_float(b.start_s),
+                       toml_float(b.duration_s));
   return out;
 }
 

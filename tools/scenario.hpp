@@ -30,6 +30,12 @@
 //   [[antenna]]   lever_arm_body_m = [x, y, z]   one table per antenna, body axes (x forward, y right,
 //                 z down) from the IMU; the first is the master (antenna0); default one antenna at the IMU
 //   [receiver]    attitude_deg = [roll, pitch, yaw]   with profile = "static": the parked body's attitude
+//                 line_bias_cycles = 0.0  phase_noise_m = 0.0   (optional, per antenna: carrier line bias, RINEX
+//                 sense, and extra carrier phase noise, 1 sigma; signals/if_synthesiser.hpp AntennaImpairment)
+//   [[cycle_slip]] antenna = 1  prn = 5  time_s = 20.0  cycles = 3.0  fade_s = 0.1   (receiver time since the
+//                 first sample; the signal fades for fade_s, then comes back stepped by `cycles`)
+//   [[blockage]]  antenna = 2  start_s = 40.0  duration_s = 5.0   (every satellite absent at that antenna)
+//                 Both need [signal]; `simulate` writes them to antenna_events.csv (the detection truth).
 // With [trajectory], [receiver] takes neither trajectory nor antenna_offsets_enu_m, and [signal] is optional:
 // without it only the IMU and truth files are written. [[antenna]] and attitude_deg need [trajectory].
 #pragma once
@@ -43,6 +49,7 @@
 #include <string_view>
 #include <vector>
 
+#include "signals/if_synthesiser.hpp"
 #include "signals/sample_format.hpp"
 
 namespace ultratrack::tools {
@@ -109,6 +116,11 @@ struct Scenario {
   // [[antenna]] and [receiver] attitude_deg (inertial scenarios)
   std::vector<std::array<double, 3>> lever_arms_body_m = {{0.0, 0.0, 0.0}};
   std::array<double, 3> attitude_deg = {0.0, 0.0, 0.0};
+  // [[antenna]] line_bias_cycles / phase_noise_m (one entry per [[antenna]] table when given), [[cycle_slip]],
+  // [[blockage]]
+  std::vector<signals::AntennaImpairment> antenna_impairments;
+  std::vector<signals::CycleSlipEvent> cycle_slips;
+  std::vector<signals::BlockageEvent> blockages;
 
   bool trajectory_enabled() const { return !trajectory_profile.empty() || !trajectory_file.empty(); }
 };

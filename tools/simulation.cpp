@@ -200,6 +200,9 @@ signals::SynthesiserOptions synthesiser_options(const Scenario& s, const Navigat
   o.clock.bias_noise_s_per_sqrt_s = s.clock_bias_noise_m_per_sqrt_s / signals::kSpeedOfLight_mps;
   o.clock.drift_noise_sps_per_sqrt_s = s.clock_drift_noise_mps_per_sqrt_s / signals::kSpeedOfLight_mps;
   o.seed = s.seed;
+  o.antenna_impairments = s.antenna_impairments;
+  o.cycle_slips = s.cycle_slips;
+  o.blockages = s.blockages;
   if (const auto err = signals::validate(o); !err.empty()) throw InputError(s.source.string(), err);
   return o;
 }
@@ -405,6 +408,16 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
   if (inertial) io::write_file_atomically(out_dir / "antenna_truth.csv", antenna_truth);
   io::write_file_atomically(out_dir / "satellites.csv", sats);
   io::write_file_atomically(out_dir / "scenario.toml", to_toml(s));
+  if (!s.cycle_slips.empty() || !s.blockages.empty()) {
+    // The injected events as the receiver should detect them: prn 0 = every satellite; end_s = when the signal
+    // is back (receiver time since the first sample).
+    std::string events = "kind,antenna,prn,start_s,end_s,cycles\n";
+    for (const auto& e : s.cycle_slips)
+      events += fmt::format("slip,{},{},{},{},{}\n", e.antenna, e.prn, e.time_s, e.time_s + e.fade_s, e.cycles);
+    for (const auto& b : s.blockages)
+      events += fmt::format("blockage,{},0,{},{},0\n", b.antenna, b.start_s, b.start_s + b.duration_s);
+    io::write_file_atomically(out_dir / "antenna_events.csv", events);
+  }
 
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   std::string prns, files;

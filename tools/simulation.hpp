@@ -15,6 +15,8 @@
 // truth.csv, whose position and velocity are then the IMU's (body origin, not an antenna) and which gains
 // roll_deg,pitch_deg,yaw_deg (body to NED, z-y-x). antenna_truth.csv: t_s, antenna, ECEF position and
 // velocity of every antenna at the truth rows. DIR/odometer.csv when [trajectory] odometer = true.
+// antenna_events.csv (scenarios with [[cycle_slip]] or [[blockage]]): kind,antenna,prn,start_s,end_s,cycles, the
+// injected events (prn 0 = all satellites; end_s = when the signal is back), for detection tests.
 // Without [signal] there is no receiver: truth.csv's t_s is the GPS time since the start, its clock columns
 // the deterministic clock model (bias + drift t), and no sample, satellite or antenna file is written.
 #pragma once

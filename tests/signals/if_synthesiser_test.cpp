@@ -438,3 +438,97 @@ TEST(IfSynthesiser, RejectsInvalidOptions) {
 
 }  // namespace
 }  // namespace ultratrack::signals
+
+namespace ultratrack::signals {
+namespace {
+
+// Two antennas at one point, noise and data off, one satellite: antenna 1's signal divided by antenna 0's is
+// exp(-j 2 pi (line bias + slips + extra noise)) (RINEX sense: the synthesised phase falls as the path grows),
+// and zero while blocked or faded.
+struct ImpairedPair {
+  std::vector<std::complex<float>> a0, a1;
+  double fs = 0.5e6;
+  ImpairedPair(SynthesiserOptions o, double seconds) {
+    o.sample_rate_hz = fs;
+    o.noise = false;
+    o.nav_data = false;
+    o.output_rms = 1.0;
+    o.ionosphere = false;
+    o.troposphere = false;
+    const Eigen::Vector3d r0 = test_support::ecef_from_llh(35.274016, 137.013759, 100.0);
+    auto eph = test_support::walker_constellation(kStart);
+    SynthesiserOptions plain = o;
+    plain.antenna_impairments.clear();
+    plain.cycle_slips.clear();
+    plain.blockages.clear();
+    IfSynthesiser probe(plain, eph, static_receiver());
+    const int prn = probe.visible_satellites(0).front().prn;
+    for (auto& s : o.cycle_slips) s.prn = prn;
+    IfSynthesiser synth(o, {eph[prn - 1]}, std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r0, r0}));
+    const auto n = static_cast<std::size_t>(seconds * fs);
+    a0.resize(n);
+    a1.resize(n);
+    std::vector<std::span<std::complex<float>>> spans{a0, a1};
+    synth.generate(spans);
+  }
+  // Phase of antenna 1 against antenna 0 at sample i, cycles (RINEX sense), or NaN when antenna 1 is silent.
+  double phase(std::size_t i) const {
+    if (std::abs(a1[i]) < 1e-6f) return NAN;
+    return -std::arg(std::complex<double>(a1[i]) * std::conj(std::complex<double>(a0[i]))) / (2 * std::numbers::pi);
+  }
+};
+
+double wrap_cycles(double x) { return x - std::round(x); }
+
+TEST(IfSynthesiser, LineBiasSlipAndBlockageOnOneAntenna) {
+  auto o = base_options(0.5e6);
+  o.antenna_impairments = {{}, {0.3, 0.0}};
+  o.cycle_slips = {{1, 1, 0.0505, 2.25, 0.01}};  // prn set to the satellite by ImpairedPair
+  o.blockages = {{1, 0.0205, 0.009}};
+  const ImpairedPair p(o, 0.1);
+  const double fs = p.fs;
+  auto at = [&](double t) { return static_cast<std::size_t>(t * fs); };
+  for (double t = 0.001; t < 0.02; t += 0.0007) EXPECT_NEAR(wrap_cycles(p.phase(at(t)) - 0.3), 0.0, 3e-4) << t;
+  // 4096-entry carrier table: +-1.2e-4 cycles per antenna. Blockage [0.0205, 0.0295) resolved to 1 ms blocks: silent from 0.021 to 0.029, present again from 0.030.
+  for (double t = 0.0212; t < 0.0289; t += 0.0003) EXPECT_TRUE(std::isnan(p.phase(at(t)))) << t;
+  for (double t = 0.0302; t < 0.05; t += 0.0007) EXPECT_NEAR(wrap_cycles(p.phase(at(t)) - 0.3), 0.0, 3e-4) << t;
+  // The slip: faded for 10 ms, then stepped by 2.25 cycles (only the quarter cycle is visible).
+  for (double t = 0.0512; t < 0.0599; t += 0.0003) EXPECT_TRUE(std::isnan(p.phase(at(t)))) << t;
+  for (double t = 0.0612; t < 0.1; t += 0.0007) EXPECT_NEAR(wrap_cycles(p.phase(at(t)) - 0.55), 0.0, 3e-4) << t;
+  // Antenna 0 is untouched throughout.
+  for (double t = 0.0; t < 0.1; t += 0.0011) EXPECT_GT(std::abs(p.a0[at(t)]), 0.1f);
+}
+
+TEST(IfSynthesiser, ExtraPhaseNoiseHasTheConfiguredSigma) {
+  // 3 mm on antenna 1 only: its phase against antenna 0 scatters by 3 mm / 19 cm = 0.0158 cycles around the
+  // line bias. 20 s against a 0.1 s correlation time: ~100 independent values, so the sample sigma is within
+  // ~7 % (1 sigma); 25 % tolerance.
+  auto o = base_options(0.5e6);
+  o.antenna_impairments = {{}, {0.1, 0.003}};
+  const ImpairedPair p(o, 20.0);
+  double sum = 0.0, sum_sq = 0.0;
+  int n = 0;
+  for (std::size_t i = 250; i < p.a0.size(); i += 500) {  // every 1 ms, mid-node
+    const double d = wrap_cycles(p.phase(i) - 0.1);
+    sum += d;
+    sum_sq += d * d;
+    ++n;
+  }
+  const double mean = sum / n, sigma = std::sqrt(sum_sq / n - mean * mean);
+  const double expected = 0.003 / kL1Wavelength_m;
+  EXPECT_NEAR(sigma, expected, 0.25 * expected);
+  EXPECT_NEAR(mean, 0.0, 0.005);  // 3 sigma of the mean of ~100 independent values
+  std::printf("extra phase noise: sigma %.5f cycles (configured %.5f), mean %.5f\n", sigma, expected, mean);
+}
+
+TEST(IfSynthesiser, RejectsImpairmentsOfMissingAntennas) {
+  auto o = base_options(0.5e6);
+  o.blockages = {{1, 0.0, 1.0}};
+  auto eph = test_support::walker_constellation(kStart);
+  EXPECT_THROW(IfSynthesiser(o, eph, static_receiver()), std::invalid_argument);
+  o.blockages = {{0, 0.0, 0.0}};
+  EXPECT_FALSE(validate(o).empty());
+}
+
+}  // namespace
+}  // namespace ultratrack::signals

@@ -127,3 +127,63 @@ troposphere = true
 
 }  // namespace
 }  // namespace ultratrack::tools
+
+namespace ultratrack::tools {
+namespace {
+
+const char* kAttitudeScenario = R"(
+[signal]
+duration_s = 30.0
+[receiver]
+llh_deg_m = [35.0, 137.0, 100.0]
+attitude_deg = [2.0, -3.0, 35.0]
+[trajectory]
+profile = "static"
+duration_s = 30.0
+[[antenna]]
+lever_arm_body_m = [0.0, 0.0, 0.0]
+phase_noise_m = 0.003
+[[antenna]]
+lever_arm_body_m = [1.0, 0.0, 0.0]
+line_bias_cycles = 0.23
+[[cycle_slip]]
+antenna = 1
+prn = 15
+time_s = 20.0
+cycles = 3.0
+[[blockage]]
+antenna = 1
+start_s = 25.0
+duration_s = 5.0
+)";
+
+TEST(Scenario, AntennaImpairmentsSlipsAndBlockagesParseAndEcho) {
+  const Scenario s = parse_scenario(kAttitudeScenario, "/data/a.toml");
+  ASSERT_EQ(s.antenna_impairments.size(), 2u);
+  EXPECT_EQ(s.antenna_impairments[0].phase_noise_m, 0.003);
+  EXPECT_EQ(s.antenna_impairments[1].line_bias_cycles, 0.23);
+  ASSERT_EQ(s.cycle_slips.size(), 1u);
+  EXPECT_EQ(s.cycle_slips[0].prn, 15);
+  EXPECT_EQ(s.cycle_slips[0].cycles, 3.0);
+  EXPECT_EQ(s.cycle_slips[0].fade_s, 0.1);  // the default
+  ASSERT_EQ(s.blockages.size(), 1u);
+  EXPECT_EQ(s.blockages[0].duration_s, 5.0);
+  const Scenario back = parse_scenario(to_toml(s), "/data/a.toml");
+  ASSERT_EQ(back.cycle_slips.size(), 1u);
+  EXPECT_EQ(back.cycle_slips[0].time_s, 20.0);
+  EXPECT_EQ(back.blockages[0].start_s, 25.0);
+  EXPECT_EQ(back.antenna_impairments[1].line_bias_cycles, 0.23);
+}
+
+TEST(Scenario, EventsOnMissingAntennasOrWithUnknownKeysAreErrors) {
+  std::string text = kAttitudeScenario;
+  EXPECT_NE(error_of(text + "[[blockage]]\nantenna = 2\nstart_s = 1.0\nduration_s = 1.0\n").find("antenna 2 does not exist"),
+            std::string::npos);
+  EXPECT_NE(error_of(text + "[[cycle_slip]]\nantenna = 0\nprn = 3\ntime_s = 1.0\n").find("cycle_slip.cycles"),
+            std::string::npos);
+  EXPECT_NE(error_of(text + "[[blockage]]\nantenna = 0\nstart_s = 1.0\nduration_s = 1.0\nprn = 4\n").find("blockage.prn"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace ultratrack::tools
