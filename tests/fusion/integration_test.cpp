@@ -38,7 +38,7 @@ const char* name(Coupling c, FilterKind f) {
 // upper side for the time correlation of the samples of one run and for unmodelled gyro output noise).
 void check_accuracy_and_consistency(Coupling coupling, FilterKind filter) {
   const int runs = 4;
-  double sum_ins = 0, sum_gnss = 0, nees_sum = 0;
+  double sum_ins = 0, sum_gnss = 0, nees_sum = 0, nees9_sum = 0;
   std::size_t nees_n = 0;
   int n_state = 0;
   for (int r = 0; r < runs; ++r) {
@@ -50,14 +50,14 @@ void check_accuracy_and_consistency(Coupling coupling, FilterKind filter) {
     const std::size_t from = 60;
     sum_ins += std::pow(test::rms3(res.pos_err_m, from), 2);
     sum_gnss += std::pow(test::rms(res.gnss_err_3d_m, from), 2);
-    for (std::size_t i = from; i < res.nees.size(); ++i) nees_sum += res.nees[i], ++nees_n;
+    for (std::size_t i = from; i < res.nees.size(); ++i) nees_sum += res.nees[i], nees9_sum += res.nees_nav[i], ++nees_n;
     // Consistent measurements pass the 0.9999 gate: at most a rare one is refused.
     EXPECT_LE(res.rejected, 1 + res.accepted / 1000) << "rejected " << res.rejected << " of " << res.accepted;
   }
   const double ins_rms = std::sqrt(sum_ins / runs), gnss_rms = std::sqrt(sum_gnss / runs);
   const double nees = nees_sum / nees_n;
-  std::printf("%s: 3-D position RMS %.2f m (GNSS-only %.2f m), mean NEES %.2f (%d states)\n",
-              name(coupling, filter), ins_rms, gnss_rms, nees, n_state);
+  std::printf("%s: 3-D position RMS %.2f m (GNSS-only %.2f m), mean NEES %.2f (%d states), %.2f (9 nav states)\n",
+              name(coupling, filter), ins_rms, gnss_rms, nees, n_state, nees9_sum / nees_n);
   EXPECT_LT(ins_rms, gnss_rms);
   EXPECT_GT(nees, 0.5 * n_state);
   EXPECT_LT(nees, 2.0 * n_state);
