@@ -23,6 +23,19 @@ struct PendingEpoch {
 };
 using Pending = std::variant<PendingFix, PendingEpoch>;
 
+bool finite(const Pending& p) {
+  if (const auto* f = std::get_if<PendingFix>(&p)) {
+    const GnssFix& x = f->fix;
+    const bool pos_ok = !x.has_position || (std::isfinite(x.lat_rad) && std::isfinite(x.lon_rad) &&
+                                            std::isfinite(x.height_m) && (x.sigma_pos_ned_m.array() > 0.0).all() &&
+                                            x.sigma_pos_ned_m.allFinite());
+    const bool vel_ok = !x.has_velocity || (x.v_n_mps.allFinite() && (x.sigma_vel_n_mps.array() > 0.0).all() &&
+                                            x.sigma_vel_n_mps.allFinite());
+    return pos_ok && vel_ok;
+  }
+  return true;  // observation epochs: prepare_satellites skips non-finite pseudoranges
+}
+
 void check_options(const IntegrationOptions& o) {
   auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
   if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
@@ -65,6 +78,10 @@ class Core final : public CoreBase {
   }
 
   void add_pending(double t_s, Pending p) override {
+    if (!std::isfinite(t_s) || !finite(p)) {
+      ++counters.invalid;
+      return;
+    }
     if (t_s < nominal_.nav.t_s - kTimeEpsilon_s) {
       ++counters.late;
       return;
@@ -79,7 +96,10 @@ class Core final : public CoreBase {
 
   void add_imu(const ins::ImuIncrement& inc) override {
     double t = nominal_.nav.t_s;
-    if (!(inc.t_s > t)) return;
+    if (!(inc.t_s > t) || !std::isfinite(inc.t_s) || !inc.dtheta_b.allFinite() || !inc.dv_b.allFinite()) {
+      ++counters.invalid;
+      return;
+    }
     ++counters.imu_steps;
     Eigen::Vector3d dth = inc.dtheta_b, dv = inc.dv_b;  // raw, still to be applied over (t, inc.t_s]
     while (!pending_.empty() && pending_.begin()->first <= inc.t_s + kTimeEpsilon_s) {

@@ -76,6 +76,7 @@ struct IntegrationCounters {
   long long rejected = 0;           // refused by the gate
   long long late = 0;               // GNSS data older than the INS time when it came (dropped)
   long long satellites_missing_ephemeris = 0;
+  long long invalid = 0;            // ignored: non-finite IMU increments or fixes, IMU times not increasing
 };
 
 // Per-update diagnostics (for NIS / consistency logs).
@@ -102,7 +103,8 @@ class GnssInsIntegration {
                         const signals::KlobucharParameters& iono = {});
 
   // One raw IMU increment covering (output().nav.t_s, inc.t_s]. Pending GNSS data with times inside the
-  // interval are applied at their exact times. Increments not later than the current time are ignored.
+  // interval are applied at their exact times. Increments not later than the current time, or with non-finite
+  // values, are ignored and counted (counters().invalid).
   void add_imu(const ins::ImuIncrement& inc);
 
   const IntegrationOutput& output() const;

@@ -220,6 +220,21 @@ TEST(Integration, RejectsWrongInputKind) {
   IntegrationOptions opt;
   GnssInsIntegration loose(ins::NavState{}, opt);
   EXPECT_THROW(loose.add_observations({}, {}), std::logic_error);
+  // Non-finite or out-of-order data are ignored and counted, never propagated into the solution.
+  ins::ImuIncrement bad;
+  bad.t_s = 0.01;
+  bad.dv_b.x() = std::nan("");
+  loose.add_imu(bad);
+  GnssFix nan_fix;
+  nan_fix.t_s = 0.5;
+  nan_fix.lat_rad = std::nan("");
+  loose.add_fix(nan_fix);
+  ins::ImuIncrement past;
+  past.t_s = -1.0;
+  loose.add_imu(past);
+  EXPECT_EQ(loose.counters().invalid, 3);
+  EXPECT_TRUE(loose.output().nav.v_n.allFinite());
+  EXPECT_EQ(loose.output().nav.t_s, 0.0);
   opt.sigma_pos_ned_m.x() = 0.0;
   EXPECT_THROW(GnssInsIntegration(ins::NavState{}, opt), std::invalid_argument);
 }
