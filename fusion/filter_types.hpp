@@ -1,0 +1,71 @@
+// Shared vocabulary of the generic filters (ekf.hpp, ukf.hpp): fixed-size state vectors and covariances,
+// the process and measurement model concepts both filters accept, innovation gating and update results.
+// Units are whatever the model uses; covariances are of the state's own units.
+#pragma once
+
+#include <Eigen/Core>
+#include <concepts>
+
+namespace ultratrack::fusion {
+
+template <int N>
+using StateVector = Eigen::Matrix<double, N, 1>;
+template <int N>
+using StateMatrix = Eigen::Matrix<double, N, N>;
+// Measurement-side quantities vary in size per epoch (k satellites): dynamic rows, fixed state columns.
+template <int N>
+using MeasurementJacobian = Eigen::Matrix<double, Eigen::Dynamic, N>;
+
+// A process model over one propagation interval dt:
+//   f(x, dt): the state after dt starting from x, without noise (may be nonlinear);
+//   F(x):     the continuous-time Jacobian d(xdot)/dx at x (the EKF discretises it to Phi; both filters use it
+//             with G and Qc for the discrete process noise Qd);
+//   G(x):     noise input matrix N x kNoiseSize (xdot = ... + G w);
+//   Qc():     power spectral density of the continuous white noise w (kNoiseSize x kNoiseSize, units^2 / Hz).
+// For a linear model f(x, dt) must equal Phi(dt) x with Phi the discretisation of F (the INS error models do).
+template <class M, int N>
+concept ProcessModel = requires(const M& m, const StateVector<N>& x, double dt) {
+  { M::kNoiseSize } -> std::convertible_to<int>;
+  { m.f(x, dt) } -> std::convertible_to<StateVector<N>>;
+  { m.F(x) } -> std::convertible_to<StateMatrix<N>>;
+  { m.G(x) } -> std::convertible_to<Eigen::Matrix<double, N, M::kNoiseSize>>;
+  { m.Qc() } -> std::convertible_to<Eigen::Matrix<double, M::kNoiseSize, M::kNoiseSize>>;
+};
+
+// One measurement (of any size k >= 1, fixed for the object's life):
+//   z():   the measured vector (k);
+//   h(x):  the predicted measurement for state x (the full nonlinear function: the UKF evaluates it at the
+//          sigma points, the EKF at the estimate);
+//   H(x):  the Jacobian dh/dx at x (k x N; used by the EKF only, tested against numerical differentiation);
+//   R():   the measurement noise covariance (k x k).
+template <class M, int N>
+concept MeasurementModel = requires(const M& m, const StateVector<N>& x) {
+  { m.z() } -> std::convertible_to<Eigen::VectorXd>;
+  { m.h(x) } -> std::convertible_to<Eigen::VectorXd>;
+  { m.H(x) } -> std::convertible_to<MeasurementJacobian<N>>;
+  { m.R() } -> std::convertible_to<Eigen::MatrixXd>;
+};
+
+// Innovation chi-square gate: a measurement is rejected (no state change) when its normalised innovation
+// squared nu' S^-1 nu exceeds the chi-square quantile with k degrees of freedom at `probability` (the
+// probability that a measurement consistent with the model passes).
+struct GateOptions {
+  bool enabled = true;
+  double probability = 0.9999;
+};
+
+struct UpdateResult {
+  bool accepted = false;
+  double nis = 0.0;        // normalised innovation squared
+  double threshold = 0.0;  // gate threshold used (infinity when gating is off)
+  int dof = 0;             // measurement size k
+  Eigen::VectorXd innovation;  // z - predicted (EKF: h(x); UKF: weighted mean of h at the sigma points)
+};
+
+struct FilterCounters {
+  long long predictions = 0;
+  long long accepted = 0;  // measurement updates applied
+  long long rejected = 0;  // measurement updates refused by the gate (or numerically unusable: S not positive)
+};
+
+}  // namespace ultratrack::fusion

@@ -1,0 +1,122 @@
+// Closed-loop GNSS/INS integration driver (seed 003 feedback filter; seed 001 17-state tight model).
+// Feed IMU increments and GNSS data in time order at any rates and times: the INS (ins::Strapdown, raw IMU
+// samples compensated by the estimated biases) runs through every IMU interval; a GNSS measurement at time t
+// inside an interval splits that interval at t (increments shared in proportion to time), so it is applied at
+// its exact time, never at the nearest IMU sample. After each update the estimated errors are fed back
+// (position, velocity, attitude via ins/nav_correction; biases into the IMU compensation; clock) and the error
+// state reset to zero. Fallback: whatever part of an epoch is present is used (position without velocity,
+// pseudoranges without Doppler, fewer than four satellites in tight mode); nothing present = pure INS.
+// Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides. EKF or UKF.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "fusion/ekf.hpp"
+#include "fusion/ins_error_model.hpp"
+#include "fusion/ins_error_state.hpp"
+#include "fusion/loose_measurements.hpp"
+#include "fusion/tight_measurements.hpp"
+#include "fusion/ukf.hpp"
+#include "ins/nav_state.hpp"
+#include "ins/strapdown.hpp"
+#include "receiver/observables.hpp"
+#include "signals/ephemeris.hpp"
+#include "signals/gps_time.hpp"
+
+namespace ultratrack::fusion {
+
+enum class Coupling { Loose, Tight };
+enum class FilterKind { Ekf, Ukf };
+
+struct IntegrationOptions {
+  Coupling coupling = Coupling::Loose;
+  FilterKind filter = FilterKind::Ekf;
+  InsErrorModelOptions model;                    // error_model_from_preset(...) is a good start
+  Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // IMU -> antenna, body axes [m]
+  // Initial 1-sigma of the nav errors (biases and clock: from `model`).
+  Eigen::Vector3d sigma_pos_ned_m = Eigen::Vector3d::Constant(10.0);
+  Eigen::Vector3d sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
+  Eigen::Vector3d sigma_att_rad = Eigen::Vector3d::Constant(0.01);
+  GateOptions gate;
+  UkfParameters ukf;
+  Discretisation discretisation = Discretisation::SecondOrderSeries;
+  // The error covariance is propagated over intervals of about this length (F at the interval's end,
+  // specific force averaged over it), and always up to each measurement time. 0: every IMU interval.
+  double propagation_interval_s = 0.05;
+  ins::StrapdownOptions strapdown;
+  TightOptions tight;
+  // Tight mode: GPS time at t_s = 0 of the run's time line. A receive time T (receiver clock) is applied at
+  // t = (T - gps_time_origin) - clock_bias / c.
+  signals::GpsTime gps_time_origin;
+  // Tight mode: initial receiver clock (c * offset, c * drift) for the nominal.
+  double initial_clock_bias_m = 0.0;
+  double initial_clock_drift_mps = 0.0;
+};
+
+// The solution after each IMU interval (and after each measurement update).
+struct IntegrationOutput {
+  ins::NavState nav;  // IMU position/velocity/attitude at nav.t_s
+  Eigen::Vector3d sigma_pos_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_vel_n_mps = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_att_rad = Eigen::Vector3d::Zero();  // psi north, east, down
+  Eigen::Vector3d accel_bias_b = Eigen::Vector3d::Zero();   // current estimates (m/s^2, rad/s)
+  Eigen::Vector3d gyro_bias_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_accel_bias_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_gyro_bias_b = Eigen::Vector3d::Zero();
+  double clock_bias_m = 0.0, clock_drift_mps = 0.0;  // tight mode (else 0)
+  double sigma_clock_bias_m = 0.0, sigma_clock_drift_mps = 0.0;
+};
+
+struct IntegrationCounters {
+  long long imu_steps = 0;
+  long long epochs = 0;             // GNSS fixes / observation epochs applied
+  long long accepted = 0;           // measurement updates (a satellite, or a fix) passed by the gate
+  long long rejected = 0;           // refused by the gate
+  long long late = 0;               // GNSS data older than the INS time when it came (dropped)
+  long long satellites_missing_ephemeris = 0;
+};
+
+// Per-update diagnostics (for NIS / consistency logs).
+struct UpdateRecord {
+  double t_s = 0.0;
+  int prn = 0;  // tight: satellite; loose: 0
+  UpdateResult result;
+};
+
+class GnssInsIntegration {
+ public:
+  // initial: the INS state at its time (alignment is the caller's: ins/coarse_alignment or a config).
+  // Throws std::invalid_argument for inconsistent options (non-positive sigmas, bad UKF parameters).
+  GnssInsIntegration(const ins::NavState& initial, const IntegrationOptions& options);
+  ~GnssInsIntegration();
+  GnssInsIntegration(GnssInsIntegration&&) noexcept;
+  GnssInsIntegration& operator=(GnssInsIntegration&&) noexcept;
+
+  // Queue GNSS data; applied when the IMU reaches its time (or at once if the INS is exactly there).
+  // Loose mode only. Throws std::logic_error in tight mode.
+  void add_fix(const GnssFix& fix);
+  // Tight mode only: an epoch with the ephemeris sets to choose from (select_ephemeris per satellite).
+  void add_observations(const receiver::ObservationEpoch& epoch, const std::vector<signals::Ephemeris>& ephemerides,
+                        const signals::KlobucharParameters& iono = {});
+
+  // One raw IMU increment covering (output().nav.t_s, inc.t_s]. Pending GNSS data with times inside the
+  // interval are applied at their exact times. Increments not later than the current time are ignored.
+  void add_imu(const ins::ImuIncrement& inc);
+
+  const IntegrationOutput& output() const;
+  // Current nominal (nav + bias estimates + clock) and the error covariance (15 x 15 or 17 x 17).
+  NominalState nominal() const;
+  Eigen::MatrixXd covariance() const;
+  const IntegrationCounters& counters() const;
+  // Updates since the last call (cleared by the call).
+  std::vector<UpdateRecord> take_update_records();
+  const IntegrationOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ultratrack::fusion
