@@ -14,5 +14,7 @@ void add_acquire_command(CLI::App& app);
 void add_receive_command(CLI::App& app);
 void add_ins_command(CLI::App& app);
 void add_imusim_command(CLI::App& app);
+void add_fuse_command(CLI::App& app);
+void add_covariance_command(CLI::App& app);
 
 }  // namespace ultratrack::tools

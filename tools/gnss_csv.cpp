@@ -42,11 +42,11 @@ bool parse_field(const std::string& file, int line, int column, std::string_view
 
 }  // namespace
 
-std::vector<GnssFix> read_gnss_csv(const std::filesystem::path& file) {
+std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::ifstream in(file);
   if (!in) throw io::InputError(name, "cannot open GNSS file");
-  std::vector<GnssFix> fixes;
+  std::vector<GnssCsvRow> fixes;
   std::string text;
   int line = 0;
   bool have_header = false;
@@ -86,7 +86,7 @@ std::vector<GnssFix> read_gnss_csv(const std::filesystem::path& file) {
     if (!fixes.empty() && !(v[0] > fixes.back().t_s))
       throw io::InputError(name, fmt::format("time does not increase (t_s {} after {})", v[0], fixes.back().t_s),
                            line);
-    GnssFix f;
+    GnssCsvRow f;
     f.t_s = v[0];
     f.lat_rad = v[1] * kDeg;
     f.lon_rad = v[2] * kDeg;
@@ -101,7 +101,7 @@ std::vector<GnssFix> read_gnss_csv(const std::filesystem::path& file) {
   return fixes;
 }
 
-void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssFix> fixes) {
+void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssCsvRow> fixes) {
   io::AtomicFile out(file);
   std::string h;
   for (const auto& c : gnss_header()) h += (h.empty() ? "" : ",") + c;

@@ -12,7 +12,7 @@
 
 namespace ultratrack::tools {
 
-struct GnssFix {
+struct GnssCsvRow {
   double t_s = 0.0;
   double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
   bool has_velocity = false;
@@ -20,9 +20,9 @@ struct GnssFix {
   Eigen::Vector3d sigma_ned_m = Eigen::Vector3d::Ones();  // 1-sigma north, east, down position error
 };
 
-std::vector<GnssFix> read_gnss_csv(const std::filesystem::path& file);
+std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file);
 
 // Writes fixes with round-trip precision (empty velocity fields where has_velocity is false), atomically.
-void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssFix> fixes);
+void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssCsvRow> fixes);
 
 }  // namespace ultratrack::tools

@@ -11,7 +11,7 @@
 
 namespace ultratrack::tools {
 
-std::vector<GnssFix> simulate_gnss_fixes(const ins::TruthInterpolator& truth, const GnssFixSimulationOptions& o) {
+std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth, const GnssFixSimulationOptions& o) {
   if (!(o.rate_hz > 0.0 && o.rate_hz <= 100.0)) throw io::InputError("GNSS simulation", "rate must be in (0, 100] Hz");
   if (!(o.sigma_ned_m.minCoeff() > 0.0)) throw io::InputError("GNSS simulation", "position sigmas must be positive");
   std::mt19937_64 rng(o.seed);
@@ -20,7 +20,7 @@ std::vector<GnssFix> simulate_gnss_fixes(const ins::TruthInterpolator& truth, co
   const double dt = 1.0 / o.rate_hz;
   double t = o.first_time_s;
   while (t < truth.start_s()) t += dt;
-  std::vector<GnssFix> fixes;
+  std::vector<GnssCsvRow> fixes;
   Eigen::Vector3d err = o.sigma_ned_m.cwiseProduct(gauss3());  // stationary start
   const double phi = o.correlation_time_s > 0.0 ? std::exp(-dt / o.correlation_time_s) : 0.0;
   const double drive = std::sqrt(1.0 - phi * phi);
@@ -33,7 +33,7 @@ std::vector<GnssFix> simulate_gnss_fixes(const ins::TruthInterpolator& truth, co
     GeographicLib::Geocentric::WGS84().Reverse(m.r_e.x(), m.r_e.y(), m.r_e.z(), lat_deg, lon_deg, h);
     const double lat = lat_deg * std::numbers::pi / 180.0, lon = lon_deg * std::numbers::pi / 180.0;
     const ins::Radii r = ins::radii_of_curvature(lat);
-    GnssFix f;
+    GnssCsvRow f;
     f.t_s = t;
     f.lat_rad = lat + err.x() / (r.meridian_m + h);
     f.lon_rad = lon + err.y() / ((r.transverse_m + h) * std::cos(lat));

@@ -25,7 +25,7 @@ struct GnssFixSimulationOptions {
   std::uint64_t seed = 1;
 };
 
-std::vector<GnssFix> simulate_gnss_fixes(const ins::TruthInterpolator& truth, const GnssFixSimulationOptions& o);
+std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth, const GnssFixSimulationOptions& o);
 
 // TruthSamples from navigation rows (no body rate: the lever arm's rotational velocity is then ignored).
 std::vector<ins::TruthSample> truth_samples_from_nav(const std::vector<ins::NavState>& nav);

@@ -16,7 +16,7 @@
 
 namespace fs = std::filesystem;
 using ultratrack::io::InputError;
-using ultratrack::tools::GnssFix;
+using ultratrack::tools::GnssCsvRow;
 
 namespace {
 
@@ -45,7 +45,7 @@ void expect_error_at(const std::string& body, int line, const std::string& words
 }  // namespace
 
 TEST(FuseGnssCsv, RoundTripIsExactWithAndWithoutVelocity) {
-  std::vector<GnssFix> in(3);
+  std::vector<GnssCsvRow> in(3);
   for (int k = 0; k < 3; ++k) {
     in[k].t_s = 0.137 + 0.2 * k;
     in[k].lat_rad = (36.1234567891 + 1e-7 * k) * kDeg;
