@@ -16,5 +16,6 @@ void add_ins_command(CLI::App& app);
 void add_imusim_command(CLI::App& app);
 void add_fuse_command(CLI::App& app);
 void add_covariance_command(CLI::App& app);
+void add_gnsssim_command(CLI::App& app);
 
 }  // namespace ultratrack::tools
