@@ -67,14 +67,15 @@ CovarianceAnalysisResult run(Filter& filter, const CovarianceAnalysisOptions& o)
   const std::vector<signals::Ephemeris> ephemerides =
       o.ephemerides.empty() ? signals::nominal_constellation(o.start).ephemerides : o.ephemerides;
   CovarianceAnalysisResult result;
-  auto sample = [&](double t, int sats) {
+  auto sample = [&](double t, std::vector<Eigen::Vector3d> los) {
     CovarianceSample c;
     c.t_s = t;
     c.sigma_pos_ned_m = filter.P().diagonal().template head<3>().cwiseSqrt();
-    c.satellites = sats;
-    result.samples.push_back(c);
+    c.satellites = static_cast<int>(los.size());
+    c.los_ned = std::move(los);
+    result.samples.push_back(std::move(c));
   };
-  sample(0.0, 0);
+  sample(0.0, {});
   double next_update = o.update_interval_s;
   while (!gen.done()) {
     const ins::TruthSample before = gen.truth();
@@ -96,7 +97,10 @@ CovarianceAnalysisResult run(Filter& filter, const CovarianceAnalysisOptions& o)
     const EpochMeasurement17 m(nominal, sats, Eigen::Vector3d::Zero(), now.w_ib_b, o.use_range_rate);
     filter.update(m);
     filter.set_x(StateVector<17>::Zero());  // closed loop: the (zero) estimate is fed back
-    sample(now.t_s, static_cast<int>(sats.size()));
+    std::vector<Eigen::Vector3d> los;
+    const Eigen::Matrix3d C_ne = ins::C_en(now.lat_rad, now.lon_rad).transpose();
+    for (const auto& sat : sats) los.push_back(C_ne * (sat.r_sat_e - r_e).normalized());
+    sample(now.t_s, std::move(los));
   }
   return result;
 }

@@ -51,6 +51,7 @@ struct CovarianceSample {
   double t_s = 0.0;
   Eigen::Vector3d sigma_pos_ned_m = Eigen::Vector3d::Zero();
   int satellites = 0;
+  std::vector<Eigen::Vector3d> los_ned;  // unit vectors antenna -> satellite (NED) of the update, for checks
 };
 
 struct CovarianceAnalysisResult {
