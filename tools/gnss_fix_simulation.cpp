@@ -18,14 +18,14 @@ std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth,
   std::normal_distribution<double> normal(0.0, 1.0);
   auto gauss3 = [&] { return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)); };
   const double dt = 1.0 / o.rate_hz;
-  double t = o.first_time_s;
-  while (t < truth.start_s()) t += dt;
+  long long k = 0;
+  while (o.first_time_s + k * dt < truth.start_s()) ++k;
   std::vector<GnssCsvRow> fixes;
   Eigen::Vector3d err = o.sigma_ned_m.cwiseProduct(gauss3());  // stationary start
   const double phi = o.correlation_time_s > 0.0 ? std::exp(-dt / o.correlation_time_s) : 0.0;
   const double drive = std::sqrt(1.0 - phi * phi);
   bool first = true;
-  for (; t <= truth.end_s() + 1e-9; t += dt) {
+  for (double t = o.first_time_s + k * dt; t <= truth.end_s() + 1e-9; t = o.first_time_s + (++k) * dt) {
     if (!first) err = phi * err + drive * o.sigma_ned_m.cwiseProduct(gauss3());
     first = false;
     const ins::EcefMotion m = truth.antenna(t, o.lever_arm_b);

@@ -11,6 +11,11 @@
 
 #include "fused_nav_csv.hpp"
 #include "gnss_csv.hpp"
+#include "gnss_fix_simulation.hpp"
+#include "ins/earth_model.hpp"
+#include "ins/trajectory.hpp"
+#include "ins/trajectory_simulator.hpp"
+#include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
 #include "support/test_data.hpp"
 
@@ -127,4 +132,35 @@ TEST(FuseNavCsv, RoundTripKeepsStateAndSigmas) {
   EXPECT_EQ(rows[1].sigma.position_ned_m, g.position_ned_m);
   EXPECT_EQ(rows[1].sigma.velocity_ned_mps, g.velocity_ned_mps);
   EXPECT_TRUE(rows[1].sigma.attitude_ned_rad.isApprox(g.attitude_ned_rad, 1e-14));
+}
+
+// Simulated fixes: exact non-integer times, and errors with the requested white statistics (2000 fixes: the
+// sample standard deviation is within 5 sampling sigmas, sqrt(1 / (2 n)) ~ 1.6 %, of the setting).
+TEST(FuseGnssFixSimulation, TimesAndErrorStatistics) {
+  const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * kDeg, 127.0 * kDeg, 100.0);
+  const ultratrack::ins::TruthInterpolator truth(ultratrack::ins::simulate(spec, 20.0).truth);
+  ultratrack::tools::GnssFixSimulationOptions o;
+  o.rate_hz = 5.0;
+  o.first_time_s = 0.137;
+  o.sigma_ned_m = {2.0, 3.0, 4.0};
+  o.sigma_velocity_mps = 0.05;
+  o.seed = 9;
+  const auto fixes = ultratrack::tools::simulate_gnss_fixes(truth, o);
+  ASSERT_EQ(fixes.size(), 2005u);  // 0.137 ... 400.937
+  Eigen::Vector3d sum2 = Eigen::Vector3d::Zero();
+  double vel2 = 0.0;
+  for (std::size_t k = 0; k < fixes.size(); ++k) {
+    EXPECT_NEAR(fixes[k].t_s, 0.137 + 0.2 * static_cast<double>(k), 1e-12);
+    const auto m = truth.antenna(fixes[k].t_s, Eigen::Vector3d::Zero());
+    const Eigen::Vector3d d = ultratrack::ins::C_en(fixes[k].lat_rad, fixes[k].lon_rad).transpose() *
+                              (ultratrack::ins::ecef_from_geodetic(fixes[k].lat_rad, fixes[k].lon_rad,
+                                                                   fixes[k].height_m) - m.r_e);
+    sum2 += d.cwiseAbs2();
+    vel2 += (fixes[k].v_n - ultratrack::ins::C_en(fixes[k].lat_rad, fixes[k].lon_rad).transpose() * m.v_e)
+                .squaredNorm();
+  }
+  const double n = static_cast<double>(fixes.size());
+  const Eigen::Vector3d sd = (sum2 / n).cwiseSqrt();
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(sd[i] / o.sigma_ned_m[i], 1.0, 0.08) << i;
+  EXPECT_NEAR(std::sqrt(vel2 / (3.0 * n)) / 0.05, 1.0, 0.05);
 }
