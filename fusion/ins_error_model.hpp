@@ -12,6 +12,7 @@
 
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"
+#include "fusion/ins_error_state.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/nav_state.hpp"
 
@@ -48,8 +49,9 @@ struct InsErrorModelOptions {
 
 // Noise settings from an ins/ IMU error preset: turn-on bias sigma -> initial bias sigma; bias instability
 // (if any) -> Gauss-Markov with the preset's correlation time; random walks -> white-noise PSDs.
-// Scale factor, misalignment and quantisation are not states: they are folded into the white noise as
-// sf_sigma * typical_rate for a rough bound (typical_rate_rps for the gyro, g for the accelerometer).
+// Turn-on bias plus instability: random constant with the instability's short-term random walk 2 s^2/tau;
+// instability alone: Gauss-Markov. Scale factor and misalignment are not states: they are added to the
+// bias sigma as sf * typical input (typical_rate_rps for the gyro, g for the accelerometer).
 InsErrorModelOptions error_model_from_preset(const ins::ImuErrorSpec& spec, double typical_rate_rps = 0.1);
 
 // The linearisation point: nominal nav state and the compensated specific force and body rate there.
@@ -75,8 +77,8 @@ class InsErrorModel {
 
   // ProcessModel interface.
   StateVector<N> f(const StateVector<N>& x, double dt) const;
-  StateMatrix<N> F(const StateVector<N>& x) const { return F_; }
-  Eigen::Matrix<double, N, kNoiseSize> G(const StateVector<N>& x) const;
+  StateMatrix<N> F(const StateVector<N>& /*x*/) const { return F_; }
+  Eigen::Matrix<double, N, kNoiseSize> G(const StateVector<N>& /*x*/) const;
   Eigen::Matrix<double, kNoiseSize, kNoiseSize> Qc() const;
 
   // Initial covariance from the option's bias / clock sigmas and the given nav sigmas.
@@ -89,6 +91,8 @@ class InsErrorModel {
   InsErrorModelOptions opt_;
   InsLinearisation lin_;
   StateMatrix<N> F_ = StateMatrix<N>::Zero();
+  mutable double cached_dt_ = -1.0;  // Phi of the last dt, reused for all sigma points
+  mutable StateMatrix<N> cached_phi_ = StateMatrix<N>::Identity();
 };
 
 // Continuous error dynamics F (N x N) at a linearisation point (what InsErrorModel::F returns).

@@ -47,11 +47,16 @@ struct SatelliteObservable {
 
 // Satellites of an epoch with usable ephemeris (signals::select_ephemeris at the transmit time), above the
 // mask as seen from r_ant_e (the current antenna estimate, ECEF), with the atmosphere evaluated there.
-// receive_time is the epoch by the receiver clock.
+// receive_time is the epoch by the receiver clock. `stats` (optional) counts what was left out.
+struct PrepareStats {
+  int missing_ephemeris = 0;
+  int below_mask = 0;
+};
 std::vector<SatelliteObservable> prepare_satellites(const receiver::ObservationEpoch& epoch,
                                                     const std::vector<signals::Ephemeris>& ephemerides,
                                                     const signals::KlobucharParameters& iono,
-                                                    const Eigen::Vector3d& r_ant_e, const TightOptions& options);
+                                                    const Eigen::Vector3d& r_ant_e, const TightOptions& options,
+                                                    PrepareStats* stats = nullptr);
 
 // Predicted pseudorange (m) and rate (m/s) at an antenna position/velocity (ECEF) and clock bias/drift.
 double predicted_pseudorange_m(const SatelliteObservable& sat, const Eigen::Vector3d& r_ant_e, double clock_bias_m);

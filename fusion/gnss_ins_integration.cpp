@@ -1,0 +1,254 @@
+#include "fusion/gnss_ins_integration.hpp"
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+#include <variant>
+
+#include "signals/gps_constants.hpp"
+
+namespace ultratrack::fusion {
+namespace {
+
+constexpr double kTimeEpsilon_s = 1e-9;  // measurement this close to the INS time: applied there
+
+struct PendingFix {
+  GnssFix fix;
+};
+struct PendingEpoch {
+  receiver::ObservationEpoch epoch;
+  std::vector<signals::Ephemeris> ephemerides;
+  signals::KlobucharParameters iono;
+};
+using Pending = std::variant<PendingFix, PendingEpoch>;
+
+void check_options(const IntegrationOptions& o) {
+  auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
+  if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
+    throw std::invalid_argument("integration: initial sigmas must be positive");
+  if (!(o.propagation_interval_s >= 0.0)) throw std::invalid_argument("integration: negative propagation interval");
+  if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
+    throw std::invalid_argument("integration: gate probability must lie in (0, 1)");
+}
+
+}  // namespace
+
+struct CoreBase {
+  virtual ~CoreBase() = default;
+  virtual void add_pending(double t_s, Pending p) = 0;
+  virtual void add_imu(const ins::ImuIncrement& inc) = 0;
+  virtual NominalState nominal() const = 0;
+  virtual Eigen::MatrixXd covariance() const = 0;
+  IntegrationOutput output;
+  IntegrationCounters counters;
+  std::vector<UpdateRecord> records;
+};
+
+namespace {
+
+template <int N, class Filter>
+class Core final : public CoreBase {
+ public:
+  Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
+      : opt_(opt), ins_(initial, opt.strapdown), model_(opt.model), filter_(std::move(filter)) {
+    nominal_.nav = ins_.state();
+    if constexpr (N == 17) {
+      nominal_.clock_bias_m = opt.initial_clock_bias_m;
+      nominal_.clock_drift_mps = opt.initial_clock_drift_mps;
+    }
+    InsLinearisation lin;
+    lin.nav = nominal_.nav;
+    lin.f_b = nominal_.nav.q_nb.conjugate() * Eigen::Vector3d(0.0, 0.0, -9.80665);
+    model_.set_linearisation(lin);
+    fill_output();
+  }
+
+  void add_pending(double t_s, Pending p) override {
+    if (t_s < nominal_.nav.t_s - kTimeEpsilon_s) {
+      ++counters.late;
+      return;
+    }
+    if (t_s <= nominal_.nav.t_s + kTimeEpsilon_s) {
+      apply(p);
+      fill_output();
+      return;
+    }
+    pending_.emplace(t_s, std::move(p));
+  }
+
+  void add_imu(const ins::ImuIncrement& inc) override {
+    double t = nominal_.nav.t_s;
+    if (!(inc.t_s > t)) return;
+    ++counters.imu_steps;
+    Eigen::Vector3d dth = inc.dtheta_b, dv = inc.dv_b;  // raw, still to be applied over (t, inc.t_s]
+    while (!pending_.empty() && pending_.begin()->first <= inc.t_s + kTimeEpsilon_s) {
+      auto node = pending_.extract(pending_.begin());
+      const double t_m = std::min(node.key(), inc.t_s);
+      if (t_m > t + kTimeEpsilon_s) {
+        const double s = (t_m - t) / (inc.t_s - t);  // increments shared in proportion to time
+        ins_step(s * dth, s * dv, t_m - t);
+        dth *= 1.0 - s;
+        dv *= 1.0 - s;
+        t = t_m;
+      }
+      apply(node.mapped());
+    }
+    if (inc.t_s - t > kTimeEpsilon_s) ins_step(dth, dv, inc.t_s - t);
+    fill_output();
+  }
+
+  NominalState nominal() const override { return nominal_; }
+  Eigen::MatrixXd covariance() const override { return filter_.P(); }
+
+ private:
+  void ins_step(const Eigen::Vector3d& dth_raw, const Eigen::Vector3d& dv_raw, double dt) {
+    const Eigen::Vector3d dth = dth_raw - nominal_.gyro_bias_b * dt;
+    const Eigen::Vector3d dv = dv_raw - nominal_.accel_bias_b * dt;
+    const Eigen::Quaterniond q0 = ins_.state().q_nb;
+    ins_.step(dth, dv, dt);
+    nominal_.nav = ins_.state();
+    if constexpr (N == 17) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
+    acc_dt_ += dt;
+    acc_dv_n_ += q0.slerp(0.5, nominal_.nav.q_nb) * dv;
+    w_ib_b_ = dth / dt;
+    if (acc_dt_ >= opt_.propagation_interval_s) propagate();
+  }
+
+  void propagate() {
+    if (acc_dt_ <= 0.0) return;
+    InsLinearisation lin;
+    lin.nav = nominal_.nav;
+    lin.f_b = nominal_.nav.q_nb.conjugate() * (acc_dv_n_ / acc_dt_);
+    lin.w_ib_b = w_ib_b_;
+    model_.set_linearisation(lin);
+    filter_.predict(model_, acc_dt_);
+    acc_dt_ = 0.0;
+    acc_dv_n_.setZero();
+  }
+
+  template <class M>
+  void update(const M& m, int prn) {
+    const UpdateResult r = filter_.update(m);
+    records.push_back(UpdateRecord{nominal_.nav.t_s, prn, r});
+    if (!r.accepted) {
+      ++counters.rejected;
+      return;
+    }
+    ++counters.accepted;
+    // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock), reset to zero.
+    nominal_ = corrected<N>(nominal_, filter_.x());
+    ins_.set_state(nominal_.nav);
+    filter_.set_x(StateVector<N>::Zero());
+  }
+
+  void apply(const Pending& p) {
+    propagate();  // covariance up to the measurement time
+    ++counters.epochs;
+    if (const auto* f = std::get_if<PendingFix>(&p)) {
+      if constexpr (N == 15) {
+        if (f->fix.has_position || f->fix.has_velocity)
+          update(LooseMeasurement<N>(nominal_, f->fix, opt_.lever_arm_b, w_ib_b_), 0);
+      }
+      return;
+    }
+    if constexpr (N == 17) {
+      const auto& e = std::get<PendingEpoch>(p);
+      PrepareStats stats;
+      const auto sats = prepare_satellites(e.epoch, e.ephemerides, e.iono,
+                                           antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight, &stats);
+      counters.satellites_missing_ephemeris += stats.missing_ephemeris;
+      for (const auto& s : sats)
+        update(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, w_ib_b_, opt_.tight.use_range_rate), s.prn);
+    }
+  }
+
+  void fill_output() {
+    IntegrationOutput& o = output;
+    o.nav = nominal_.nav;
+    const StateVector<N> sd = filter_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
+    o.sigma_pos_ned_m = sd.template segment<3>(ix::kPos);
+    o.sigma_vel_n_mps = sd.template segment<3>(ix::kVel);
+    o.sigma_att_rad = sd.template segment<3>(ix::kAtt);
+    o.accel_bias_b = nominal_.accel_bias_b;
+    o.gyro_bias_b = nominal_.gyro_bias_b;
+    o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
+    o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
+    if constexpr (N == 17) {
+      o.clock_bias_m = nominal_.clock_bias_m;
+      o.clock_drift_mps = nominal_.clock_drift_mps;
+      o.sigma_clock_bias_m = sd(ix::kClockBias);
+      o.sigma_clock_drift_mps = sd(ix::kClockDrift);
+    }
+  }
+
+  IntegrationOptions opt_;
+  ins::Strapdown ins_;
+  InsErrorModel<N> model_;
+  Filter filter_;
+  NominalState nominal_;
+  std::multimap<double, Pending> pending_;
+  double acc_dt_ = 0.0;
+  Eigen::Vector3d acc_dv_n_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d w_ib_b_ = Eigen::Vector3d::Zero();
+};
+
+template <int N>
+std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const IntegrationOptions& o) {
+  InsErrorModelOptions mo = o.model;
+  mo.discretisation = o.discretisation;
+  IntegrationOptions oo = o;
+  oo.model = mo;
+  const InsErrorModel<N> model(mo);
+  const StateMatrix<N> P0 = model.initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  const StateVector<N> x0 = StateVector<N>::Zero();
+  if (o.filter == FilterKind::Ekf)
+    return std::make_unique<Core<N, Ekf<N>>>(initial, oo, Ekf<N>(x0, P0, EkfOptions{o.discretisation, o.gate}));
+  return std::make_unique<Core<N, Ukf<N>>>(initial, oo, Ukf<N>(x0, P0, UkfOptions{o.ukf, o.discretisation, o.gate}));
+}
+
+}  // namespace
+
+struct GnssInsIntegration::Impl {
+  IntegrationOptions options;
+  std::unique_ptr<CoreBase> core;
+};
+
+GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const IntegrationOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  check_options(options);
+  impl_->options = options;
+  impl_->core = options.coupling == Coupling::Loose ? make_core<15>(initial, options) : make_core<17>(initial, options);
+}
+
+GnssInsIntegration::~GnssInsIntegration() = default;
+GnssInsIntegration::GnssInsIntegration(GnssInsIntegration&&) noexcept = default;
+GnssInsIntegration& GnssInsIntegration::operator=(GnssInsIntegration&&) noexcept = default;
+
+void GnssInsIntegration::add_fix(const GnssFix& fix) {
+  if (impl_->options.coupling != Coupling::Loose) throw std::logic_error("add_fix: integration is tightly coupled");
+  impl_->core->add_pending(fix.t_s, PendingFix{fix});
+}
+
+void GnssInsIntegration::add_observations(const receiver::ObservationEpoch& epoch,
+                                          const std::vector<signals::Ephemeris>& ephemerides,
+                                          const signals::KlobucharParameters& iono) {
+  if (impl_->options.coupling != Coupling::Tight)
+    throw std::logic_error("add_observations: integration is loosely coupled");
+  const double t_s = signals::seconds_between(epoch.receive_time, impl_->options.gps_time_origin) -
+                     impl_->core->nominal().clock_bias_m / signals::kSpeedOfLight_mps;
+  impl_->core->add_pending(t_s, PendingEpoch{epoch, ephemerides, iono});
+}
+
+void GnssInsIntegration::add_imu(const ins::ImuIncrement& inc) { impl_->core->add_imu(inc); }
+const IntegrationOutput& GnssInsIntegration::output() const { return impl_->core->output; }
+NominalState GnssInsIntegration::nominal() const { return impl_->core->nominal(); }
+Eigen::MatrixXd GnssInsIntegration::covariance() const { return impl_->core->covariance(); }
+const IntegrationCounters& GnssInsIntegration::counters() const { return impl_->core->counters; }
+std::vector<UpdateRecord> GnssInsIntegration::take_update_records() {
+  std::vector<UpdateRecord> out;
+  out.swap(impl_->core->records);
+  return out;
+}
+const IntegrationOptions& GnssInsIntegration::options() const { return impl_->options; }
+
+}  // namespace ultratrack::fusion
