@@ -150,7 +150,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
                  std::clamp(2.0 * heading, 0.5 * kDeg, 60.0 * kDeg)};
     result.alignment_note = fmt::format("static over {:.1f} s", a.duration_s);
     if (heading > 10.0 * kDeg)
-      result.alignment_note += fmt::format(" (heading 1-sigma {:.0f} deg: this IMU cannot gyrocompass; use --align motion)",
+      result.alignment_note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
                                            heading / kDeg);
   } else if (s.align == AlignMode::Motion) {
     const auto a = fusion::align_in_motion(imu, gnss_velocities(gnss), {c.motion_min_speed_mps, c.motion_window_s});
