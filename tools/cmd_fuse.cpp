@@ -68,7 +68,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
   std::vector<ins::NavState> truth;
   if (!o.truth_file.empty()) truth = read_truth_csv(o.truth_file);
   if (!o.quiet)
-    fmt::print("fuse: {} IMU rows ({:.3f}-{:.3f} s), {} GNSS fixes ({:.3f}-{:.3f} s), loose {} , align {}\n",
+    fmt::print("fuse: {} IMU rows ({:.3f}-{:.3f} s), {} GNSS fixes ({:.3f}-{:.3f} s), loose {}, align {}\n",
                imu.size(), imu.front().t_s, imu.back().t_s, gnss.size(), gnss.front().t_s, gnss.back().t_s, o.filter,
                o.align);
 

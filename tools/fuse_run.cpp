@@ -109,6 +109,19 @@ ErrorRms rms_of(const std::vector<RowError>& e, double from_t) {
   return r;
 }
 
+std::string json_escape(const std::string& in) {
+  std::string out;
+  for (char ch : in) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
+      continue;
+    }
+    out += ch;
+  }
+  return out;
+}
+
 }  // namespace
 
 FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssCsvRow>& gnss,
@@ -315,13 +328,13 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   };
   const char* align = s.align == AlignMode::Static ? "static" : s.align == AlignMode::Motion ? "motion" : "config";
   std::string j = "{\n";
-  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", imu_file, gnss_file);
-  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", truth_file);
+  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", json_escape(imu_file), json_escape(gnss_file));
+  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", json_escape(truth_file));
   j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
                    s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
   j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
                    "\"yaw_deg\": {:.6f}}},\n",
-                   r.alignment_note, r.start_s, r.initial_attitude.roll_rad / kDeg,
+                   json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
                    r.initial_attitude.pitch_rad / kDeg, r.initial_attitude.yaw_rad / kDeg);
   j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
   j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
