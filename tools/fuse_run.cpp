@@ -54,15 +54,25 @@ Eigen::Vector3d ned_difference(double lat_a, double lon_a, double h_a, double la
   return ins::C_en(lat_a, lon_a).transpose() * d_e;
 }
 
-// GNSS velocities for the motion alignment: the fixes' own, else central differences of positions.
+// GNSS velocities for the motion alignment: the fixes' own, else central differences of positions over at
+// least kPositionDifferenceSpan_s (at 1.5 m noise: ~0.4 m/s per axis; neighbours alone would give metres per
+// second at 5 Hz and fake motion while parked).
+constexpr double kPositionDifferenceSpan_s = 5.0;
+
 std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssCsvRow>& g) {
   std::vector<fusion::GnssVelocitySample> out;
+  std::size_t lo = 0, hi = 0;
   for (std::size_t i = 0; i < g.size(); ++i) {
     fusion::GnssVelocitySample s{g[i].t_s, g[i].lat_rad, g[i].height_m, g[i].v_n};
     if (!g[i].has_velocity) {
-      if (i == 0 || i + 1 == g.size()) continue;
-      const auto& a = g[i - 1];
-      const auto& b = g[i + 1];
+      const double half = 0.5 * kPositionDifferenceSpan_s;
+      while (lo < i && g[lo + 1].t_s <= g[i].t_s - half) ++lo;
+      if (g[lo].t_s > g[i].t_s - half + 1e-9) continue;  // not enough history yet
+      hi = std::max(hi, i);
+      while (hi < g.size() && g[hi].t_s < g[i].t_s + half - 1e-9) ++hi;
+      if (hi == g.size()) continue;
+      const auto& a = g[lo];
+      const auto& b = g[hi];
       s.v_n = ned_difference(a.lat_rad, a.lon_rad, a.height_m, b.lat_rad, b.lon_rad, b.height_m) / (b.t_s - a.t_s);
     }
     out.push_back(s);
@@ -166,7 +176,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       result.alignment_note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
                                            heading / kDeg);
   } else if (s.align == AlignMode::Motion) {
-    const auto a = fusion::align_in_motion(imu, gnss_velocities(gnss), {c.motion_min_speed_mps, c.motion_window_s});
+    // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
+    const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssCsvRow& r) { return r.has_velocity; });
+    const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
+    const auto a = fusion::align_in_motion(imu, gnss_velocities(gnss), {c.motion_min_speed_mps, window});
     if (!a)
       throw io::InputError("GNSS file", fmt::format("no in-motion alignment: the fixes never show {} m/s for {} s "
                                                     "within the IMU data",
@@ -174,8 +187,9 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     init.t_s = a->t_s;
     init.q_nb = a->q_nb;
     init.v_n = a->v_n;
-    sigma_vel = Eigen::Vector3d::Constant(c.velocity_sigma_mps * 2.0);
-    sigma_att = {1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg};
+    sigma_vel = Eigen::Vector3d::Constant(position_only ? 1.0 : c.velocity_sigma_mps * 2.0);
+    sigma_att = position_only ? Eigen::Vector3d(3.0 * kDeg, 3.0 * kDeg, 5.0 * kDeg)
+                              : Eigen::Vector3d(1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg);
     result.alignment_note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
   } else {
     if (!c.attitude_deg) throw io::InputError("configuration", "--align config needs [initial] attitude_deg");

@@ -178,3 +178,21 @@ TEST(FuseCommand, BadInputIsOneInputError) {
   EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", (dir / "late.csv").string(), "--out", out}), InputError);
   EXPECT_FALSE(fs::exists(dir / "fuse/nav.csv"));  // nothing half-written
 }
+
+// Position-only fixes (empty velocity columns): the in-motion alignment takes the track from position
+// differences and the filter updates with positions alone (the seed 003 fallback).
+TEST(FuseCommand, PositionOnlyFixesAlignFromPositionDifferences) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  run({"imusim", "--profile", "land", "--duration", "240", "--rate", "200", "--preset", "hg1700ae", "--seed", "11",
+       "--out", (dir / "sim").string()});
+  run({"gnsssim", "--truth", (dir / "sim/truth.csv").string(), "--rate", "5", "--first", "0.137", "--no-velocity",
+       "--seed", "5", "--out", (dir / "gnss.csv").string()});
+  EXPECT_FALSE(ultratrack::tools::read_gnss_csv(dir / "gnss.csv").front().has_velocity);
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--truth",
+       (dir / "sim/truth.csv").string(), "--quiet", "--out", (dir / "fuse").string()});
+  const fs::path summary = dir / "fuse/summary.json";
+  EXPECT_EQ(json_number(summary, "converged"), 1.0);
+  EXPECT_LT(json_number(summary, "horizontal_m", "rms_converged"),
+            0.7 * json_number(summary, "horizontal_m", "gnss_only_rms"));
+  EXPECT_LT(json_number(summary, "heading_deg", "rms_converged"), 1.0);
+}
