@@ -11,6 +11,7 @@ namespace ultratrack::fusion {
 namespace {
 
 constexpr double kTimeEpsilon_s = 1e-9;  // measurement this close to the INS time: applied there
+constexpr std::size_t kMaxRecords = 8192;  // update records kept when nobody takes them (oldest half dropped)
 
 struct PendingFix {
   GnssFix fix;
@@ -129,6 +130,7 @@ class Core final : public CoreBase {
   template <class M>
   void update(const M& m, int prn) {
     const UpdateResult r = filter_.update(m);
+    if (records.size() >= kMaxRecords) records.erase(records.begin(), records.begin() + kMaxRecords / 2);
     records.push_back(UpdateRecord{nominal_.nav.t_s, prn, r});
     if (!r.accepted) {
       ++counters.rejected;

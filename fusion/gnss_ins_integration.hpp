@@ -110,7 +110,7 @@ class GnssInsIntegration {
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;
   const IntegrationCounters& counters() const;
-  // Updates since the last call (cleared by the call).
+  // Updates since the last call (cleared by the call; at most 8192 are kept, the oldest half dropped first).
   std::vector<UpdateRecord> take_update_records();
   const IntegrationOptions& options() const;
 

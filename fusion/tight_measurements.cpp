@@ -54,10 +54,11 @@ void satellite_rows(const NominalState& nominal, const SatelliteObservable& sat,
   const Eigen::Matrix3d Hv_psi = -ins::skew(C * w_ib_b.cross(l_b)) + ins::skew(w_in) * ins::skew(l_n);
   h_rate.setZero();
   // Line-of-sight change with position: d(u . v_rel)/dr_ant = -v_rel' (I - u u') / rho; r_ant moves by -C_en dr.
-  h_rate.segment<3>(ix::kPos) =
-      (v_rel.transpose() * (Eigen::Matrix3d::Identity() - u_e * u_e.transpose()) * C_en) / rho;
+  const Eigen::RowVector3d a = (v_rel.transpose() * (Eigen::Matrix3d::Identity() - u_e * u_e.transpose()) * C_en) / rho;
+  h_rate.segment<3>(ix::kPos) = a;
   h_rate.segment<3>(ix::kVel) = u_n.transpose();
-  h_rate.segment<3>(ix::kAtt) = -u_n.transpose() * Hv_psi;
+  // Attitude moves the antenna velocity (lever arm) and, through the antenna position, the line of sight.
+  h_rate.segment<3>(ix::kAtt) = -u_n.transpose() * Hv_psi + a * ins::skew(l_n);
   h_rate.segment<3>(ix::kGyroBias) = -u_n.transpose() * C * ins::skew(l_b);
   h_rate(ix::kClockDrift) = -1.0;
 }
@@ -128,7 +129,11 @@ double predicted_pseudorange_m(const SatelliteObservable& sat, const Eigen::Vect
 double predicted_range_rate_mps(const SatelliteObservable& sat, const Eigen::Vector3d& r_ant_e,
                                 const Eigen::Vector3d& v_ant_e, double clock_drift_mps) {
   const Eigen::Vector3d u = (sat.r_sat_e - r_ant_e).normalized();
-  return u.dot(sat.v_sat_e - v_ant_e) + clock_drift_mps - sat.sv_drift_mps;
+  // The receiver's own part of the travel-time rate (receiver/pvt leaves it out: up to 2 mm/s at 140 m/s).
+  const double dtau = -u.dot(v_ant_e) / kSpeedOfLight_mps;
+  const Eigen::Vector3d omega_e(0.0, 0.0, signals::kEarthRotationRate_radps);
+  const Eigen::Vector3d v_sat = sat.v_sat_e - dtau * (sat.v_sat_e + omega_e.cross(sat.r_sat_e));
+  return u.dot(v_sat - v_ant_e) + clock_drift_mps - sat.sv_drift_mps;
 }
 
 SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, const SatelliteObservable& sat,

@@ -4,7 +4,9 @@
 // (t_tx = t_rx - rho / c - dt_sv), rotated into the receive-time ECEF frame (Sagnac); L1 C/A clock
 // correction (af polynomial + relativistic - TGD), broadcast Klobuchar ionosphere and the standard
 // troposphere exactly as receiver/pvt. Pseudorange rate = -lambda_L1 * Doppler; prediction
-// u . (v_sat_apparent - v_ant_e) + clock drift - c * SV clock drift (pvt's apparent satellite velocity).
+// u . (v_sat_apparent - v_ant_e) + clock drift - c * SV clock drift (pvt's apparent satellite velocity, plus the
+// receiver's own velocity in the travel-time rate, which pvt leaves out; like pvt, the rate of the atmospheric
+// delays, up to ~2 mm/s at low elevation, is not modelled).
 // Metres, m/s, seconds.
 #pragma once
 

@@ -68,7 +68,7 @@ double rms(const std::vector<double>& v, std::size_t from) {
 SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::Vector3d& lever_arm_b,
                               const std::vector<signals::Ephemeris>& ephemerides,
                               const signals::KlobucharParameters& iono, const signals::GpsTime& origin,
-                              double t_true_s, const TruthClock& clock) {
+                              double t_true_s, const TruthClock& clock, bool troposphere) {
   SimulatedEpoch out;
   out.t_true_s = t_true_s;
   out.epoch.receive_time = signals::add_seconds(origin, t_true_s + clock.bias_m / kC);
@@ -89,7 +89,7 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
       el = la.elevation_rad;
       double lat, lon, h;
       geodetic(r_rx, lat, lon, h);
-      double delay = signals::troposphere_delay_m(lat, h, std::max(el, 5.0 * kDeg));
+      double delay = troposphere ? signals::troposphere_delay_m(lat, h, std::max(el, 5.0 * kDeg)) : 0.0;
       if (iono.valid) delay += kC * signals::klobuchar_delay_s(iono, lat, lon, la.azimuth_rad, el, t_tx.tow_s);
       return kC * tau + b - kC * signals::l1_ca_clock_correction_s(eph, t_tx) + delay;
     };

@@ -74,6 +74,6 @@ struct SimulatedEpoch {
 SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::Vector3d& lever_arm_b,
                               const std::vector<signals::Ephemeris>& ephemerides,
                               const signals::KlobucharParameters& iono, const signals::GpsTime& origin,
-                              double t_true_s, const TruthClock& clock);
+                              double t_true_s, const TruthClock& clock, bool troposphere = true);
 
 }  // namespace ultratrack::fusion::test
