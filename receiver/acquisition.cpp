@@ -171,15 +171,26 @@ void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, co
   for (int k = 0; k < options_.noncoherent; ++k) {
     const FftwBuffer* spectrum = cached ? cached + k : &spectrum_scratch_;
     if (!cached) doppler_spectrum(samples, k, doppler_hz, spectrum_scratch_);
-    for (std::size_t i = 0; i < fft_size_; ++i) product_[i] = (*spectrum)[i] * code[i];
+    // X * C in real arithmetic: std::complex's operator* carries a NaN-recovery branch that stops vectorisation.
+    const float* x = reinterpret_cast<const float*>(spectrum->data());
+    const float* c = reinterpret_cast<const float*>(code.data());
+    float* p = reinterpret_cast<float*>(product_.data());
+    for (std::size_t i = 0; i < fft_size_; ++i) {
+      const float xr = x[2 * i], xi = x[2 * i + 1], cr = c[2 * i], ci = c[2 * i + 1];
+      p[2 * i] = xr * cr - xi * ci;
+      p[2 * i + 1] = xr * ci + xi * cr;
+    }
     backward_.execute(product_, correlation_);
     const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
-    const auto shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period)));
-    for (std::size_t lag = 0; lag < lags_; ++lag) {
-      std::ptrdiff_t index = (static_cast<std::ptrdiff_t>(lag) + shift) % n;
-      if (index < 0) index += n;
-      row_[lag] += std::norm(correlation_[static_cast<std::size_t>(index)]);
-    }
+    std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
+    if (shift < 0) shift += n;
+    // row[lag] += |corr[(lag + shift) mod n]|^2, in the two unwrapped runs.
+    const auto* y = reinterpret_cast<const float*>(correlation_.data());
+    const auto first_run = static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(lags_), n - shift));
+    const float* a = y + 2 * shift;
+    for (std::size_t lag = 0; lag < first_run; ++lag) row_[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
+    const float* b = y - 2 * static_cast<std::ptrdiff_t>(first_run);
+    for (std::size_t lag = first_run; lag < lags_; ++lag) row_[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
   }
 }
 
@@ -189,15 +200,23 @@ std::complex<double> Acquisition::correlate_time(std::span<const std::complex<fl
   const std::size_t first = static_cast<std::size_t>(block) * block_size_;
   const double chips_per_sample = code_rate_hz(doppler_hz) / options_.fs_hz;
   const std::complex<double> step = std::polar(1.0, -kTwoPi * doppler_hz / options_.fs_hz);
-  std::complex<double> nco(1.0, 0.0), sum(0.0, 0.0);
+  // The complex products written out in real arithmetic (the same operations as std::complex's, without its
+  // NaN-recovery branches, which cost more than the arithmetic).
+  const double step_re = step.real(), step_im = step.imag();
+  double nco_re = 1.0, nco_im = 0.0, sum_re = 0.0, sum_im = 0.0;
   double phase = (static_cast<double>(first) - lag_samples) * chips_per_sample;
+  const auto* x = reinterpret_cast<const float*>(samples.data() + first);
   for (std::size_t m = 0; m < block_size_; ++m) {
-    const std::complex<float> x = samples[first + m];
-    sum += std::complex<double>(x.real(), x.imag()) * nco * static_cast<double>(chip_at(code, phase));
-    nco *= step;
+    const double xr = x[2 * m], xi = x[2 * m + 1];
+    const double chip = chip_at(code, phase);
+    sum_re += (xr * nco_re - xi * nco_im) * chip;
+    sum_im += (xr * nco_im + xi * nco_re) * chip;
+    const double next_re = nco_re * step_re - nco_im * step_im;
+    nco_im = nco_re * step_im + nco_im * step_re;
+    nco_re = next_re;
     phase += chips_per_sample;
   }
-  return sum;
+  return {sum_re, sum_im};
 }
 
 double Acquisition::power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz,

@@ -3,9 +3,9 @@
 // one clock), the line of sight, and the slip flags. Units: cycles of L1, metres, dB-Hz; frames in the names.
 //
 // Between two antennas of one satellite the receiver clock, the satellite clock, the atmosphere and the navigation
-// bit cancel: carrier_phase_cycles[k] - carrier_phase_cycles[0] = (b_k . los) / lambda + N_k + line bias + noise,
-// with b_k the ECEF baseline from the master to antenna k and N_k an integer that stays fixed while no slip flag
-// is raised for antenna k.
+// bit cancel: carrier_phase_cycles[k] - carrier_phase_cycles[0] = -(b_k . los) / lambda + N_k + line bias + noise
+// (minus: an antenna nearer the satellite sees a shorter range), with b_k the ECEF baseline from the master to
+// antenna k and N_k an integer that stays fixed while no slip flag is raised for antenna k.
 #pragma once
 
 #include <array>

@@ -21,7 +21,9 @@ void BitSynchronizer::add(std::int64_t code_period, std::complex<float> prompt) 
   int runner_up = 0;
   for (auto it = bins_.begin(); it != bins_.end(); ++it)
     if (it != best) runner_up = std::max(runner_up, *it);
-  if (*best >= options_.min_ratio * std::max(runner_up, 1)) {
+  const bool ratio = *best >= options_.min_ratio * std::max(runner_up, 1);
+  const bool lead = *best - runner_up >= options_.min_lead_sigma * std::sqrt(static_cast<double>(*best + runner_up));
+  if (ratio || lead) {
     synchronised_ = true;
     edge_ = best - bins_.begin();  // period index modulo 20 at which bits start
   }

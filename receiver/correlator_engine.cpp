@@ -44,31 +44,6 @@ __attribute__((noinline)) void fill_code_baseline(const float* __restrict chips,
   for (int i = 0; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
 }
 
-#ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-// Below one chip per sample (any sample rate above the chip rate), 8 consecutive samples read at most 8
-// consecutive chips: one unaligned load of those chips and a lane permutation replace an 8-way gather.
-// fp-contract=off and noinline: no fused multiply-add, so the chip indices are those of the baseline copy.
-__attribute__((target("avx2,fma"), optimize("fp-contract=off"), noinline)) void fill_code_avx2(const float* __restrict chips, float frac, float step, int n,
-                                                         float* __restrict out) {
-  if (!(step <= 0.99f)) {  // margin for the float rounding of frac + step * i (< 1e-4 chips)
-    fill_code_baseline(chips, frac, step, n, out);
-    return;
-  }
-  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256 vfrac = _mm256_set1_ps(frac);
-  const __m256 vstep = _mm256_set1_ps(step);
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    const __m256 x = _mm256_add_ps(vfrac, _mm256_mul_ps(vstep, _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(i), lane))));
-    const __m256i index = _mm256_cvttps_epi32(x);
-    const int first = _mm256_cvtsi256_si32(index);  // lane 0: the window starts at this sample's chip
-    const __m256 window = _mm256_loadu_ps(chips + first);
-    const __m256i rel = _mm256_sub_epi32(index, _mm256_set1_epi32(first));
-    _mm256_storeu_ps(out + i, _mm256_permutevar8x32_ps(window, rel));
-  }
-  for (; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
-}
-#endif
 
 template <int kTaps, CodeFill kFill>
 ULTRATRACK_ALWAYS_INLINE void correlate_chunked(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
@@ -159,12 +134,110 @@ void correlate_baseline(const float* table, const double* offsets, std::span<con
 }
 
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
+// The AVX2 copy with the code fill fused into the multiply-accumulate loop: each tap's chips for 8 samples are
+// made in a register (index, one unaligned load of 8 chips, a lane permutation) and used at once, instead of
+// being stored to a buffer and read back; the step * i product is shared by all taps. Samples are taken in
+// the lane order 0 1 4 5 2 3 6 7, which is what a two-shuffle de-interleave of I/Q gives; the carrier rotation
+// table and the chip index lanes follow that order, and the sums do not care. Chip indices are evaluated with
+// the same float expression as fill_code_baseline (fp-contract=off: no fused multiply-add there), so every
+// tap reads the same chips as the portable copy; the carrier and the sums use explicit FMA.
 template <int kTaps>
-__attribute__((target("avx2,fma"))) void correlate_avx2(const float* table, const double* offsets,
-                                                         std::span<const std::complex<float>* const> antennas,
-                                                         int num_samples, const ReplicaSegment& rep,
-                                                         std::span<TapSums> sums) {
-  correlate_chunked<kTaps, fill_code_avx2>(table, offsets, antennas, num_samples, rep, sums);
+__attribute__((target("avx2,fma"), optimize("fp-contract=off"))) void correlate_avx2(
+    const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas, int num_samples,
+    const ReplicaSegment& rep, std::span<TapSums> sums) {
+  const auto step_f = static_cast<float>(rep.code_step_chips);
+  if (!(step_f <= 0.99f)) {  // above ~1 chip per sample 8 samples can span more than 8 chips
+    correlate_chunked<kTaps, fill_code_baseline>(table, offsets, antennas, num_samples, rep, sums);
+    return;
+  }
+  constexpr int kOrder[8] = {0, 1, 4, 5, 2, 3, 6, 7};
+  alignas(64) float rotation_cos[kChunk];
+  alignas(64) float rotation_sin[kChunk];
+  alignas(64) float carrier_cos[kChunk];
+  alignas(64) float carrier_sin[kChunk];
+  const int table_n = num_samples < kChunk ? num_samples : kChunk;
+  const int table_vec = table_n - table_n % 8;
+  for (int i = 0; i < table_n; ++i) {
+    const int sample = i < table_vec ? (i & ~7) + kOrder[i & 7] : i;  // lane order inside whole groups of 8
+    float c, s;
+    sincos_q32(rep.carrier_step_q32 * static_cast<std::uint32_t>(sample), c, s);
+    rotation_cos[i] = c;
+    rotation_sin[i] = s;
+  }
+  const int num_antennas = static_cast<int>(antennas.size());
+  const __m256 vstep = _mm256_set1_ps(step_f);
+  const __m256 lane_order = _mm256_setr_ps(0, 1, 4, 5, 2, 3, 6, 7);
+  for (int start = 0; start < num_samples; start += kChunk) {
+    const int n = num_samples - start < kChunk ? num_samples - start : kChunk;
+    const int n_vec = n - n % 8;
+    const std::uint32_t phase0 = rep.carrier_phase_q32 + rep.carrier_step_q32 * static_cast<std::uint32_t>(start);
+    float c0, s0;
+    sincos_q32(phase0, c0, s0);
+    for (int i = 0; i < n_vec; ++i) {
+      carrier_cos[i] = c0 * rotation_cos[i] - s0 * rotation_sin[i];
+      carrier_sin[i] = s0 * rotation_cos[i] + c0 * rotation_sin[i];
+    }
+    const double code0 = rep.code_phase_chips + rep.code_step_chips * start + 2 * kCodeLength;
+    const float* chips[kTaps];
+    float frac[kTaps];
+    __m256 vfrac[kTaps];
+    for (int t = 0; t < kTaps; ++t) {
+      const double base = code0 + offsets[t];
+      const int whole = static_cast<int>(base);
+      frac[t] = static_cast<float>(base - whole);
+      chips[t] = table + whole;
+      vfrac[t] = _mm256_set1_ps(frac[t]);
+    }
+    for (int a = 0; a < num_antennas; ++a) {
+      const float* x = reinterpret_cast<const float*>(antennas[a] + start);
+      __m256 acc_re[kTaps], acc_im[kTaps];
+      for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm256_setzero_ps();
+      __m256 vi = lane_order;
+      for (int i = 0; i < n_vec; i += 8) {
+        const __m256 lo = _mm256_loadu_ps(x + 2 * i), hi = _mm256_loadu_ps(x + 2 * i + 8);
+        const __m256 xr = _mm256_shuffle_ps(lo, hi, 0x88);  // samples 0 1 4 5 2 3 6 7, in-phase
+        const __m256 xi = _mm256_shuffle_ps(lo, hi, 0xDD);  // quadrature
+        const __m256 cr = _mm256_load_ps(carrier_cos + i), ci = _mm256_load_ps(carrier_sin + i);
+        const __m256 wr = _mm256_fmadd_ps(xr, cr, _mm256_mul_ps(xi, ci));  // x * exp(-j phase)
+        const __m256 wi = _mm256_fmsub_ps(xi, cr, _mm256_mul_ps(xr, ci));
+        const __m256 advance = _mm256_mul_ps(vstep, vi);
+        for (int t = 0; t < kTaps; ++t) {
+          const __m256i index = _mm256_cvttps_epi32(_mm256_add_ps(vfrac[t], advance));
+          const int first = _mm256_cvtsi256_si32(index);  // lane 0 is the group's first sample
+          const __m256 code = _mm256_permutevar8x32_ps(_mm256_loadu_ps(chips[t] + first),
+                                                       _mm256_sub_epi32(index, _mm256_set1_epi32(first)));
+          acc_re[t] = _mm256_fmadd_ps(wr, code, acc_re[t]);
+          acc_im[t] = _mm256_fmadd_ps(wi, code, acc_im[t]);
+        }
+        vi = _mm256_add_ps(vi, _mm256_set1_ps(8.0f));
+      }
+      alignas(32) float re[kTaps][8], im[kTaps][8];
+      for (int t = 0; t < kTaps; ++t) {
+        _mm256_store_ps(re[t], acc_re[t]);
+        _mm256_store_ps(im[t], acc_im[t]);
+      }
+      for (int i = n_vec; i < n; ++i) {  // the last < 8 samples, natural order, carrier straight from the phase
+        float cr, ci;
+        sincos_q32(phase0 + rep.carrier_step_q32 * static_cast<std::uint32_t>(i), cr, ci);
+        const float xr = x[2 * i], xi = x[2 * i + 1];
+        const float wr = xr * cr + xi * ci;
+        const float wi = xi * cr - xr * ci;
+        for (int t = 0; t < kTaps; ++t) {
+          const float code = chips[t][static_cast<int>(frac[t] + step_f * static_cast<float>(i))];
+          re[t][0] += wr * code;
+          im[t][0] += wi * code;
+        }
+      }
+      for (int t = 0; t < kTaps; ++t) {
+        double sum_re = 0.0, sum_im = 0.0;
+        for (int l = 0; l < 8; ++l) {
+          sum_re += re[t][l];
+          sum_im += im[t][l];
+        }
+        sums[a][t] += std::complex<double>(sum_re, sum_im);
+      }
+    }
+  }
 }
 #endif
 

@@ -2,8 +2,9 @@
 // early, early, prompt, late, very late, noise: any set of code offsets in chips) over one block of complex
 // baseband samples, for 1..kMaxAntennas antennas against one replica in one pass. Code chips come from a table
 // built once per PRN; the carrier from a 32-bit fixed-point phase and a polynomial sin/cos (|error| < 1e-6).
-// No allocation, no exceptions per call. Scalar C++ written for auto-vectorisation, compiled twice (baseline
-// x86-64 and AVX2+FMA) with the copy chosen once at run time from the CPU's features.
+// No allocation, no exceptions per call. Two copies chosen once at run time from the CPU's features: portable
+// C++ written for auto-vectorisation (baseline x86-64), and AVX2+FMA intrinsics with the code fill fused into the
+// multiply-accumulate loop (same chip indices as the portable copy; sums equal to float rounding).
 #pragma once
 
 #include <array>

@@ -37,7 +37,8 @@ class FftwBuffer {
 };
 
 // An unnormalised forward (e^{-j...}) or backward (e^{+j...}) DFT of n points, planned with
-// FFTW_ESTIMATE (no measuring, so plans are cheap to make). execute() may be called on any pair of
+// FFTW_ESTIMATE (no measuring, so plans are cheap to make), or, when the environment variable
+// ULTRATRACK_FFTW_WISDOM names a wisdom file, with FFTW_PATIENT from that file (measured and added on first use). execute() may be called on any pair of
 // FftwBuffers of size n (out of place: in and out distinct), from any thread.
 class FftwPlan {
  public:

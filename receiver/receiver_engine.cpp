@@ -34,6 +34,7 @@ ReceiverEngine::ReceiverEngine(const ReceiverOptions& options, ReceiverObserver&
     : options_(checked(options)),
       observer_(observer),
       acquisition_(acquisition_options(options_)),
+      pool_(options_.threads),
       smoothing_(std::max(1, static_cast<int>(std::lround(options_.smoothing_window_s / options_.observation_interval_s)))) {
   channels_.resize(static_cast<std::size_t>(options_.channels));
   prns_ = options_.prns;
@@ -42,12 +43,21 @@ ReceiverEngine::ReceiverEngine(const ReceiverOptions& options, ReceiverObserver&
   observation_step_ = std::max<std::int64_t>(1, std::llround(options_.observation_interval_s * options_.fs_hz));
   record_periods_ = std::max(1, static_cast<int>(std::lround(options_.tracking_record_interval_s * 1e3)));
   snapshot_.resize(acquisition_.samples_needed());
+  records_.resize(channels_.size());
+  for (auto& r : records_) r.reserve(64);
   epoch_.observations.reserve(32);
   measured_.reserve(32);
   pvt_input_.reserve(32);
 }
 
-ReceiverEngine::~ReceiverEngine() = default;
+ReceiverEngine::~ReceiverEngine() {
+  if (search_.pending) {
+    try {
+      pool_.wait(search_);  // the task reads snapshot_ and acquisition_: let it finish first
+    } catch (...) {
+    }
+  }
+}
 
 void ReceiverEngine::add_navigation(const std::vector<signals::Ephemeris>& ephemerides,
                                     const signals::KlobucharParameters& iono, const signals::UtcParameters& utc) {
@@ -115,13 +125,24 @@ std::optional<DopplerWindow> ReceiverEngine::assistance(int prn, const signals::
   return DopplerWindow{doppler, options_.assisted_doppler_half_width_hz};
 }
 
-void ReceiverEngine::acquire(std::int64_t start_sample) {
+void ReceiverEngine::AcquisitionTask::run() {
+  results.clear();
+  for (const auto& [prn, window] : assisted) results.push_back(acquisition->search(samples, prn, window));
+  if (!blind.empty()) {
+    auto more = acquisition->search(samples, blind);
+    results.insert(results.end(), more.begin(), more.end());
+  }
+}
+
+// The snapshot is complete at end_sample: decide what to search (from this thread's state only) and start it.
+void ReceiverEngine::start_acquisition(std::int64_t end_sample) {
   snapshot_active_ = false;
-  next_reacquisition_ = start_sample + std::llround(options_.reacquisition_interval_s * options_.fs_hz);
-  const std::span<const std::complex<float>> samples(snapshot_.data(), snapshot_.size());
-  std::vector<int> blind;
-  std::vector<AcquisitionResult> results;
+  search_.acquisition = &acquisition_;
+  search_.samples = std::span<const std::complex<float>>(snapshot_.data(), snapshot_.size());
+  search_.assisted.clear();
+  search_.blind.clear();
   const bool can_assist = last_fix_ && clock_;
+  std::vector<int> blind;
   for (int prn : missing_prns()) {
     if (!can_assist) {
       blind.push_back(prn);
@@ -131,14 +152,34 @@ void ReceiverEngine::acquire(std::int64_t start_sample) {
     const auto window = assistance(prn, clock_->time_at(snapshot_first_), &below);
     if (below) continue;
     if (window)
-      results.push_back(acquisition_.search(samples, prn, window));
+      search_.assisted.emplace_back(prn, *window);
     else
       blind.push_back(prn);
   }
-  if (!blind.empty()) {
-    auto more = acquisition_.search(samples, blind);
-    results.insert(results.end(), more.begin(), more.end());
+  const bool cold = channels_in_use() == 0;
+  const auto limit = static_cast<std::size_t>(options_.blind_prns_per_snapshot);
+  if (cold || limit == 0 || blind.size() <= limit) {
+    search_.blind = blind;
+  } else {
+    // Round robin over the PRN list: the next `limit` missing PRNs from the cursor on.
+    for (std::size_t k = 0; k < prns_.size() && search_.blind.size() < limit; ++k) {
+      const std::size_t i = (blind_cursor_ + k) % prns_.size();
+      if (std::find(blind.begin(), blind.end(), prns_[i]) == blind.end()) continue;
+      search_.blind.push_back(prns_[i]);
+      blind_cursor_ = (i + 1) % prns_.size();
+    }
   }
+  // Nothing tracks during a cold start, so nothing to overlap: the satellites join at once.
+  search_.apply_at = cold ? end_sample : end_sample + std::llround(options_.reacquisition_latency_s * options_.fs_hz);
+  search_.pending = true;
+  pool_.start(search_);
+}
+
+void ReceiverEngine::finish_acquisition(std::int64_t start_sample) {
+  pool_.wait(search_);
+  search_.pending = false;
+  next_reacquisition_ = start_sample + std::llround(options_.reacquisition_interval_s * options_.fs_hz);
+  const std::vector<AcquisitionResult>& results = search_.results;
   observer_.on_acquisition(snapshot_first_, results);
   std::vector<const AcquisitionResult*> detected;
   for (const auto& r : results)
@@ -154,23 +195,34 @@ void ReceiverEngine::acquire(std::int64_t start_sample) {
   }
 }
 
+void ReceiverEngine::feed_channel(int slot) {
+  auto& channel = channels_[static_cast<std::size_t>(slot)];
+  auto& records = records_[static_cast<std::size_t>(slot)];
+  records.clear();
+  if (!channel) return;
+  channel->feed(view_, [&records](const TrackingRecord& r) { records.push_back(r); });
+}
+
 void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
-  SampleBlockView view;
-  view.first_sample = first_sample;
-  view.num_samples = static_cast<int>(samples.size());
-  view.num_antennas = 1;
-  view.antenna[0] = samples.data();
-  for (auto& channel : channels_) {
-    if (!channel) continue;
-    channel->feed(view, [this](const TrackingRecord& r) {
+  view_.first_sample = first_sample;
+  view_.num_samples = static_cast<int>(samples.size());
+  view_.num_antennas = 1;
+  view_.antenna[0] = samples.data();
+  // Channels are independent given the block: each job touches only its own channel and record buffer.
+  auto job = [this](int slot) { feed_channel(slot); };
+  pool_.parallel_for(static_cast<int>(channels_.size()), job);
+  // Everything shared, in channel order, on this thread: the same sequence as one thread feeding them in turn.
+  for (std::size_t slot = 0; slot < channels_.size(); ++slot) {
+    if (!channels_[slot]) continue;
+    for (const TrackingRecord& r : records_[slot]) {
       if (!std::isnan(r.cn0_dbhz) && r.state != TrackingState::kLost) {
         auto& stats = stats_.satellites[static_cast<std::size_t>(r.prn)];
         stats.tracking_cn0_sum_dbhz += r.cn0_dbhz;
         ++stats.tracking_cn0_count;
       }
       observer_.on_tracking(r);
-    });
-    collect_navigation(*channel);
+    }
+    collect_navigation(*channels_[slot]);
   }
 }
 
@@ -213,8 +265,10 @@ void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::
   const std::int64_t end = first_sample + static_cast<std::int64_t>(samples.size());
   std::int64_t s = first_sample;
   while (s < end) {
+    if (search_.pending && search_.apply_at <= s) finish_acquisition(s);  // only after a gap in the samples
     std::int64_t stop = std::min(end, next_observation_);
     if (snapshot_active_) stop = std::min(stop, s + static_cast<std::int64_t>(snapshot_.size() - snapshot_have_));
+    if (search_.pending) stop = std::min(stop, search_.apply_at);
     const auto part = samples.subspan(static_cast<std::size_t>(s - first_sample), static_cast<std::size_t>(stop - s));
     if (snapshot_active_) {
       std::copy(part.begin(), part.end(), snapshot_.begin() + static_cast<std::ptrdiff_t>(snapshot_have_));
@@ -222,14 +276,15 @@ void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::
     }
     feed_channels(part, s);
     s = stop;
-    if (snapshot_active_ && snapshot_have_ == snapshot_.size()) acquire(s);
+    if (snapshot_active_ && snapshot_have_ == snapshot_.size()) start_acquisition(s);
+    if (search_.pending && search_.apply_at == s) finish_acquisition(s);
     if (s == next_observation_) {
       observation_epoch(s);
       next_observation_ += observation_step_;
     }
     release_lost_channels();
-    if (!snapshot_active_ && s >= next_reacquisition_ && channels_in_use() < options_.channels &&
-        !missing_prns().empty())
+    if (!snapshot_active_ && !search_.pending && s >= next_reacquisition_ &&
+        channels_in_use() < options_.channels && !missing_prns().empty())
       begin_snapshot(s);
   }
   next_sample_ = end;

@@ -3,6 +3,10 @@
 // they exist), allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh
 // snapshots, forms observables at common receive epochs (every observation_interval_s, in samples), and solves
 // PVT from them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
+// Threads (receiver/worker_pool.hpp): the channels of each block run in parallel, each sample read once and
+// shared; a re-acquisition searches in the background and its satellites join at a fixed later sample. Every
+// observer call is made on the caller's thread in a fixed order, so the results are the same for any number
+// of threads.
 // The receiver clock is a GpsTime tied to a sample index (ReceiverClock); pseudorange = c (t_rx - t_tx).
 // Units: samples, seconds, metres, Hz.
 #pragma once
@@ -23,11 +27,13 @@
 #include "receiver/receiver_channel.hpp"
 #include "receiver/receiver_clock.hpp"
 #include "receiver/receiver_options.hpp"
+#include "receiver/worker_pool.hpp"
 #include "signals/ephemeris.hpp"
 
 namespace ultratrack::receiver {
 
-// Receives what the engine produces, synchronously, from process(). Default: ignore.
+// Receives what the engine produces, synchronously, from process(), on the thread that calls process().
+// Default: ignore.
 class ReceiverObserver {
  public:
   virtual ~ReceiverObserver() = default;
@@ -81,6 +87,7 @@ class ReceiverEngine {
   const std::optional<PvtSolution>& last_fix() const { return last_fix_; }
   int channels_in_use() const;
   int channels_synchronised() const;
+  int threads() const { return pool_.threads(); }
   // Ephemerides decoded from the signal (each new set once), and the broadcast Klobuchar/UTC parameters.
   const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return decoded_; }
   const signals::KlobucharParameters& klobuchar() const { return iono_; }
@@ -92,11 +99,26 @@ class ReceiverEngine {
   std::vector<int> tracked_prns() const;
 
  private:
+  // A re-acquisition search: what to search, decided on the caller's thread when the snapshot is complete,
+  // run by the pool, applied at apply_at.
+  struct AcquisitionTask final : BackgroundTask {
+    Acquisition* acquisition = nullptr;
+    std::span<const std::complex<float>> samples;
+    std::vector<std::pair<int, DopplerWindow>> assisted;
+    std::vector<int> blind;
+    std::vector<AcquisitionResult> results;
+    std::int64_t apply_at = 0;
+    bool pending = false;
+    void run() override;
+  };
+
   void begin_snapshot(std::int64_t sample);
-  void acquire(std::int64_t start_sample);
+  void start_acquisition(std::int64_t end_sample);
+  void finish_acquisition(std::int64_t start_sample);
   std::vector<int> missing_prns() const;
   std::optional<DopplerWindow> assistance(int prn, const signals::GpsTime& t, bool* below_horizon) const;
   void feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+  void feed_channel(int slot);
   void collect_navigation(ReceiverChannel& channel);
   void release_lost_channels();
   void observation_epoch(std::int64_t sample);
@@ -106,6 +128,11 @@ class ReceiverEngine {
   ReceiverObserver& observer_;
   Acquisition acquisition_;
   std::vector<std::unique_ptr<ReceiverChannel>> channels_;  // nullptr = free
+  std::vector<std::vector<TrackingRecord>> records_;        // per channel slot, one block's records (reused)
+  SampleBlockView view_;                                     // the block the channels are fed
+  WorkerPool pool_;
+  AcquisitionTask search_;
+  std::size_t blind_cursor_ = 0;  // round robin over prns_ for blind re-acquisitions
   std::vector<int> prns_;
 
   bool started_ = false;

@@ -16,6 +16,11 @@ std::string ReceiverOptions::validate() const {
     return fmt::format("observation interval {} s outside [0.001, 60]", observation_interval_s);
   if (!(reacquisition_interval_s >= 0.1 && reacquisition_interval_s <= 3600.0))
     return fmt::format("re-acquisition interval {} s outside [0.1, 3600]", reacquisition_interval_s);
+  if (!(reacquisition_latency_s >= 0.0 && reacquisition_latency_s <= 10.0))
+    return fmt::format("re-acquisition latency {} s outside [0, 10]", reacquisition_latency_s);
+  if (blind_prns_per_snapshot < 0 || blind_prns_per_snapshot > 32)
+    return fmt::format("blind PRNs per snapshot {} outside 0..32", blind_prns_per_snapshot);
+  if (threads < 0 || threads > 256) return fmt::format("threads = {}: must be within 0..256", threads);
   if (!(assisted_doppler_half_width_hz > 0.0 && assisted_doppler_half_width_hz <= 5000.0))
     return fmt::format("assisted Doppler half width {} Hz outside (0, 5000]", assisted_doppler_half_width_hz);
   if (!(initial_travel_time_s >= 0.06 && initial_travel_time_s <= 0.09))

@@ -22,6 +22,15 @@ struct ReceiverOptions {
   bool reference_week_is_signal_week = false;
   double observation_interval_s = 0.1;     // common receive epochs (observables, PVT), rounded to samples
   double reacquisition_interval_s = 5.0;   // a fresh snapshot for missing PRNs this often (with free channels)
+  // A re-acquisition searches on a worker thread while the channels track; its satellites join the channels
+  // this long after the snapshot ends (a fixed sample point, so results do not depend on thread timing).
+  // With no channel tracking (the cold start) they join at once. [0, 10] s.
+  double reacquisition_latency_s = 1.0;
+  // Blind (unassisted) re-acquisitions while some channel tracks search at most this many missing PRNs per
+  // snapshot, round robin (each search keeps its full sensitivity; a PRN comes round every few snapshots).
+  // 0: all of them every time. The cold start always searches every PRN.
+  int blind_prns_per_snapshot = 8;
+  int threads = 0;                         // worker threads including the caller's, 1..256; 0 = hardware threads
   double assisted_doppler_half_width_hz = 600.0;  // assisted search window around the predicted Doppler
   double assisted_elevation_min_deg = -5.0;       // assisted search skips satellites below this
   double initial_travel_time_s = 0.068;    // receiver clock set to (latest transmit time + this) at first sync

@@ -83,10 +83,13 @@ float gain_for(const std::filesystem::path& path, signals::SampleFormat format, 
     case signals::SampleFormat::i16:
     case signals::SampleFormat::r16:
       return 0.25f;  // 32767 / 4 * sqrt(2) = 11585
+    case signals::SampleFormat::r2:
+    case signals::SampleFormat::i2:
+      return 1024.0f;  // 3 * 1024 * sqrt(2) = 4345
     case signals::SampleFormat::f32:
       break;
   }
-  signals::SampleReader probe(path, format, 0);
+  signals::SampleReader probe(path, format, 0, options.two_bit);
   std::vector<std::complex<float>> head(std::size_t{1} << 16);
   const std::size_t n = probe.read(head);
   double power = 0.0;
@@ -99,7 +102,7 @@ float gain_for(const std::filesystem::path& path, signals::SampleFormat format, 
 
 SampleSource::SampleSource(std::filesystem::path path, signals::SampleFormat format, const SampleSourceOptions& options)
     : options_(checked(path, format, options)),
-      reader_(path, format, options.start_sample),
+      reader_(path, format, options.start_sample, options.two_bit),
       converter_(options_, signals::is_complex(format)),
       int16_gain_(gain_for(path, format, options_)) {}
 

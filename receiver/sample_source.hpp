@@ -32,6 +32,7 @@ struct SampleSourceOptions {
   bool q_negate = false;
   std::int64_t start_sample = 0;  // samples of the file to skip; the counter still counts from the file start
   double int16_gain = 0.0;        // file scale -> int16 output; 0: automatic (see SampleSource::int16_gain)
+  signals::TwoBitLayout two_bit;  // packing of the 2-bit formats (r2, i2)
 
   // False with a reason when the options cannot describe a recording of `format`.
   bool IsValid(signals::SampleFormat format, std::string* error) const;
@@ -71,7 +72,7 @@ class SampleSource {
 
   // Gain from the file's sample scale to the int16 output, options.int16_gain when given. Automatic:
   // i8/r8 64 and i16/r16 1/4 (full scale to ~11500, headroom for the sqrt(2) growth of the mixing
-  // rotation); f32, which has no full scale, 2048 / RMS of the first 2^16 samples (Gaussian peaks at
+  // rotation); r2/i2 1024 (levels +-1, +-3: RMS ~1900 at the 1-sigma threshold, as i8 at full scale / 4); f32, which has no full scale, 2048 / RMS of the first 2^16 samples (Gaussian peaks at
   // 6 sigma stay below 32767; quantisation noise is 66 dB below the input noise; 1 for an all-zero head).
   float int16_gain() const { return int16_gain_; }
   std::int64_t next_sample() const { return converter_.next_sample(); }

@@ -62,6 +62,8 @@ std::string validation_error(const ScalarTrackingOptions& o) {
           "coherent_ms", o.coherent_ms, "{1, 2, 4, 5, 10, 20} ms");
   c.check(o.bit_sync.min_edges >= 3 && o.bit_sync.min_edges <= 1000, "bit_sync.min_edges", o.bit_sync.min_edges, "[3, 1000]");
   c.check(o.bit_sync.min_ratio >= 1.5 && o.bit_sync.min_ratio <= 100, "bit_sync.min_ratio", o.bit_sync.min_ratio, "[1.5, 100]");
+  c.check(o.bit_sync.min_lead_sigma >= 3 && o.bit_sync.min_lead_sigma <= 100, "bit_sync.min_lead_sigma",
+          o.bit_sync.min_lead_sigma, "[3, 100]");
   c.check(o.bit_sync.max_periods >= 200, "bit_sync.max_periods", o.bit_sync.max_periods, "[200, inf)");
   c.check(o.cn0_window_s >= 0.02 && o.cn0_window_s <= 5, "cn0_window_s", o.cn0_window_s, "[0.02, 5] s");
   c.check(o.cn0_loss_threshold_dbhz >= 0 && o.cn0_loss_threshold_dbhz <= 45, "cn0_loss_threshold_dbhz",

@@ -13,6 +13,7 @@
 
 #include "cli_parse.hpp"
 #include "commands.hpp"
+#include "format_options.hpp"
 #include "receiver/acquisition.hpp"
 #include "receiver/sample_source.hpp"
 #include "signals/input_error.hpp"
@@ -24,19 +25,16 @@ namespace {
 
 // Numbers are taken as text and parsed by cli_parse.hpp so that a malformed one is an InputError like any other.
 struct AcquireArgs {
-  std::string input, format, fs = "", if_hz = "0", ms = "1", noncoh = "10", prns = "1-32";
+  std::string input, fs = "", if_hz = "0", ms = "1", noncoh = "10", prns = "1-32";
   std::string doppler_max = "5000", doppler_step = "0", pfa = "1e-3";
+  FormatArgs format;
   bool iq_swap = false, q_negate = false, json = false, all = false;
 };
 
-signals::InputError bad_option(const std::string& option, const std::string& problem) {
-  return signals::InputError("command line", option + ": " + problem);
-}
-
 void run_acquire(const AcquireArgs& args) {
-  const auto format = signals::parse_sample_format(args.format);
-  if (!format) throw bad_option("--format", "unknown sample format '" + args.format + "' (i8, i16, f32, r8, r16)");
+  const auto format = parse_format(args.format);
   receiver::SampleSourceOptions source_options;
+  source_options.two_bit = parse_two_bit_layout(args.format);
   source_options.fs_hz = parse_double_option("--fs", args.fs);
   source_options.if_hz = parse_double_option("--if", args.if_hz);
   source_options.iq_swap = args.iq_swap;
@@ -53,7 +51,7 @@ void run_acquire(const AcquireArgs& args) {
   std::string why;
   if (!options.IsValid(&why)) throw signals::InputError("command line", why);
 
-  receiver::SampleSource source(args.input, *format, source_options);
+  receiver::SampleSource source(args.input, format, source_options);
   // A recording shorter than K blocks is searched with the whole blocks it holds (said on stderr).
   const auto block = static_cast<std::int64_t>(std::llround(options.fs_hz * options.coherent_s()));
   const std::int64_t blocks_in_file = source.total_samples() / block;
@@ -79,7 +77,7 @@ void run_acquire(const AcquireArgs& args) {
     fmt::print(
         "{{\"input\": \"{}\", \"format\": \"{}\", \"fs_hz\": {}, \"if_hz\": {}, \"coherent_ms\": {}, "
         "\"noncoherent\": {}, \"pfa\": {}, \"satellites\": [",
-        args.input, args.format, options.fs_hz, source_options.if_hz, options.coherent_ms, options.noncoherent,
+        args.input, args.format.format, options.fs_hz, source_options.if_hz, options.coherent_ms, options.noncoherent,
         options.pfa);
     for (std::size_t i = 0; i < shown.size(); ++i) {
       const auto& r = shown[i];
@@ -108,7 +106,7 @@ void add_acquire_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("acquire", "Search a recording for GPS L1 C/A satellites (FFT acquisition)");
   auto args = std::make_shared<AcquireArgs>();
   cmd->add_option("--input", args->input, "IF sample file")->required();
-  cmd->add_option("--format", args->format, "sample format: i8, i16, f32, r8, r16")->required();
+  add_format_options(cmd, args->format);
   cmd->add_option("--fs", args->fs, "sample rate, Hz")->required();
   cmd->add_option("--if", args->if_hz, "intermediate frequency, Hz (0: complex baseband)")->capture_default_str();
   cmd->add_option("--ms", args->ms, "coherent integration, ms (1-10)")->capture_default_str();

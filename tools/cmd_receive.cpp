@@ -22,6 +22,7 @@
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "format_options.hpp"
 #include "receive_config.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
@@ -46,8 +47,9 @@ struct SigintGuard {
 };
 
 struct ReceiveArgs {
-  std::string input, format, fs, if_hz = "0", config, nav, out;
-  std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week;
+  std::string input, fs, if_hz = "0", config, nav, out;
+  std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
+  FormatArgs format;
   bool iq_swap = false, q_negate = false, quiet = false;
 };
 
@@ -106,9 +108,9 @@ class Progress {
 };
 
 void run_receive(const ReceiveArgs& args) {
-  const auto format = signals::parse_sample_format(args.format);
-  if (!format) throw signals::InputError("command line", "--format: unknown sample format '" + args.format + "' (i8, i16, f32, r8, r16)");
+  const auto format = parse_format(args.format);
   receiver::SampleSourceOptions source_options;
+  source_options.two_bit = parse_two_bit_layout(args.format);
   source_options.fs_hz = parse_double_option("--fs", args.fs);
   source_options.if_hz = parse_double_option("--if", args.if_hz);
   source_options.iq_swap = args.iq_swap;
@@ -125,6 +127,7 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.troposphere.empty()) options.pvt.troposphere = on_off("--troposphere", args.troposphere, "on", "off");
   if (!args.ionosphere.empty()) options.pvt.ionosphere = on_off("--ionosphere", args.ionosphere, "broadcast", "off");
   if (!args.channels.empty()) options.channels = parse_int_option("--channels", args.channels);
+  if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   signals::RinexNavData nav;
   if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
@@ -141,7 +144,7 @@ void run_receive(const ReceiveArgs& args) {
   if (args.out.empty()) throw signals::InputError("command line", "--out: an output folder is required");
   if (const std::string why = options.validate(); !why.empty()) throw signals::InputError(args.config.empty() ? "command line" : args.config, why);
 
-  receiver::SampleSource source(args.input, *format, source_options);
+  receiver::SampleSource source(args.input, format, source_options);
   const std::int64_t available = source.total_samples() - source_options.start_sample;
   std::int64_t to_process = available;
   if (duration_s > 0.0) to_process = std::min<std::int64_t>(to_process, std::llround(duration_s * options.fs_hz));
@@ -187,7 +190,10 @@ void run_receive(const ReceiveArgs& args) {
 
   receiver::RunDescription run;
   run.input = args.input;
-  run.format = args.format;
+  run.format = args.format.format;
+  if (signals::is_two_bit(format))
+    run.format += fmt::format(" ({}, {})", signals::to_string(source_options.two_bit.coding),
+                              signals::to_string(source_options.two_bit.order));
   run.fs_hz = options.fs_hz;
   run.if_hz = source_options.if_hz;
   run.skip_s = skip_s;
@@ -196,8 +202,8 @@ void run_receive(const ReceiveArgs& args) {
   outputs.finish(engine, run);
 
   const double t = receiver::processed_seconds(engine);
-  fmt::print("receive: {:.1f} s of signal in {:.1f} s ({:.1f}x real time){}\n", t, wall_s, wall_s > 0 ? t / wall_s : 0.0,
-             run.interrupted ? ", interrupted" : "");
+  fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
+             wall_s > 0 ? t / wall_s : 0.0, engine.threads(), run.interrupted ? ", interrupted" : "");
   int used = 0, tracked = 0;
   for (int prn = 1; prn <= 32; ++prn) {
     used += stats.satellites[static_cast<std::size_t>(prn)].used_in_fixes > 0;
@@ -206,8 +212,9 @@ void run_receive(const ReceiveArgs& args) {
   fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", tracked, used, stats.fixes,
              engine.decoded_ephemerides().size());
   if (stats.fixes == 0)
-    throw CommandExit(3, fmt::format("no position fix in {:.1f} s of signal (outputs up to the end are in {})", t,
-                                     args.out));
+    throw CommandExit(3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} "
+                                     "ephemerides decoded; --nav gives a hot start); outputs up to the end are in {}",
+                                     args.input, t, tracked, engine.decoded_ephemerides().size(), args.out));
   const auto& s = stats;
   fmt::print("receive: first fix after {:.2f} s; mean position {:.7f} deg, {:.7f} deg, {:.2f} m; outputs in {}\n",
              receiver::ttff_seconds(engine), s.sum_lat_rad / s.fixes * 180.0 / M_PI,
@@ -220,7 +227,7 @@ void add_receive_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("receive", "Receive a recording: acquisition, tracking, decoding, observables, PVT");
   auto args = std::make_shared<ReceiveArgs>();
   cmd->add_option("--input", args->input, "IF sample file")->required();
-  cmd->add_option("--format", args->format, "sample format: i8, i16, f32, r8, r16")->required();
+  add_format_options(cmd, args->format);
   cmd->add_option("--fs", args->fs, "sample rate, Hz")->required();
   cmd->add_option("--if", args->if_hz, "intermediate frequency, Hz (0: complex baseband)")->capture_default_str();
   cmd->add_option("--out", args->out, "output folder (created when missing)")->required();
@@ -230,6 +237,7 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--troposphere", args->troposphere, "on|off (default on)");
   cmd->add_option("--ionosphere", args->ionosphere, "broadcast|off (default broadcast)");
   cmd->add_option("--channels", args->channels, "tracking channels (default 12)");
+  cmd->add_option("--threads", args->threads, "worker threads including the main one (default: all cores)");
   cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15 (default all)");
   cmd->add_option("--duration", args->duration, "seconds of signal to process (default: to the end)");
   cmd->add_option("--skip", args->skip, "seconds of signal to skip at the start");

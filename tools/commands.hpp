@@ -17,5 +17,6 @@ void add_imusim_command(CLI::App& app);
 void add_fuse_command(CLI::App& app);
 void add_covariance_command(CLI::App& app);
 void add_gnsssim_command(CLI::App& app);
+void add_compare_command(CLI::App& app);
 
 }  // namespace ultratrack::tools

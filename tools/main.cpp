@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_fuse_command(app);
   ultratrack::tools::add_covariance_command(app);
   ultratrack::tools::add_gnsssim_command(app);
+  ultratrack::tools::add_compare_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

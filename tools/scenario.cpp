@@ -141,8 +141,16 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
           s.if_hz = r.number(n, name);
         } else if (key == "format") {
           const auto f = signals::parse_sample_format(r.string(n, name));
-          if (!f) r.fail(n, name, "unknown sample format (i8, i16, f32, r8, r16)");
+          if (!f) r.fail(n, name, "unknown sample format (" + std::string(signals::sample_format_names()) + ")");
           s.format = *f;
+        } else if (key == "two_bit_coding") {
+          const auto c = signals::parse_two_bit_coding(r.string(n, name));
+          if (!c) r.fail(n, name, "unknown 2-bit coding (" + std::string(signals::two_bit_coding_names()) + ")");
+          s.two_bit.coding = *c;
+        } else if (key == "two_bit_order") {
+          const auto o = signals::parse_bit_order(r.string(n, name));
+          if (!o) r.fail(n, name, "unknown bit order (" + std::string(signals::bit_order_names()) + ")");
+          s.two_bit.order = *o;
         } else if (key == "duration_s") {
           s.duration_s = r.number(n, name);
           check_range(r, n, name, s.duration_s > 0 && s.duration_s <= 86400, "must be within (0, 86400] s");
@@ -390,6 +398,9 @@ std::string to_toml(const Scenario& s) {
     }
     out += first ? "}\n" : " }\n";
     out += fmt::format("nav_data = {}\nnoise = {}\n", s.nav_data, s.noise);
+    if (signals::is_two_bit(s.format))
+      out += fmt::format("two_bit_coding = \"{}\"\ntwo_bit_order = \"{}\"\n", signals::to_string(s.two_bit.coding),
+                         signals::to_string(s.two_bit.order));
   }
   out += fmt::format("\n[time]\ngps_week = {}\ntow_s = {}\n", s.gps_week, toml_float(s.tow_s));
   out += "\n[navigation]\n";

@@ -4,6 +4,7 @@
 //
 //   [signal]      sample_rate_hz = 2.6e6  if_hz = 0.0  format = "i8"  duration_s = 60.0  cn0_dbhz = 45.0
 //                 seed = 1  cn0_dbhz_by_prn = { 5 = 40.0 }  nav_data = true  noise = true
+//                 two_bit_coding = "twos"  two_bit_order = "lsb-first"   (r2/i2 packing, signals/sample_format.hpp)
 //   [time]        gps_week = 2190  tow_s = 518400.0            (true GPS time of the first sample)
 //   [navigation]  rinex = "brdc0010.22n"  or  constellation = "nominal"
 //                 elevation_mask_deg = 5.0  include_unhealthy = false
@@ -53,6 +54,7 @@ struct Scenario {
   double sample_rate_hz = 2.6e6;
   double if_hz = 0.0;
   signals::SampleFormat format = signals::SampleFormat::i8;
+  signals::TwoBitLayout two_bit;  // r2/i2 only
   double duration_s = 60.0;
   double cn0_dbhz = 45.0;
   std::uint64_t seed = 1;

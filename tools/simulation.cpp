@@ -181,8 +181,9 @@ signals::SynthesiserOptions synthesiser_options(const Scenario& s, const Navigat
   o.sample_rate_hz = s.sample_rate_hz;
   o.if_hz = s.if_hz;
   o.real_output = !signals::is_complex(s.format);
-  // Automatic gain: noise plus signals at RMS = full scale / 4 per component (clipping beyond 4 sigma).
-  o.output_rms = signals::full_scale(s.format) / 4.0;
+  // Automatic gain: noise plus signals at RMS = full scale / 4 per component (clipping beyond 4 sigma); the
+  // 2-bit formats rescale to the noise alone in run_simulation (quantiser threshold at 1 noise sigma).
+  o.output_rms = signals::nominal_rms(s.format);
   o.start = {s.gps_week, s.tow_s};
   o.default_cn0_dbhz = s.cn0_dbhz;
   o.cn0_dbhz_by_prn = s.cn0_dbhz_by_prn;
@@ -320,11 +321,15 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
   std::vector<std::unique_ptr<signals::SampleWriter>> writers;
   for (int a = 0; a < n_ant; ++a) {
     const auto path = out_dir / fmt::format("antenna{}.{}.bin", a, signals::to_string(s.format));
-    writers.push_back(std::make_unique<signals::SampleWriter>(path, s.format));
+    writers.push_back(std::make_unique<signals::SampleWriter>(path, s.format, s.two_bit));
     result.sample_files.push_back(path);
   }
   result.satellites = synth.visible_satellites(0);
-  result.noise_sigma = synth.noise_sigma();
+  // 2-bit quantiser threshold (2 in file units, sample_writer.hpp) at 1 sigma of the noise alone, the
+  // minimum-loss setting, set from the noise because the signals (up to ~10 % of the power with ten
+  // satellites at 45 dB-Hz and a few MHz) are not what the threshold should scale with.
+  const float to_file = signals::is_two_bit(s.format) ? static_cast<float>(2.0 / synth.noise_sigma()) : 1.0f;
+  result.noise_sigma = synth.noise_sigma() * to_file;
 
   // Truth rows at receiver times k / truth_rate (sample-exact), CSV built in memory (small).
   std::string truth = std::string(kTruthHeader) + (inertial ? ",roll_deg,pitch_deg,yaw_deg\n" : "\n");
@@ -371,7 +376,11 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
         {static_cast<std::int64_t>(chunk), total - n, std::max<std::int64_t>(1, truth_sample(next_truth) - n)}));
     for (int a = 0; a < n_ant; ++a) spans[a] = std::span(buffers[a].data(), count);
     synth.generate(spans);
-    for (int a = 0; a < n_ant; ++a) writers[a]->write(spans[a]);
+    for (int a = 0; a < n_ant; ++a) {
+      if (to_file != 1.0f)
+        for (auto& x : spans[a]) x *= to_file;
+      writers[a]->write(spans[a]);
+    }
     n += static_cast<std::int64_t>(count);
     const int decile = static_cast<int>(10 * n / total);
     if (progress && decile > last_decile) {

@@ -4,7 +4,8 @@
 # by the throughput comparison. Skips (exit 0, message) when gnss-sdr is not installed.
 #
 #   benchmarks/peers/gnss_sdr_run.sh FILE FORMAT FS_HZ OUT_DIR [CHANNELS] [IF_HZ]
-#   FORMAT: i8 | i16 | f32 (interleaved I/Q)
+#   FORMAT: i8 | i16 | f32 (interleaved I/Q) | i2 (2-bit packed I/Q as ultratrack writes it by default:
+#           twos, lsb-first = GNSS-SDR's Two_Bit_Packed_File_Signal_Source, sample_type=iq, big_endian_bytes=false)
 #
 # GNSS-SDR configuration used (documented so that the comparison is fair): File_Signal_Source, a pass-through
 # signal conditioner (no filtering or resampling), PCPS acquisition (+-5 kHz, 250 Hz step, pfa 0.01 threshold),
@@ -22,15 +23,20 @@ case "$format" in
   i8) item=ibyte; adapter=Ibyte_To_Complex ;;
   i16) item=ishort; adapter=Ishort_To_Complex ;;
   f32) item=gr_complex; adapter=Pass_Through ;;
+  i2) item=byte; adapter=Pass_Through ;;
   *) echo "gnss_sdr_run.sh: format $format not supported" >&2; exit 2 ;;
 esac
+source=File_Signal_Source
+[[ "$format" == i2 ]] && source=Two_Bit_Packed_File_Signal_Source
 conf=$out/gnss-sdr.conf
 cat > "$conf" <<CONF
 [GNSS-SDR]
 GNSS-SDR.internal_fs_sps=$fs
-SignalSource.implementation=File_Signal_Source
+SignalSource.implementation=$source
 SignalSource.filename=$file
 SignalSource.item_type=$item
+SignalSource.sample_type=iq
+SignalSource.big_endian_bytes=false
 SignalSource.sampling_frequency=$fs
 SignalSource.samples=0
 SignalSource.repeat=false
@@ -75,13 +81,13 @@ cd "$out"
 wall=$(grep "Elapsed (wall clock)" "$out/time.txt" | awk '{print $NF}')
 peak_kb=$(grep "Maximum resident set size" "$out/time.txt" | awk '{print $NF}')
 bytes=$(stat -c %s "$file")
-case "$format" in i8) bps=2 ;; i16) bps=4 ;; f32) bps=8 ;; esac
+case "$format" in i8) bps=2 ;; i16) bps=4 ;; f32) bps=8 ;; i2) bps=0.5 ;; esac
 python3 - "$wall" "$peak_kb" "$bytes" "$bps" "$fs" "$log" <<'PY'
 import re, sys
 wall, peak_kb, nbytes, bps, fs, log = sys.argv[1:]
 parts = [float(p) for p in wall.split(':')]
 secs = sum(p * 60 ** i for i, p in enumerate(reversed(parts)))
-duration = int(nbytes) / int(bps) / float(fs)
+duration = int(nbytes) / float(bps) / float(fs)
 pos = [l for l in open(log, errors='replace') if 'Position at' in l]
 print(f"gnss-sdr: signal {duration:.1f} s, wall {secs:.1f} s, realtime factor {duration / secs:.2f}, "
       f"peak memory {int(peak_kb) / 1024:.0f} MB, fixes {len(pos)}")

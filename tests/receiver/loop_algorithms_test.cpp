@@ -200,3 +200,42 @@ TEST(BitSync, HistogramFindsTheEdgeAt35DbHz) {
     EXPECT_LT(k - 1000, 2000);
   }
 }
+
+// Below ~31 dB-Hz noise flips the 1 ms sign test so often (p = exp(-C/N0 T) / 2 = 0.30 at 27 dB-Hz, 0.36 at 25)
+// that the edge bin's count is never 3 times the runner-up's (expected ratio 1 / (2 p) = 1.6 and 1.4): the lead
+// test must decide, on the right edge, in about (4 / (1/2 - p))^2 bits plus the runner-up's max-of-19 margin
+// (~7-10 s at 27 dB-Hz, ~15-20 s at 25); the bounds are twice that.
+TEST(BitSync, LeadTestFindsTheEdgeAt27And25DbHz) {
+  std::normal_distribution<double> g(0.0, std::sqrt(0.5));
+  std::bernoulli_distribution bit(0.5);
+  for (double cn0 : {27.0, 25.0}) {
+    const double s = std::sqrt(std::pow(10.0, cn0 / 10.0) * 1e-3);
+    int seed = 31;
+    for (int edge : {0, 7, 19}) {
+      std::mt19937 rng(++seed);
+      BitSynchronizer sync;
+      int value = 1;
+      int k = 1000;
+      for (; k < 61000 && !sync.synchronised(); ++k) {
+        if ((k - edge) % 20 == 0) value = bit(rng) ? 1 : -1;
+        sync.add(k, polar(value * s, 0.002 * k) + std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))));
+      }
+      ASSERT_TRUE(sync.synchronised()) << cn0 << " dB-Hz, edge " << edge;
+      EXPECT_EQ(((sync.edge_period() - edge) % 20 + 20) % 20, 0) << cn0 << " dB-Hz, edge " << edge;
+      EXPECT_LT(k - 1000, cn0 > 26.0 ? 20000 : 40000) << cn0 << " dB-Hz, edge " << edge;
+    }
+  }
+}
+
+// Noise alone: every bin grows at 1/2 per bit; in 60 s no bin may lead by 4 sigma (a false edge would make the
+// channel integrate across bit edges).
+TEST(BitSync, NoiseAloneNeverSynchronisesIn60s) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  for (int seed : {5, 6, 7}) {
+    std::mt19937 rng(seed);
+    BitSynchronizer sync;
+    for (int k = 0; k < 60000; ++k)
+      sync.add(k, std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))));
+    EXPECT_FALSE(sync.synchronised()) << "seed " << seed;
+  }
+}

@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 
 #include "receiver/acquisition.hpp"
@@ -169,4 +171,77 @@ TEST(ReceiverEngine, ReleasesALostChannelAndReacquiresTheSatellite) {
   const TrackingRecord& last = recorder.records.at(9).back();
   EXPECT_TRUE(last.phase_locked);
   EXPECT_NEAR(last.doppler_hz, test::true_doppler_hz(again, static_cast<double>(last.sample_index) / kFs), 5.0);
+}
+
+// Threads change nothing: a satellite that rises at 1.2 s while two others are tracked is found by a
+// background re-acquisition (snapshots every 1 s) and joins exactly reacquisition_latency_s after its
+// snapshot ended; every tracking record and acquisition report, in order, is identical with 1, 2 and 3
+// threads (the engine feeds blocks of odd sizes so that segment boundaries fall everywhere).
+TEST(ReceiverEngine, ResultsAreIdenticalForAnyNumberOfThreads) {
+  test::TestSatellite late = satellite(21, -1500.0, 77.7);
+  late.start_s = 1.2;
+  const std::vector<test::TestSatellite> sats = {satellite(4, 2100.0, 300.3), satellite(13, -700.0, 900.9), late};
+  struct Log : ReceiverObserver {
+    std::vector<TrackingRecord> records;
+    std::vector<std::pair<std::int64_t, std::vector<AcquisitionResult>>> acquisitions;
+    void on_tracking(const TrackingRecord& r) override { records.push_back(r); }
+    void on_acquisition(std::int64_t first, const std::vector<AcquisitionResult>& results) override {
+      acquisitions.emplace_back(first, results);
+    }
+  };
+  const std::int64_t total = static_cast<std::int64_t>(4.0 * kFs);
+  const auto signal = test::generate(sats, test::TestSignal{kFs, true, 17}, 0, total);
+  std::vector<Log> logs(3);
+  for (int threads = 1; threads <= 3; ++threads) {
+    ReceiverOptions options;
+    options.fs_hz = kFs;
+    options.prns = {4, 9, 13, 21, 30};
+    options.reacquisition_interval_s = 1.0;
+    options.reacquisition_latency_s = 0.5;
+    options.threads = threads;
+    Log& log = logs[static_cast<std::size_t>(threads - 1)];
+    ReceiverEngine engine(options, log);
+    EXPECT_EQ(engine.threads(), threads);
+    for (std::int64_t first = 0, block = 50001; first < total; first += block, block = block == 50001 ? 77777 : 50001) {
+      const auto n = std::min<std::int64_t>(block, total - first);
+      engine.process(std::span(signal.data() + first, static_cast<std::size_t>(n)), first);
+    }
+    EXPECT_EQ(engine.channels_in_use(), 3) << threads;
+  }
+  const Log& one = logs[0];
+  // PRN 21's first record: its channel starts at the end of the snapshot that found it + the latency; records
+  // fall on every 20th code period of the channel's count, so the first comes within 20 periods (+ 1 for the
+  // replica's first period start).
+  std::optional<std::int64_t> found_snapshot;
+  for (const auto& [first, results] : one.acquisitions)
+    for (const auto& r : results)
+      if (r.prn == 21 && r.detected && !found_snapshot) found_snapshot = first;
+  ASSERT_TRUE(found_snapshot.has_value());
+  EXPECT_GE(static_cast<double>(*found_snapshot) / kFs, 1.2 - 0.02);
+  const auto first21 = std::find_if(one.records.begin(), one.records.end(), [](const auto& r) { return r.prn == 21; });
+  ASSERT_NE(first21, one.records.end());
+  const std::int64_t join = *found_snapshot + 52000 + static_cast<std::int64_t>(0.5 * kFs);  // 20 ms snapshot
+  EXPECT_GE(first21->sample_index, join);
+  EXPECT_LE(first21->sample_index, join + 21 * 2600);
+  for (std::size_t t = 1; t < logs.size(); ++t) {
+    const Log& other = logs[t];
+    ASSERT_EQ(other.records.size(), one.records.size()) << t + 1 << " threads";
+    for (std::size_t i = 0; i < one.records.size(); ++i) {
+      const TrackingRecord &a = one.records[i], &b = other.records[i];
+      ASSERT_TRUE(a.prn == b.prn && a.sample_index == b.sample_index && a.prompt == b.prompt &&
+                  a.doppler_hz == b.doppler_hz && a.code_phase_chips == b.code_phase_chips && a.state == b.state &&
+                  (a.cn0_dbhz == b.cn0_dbhz || (std::isnan(a.cn0_dbhz) && std::isnan(b.cn0_dbhz))))
+          << "record " << i << " differs with " << t + 1 << " threads";
+    }
+    ASSERT_EQ(other.acquisitions.size(), one.acquisitions.size());
+    for (std::size_t i = 0; i < one.acquisitions.size(); ++i) {
+      EXPECT_EQ(other.acquisitions[i].first, one.acquisitions[i].first);
+      ASSERT_EQ(other.acquisitions[i].second.size(), one.acquisitions[i].second.size());
+      for (std::size_t j = 0; j < one.acquisitions[i].second.size(); ++j) {
+        EXPECT_EQ(other.acquisitions[i].second[j].prn, one.acquisitions[i].second[j].prn);
+        EXPECT_EQ(other.acquisitions[i].second[j].doppler_hz, one.acquisitions[i].second[j].doppler_hz);
+        EXPECT_EQ(other.acquisitions[i].second[j].metric, one.acquisitions[i].second[j].metric);
+      }
+    }
+  }
 }

@@ -1,0 +1,22 @@
+// The sample-format options every command shares (--format, --2bit-coding, --2bit-order), declared and
+// parsed in this one place so that names, help and messages stay the same (signals/sample_format.hpp).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "signals/sample_format.hpp"
+
+namespace ultratrack::tools {
+
+struct FormatArgs {
+  std::string format, coding = "twos", order = "lsb-first";
+};
+
+// Adds the three options to cmd (--format required) with help that lists every name.
+void add_format_options(CLI::App* cmd, FormatArgs& args);
+// Parsed values; an unknown name is an InputError("command line", ...) that lists the known ones.
+signals::SampleFormat parse_format(const FormatArgs& args);
+signals::TwoBitLayout parse_two_bit_layout(const FormatArgs& args);
+
+}  // namespace ultratrack::tools
