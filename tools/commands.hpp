@@ -14,6 +14,9 @@ void add_acquire_command(CLI::App& app);
 void add_receive_command(CLI::App& app);
 void add_ins_command(CLI::App& app);
 void add_imusim_command(CLI::App& app);
+void add_fuse_command(CLI::App& app);
+void add_covariance_command(CLI::App& app);
+void add_gnsssim_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_attitude_command(CLI::App& app);
 

@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   ultratrack::tools::add_receive_command(app);
   ultratrack::tools::add_ins_command(app);
   ultratrack::tools::add_imusim_command(app);
+  ultratrack::tools::add_fuse_command(app);
+  ultratrack::tools::add_covariance_command(app);
+  ultratrack::tools::add_gnsssim_command(app);
   ultratrack::tools::add_compare_command(app);
   ultratrack::tools::add_attitude_command(app);
   try {

@@ -1,0 +1,88 @@
+#include "fusion/fuse_motion_alignment.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "ins/earth_model.hpp"
+
+namespace ultratrack::fusion {
+
+std::optional<ins::EulerAngles> level_with_heading(const Eigen::Vector3d& f_b, const Eigen::Vector3d& f_n,
+                                                   double heading_rad) {
+  // Remove the heading: f_h = Rz(-heading) f_n must equal Ry(pitch) Rx(roll) f_b. Rx leaves x alone, so
+  // f_b.x = cos(pitch) f_h.x - sin(pitch) f_h.z, i.e. A cos + B sin = C.
+  const Eigen::Vector3d f_h = Eigen::AngleAxisd(-heading_rad, Eigen::Vector3d::UnitZ()) * f_n;
+  const double A = f_h.x(), B = -f_h.z(), C = f_b.x();
+  const double R = std::hypot(A, B);
+  if (!(R > 0.0)) return std::nullopt;
+  const double ratio = C / R;
+  if (std::fabs(ratio) > 1.0 + 0.05) return std::nullopt;
+  const double base = std::atan2(B, A);
+  const double d = std::acos(std::clamp(ratio, -1.0, 1.0));
+  const double p1 = ins::wrap_pi(base - d), p2 = ins::wrap_pi(base + d);
+  ins::EulerAngles e;
+  e.pitch_rad = std::fabs(p1) <= std::fabs(p2) ? p1 : p2;
+  if (std::fabs(e.pitch_rad) > 1.5) return std::nullopt;
+  // Then Rx(roll) f_b = Ry(-pitch) f_h in the y-z plane.
+  const Eigen::Vector3d v = Eigen::AngleAxisd(-e.pitch_rad, Eigen::Vector3d::UnitY()) * f_h;
+  e.roll_rad = ins::wrap_pi(std::atan2(v.z(), v.y()) - std::atan2(f_b.z(), f_b.y()));
+  e.yaw_rad = ins::wrap_pi(heading_rad);
+  return e;
+}
+
+std::optional<MotionAlignment> align_in_motion(std::span<const ins::ImuIncrement> imu,
+                                               std::span<const GnssVelocitySample> gnss,
+                                               const MotionAlignmentOptions& o) {
+  if (imu.size() < 2 || gnss.size() < 2) return std::nullopt;
+  auto fast = [&](const GnssVelocitySample& s) { return s.v_n.head<2>().norm() >= o.min_speed_mps; };
+  // The IMU's first interval starts one sample period before its first row.
+  const double imu_start = imu[0].t_s - (imu[1].t_s - imu[0].t_s);
+  for (std::size_t i = 0; i < gnss.size(); ++i) {
+    if (!fast(gnss[i]) || gnss[i].t_s < imu_start) continue;
+    std::size_t j = i + 1;
+    while (j < gnss.size() && gnss[j].t_s - gnss[i].t_s < o.window_s) ++j;
+    if (j == gnss.size()) return std::nullopt;
+    if (!fast(gnss[j]) || gnss[j].t_s > imu.back().t_s) continue;
+    // Mean specific force over the IMU rows whose intervals end in (t_i, t_j], every increment rotated by
+    // the gyros into the body frame at the window's end (the attitude changes during roll-in or turns).
+    std::size_t k_first = 0, k_last = 0;
+    int rows = 0;
+    for (std::size_t k = 1; k < imu.size(); ++k) {
+      if (imu[k].t_s <= gnss[i].t_s) continue;
+      if (imu[k].t_s > gnss[j].t_s) break;
+      if (rows == 0) k_first = k;
+      k_last = k;
+      ++rows;
+    }
+    if (rows < 2) continue;
+    Eigen::Vector3d sum_dv = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d to_end = Eigen::Matrix3d::Identity();  // body at the end of interval k -> body at t_last
+    for (std::size_t k = k_last + 1; k-- > k_first;) {
+      const Eigen::Matrix3d half = ins::quaternion_from_rotation_vector(0.5 * imu[k].dtheta_b).toRotationMatrix();
+      sum_dv += to_end * half.transpose() * imu[k].dv_b;
+      to_end = to_end * ins::quaternion_from_rotation_vector(imu[k].dtheta_b).toRotationMatrix().transpose();
+    }
+    const double t_first = imu[k_first - 1].t_s, t_last = imu[k_last].t_s;
+    const GnssVelocitySample &a = gnss[i], &b = gnss[j];
+    const double T = b.t_s - a.t_s;
+    const Eigen::Vector3d v_mid = 0.5 * (a.v_n + b.v_n);
+    const double lat = 0.5 * (a.lat_rad + b.lat_rad), h = 0.5 * (a.height_m + b.height_m);
+    const Eigen::Vector3d f_n = (b.v_n - a.v_n) / T - ins::gravity_n(lat, h) +
+                                (2.0 * ins::earth_rate_n(lat) + ins::transport_rate_n(lat, h, v_mid)).cross(v_mid);
+    const Eigen::Vector3d f_b = sum_dv / (t_last - t_first);
+    const double heading_end = std::atan2(b.v_n.y(), b.v_n.x());
+    const auto level = level_with_heading(f_b, f_n, heading_end);
+    if (!level) continue;
+    MotionAlignment r;
+    r.t_s = b.t_s;
+    r.euler = *level;
+    r.q_nb = ins::quaternion_from_euler(r.euler);
+    r.v_n = b.v_n;
+    r.mean_f_b = f_b;
+    r.f_n = f_n;
+    return r;
+  }
+  return std::nullopt;
+}
+
+}  // namespace ultratrack::fusion

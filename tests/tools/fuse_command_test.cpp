@@ -1,0 +1,198 @@
+// `ultratrack fuse` end to end, in process, on simulated data: a "foreign" data set (200 Hz IMU, 5 Hz GNSS
+// fixes at non-integer times t = 0.137 + 0.2 k) aligned in motion converges, beats the fixes it was given and
+// stays consistent with its own 1-sigma; static and configured alignments; outages; bad input is one clear
+// InputError. Truth is the trajectory simulator's.
+#include <gtest/gtest.h>
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "fused_nav_csv.hpp"
+#include "gnss_csv.hpp"
+#include "io/input_error.hpp"
+#include "support/test_data.hpp"
+
+namespace fs = std::filesystem;
+using ultratrack::io::InputError;
+
+namespace {
+
+void run(std::vector<std::string> args) {
+  CLI::App app{"ultratrack"};
+  app.require_subcommand(1);
+  ultratrack::tools::add_imusim_command(app);
+  ultratrack::tools::add_gnsssim_command(app);
+  ultratrack::tools::add_fuse_command(app);
+  std::vector<std::string> rev(args.rbegin(), args.rend());  // CLI11 parses a reversed vector
+  app.parse(rev);
+}
+
+std::string read_text(const fs::path& f) {
+  std::ifstream in(f);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The number after "key": (first occurrence after the optional section key).
+double json_number(const fs::path& file, const std::string& key, const std::string& section = "") {
+  std::string text = read_text(file);
+  if (!section.empty()) {
+    const auto at = text.find("\"" + section + "\"");
+    if (at == std::string::npos) {
+      ADD_FAILURE() << section << " missing in " << file;
+      return 1e300;
+    }
+    text = text.substr(at);
+  }
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex("\"" + key + "\": ([-+0-9.eE]+|true|false|null)"))) {
+    ADD_FAILURE() << key << " missing in " << file;
+    return 1e300;
+  }
+  if (m[1] == "true") return 1.0;
+  if (m[1] == "false" || m[1] == "null") return 0.0;
+  return std::stod(m[1]);
+}
+
+// A land vehicle (10 s parked, then accelerating, turning, climbing) with an HG1700AE at 200 Hz, and 5 Hz
+// fixes with white 1.5/1.5/3 m errors and 0.05 m/s velocities at t = 0.137 + 0.2 k.
+fs::path make_land_data(double duration_s, const std::string& preset = "hg1700ae") {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  run({"imusim", "--profile", "land", "--duration", std::to_string(duration_s), "--rate", "200", "--preset", preset,
+       "--seed", "11", "--out", (dir / "sim").string()});
+  run({"gnsssim", "--truth", (dir / "sim/truth.csv").string(), "--rate", "5", "--first", "0.137", "--seed", "5",
+       "--out", (dir / "gnss.csv").string()});
+  return dir;
+}
+
+void expect_converged_and_better_than_gnss(const fs::path& summary) {
+  EXPECT_EQ(json_number(summary, "converged"), 1.0);
+  const double fused = json_number(summary, "horizontal_m", "rms_converged");
+  const double gnss = json_number(summary, "horizontal_m", "gnss_only_rms");
+  // white 1.5 m per axis: GNSS-only horizontal RMS ~ 2.1 m; the INS smooths it over many fixes
+  EXPECT_GT(gnss, 1.8);
+  EXPECT_LT(gnss, 2.4);
+  EXPECT_LT(fused, 0.7 * gnss);
+  EXPECT_LT(json_number(summary, "vertical_m", "rms_converged"), json_number(summary, "vertical_m", "gnss_only_rms"));
+  // HG1700AE heading once converged: well below the 1 deg convergence threshold
+  EXPECT_LT(json_number(summary, "heading_deg", "rms_converged"), 0.5);
+  // consistency: nearly every row within 3 sigma on all three axes (a Gaussian gives 99.2 %)
+  EXPECT_GT(json_number(summary, "within_3sigma", "rms_converged"), 0.95);
+  EXPECT_LE(json_number(summary, "updates_rejected"), 0.01 * json_number(summary, "fixes_used"));
+}
+
+}  // namespace
+
+TEST(FuseCommand, ForeignRatesAndTimesAlignInMotionAndConverge) {
+  const fs::path dir = make_land_data(240.0);
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--coupling", "loose",
+       "--filter", "ekf", "--align", "motion", "--truth", (dir / "sim/truth.csv").string(), "--quiet", "--out",
+       (dir / "fuse").string()});
+  const fs::path summary = dir / "fuse/summary.json";
+  expect_converged_and_better_than_gnss(summary);
+  // the alignment happens at a fix time (0.137 + 0.2 k) once the car moves: after the 10 s stop
+  const double t0 = json_number(summary, "t_s", "alignment");
+  EXPECT_GT(t0, 10.0);
+  EXPECT_NEAR(std::remainder(t0 - 0.137, 0.2), 0.0, 1e-9);
+  const auto rows = ultratrack::tools::read_fused_nav_csv(dir / "fuse/nav.csv");
+  ASSERT_GT(rows.size(), 40000u);
+  EXPECT_EQ(rows.front().nav.t_s, t0);  // starts exactly at the alignment time, between IMU samples
+  EXPECT_NEAR(rows.back().nav.t_s, 240.0, 1e-9);
+  const auto fixes = ultratrack::tools::read_gnss_csv(dir / "gnss.csv");
+  long long after = 0;
+  for (const auto& f : fixes) after += f.t_s > t0 ? 1 : 0;
+  EXPECT_EQ(json_number(summary, "fixes_used"), after);
+}
+
+TEST(FuseCommand, UkfOnTheSameForeignDataConvergesToo) {
+  const fs::path dir = make_land_data(240.0);
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--filter", "ukf",
+       "--truth", (dir / "sim/truth.csv").string(), "--quiet", "--out", (dir / "fuse").string()});
+  expect_converged_and_better_than_gnss(dir / "fuse/summary.json");
+}
+
+// The car's first 10 s are parked: the HG1700AE gyrocompasses (heading ~ 1 deg/h / (15 deg/h cos L) ~ 5 deg
+// at most), then the filter refines heading once the car accelerates and turns.
+TEST(FuseCommand, StaticAlignmentFromTheParkedStart) {
+  const fs::path dir = make_land_data(240.0);
+  std::ofstream(dir / "c.toml") << "[alignment]\nstatic_duration_s = 9.0\n";
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--align", "static",
+       "--config", (dir / "c.toml").string(), "--truth", (dir / "sim/truth.csv").string(), "--quiet", "--out",
+       (dir / "fuse").string()});
+  const fs::path summary = dir / "fuse/summary.json";
+  EXPECT_NEAR(json_number(summary, "t_s", "alignment"), 9.0, 0.005);
+  expect_converged_and_better_than_gnss(summary);
+}
+
+TEST(FuseCommand, ConfiguredAttitudeAndAnOutage) {
+  const fs::path dir = make_land_data(240.0);
+  // parked level heading north at the start (the land profile's initial state)
+  std::ofstream(dir / "c.toml") << "[initial]\nattitude_deg = [0.0, 0.0, 0.0]\nsigma_attitude_deg = [0.5, 0.5, 2.0]\n";
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--align", "config",
+       "--config", (dir / "c.toml").string(), "--outage", "150", "30", "--truth", (dir / "sim/truth.csv").string(),
+       "--quiet", "--out", (dir / "fuse").string()});
+  const fs::path summary = dir / "fuse/summary.json";
+  EXPECT_EQ(json_number(summary, "fixes_in_outage"), 150);  // 30 s of 5 Hz fixes dropped
+  const double err = json_number(summary, "horizontal_error_m", "outages");
+  const double sigma = json_number(summary, "sigma_horizontal_m", "outages");
+  EXPECT_GT(sigma, 0.1);
+  EXPECT_LT(err, 4.0 * sigma);  // the drift is what the filter says it could be
+  EXPECT_LT(err, 10.0);         // HG1700AE over 30 s after convergence
+}
+
+TEST(FuseCommand, BadInputIsOneInputError) {
+  const fs::path dir = make_land_data(30.0);
+  const std::string imu = (dir / "sim/imu.csv").string(), gnss = (dir / "gnss.csv").string();
+  const std::string out = (dir / "fuse").string();
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--filter", "kf", "--out", out}), InputError);
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--coupling", "tight", "--out", out}), InputError);
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--align", "config", "--out", out}), InputError);
+  // never faster than 5 m/s for 2 s within 12 s of data
+  std::ofstream(dir / "short.toml") << "[alignment]\nmotion_min_speed_mps = 500.0\n";
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--config", (dir / "short.toml").string(), "--out", out}),
+               InputError);
+  std::ofstream(dir / "bad.toml") << "[filter]\nukf_alpha = -1.0\n";
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--config", (dir / "bad.toml").string(), "--out", out}),
+               InputError);
+  std::ofstream(dir / "g.csv")
+      << "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m\n"
+         "1.0,36.37,127.36,100,,,,1,1,2\n2.0,36.37,127.36,nan,,,,1,1,2\n";
+  try {
+    run({"fuse", "--imu", imu, "--gnss", (dir / "g.csv").string(), "--out", out});
+    ADD_FAILURE() << "NaN accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 3);
+  }
+  // fixes entirely after the IMU data
+  std::ofstream(dir / "late.csv")
+      << "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m\n"
+         "1000.0,36.37,127.36,100,,,,1,1,2\n";
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", (dir / "late.csv").string(), "--out", out}), InputError);
+  EXPECT_FALSE(fs::exists(dir / "fuse/nav.csv"));  // nothing half-written
+}
+
+// Position-only fixes (empty velocity columns): the in-motion alignment takes the track from position
+// differences and the filter updates with positions alone (the seed 003 fallback).
+TEST(FuseCommand, PositionOnlyFixesAlignFromPositionDifferences) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  run({"imusim", "--profile", "land", "--duration", "240", "--rate", "200", "--preset", "hg1700ae", "--seed", "11",
+       "--out", (dir / "sim").string()});
+  run({"gnsssim", "--truth", (dir / "sim/truth.csv").string(), "--rate", "5", "--first", "0.137", "--no-velocity",
+       "--seed", "5", "--out", (dir / "gnss.csv").string()});
+  EXPECT_FALSE(ultratrack::tools::read_gnss_csv(dir / "gnss.csv").front().has_velocity);
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--truth",
+       (dir / "sim/truth.csv").string(), "--quiet", "--out", (dir / "fuse").string()});
+  const fs::path summary = dir / "fuse/summary.json";
+  EXPECT_EQ(json_number(summary, "converged"), 1.0);
+  EXPECT_LT(json_number(summary, "horizontal_m", "rms_converged"),
+            0.7 * json_number(summary, "horizontal_m", "gnss_only_rms"));
+  EXPECT_LT(json_number(summary, "heading_deg", "rms_converged"), 1.0);
+}

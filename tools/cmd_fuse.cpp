@@ -1,0 +1,141 @@
+// `ultratrack fuse`: loosely coupled GNSS/INS from an IMU CSV and a GNSS fix CSV (EKF or UKF, closed loop),
+// after a static, in-motion or configured alignment. Writes DIR/nav.csv (nav columns + 1-sigma) and
+// DIR/summary.json (update counts, convergence, RMS against --truth); progress and a summary on stdout.
+#include <fmt/core.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <filesystem>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "fuse_run.hpp"
+#include "fused_nav_csv.hpp"
+#include "gnss_csv.hpp"
+#include "ins/imu_csv.hpp"
+#include "io/atomic_file.hpp"
+#include "io/input_error.hpp"
+#include "truth_csv.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct FuseCommandOptions {
+  std::string imu_file, gnss_file, truth_file, config_file, out_dir;
+  std::string coupling = "loose", filter = "ekf", align = "motion";
+  std::vector<double> outage;  // START DURATION pairs
+  int decimate = 1;
+  bool quiet = false;
+};
+
+void run_fuse_command(const FuseCommandOptions& o) {
+  if (o.coupling != "loose")
+    throw io::InputError("command line", "--coupling " + o.coupling +
+                                             ": fuse takes external position/velocity fixes, only 'loose' applies "
+                                             "(tight coupling runs from observables: ultratrack receive --imu)");
+  FuseSettings s;
+  if (o.filter == "ekf") {
+    s.filter = fusion::FilterKind::Ekf;
+  } else if (o.filter == "ukf") {
+    s.filter = fusion::FilterKind::Ukf;
+  } else {
+    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + o.filter + "'");
+  }
+  if (o.align == "static") {
+    s.align = AlignMode::Static;
+  } else if (o.align == "motion") {
+    s.align = AlignMode::Motion;
+  } else if (o.align == "config") {
+    s.align = AlignMode::Config;
+  } else {
+    throw io::InputError("command line", "--align must be static, motion or config, got '" + o.align + "'");
+  }
+  if (o.decimate < 1) throw io::InputError("command line", "--decimate must be at least 1");
+  if (o.outage.size() % 2 != 0) throw io::InputError("command line", "--outage takes START DURATION pairs");
+  for (std::size_t i = 0; i < o.outage.size(); i += 2) {
+    if (!(o.outage[i + 1] > 0.0)) throw io::InputError("command line", "--outage duration must be positive");
+    s.outages.emplace_back(o.outage[i], o.outage[i + 1]);
+  }
+  if (!o.config_file.empty()) s.config = read_fuse_config(o.config_file);
+
+  const auto imu = ins::read_imu_csv(o.imu_file);
+  const auto gnss = read_gnss_csv(o.gnss_file);
+  std::vector<ins::NavState> truth;
+  if (!o.truth_file.empty()) truth = read_truth_csv(o.truth_file);
+  if (!o.quiet)
+    fmt::print("fuse: {} IMU rows ({:.3f}-{:.3f} s), {} GNSS fixes ({:.3f}-{:.3f} s), loose {}, align {}\n",
+               imu.size(), imu.front().t_s, imu.back().t_s, gnss.size(), gnss.front().t_s, gnss.back().t_s, o.filter,
+               o.align);
+
+  fs::create_directories(o.out_dir);
+  FusedNavCsvWriter nav(fs::path(o.out_dir) / "nav.csv");
+  long long rows = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  const FuseResult r = fuse(
+      imu, gnss, truth, s,
+      [&](const ins::NavState& state, const NavSigma& sigma) {
+        if (rows++ % o.decimate == 0) nav.write(state, sigma);
+      },
+      [&](double fraction) {
+        if (!o.quiet) fmt::print("fuse: {:3.0f} %\n", 100.0 * fraction);
+      });
+  nav.commit();
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  io::write_file_atomically(fs::path(o.out_dir) / "summary.json",
+                            fuse_summary_json(r, s, o.imu_file, o.gnss_file, o.truth_file));
+
+  const auto& e = r.initial_attitude;
+  fmt::print("fuse: aligned {}: roll {:.3f} pitch {:.3f} yaw {:.3f} deg\n", r.alignment_note, e.roll_rad / kDeg,
+             e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+  fmt::print("fuse: {:.1f} s navigated in {:.2f} s; fixes used {}, updates accepted {}, rejected {}{}\n",
+             r.end_s - r.start_s, wall_s, r.fixes_used, r.counters.accepted, r.counters.rejected,
+             r.fixes_in_outage ? fmt::format(", {} dropped in outages", r.fixes_in_outage) : std::string());
+  fmt::print("fuse: {}; final 1-sigma: horizontal {:.2f} m, vertical {:.2f} m, heading {:.3f} deg\n",
+             r.converged_at_s ? fmt::format("converged (heading 1-sigma < {} deg) from {:.1f} s",
+                                            s.config.convergence_heading_sigma_deg, *r.converged_at_s)
+                              : std::string("NOT converged"),
+             r.final_sigma.position_ned_m.head<2>().norm(), r.final_sigma.position_ned_m.z(),
+             r.final_sigma.attitude_ned_rad.z() / kDeg);
+  if (r.rms_all)
+    fmt::print("fuse: against truth: position RMS {:.3f} m (horizontal {:.3f}, vertical {:.3f}), velocity {:.4f} m/s, "
+               "attitude {:.4f} deg; GNSS fixes alone {:.3f} m\n",
+               r.rms_all->position_3d_m, r.rms_all->horizontal_m, r.rms_all->vertical_m, r.rms_all->velocity_mps,
+               r.rms_all->attitude_deg, r.gnss_rms ? r.gnss_rms->position_3d_m : 0.0);
+  for (const auto& oo : r.outages)
+    fmt::print("fuse: outage {:.1f}-{:.1f} s: horizontal error at its end {:.3f} m (1-sigma {:.3f} m)\n", oo.start_s,
+               oo.end_s, oo.horizontal_error_m, oo.sigma_horizontal_m);
+  fmt::print("fuse: wrote {}/nav.csv and summary.json\n", o.out_dir);
+}
+
+}  // namespace
+
+void add_fuse_command(CLI::App& app) {
+  auto o = std::make_shared<FuseCommandOptions>();
+  auto* cmd = app.add_subcommand("fuse", "Loosely coupled GNSS/INS (EKF or UKF) from IMU and GNSS fix CSV files");
+  cmd->add_option("--imu", o->imu_file, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--gnss", o->gnss_file,
+                  "GNSS CSV (t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--coupling", o->coupling, "loose (external fixes)");
+  cmd->add_option("--filter", o->filter, "ekf or ukf (default ekf)");
+  cmd->add_option("--config", o->config_file, "TOML: [imu] [initial] [alignment] [gnss] [filter] [output]")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--align", o->align, "static, motion (default) or config");
+  cmd->add_option("--truth", o->truth_file, "truth/nav CSV on the IMU time line: RMS errors in summary.json")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--outage", o->outage, "START DURATION: drop GNSS fixes in [START, START+DURATION) (repeatable)")
+      ->expected(2)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--decimate", o->decimate, "write every Nth solution row (default 1)");
+  cmd->add_flag("--quiet", o->quiet, "no progress lines");
+  cmd->add_option("--out", o->out_dir, "output folder")->required();
+  cmd->callback([o] { run_fuse_command(*o); });
+}
+
+}  // namespace ultratrack::tools

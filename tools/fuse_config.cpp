@@ -1,0 +1,122 @@
+#include "fuse_config.hpp"
+
+#include <functional>
+#include <map>
+#include <string>
+#include <toml++/toml.h>
+
+#include "io/input_error.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+struct Value {
+  std::string file, key;
+  const toml::node& node;
+
+  int line() const { return static_cast<int>(node.source().begin.line); }
+  double number() const {
+    if (auto v = node.value<double>()) return *v;
+    throw io::InputError(file, "key '" + key + "' must be a number", line());
+  }
+  double positive() const {
+    const double v = number();
+    if (!(v > 0.0)) throw io::InputError(file, "key '" + key + "' must be positive", line());
+    return v;
+  }
+  bool boolean() const {
+    if (auto v = node.value<bool>()) return *v;
+    throw io::InputError(file, "key '" + key + "' must be true or false", line());
+  }
+  std::string text() const {
+    if (auto v = node.value<std::string>()) return *v;
+    throw io::InputError(file, "key '" + key + "' must be a string", line());
+  }
+  Eigen::Vector3d vector3(bool positive_only = false) const {
+    const auto* a = node.as_array();
+    if (!a || a->size() != 3) throw io::InputError(file, "key '" + key + "' must be an array of 3 numbers", line());
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) {
+      const auto x = (*a)[static_cast<std::size_t>(i)].value<double>();
+      if (!x) throw io::InputError(file, "key '" + key + "' must be an array of 3 numbers", line());
+      if (positive_only && !(*x > 0.0)) throw io::InputError(file, "key '" + key + "' must be positive", line());
+      v[i] = *x;
+    }
+    return v;
+  }
+};
+
+using Table = std::map<std::string, std::function<void(const Value&, FuseConfig&)>>;
+
+const std::map<std::string, Table>& sections() {
+  using C = FuseConfig;
+  static const std::map<std::string, Table> s = {
+      {"imu", {{"preset", [](const Value& v, C& c) { c.imu_preset = v.text(); }}}},
+      {"initial",
+       {{"attitude_deg", [](const Value& v, C& c) { c.attitude_deg = v.vector3(); }},
+        {"position_deg_m",
+         [](const Value& v, C& c) {
+           c.position_deg_m = v.vector3();
+           if (std::fabs(c.position_deg_m->x()) > 90.0)
+             throw io::InputError(v.file, "key '" + v.key + "': latitude outside [-90, 90]", v.line());
+         }},
+        {"sigma_position_m", [](const Value& v, C& c) { c.sigma_position_m = v.vector3(true); }},
+        {"sigma_velocity_mps", [](const Value& v, C& c) { c.sigma_velocity_mps = v.vector3(true); }},
+        {"sigma_attitude_deg", [](const Value& v, C& c) { c.sigma_attitude_deg = v.vector3(true); }}}},
+      {"alignment",
+       {{"static_duration_s", [](const Value& v, C& c) { c.static_duration_s = v.positive(); }},
+        {"motion_min_speed_mps", [](const Value& v, C& c) { c.motion_min_speed_mps = v.positive(); }},
+        {"motion_window_s", [](const Value& v, C& c) { c.motion_window_s = v.positive(); }}}},
+      {"gnss",
+       {{"velocity_sigma_mps", [](const Value& v, C& c) { c.velocity_sigma_mps = v.positive(); }},
+        {"use_velocity", [](const Value& v, C& c) { c.use_velocity = v.boolean(); }},
+        {"lever_arm_body_m", [](const Value& v, C& c) { c.lever_arm_b = v.vector3(); }}}},
+      {"filter",
+       {{"ukf_alpha", [](const Value& v, C& c) { c.ukf.alpha = v.positive(); }},
+        {"ukf_beta", [](const Value& v, C& c) { c.ukf.beta = v.number(); }},
+        {"ukf_kappa", [](const Value& v, C& c) { c.ukf.kappa = v.number(); }},
+        {"gate", [](const Value& v, C& c) { c.gate.enabled = v.boolean(); }},
+        {"gate_probability",
+         [](const Value& v, C& c) {
+           c.gate.probability = v.number();
+           if (!(c.gate.probability > 0.0 && c.gate.probability < 1.0))
+             throw io::InputError(v.file, "key '" + v.key + "' must be in (0, 1)", v.line());
+         }},
+        {"propagation_interval_s", [](const Value& v, C& c) { c.propagation_interval_s = v.positive(); }}}},
+      {"output",
+       {{"convergence_heading_sigma_deg", [](const Value& v, C& c) { c.convergence_heading_sigma_deg = v.positive(); }}}},
+  };
+  return s;
+}
+
+}  // namespace
+
+FuseConfig read_fuse_config(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  if (!std::filesystem::is_regular_file(path)) throw io::InputError(file, "configuration file does not exist");
+  toml::table root;
+  try {
+    root = toml::parse_file(file);
+  } catch (const toml::parse_error& e) {
+    throw io::InputError(file, std::string(e.description()), static_cast<int>(e.source().begin.line));
+  }
+  FuseConfig c;
+  for (const auto& [section_key, section_node] : root) {
+    const std::string section(section_key.str());
+    const auto known = sections().find(section);
+    const auto* table = section_node.as_table();
+    if (known == sections().end() || !table)
+      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, filter, output)",
+                           static_cast<int>(section_node.source().begin.line));
+    for (const auto& [key_name, node] : *table) {
+      const std::string key = section + "." + std::string(key_name.str());
+      const auto setter = known->second.find(std::string(key_name.str()));
+      if (setter == known->second.end())
+        throw io::InputError(file, "unknown key '" + key + "'", static_cast<int>(node.source().begin.line));
+      setter->second(Value{file, key, node}, c);
+    }
+  }
+  return c;
+}
+
+}  // namespace ultratrack::tools

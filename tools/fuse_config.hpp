@@ -1,0 +1,42 @@
+// The `fuse` command's TOML configuration (--config). Sections and keys (all optional):
+//   [imu]        preset = "hg1700ae"  (the filter's noise model: fusion::error_model_from_preset)
+//   [initial]    attitude_deg = [roll, pitch, yaw] (needed by --align config), position_deg_m = [lat, lon, h]
+//                (else the first GNSS fix), sigma_position_m, sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
+//   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2
+//   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z]
+//   [filter]     ukf_alpha = 1, ukf_beta = 2, ukf_kappa = 0, gate = true, gate_probability = 0.9999,
+//                propagation_interval_s = 0.05
+//   [output]     convergence_heading_sigma_deg = 1
+// Unknown sections or keys and wrong value types are InputErrors naming the file and line.
+#pragma once
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "fusion/gnss_ins_integration.hpp"
+
+namespace ultratrack::tools {
+
+struct FuseConfig {
+  std::string imu_preset = "hg1700ae";
+  std::optional<Eigen::Vector3d> attitude_deg;    // roll, pitch, yaw
+  std::optional<Eigen::Vector3d> position_deg_m;  // lat_deg, lon_deg, height_m
+  std::optional<Eigen::Vector3d> sigma_position_m, sigma_velocity_mps, sigma_attitude_deg;
+  double static_duration_s = 60.0;
+  double motion_min_speed_mps = 5.0;
+  double motion_window_s = 2.0;
+  double velocity_sigma_mps = 0.1;
+  bool use_velocity = true;
+  Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();
+  fusion::UkfParameters ukf;
+  fusion::GateOptions gate;
+  double propagation_interval_s = 0.05;
+  double convergence_heading_sigma_deg = 1.0;
+};
+
+// Reads the file over the defaults; throws io::InputError.
+FuseConfig read_fuse_config(const std::filesystem::path& path);
+
+}  // namespace ultratrack::tools

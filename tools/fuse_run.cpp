@@ -1,0 +1,378 @@
+#include "fuse_run.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+
+#include "fusion/fuse_motion_alignment.hpp"
+#include "gnss_fix_simulation.hpp"
+#include "ins/coarse_alignment.hpp"
+#include "ins/earth_model.hpp"
+#include "ins/imu_error_model.hpp"
+#include "ins/truth_interpolator.hpp"
+#include "io/input_error.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kG = 9.80665;
+
+// GNSS position/velocity linearly interpolated at t (clamped to the fixes' span).
+struct GnssState {
+  double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
+  bool has_velocity = false;
+  Eigen::Vector3d v_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_ned_m = Eigen::Vector3d::Ones();
+};
+
+GnssState gnss_at(const std::vector<GnssCsvRow>& g, double t) {
+  auto from = [](const GnssCsvRow& r) {
+    return GnssState{r.lat_rad, r.lon_rad, r.height_m, r.has_velocity, r.v_n, r.sigma_ned_m};
+  };
+  if (t <= g.front().t_s) return from(g.front());
+  if (t >= g.back().t_s) return from(g.back());
+  const auto it = std::upper_bound(g.begin(), g.end(), t, [](double x, const GnssCsvRow& r) { return x < r.t_s; });
+  const GnssCsvRow &b = *it, &a = *(it - 1);
+  const double w = (t - a.t_s) / (b.t_s - a.t_s);
+  GnssState s;
+  s.lat_rad = a.lat_rad + w * (b.lat_rad - a.lat_rad);
+  s.lon_rad = a.lon_rad + w * (b.lon_rad - a.lon_rad);
+  s.height_m = a.height_m + w * (b.height_m - a.height_m);
+  s.has_velocity = a.has_velocity && b.has_velocity;
+  s.v_n = a.v_n + w * (b.v_n - a.v_n);
+  s.sigma_ned_m = a.sigma_ned_m.cwiseMax(b.sigma_ned_m);
+  return s;
+}
+
+// NED offset (m) of geodetic point b from a, small distances.
+Eigen::Vector3d ned_difference(double lat_a, double lon_a, double h_a, double lat_b, double lon_b, double h_b) {
+  const Eigen::Vector3d d_e = ins::ecef_from_geodetic(lat_b, lon_b, h_b) - ins::ecef_from_geodetic(lat_a, lon_a, h_a);
+  return ins::C_en(lat_a, lon_a).transpose() * d_e;
+}
+
+// GNSS velocities for the motion alignment: the fixes' own, else central differences of positions over at
+// least kPositionDifferenceSpan_s (at 1.5 m noise: ~0.4 m/s per axis; neighbours alone would give metres per
+// second at 5 Hz and fake motion while parked).
+constexpr double kPositionDifferenceSpan_s = 5.0;
+
+std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssCsvRow>& g) {
+  std::vector<fusion::GnssVelocitySample> out;
+  std::size_t lo = 0, hi = 0;
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    fusion::GnssVelocitySample s{g[i].t_s, g[i].lat_rad, g[i].height_m, g[i].v_n};
+    if (!g[i].has_velocity) {
+      const double half = 0.5 * kPositionDifferenceSpan_s;
+      while (lo < i && g[lo + 1].t_s <= g[i].t_s - half) ++lo;
+      if (g[lo].t_s > g[i].t_s - half + 1e-9) continue;  // not enough history yet
+      hi = std::max(hi, i);
+      while (hi < g.size() && g[hi].t_s < g[i].t_s + half - 1e-9) ++hi;
+      if (hi == g.size()) continue;
+      const auto& a = g[lo];
+      const auto& b = g[hi];
+      s.v_n = ned_difference(a.lat_rad, a.lon_rad, a.height_m, b.lat_rad, b.lon_rad, b.height_m) / (b.t_s - a.t_s);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+bool in_outage(const FuseSettings& s, double t) {
+  for (const auto& [start, duration] : s.outages)
+    if (t >= start && t < start + duration) return true;
+  return false;
+}
+
+struct RowError {
+  double t_s;
+  Eigen::Vector3d pos_ned_m, sigma_pos_m;
+  double vel_mps;
+  Eigen::Vector3d att_rad;
+};
+
+ErrorRms rms_of(const std::vector<RowError>& e, double from_t) {
+  ErrorRms r;
+  double h2 = 0, v2 = 0, vel2 = 0, att2 = 0, hd2 = 0;
+  int inside = 0;
+  for (const auto& x : e) {
+    if (x.t_s < from_t) continue;
+    ++r.rows;
+    h2 += x.pos_ned_m.head<2>().squaredNorm();
+    v2 += x.pos_ned_m.z() * x.pos_ned_m.z();
+    vel2 += x.vel_mps * x.vel_mps;
+    att2 += x.att_rad.squaredNorm();
+    hd2 += x.att_rad.z() * x.att_rad.z();
+    if ((x.pos_ned_m.cwiseAbs().array() <= 3.0 * x.sigma_pos_m.array()).all()) ++inside;
+  }
+  if (r.rows == 0) return r;
+  const double n = r.rows;
+  r.horizontal_m = std::sqrt(h2 / n);
+  r.vertical_m = std::sqrt(v2 / n);
+  r.position_3d_m = std::sqrt((h2 + v2) / n);
+  r.velocity_mps = std::sqrt(vel2 / n);
+  r.attitude_deg = std::sqrt(att2 / n) / kDeg;
+  r.heading_deg = std::sqrt(hd2 / n) / kDeg;
+  r.within_3sigma = inside / n;
+  return r;
+}
+
+std::string json_escape(const std::string& in) {
+  std::string out;
+  for (char ch : in) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
+      continue;
+    }
+    out += ch;
+  }
+  return out;
+}
+
+}  // namespace
+
+FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssCsvRow>& gnss,
+                const std::vector<ins::NavState>& truth, const FuseSettings& s,
+                const std::function<void(const ins::NavState&, const NavSigma&)>& on_row,
+                const std::function<void(double)>& on_progress) {
+  const FuseConfig& c = s.config;
+  if (imu.size() < 2) throw io::InputError("IMU file", "fewer than 2 IMU rows");
+  if (gnss.empty()) throw io::InputError("GNSS file", "no fixes");
+  const double imu_start = imu[0].t_s - (imu[1].t_s - imu[0].t_s);  // the first row's interval start
+  if (gnss.back().t_s <= imu_start || gnss.front().t_s >= imu.back().t_s)
+    throw io::InputError("GNSS file", fmt::format("fixes ({:.3f}-{:.3f} s) do not overlap the IMU data ({:.3f}-{:.3f} s)",
+                                                  gnss.front().t_s, gnss.back().t_s, imu_start, imu.back().t_s));
+  const ins::ImuErrorSpec preset = ins::imu_preset(c.imu_preset);
+
+  // --- initial state ---
+  FuseResult result;
+  ins::NavState init;
+  Eigen::Vector3d sigma_att;
+  Eigen::Vector3d sigma_vel = Eigen::Vector3d::Constant(0.5);
+  const double lat_hint = c.position_deg_m ? c.position_deg_m->x() * kDeg : gnss.front().lat_rad;
+  if (s.align == AlignMode::Static) {
+    std::size_t end = 0;
+    while (end < imu.size() && imu[end].t_s <= imu_start + c.static_duration_s + 1e-9) ++end;
+    if (end < 2 || end == imu.size())
+      throw io::InputError("IMU file", fmt::format("the static alignment span ({} s) needs IMU data beyond it",
+                                                   c.static_duration_s));
+    const ins::AlignmentResult a = ins::coarse_align(std::span(imu).first(end), imu_start, lat_hint);
+    init.t_s = imu[end - 1].t_s;
+    init.q_nb = a.q_nb;
+    init.v_n.setZero();
+    sigma_vel = Eigen::Vector3d::Constant(0.1);
+    // residual-bias alignment errors (seed 002): tilt = b_a / g, heading = b_g / (W cos L), twice for margin
+    const Eigen::Vector3d noise = ins::alignment_noise_sigma(preset, a.duration_s, lat_hint, kG);
+    const double tilt = std::hypot(preset.accel.bias_sigma / kG, noise.x());
+    const double heading =
+        std::hypot(preset.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(lat_hint)), noise.z());
+    sigma_att = {std::max(2.0 * tilt, 0.05 * kDeg), std::max(2.0 * tilt, 0.05 * kDeg),
+                 std::clamp(2.0 * heading, 0.5 * kDeg, 60.0 * kDeg)};
+    result.alignment_note = fmt::format("static over {:.1f} s", a.duration_s);
+    if (heading > 10.0 * kDeg)
+      result.alignment_note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
+                                           heading / kDeg);
+  } else if (s.align == AlignMode::Motion) {
+    // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
+    const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssCsvRow& r) { return r.has_velocity; });
+    const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
+    const auto a = fusion::align_in_motion(imu, gnss_velocities(gnss), {c.motion_min_speed_mps, window});
+    if (!a)
+      throw io::InputError("GNSS file", fmt::format("no in-motion alignment: the fixes never show {} m/s for {} s "
+                                                    "within the IMU data",
+                                                    c.motion_min_speed_mps, c.motion_window_s));
+    init.t_s = a->t_s;
+    init.q_nb = a->q_nb;
+    init.v_n = a->v_n;
+    sigma_vel = Eigen::Vector3d::Constant(position_only ? 1.0 : c.velocity_sigma_mps * 2.0);
+    sigma_att = position_only ? Eigen::Vector3d(3.0 * kDeg, 3.0 * kDeg, 5.0 * kDeg)
+                              : Eigen::Vector3d(1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg);
+    result.alignment_note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
+  } else {
+    if (!c.attitude_deg) throw io::InputError("configuration", "--align config needs [initial] attitude_deg");
+    auto it = std::find_if(gnss.begin(), gnss.end(), [&](const GnssCsvRow& r) { return r.t_s >= imu_start; });
+    init.t_s = it->t_s;
+    init.q_nb = ins::quaternion_from_euler({c.attitude_deg->x() * kDeg, c.attitude_deg->y() * kDeg,
+                                            c.attitude_deg->z() * kDeg});
+    sigma_att = Eigen::Vector3d(1.0, 1.0, 5.0) * kDeg;
+    sigma_vel = Eigen::Vector3d::Constant(1.0);
+    result.alignment_note = "attitude from the configuration";
+  }
+  const GnssState g0 = gnss_at(gnss, init.t_s);
+  if (s.align == AlignMode::Config && g0.has_velocity) init.v_n = g0.v_n;
+  Eigen::Vector3d sigma_pos = g0.sigma_ned_m;
+  if (c.position_deg_m) {
+    init.lat_rad = c.position_deg_m->x() * kDeg;
+    init.lon_rad = c.position_deg_m->y() * kDeg;
+    init.height_m = c.position_deg_m->z();
+  } else {
+    // the fix is the antenna's: move to the IMU by the lever arm
+    const Eigen::Vector3d l_n = init.q_nb * c.lever_arm_b;
+    const ins::Radii r = ins::radii_of_curvature(g0.lat_rad);
+    init.lat_rad = g0.lat_rad - l_n.x() / (r.meridian_m + g0.height_m);
+    init.lon_rad = g0.lon_rad - l_n.y() / ((r.transverse_m + g0.height_m) * std::cos(g0.lat_rad));
+    init.height_m = g0.height_m + l_n.z();
+  }
+  if (c.sigma_position_m) sigma_pos = *c.sigma_position_m;
+  if (c.sigma_velocity_mps) sigma_vel = *c.sigma_velocity_mps;
+  if (c.sigma_attitude_deg) sigma_att = *c.sigma_attitude_deg * kDeg;
+  result.initial_attitude = ins::euler_from_quaternion(init.q_nb);
+  result.start_s = init.t_s;
+
+  fusion::IntegrationOptions o;
+  o.coupling = fusion::Coupling::Loose;
+  o.filter = s.filter;
+  o.model = fusion::error_model_from_preset(preset);
+  o.lever_arm_b = c.lever_arm_b;
+  o.sigma_pos_ned_m = sigma_pos;
+  o.sigma_vel_n_mps = sigma_vel;
+  o.sigma_att_rad = sigma_att;
+  o.gate = c.gate;
+  o.ukf = c.ukf;
+  o.propagation_interval_s = c.propagation_interval_s;
+  fusion::GnssInsIntegration integration(init, o);
+
+  // --- run ---
+  std::optional<ins::TruthInterpolator> truth_at;
+  if (truth.size() >= 2) truth_at.emplace(truth_samples_from_nav(truth));
+  std::vector<RowError> errors;
+  std::optional<double> converged_since;
+  std::size_t g = 0;
+  while (g < gnss.size() && gnss[g].t_s <= init.t_s) {
+    ++result.fixes_before_start;
+    ++g;
+  }
+  std::size_t k = 0;
+  while (k < imu.size() && imu[k].t_s <= init.t_s) ++k;
+  const std::size_t k_first = k;
+  const double progress_step = std::max<std::size_t>(1, (imu.size() - k_first) / 10);
+  auto emit = [&](const fusion::IntegrationOutput& out) {
+    NavSigma sig{out.sigma_pos_ned_m, out.sigma_vel_n_mps, out.sigma_att_rad};
+    if (on_row) on_row(out.nav, sig);
+    if (sig.attitude_ned_rad.z() > c.convergence_heading_sigma_deg * kDeg)
+      converged_since.reset();
+    else if (!converged_since)
+      converged_since = out.nav.t_s;
+    if (truth_at && out.nav.t_s >= truth_at->start_s() - 1e-9 && out.nav.t_s <= truth_at->end_s() + 1e-9) {
+      const double t = out.nav.t_s;
+      const ins::EcefMotion m = truth_at->antenna(t, Eigen::Vector3d::Zero());
+      const Eigen::Vector3d r_nav = ins::ecef_from_geodetic(out.nav.lat_rad, out.nav.lon_rad, out.nav.height_m);
+      const Eigen::Matrix3d C_ne = ins::C_en(out.nav.lat_rad, out.nav.lon_rad).transpose();
+      errors.push_back({t, C_ne * (r_nav - m.r_e), sig.position_ned_m, (out.nav.v_n - C_ne * m.v_e).norm(),
+                        ins::attitude_error_n(out.nav.q_nb, truth_at->attitude(t))});
+    }
+    result.final_sigma = sig;
+    result.final_nav = out.nav;
+  };
+  emit(integration.output());
+  for (; k < imu.size(); ++k) {
+    while (g < gnss.size() && gnss[g].t_s <= imu[k].t_s) {
+      const GnssCsvRow& r = gnss[g++];
+      if (in_outage(s, r.t_s)) {
+        ++result.fixes_in_outage;
+        continue;
+      }
+      fusion::GnssFix f;
+      f.t_s = r.t_s;
+      f.lat_rad = r.lat_rad;
+      f.lon_rad = r.lon_rad;
+      f.height_m = r.height_m;
+      f.sigma_pos_ned_m = r.sigma_ned_m;
+      f.has_velocity = r.has_velocity && c.use_velocity;
+      f.v_n_mps = r.v_n;
+      f.sigma_vel_n_mps = Eigen::Vector3d::Constant(c.velocity_sigma_mps);
+      integration.add_fix(f);
+      ++result.fixes_used;
+    }
+    ins::ImuIncrement inc = imu[k];
+    const double t_prev = k > 0 ? imu[k - 1].t_s : imu_start;
+    if (k == k_first && t_prev < init.t_s) {  // the first interval straddles the start: keep its share
+      const double share = (inc.t_s - init.t_s) / (inc.t_s - t_prev);
+      inc.dtheta_b *= share;
+      inc.dv_b *= share;
+    }
+    integration.add_imu(inc);
+    emit(integration.output());
+    if (on_progress && (k - k_first + 1) % static_cast<std::size_t>(progress_step) == 0)
+      on_progress(double(k - k_first + 1) / double(imu.size() - k_first));
+  }
+  result.end_s = integration.output().nav.t_s;
+  result.counters = integration.counters();
+  result.converged_at_s = converged_since;
+
+  if (truth_at) {
+    result.rms_all = rms_of(errors, -1e300);
+    if (result.converged_at_s) result.rms_converged = rms_of(errors, *result.converged_at_s);
+    for (const auto& [start, duration] : s.outages) {
+      OutageResult oo{start, start + duration};
+      const RowError* last = nullptr;
+      for (const auto& e : errors)
+        if (e.t_s <= start + duration + 1e-9) last = &e;
+      if (last) {
+        oo.horizontal_error_m = last->pos_ned_m.head<2>().norm();
+        oo.sigma_horizontal_m = last->sigma_pos_m.head<2>().norm();
+      }
+      result.outages.push_back(oo);
+    }
+    // The fixes themselves (antenna positions) against the truth antenna.
+    std::vector<RowError> ge;
+    for (const auto& r : gnss) {
+      if (r.t_s < truth_at->start_s() || r.t_s > truth_at->end_s()) continue;
+      const ins::EcefMotion m = truth_at->antenna(r.t_s, c.lever_arm_b);
+      const Eigen::Vector3d r_fix = ins::ecef_from_geodetic(r.lat_rad, r.lon_rad, r.height_m);
+      ge.push_back({r.t_s, ins::C_en(r.lat_rad, r.lon_rad).transpose() * (r_fix - m.r_e), r.sigma_ned_m, 0.0,
+                    Eigen::Vector3d::Zero()});
+    }
+    if (!ge.empty()) result.gnss_rms = rms_of(ge, -1e300);
+  }
+  return result;
+}
+
+std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
+                              const std::string& gnss_file, const std::string& truth_file) {
+  auto rms_json = [](const ErrorRms& e) {
+    return fmt::format(
+        "{{\"rows\": {}, \"horizontal_m\": {:.6g}, \"vertical_m\": {:.6g}, \"position_3d_m\": {:.6g}, "
+        "\"velocity_mps\": {:.6g}, \"attitude_deg\": {:.6g}, \"heading_deg\": {:.6g}, \"within_3sigma\": {:.4f}}}",
+        e.rows, e.horizontal_m, e.vertical_m, e.position_3d_m, e.velocity_mps, e.attitude_deg, e.heading_deg,
+        e.within_3sigma);
+  };
+  const char* align = s.align == AlignMode::Static ? "static" : s.align == AlignMode::Motion ? "motion" : "config";
+  std::string j = "{\n";
+  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", json_escape(imu_file), json_escape(gnss_file));
+  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", json_escape(truth_file));
+  j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
+                   s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
+  j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
+                   "\"yaw_deg\": {:.6f}}},\n",
+                   json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
+                   r.initial_attitude.pitch_rad / kDeg, r.initial_attitude.yaw_rad / kDeg);
+  j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
+  j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
+                   r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
+  j += fmt::format("  \"updates_accepted\": {},\n  \"updates_rejected\": {},\n  \"fixes_late\": {},\n",
+                   r.counters.accepted, r.counters.rejected, r.counters.late);
+  j += fmt::format("  \"converged\": {},\n  \"converged_at_s\": {},\n", r.converged_at_s.has_value(),
+                   r.converged_at_s ? fmt::format("{}", *r.converged_at_s) : std::string("null"));
+  j += fmt::format("  \"convergence_heading_sigma_deg\": {},\n", s.config.convergence_heading_sigma_deg);
+  const NavSigma& g = r.final_sigma;
+  j += fmt::format("  \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, \"vel_mps\": {:.6g}, "
+                   "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
+                   g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
+                   g.attitude_ned_rad.x() / kDeg, g.attitude_ned_rad.y() / kDeg, g.attitude_ned_rad.z() / kDeg);
+  if (r.rms_all) j += "  \"rms_all\": " + rms_json(*r.rms_all) + ",\n";
+  if (r.rms_converged) j += "  \"rms_converged\": " + rms_json(*r.rms_converged) + ",\n";
+  if (r.gnss_rms) j += "  \"gnss_only_rms\": " + rms_json(*r.gnss_rms) + ",\n";
+  j += "  \"outages\": [";
+  for (std::size_t i = 0; i < r.outages.size(); ++i)
+    j += fmt::format("{}{{\"start_s\": {}, \"end_s\": {}, \"horizontal_error_m\": {:.6g}, \"sigma_horizontal_m\": {:.6g}}}",
+                     i ? ", " : "", r.outages[i].start_s, r.outages[i].end_s, r.outages[i].horizontal_error_m,
+                     r.outages[i].sigma_horizontal_m);
+  j += "]\n}\n";
+  return j;
+}
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,72 @@
+// The work of `ultratrack fuse`, callable in process (tests, figures): external GNSS fixes and IMU increments
+// through fusion::GnssInsIntegration (loose, EKF or UKF) after a coarse alignment (static: levelling +
+// gyrocompassing over the first seconds; motion: heading from the GNSS track, tilt from the accelerometers;
+// config: the configuration's attitude), with optional GNSS outages, and the statistics the summary reports
+// (update counts, convergence, RMS against a truth trajectory and of the GNSS fixes themselves).
+// Units SI inside; times on the IMU file's time line.
+#pragma once
+
+#include <Eigen/Core>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fuse_config.hpp"
+#include "fused_nav_csv.hpp"
+#include "fusion/gnss_ins_integration.hpp"
+#include "gnss_csv.hpp"
+#include "ins/attitude.hpp"
+#include "ins/nav_state.hpp"
+
+namespace ultratrack::tools {
+
+enum class AlignMode { Static, Motion, Config };
+
+struct FuseSettings {
+  fusion::FilterKind filter = fusion::FilterKind::Ekf;
+  AlignMode align = AlignMode::Motion;
+  FuseConfig config;
+  std::vector<std::pair<double, double>> outages;  // [start, start + duration): GNSS fixes dropped
+};
+
+struct ErrorRms {
+  int rows = 0;
+  double horizontal_m = 0.0, vertical_m = 0.0, position_3d_m = 0.0, velocity_mps = 0.0, attitude_deg = 0.0,
+         heading_deg = 0.0;
+  double within_3sigma = 0.0;  // fraction of rows with every position axis inside 3 sigma
+};
+
+struct OutageResult {
+  double start_s = 0.0, end_s = 0.0;
+  double horizontal_error_m = 0.0;  // at the end of the outage (truth needed)
+  double sigma_horizontal_m = 0.0;  // the filter's horizontal 1-sigma there
+};
+
+struct FuseResult {
+  double start_s = 0.0, end_s = 0.0;  // navigation span
+  ins::EulerAngles initial_attitude;
+  std::string alignment_note;
+  fusion::IntegrationCounters counters;
+  long long fixes_used = 0, fixes_before_start = 0, fixes_in_outage = 0;
+  std::optional<double> converged_at_s;  // heading 1-sigma below the threshold from here to the end
+  NavSigma final_sigma;
+  ins::NavState final_nav;
+  std::optional<ErrorRms> rms_all, rms_converged;  // against truth
+  std::optional<ErrorRms> gnss_rms;                // the fixes themselves against truth (antenna)
+  std::vector<OutageResult> outages;
+};
+
+// Every solution row (after each IMU interval) goes to on_row. Throws io::InputError for inputs that do not
+// fit together (no overlap in time, no alignment window, unknown preset, ...).
+FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssCsvRow>& gnss,
+                const std::vector<ins::NavState>& truth, const FuseSettings& settings,
+                const std::function<void(const ins::NavState&, const NavSigma&)>& on_row = {},
+                const std::function<void(double fraction)>& on_progress = {});
+
+// summary.json text of a run.
+std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
+                              const std::string& gnss_file, const std::string& truth_file);
+
+}  // namespace ultratrack::tools
