@@ -1,6 +1,7 @@
 #include "receiver/acquisition.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -90,12 +91,29 @@ Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) 
   lags_ = std::min(fft_size_, static_cast<std::size_t>(std::ceil(period)));
   forward_ = FftwPlan(fft_size_, FftwPlan::Direction::forward);
   backward_ = FftwPlan(fft_size_, FftwPlan::Direction::backward);
-  mixed_ = FftwBuffer(fft_size_);
-  product_ = FftwBuffer(fft_size_);
-  correlation_ = FftwBuffer(fft_size_);
-  spectrum_scratch_ = FftwBuffer(fft_size_);
+  scratch_.push_back(std::make_unique<Scratch>(fft_size_, lags_));
   code_spectra_.resize(signals::kMaxPrn);
-  row_.resize(lags_);
+}
+
+Acquisition::Scratch::Scratch(std::size_t fft_size, std::size_t lags)
+    : mixed(fft_size), product(fft_size), correlation(fft_size), spectrum(fft_size), row(lags) {}
+
+template <class F>
+void Acquisition::spread(WorkerPool* pool, int n, F&& f) {
+  const int jobs = pool ? std::min(pool->threads(), n) : 1;
+  if (jobs <= 1) {
+    for (int i = 0; i < n; ++i) f(i, *scratch_[0]);
+    return;
+  }
+  while (scratch_.size() < static_cast<std::size_t>(jobs)) scratch_.push_back(std::make_unique<Scratch>(fft_size_, lags_));
+  // One job per scratch set; each takes the next item until none is left. Items are independent, so which
+  // thread computes which does not change any result.
+  std::atomic<int> next{0};
+  auto job = [&](int j) {
+    Scratch& s = *scratch_[static_cast<std::size_t>(j)];
+    for (int i = next.fetch_add(1); i < n; i = next.fetch_add(1)) f(i, s);
+  };
+  pool->parallel_for(jobs, job);
 }
 
 double Acquisition::cells() const { return static_cast<double>(doppler_grid(std::nullopt).size() * lags_); }
@@ -116,10 +134,11 @@ const FftwBuffer& Acquisition::code_spectrum(int prn) {
     // Replica sampled at the actual rate (non-integer samples per chip), code phase 0 at sample 0,
     // as conj(FFT) / F so that IFFT(X conj(C) / F) is the plain correlation sum.
     const auto& code = signals::ca_code(prn);
+    FftwBuffer& mixed = scratch_[0]->mixed;
     for (std::size_t m = 0; m < fft_size_; ++m)
-      mixed_[m] = {chip_at(code, static_cast<double>(m) / samples_per_chip_), 0.0f};
+      mixed[m] = {chip_at(code, static_cast<double>(m) / samples_per_chip_), 0.0f};
     FftwBuffer spectrum(fft_size_);
-    forward_.execute(mixed_, spectrum);
+    forward_.execute(mixed, spectrum);
     const float scale = 1.0f / static_cast<float>(fft_size_);
     for (std::size_t i = 0; i < fft_size_; ++i) spectrum[i] = std::conj(spectrum[i]) * scale;
     slot = std::move(spectrum);
@@ -128,7 +147,7 @@ const FftwBuffer& Acquisition::code_spectrum(int prn) {
 }
 
 void Acquisition::doppler_spectrum(std::span<const std::complex<float>> samples, int block, double doppler_hz,
-                                   FftwBuffer& out) {
+                                   FftwBuffer& out, Scratch& s) const {
   // Carrier wipe-off as x[m] * base[m % 256] * anchor[m / 256]: 256 phasors from a double recursion, anchors
   // exact in double, and a plain float inner loop (real arithmetic, no complex-multiply NaN path) that vectorises.
   constexpr std::size_t kChunk = 256;
@@ -137,11 +156,11 @@ void Acquisition::doppler_spectrum(std::span<const std::complex<float>> samples,
   const std::complex<double> step = std::polar(1.0, -kTwoPi * cycles_per_sample);
   std::complex<double> p(1.0, 0.0);
   for (std::size_t m = 0; m < kChunk; ++m, p *= step) {
-    base_re_[m] = static_cast<float>(p.real());
-    base_im_[m] = static_cast<float>(p.imag());
+    s.base_re[m] = static_cast<float>(p.real());
+    s.base_im[m] = static_cast<float>(p.imag());
   }
-  std::fill(mixed_.data(), mixed_.data() + fft_size_, std::complex<float>{});
-  auto* folded = reinterpret_cast<float*>(mixed_.data());
+  std::fill(s.mixed.data(), s.mixed.data() + fft_size_, std::complex<float>{});
+  auto* folded = reinterpret_cast<float*>(s.mixed.data());
   const auto* x = reinterpret_cast<const float*>(samples.data() + first);
   std::size_t at = 0;  // index into the folded buffer
   for (std::size_t chunk = 0; chunk * kChunk < block_size_; ++chunk) {
@@ -150,47 +169,48 @@ void Acquisition::doppler_spectrum(std::span<const std::complex<float>> samples,
     const auto a_re = static_cast<float>(anchor.real()), a_im = static_cast<float>(anchor.imag());
     const std::size_t count = std::min(kChunk, block_size_ - chunk * kChunk);
     for (std::size_t m = 0; m < count; ++m) {
-      const float c_re = base_re_[m] * a_re - base_im_[m] * a_im;
-      const float c_im = base_re_[m] * a_im + base_im_[m] * a_re;
+      const float c_re = s.base_re[m] * a_re - s.base_im[m] * a_im;
+      const float c_im = s.base_re[m] * a_im + s.base_im[m] * a_re;
       const float s_re = x[2 * (chunk * kChunk + m)], s_im = x[2 * (chunk * kChunk + m) + 1];
       folded[2 * at] += s_re * c_re - s_im * c_im;
       folded[2 * at + 1] += s_re * c_im + s_im * c_re;
       if (++at == fft_size_) at = 0;
     }
   }
-  forward_.execute(mixed_, out);
+  forward_.execute(s.mixed, out);
 }
 
 void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, const FftwBuffer* cached, int prn,
-                                double doppler_hz) {
-  const FftwBuffer& code = code_spectrum(prn);
-  std::fill(row_.begin(), row_.end(), 0.0f);
+                                double doppler_hz, Scratch& s) const {
+  const FftwBuffer& code = *code_spectra_[static_cast<std::size_t>(prn - 1)];  // made before the search
+  std::vector<float>& acc = s.row;
+  std::fill(acc.begin(), acc.end(), 0.0f);
   // Code-phase drift per block from the code Doppler (and from N not being a whole number of periods).
   const double period = kCodeLength * options_.fs_hz / code_rate_hz(doppler_hz);
   const auto n = static_cast<std::ptrdiff_t>(fft_size_);
   for (int k = 0; k < options_.noncoherent; ++k) {
-    const FftwBuffer* spectrum = cached ? cached + k : &spectrum_scratch_;
-    if (!cached) doppler_spectrum(samples, k, doppler_hz, spectrum_scratch_);
+    const FftwBuffer* spectrum = cached ? cached + k : &s.spectrum;
+    if (!cached) doppler_spectrum(samples, k, doppler_hz, s.spectrum, s);
     // X * C in real arithmetic: std::complex's operator* carries a NaN-recovery branch that stops vectorisation.
     const float* x = reinterpret_cast<const float*>(spectrum->data());
     const float* c = reinterpret_cast<const float*>(code.data());
-    float* p = reinterpret_cast<float*>(product_.data());
+    float* p = reinterpret_cast<float*>(s.product.data());
     for (std::size_t i = 0; i < fft_size_; ++i) {
       const float xr = x[2 * i], xi = x[2 * i + 1], cr = c[2 * i], ci = c[2 * i + 1];
       p[2 * i] = xr * cr - xi * ci;
       p[2 * i + 1] = xr * ci + xi * cr;
     }
-    backward_.execute(product_, correlation_);
+    backward_.execute(s.product, s.correlation);
     const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
     std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
     if (shift < 0) shift += n;
     // row[lag] += |corr[(lag + shift) mod n]|^2, in the two unwrapped runs.
-    const auto* y = reinterpret_cast<const float*>(correlation_.data());
+    const auto* y = reinterpret_cast<const float*>(s.correlation.data());
     const auto first_run = static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(lags_), n - shift));
     const float* a = y + 2 * shift;
-    for (std::size_t lag = 0; lag < first_run; ++lag) row_[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
+    for (std::size_t lag = 0; lag < first_run; ++lag) acc[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
     const float* b = y - 2 * static_cast<std::ptrdiff_t>(first_run);
-    for (std::size_t lag = first_run; lag < lags_; ++lag) row_[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
+    for (std::size_t lag = first_run; lag < lags_; ++lag) acc[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
   }
 }
 
@@ -228,23 +248,26 @@ double Acquisition::power_at(std::span<const std::complex<float>> samples, int p
 }
 
 AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> samples, int prn,
-                                           const std::vector<double>& dopplers, bool cached) {
+                                           const std::vector<double>& dopplers, bool cached, Scratch& s) const {
+  std::vector<float>& acc = s.row;
+  std::vector<float>& grid = s.grid;
+  std::vector<double>& row_noise = s.row_noise;
   const std::size_t bins = dopplers.size();
-  if (grid_.size() < bins * lags_) grid_.resize(bins * lags_);
-  row_noise_.resize(bins);
+  if (grid.size() < bins * lags_) grid.resize(bins * lags_);
+  row_noise.resize(bins);
   // Candidate peak on rows normalised by their plain means (the signal raises its row's mean a little).
   double candidate = -1.0;
   std::size_t candidate_lag = 0;
   for (std::size_t d = 0; d < bins; ++d) {
     correlate_bin(samples, cached ? &spectrum_cache_[d * static_cast<std::size_t>(options_.noncoherent)] : nullptr, prn,
-                  dopplers[d]);
-    std::copy(row_.begin(), row_.end(), grid_.begin() + static_cast<std::ptrdiff_t>(d * lags_));
+                  dopplers[d], s);
+    std::copy(acc.begin(), acc.end(), grid.begin() + static_cast<std::ptrdiff_t>(d * lags_));
     double sum = 0.0;
-    for (float v : row_) sum += v;
+    for (float v : acc) sum += v;
     const double mean = sum / static_cast<double>(lags_);
     for (std::size_t lag = 0; lag < lags_; ++lag) {
-      if (row_[lag] > candidate * mean) {
-        candidate = row_[lag] / mean;
+      if (acc[lag] > candidate * mean) {
+        candidate = acc[lag] / mean;
         candidate_lag = lag;
       }
     }
@@ -264,7 +287,7 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
   int best_bin = 0;
   std::size_t best_lag = 0;
   for (std::size_t d = 0; d < bins; ++d) {
-    const float* row = &grid_[d * lags_];
+    const float* row = &grid[d * lags_];
     double sum = 0.0;
     std::size_t count = 0;
     for (std::size_t lag = 0; lag < lags_; ++lag) {
@@ -272,17 +295,17 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
       sum += row[lag];
       ++count;
     }
-    row_noise_[d] = sum / static_cast<double>(count);
+    row_noise[d] = sum / static_cast<double>(count);
     for (std::size_t lag = 0; lag < lags_; ++lag) {
-      if (row[lag] > best * row_noise_[d]) {
-        best = row[lag] / row_noise_[d];
+      if (row[lag] > best * row_noise[d]) {
+        best = row[lag] / row_noise[d];
         best_bin = static_cast<int>(d);
         best_lag = lag;
       }
     }
   }
   const double k = options_.noncoherent;
-  const double noise_power = row_noise_[static_cast<std::size_t>(best_bin)] / k;  // P_n, one coherent block
+  const double noise_power = row_noise[static_cast<std::size_t>(best_bin)] / k;  // P_n, one coherent block
 
   AcquisitionResult result;
   result.prn = prn;
@@ -343,11 +366,13 @@ void Acquisition::check(std::span<const std::complex<float>> samples, int prn) c
 AcquisitionResult Acquisition::search(std::span<const std::complex<float>> samples, int prn,
                                       std::optional<DopplerWindow> assist) {
   check(samples, prn);
-  return search_grid(samples, prn, doppler_grid(assist), false);
+  code_spectrum(prn);
+  return search_grid(samples, prn, doppler_grid(assist), false, *scratch_[0]);
 }
 
 std::vector<AcquisitionResult> Acquisition::search_each(std::span<const std::complex<float>> samples,
-                                                        std::span<const int> prns) {
+                                                        std::span<const int> prns, WorkerPool* pool) {
+  for (int prn : prns) code_spectrum(prn);  // made here, read-only below
   const std::vector<double> dopplers = doppler_grid(std::nullopt);
   const std::size_t spectra = dopplers.size() * static_cast<std::size_t>(options_.noncoherent);
   const bool cache = prns.size() > 1 && spectra * fft_size_ * sizeof(std::complex<float>) <= memory_budget_bytes_;
@@ -358,13 +383,15 @@ std::vector<AcquisitionResult> Acquisition::search_each(std::span<const std::com
       for (std::size_t i = 0; i < spectra; ++i) spectrum_cache_.emplace_back(fft_size_);
     }
     const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
-    for (std::size_t d = 0; d < dopplers.size(); ++d)
-      for (std::size_t k = 0; k < k_blocks; ++k)
-        doppler_spectrum(samples, static_cast<int>(k), dopplers[d], spectrum_cache_[d * k_blocks + k]);
+    spread(pool, static_cast<int>(spectra), [&](int i, Scratch& s) {
+      const auto d = static_cast<std::size_t>(i) / k_blocks, k = static_cast<std::size_t>(i) % k_blocks;
+      doppler_spectrum(samples, static_cast<int>(k), dopplers[d], spectrum_cache_[d * k_blocks + k], s);
+    });
   }
-  std::vector<AcquisitionResult> results;
-  results.reserve(prns.size());
-  for (int prn : prns) results.push_back(search_grid(samples, prn, dopplers, cache));
+  std::vector<AcquisitionResult> results(prns.size());
+  spread(pool, static_cast<int>(prns.size()), [&](int i, Scratch& s) {
+    results[static_cast<std::size_t>(i)] = search_grid(samples, prns[static_cast<std::size_t>(i)], dopplers, cache, s);
+  });
   return results;
 }
 
@@ -397,9 +424,9 @@ void Acquisition::cancel(std::span<std::complex<float>> samples, const Acquisiti
 }
 
 std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<float>> samples,
-                                                   std::span<const int> prns) {
+                                                   std::span<const int> prns, WorkerPool* pool) {
   for (int prn : prns) check(samples, prn);
-  std::vector<AcquisitionResult> results = search_each(samples, prns);
+  std::vector<AcquisitionResult> results = search_each(samples, prns, pool);
   if (!options_.cancel_cross_correlation) return results;
 
   // Successive cancellation: confirm detections from the strongest down, each on the samples with the
@@ -414,14 +441,14 @@ std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<
   cleaned_.assign(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples_needed()));
   for (std::size_t n = 0; n < order.size(); ++n) {
     AcquisitionResult& r = results[order[n]];
-    if (n > 0) r = search_grid(cleaned_, r.prn, doppler_grid(std::nullopt), false);
+    if (n > 0) r = search_grid(cleaned_, r.prn, doppler_grid(std::nullopt), false, *scratch_[0]);
     if (r.detected) cancel(cleaned_, r);
   }
   std::vector<int> rest;
   for (const auto& r : results)
     if (std::find(order.begin(), order.end(), static_cast<std::size_t>(&r - results.data())) == order.end())
       rest.push_back(r.prn);
-  const std::vector<AcquisitionResult> again = search_each(cleaned_, rest);
+  const std::vector<AcquisitionResult> again = search_each(cleaned_, rest, pool);
   for (const auto& r : again)
     for (auto& slot : results)
       if (slot.prn == r.prn) slot = r;

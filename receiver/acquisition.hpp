@@ -40,6 +40,7 @@
 
 #include <array>
 #include <complex>
+#include <memory>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -47,6 +48,7 @@
 #include <vector>
 
 #include "receiver/fftw_plan.hpp"
+#include "receiver/worker_pool.hpp"
 
 namespace ultratrack::receiver {
 
@@ -108,27 +110,39 @@ class Acquisition {
   // Searches several PRNs over the same samples; the Doppler-shifted signal spectra are shared between
   // them (cached when they fit in memory_budget_bytes). With options.cancel_cross_correlation, detections
   // are confirmed by successive cancellation (see AcquisitionOptions) and the rest searched again.
-  std::vector<AcquisitionResult> search(std::span<const std::complex<float>> samples, std::span<const int> prns);
+  // With a pool, the signal spectra and the PRNs are spread over its threads (one scratch set per thread,
+  // made on first use); each PRN's result is the same whatever the number of threads. The pool must be idle
+  // (no parallel_for running, this call not inside one of its jobs or tasks).
+  std::vector<AcquisitionResult> search(std::span<const std::complex<float>> samples, std::span<const int> prns,
+                                        WorkerPool* pool = nullptr);
 
  private:
-  struct Peak {
-    double value = -1.0;
-    int bin = 0;
-    std::size_t lag = 0;
+  // Buffers one search works in: one set per thread of a parallel search.
+  struct Scratch {
+    explicit Scratch(std::size_t fft_size, std::size_t lags);
+    FftwBuffer mixed, product, correlation, spectrum;
+    std::vector<float> row, grid;             // one Doppler row; all rows [bin * lags + lag]
+    std::vector<double> row_noise;            // noise cell mean per Doppler row
+    std::array<float, 256> base_re{}, base_im{};  // carrier wipe-off phasors of one chunk
   };
   const FftwBuffer& code_spectrum(int prn);
-  void doppler_spectrum(std::span<const std::complex<float>> samples, int block, double doppler_hz, FftwBuffer& out);
-  // Fills row_ with the non-coherent sum over lags for one Doppler bin; cached: K spectra of that bin.
+  // Calls f(i, scratch) for i in [0, n), spread over the pool's threads when there is one.
+  template <class F>
+  void spread(WorkerPool* pool, int n, F&& f);
+  void doppler_spectrum(std::span<const std::complex<float>> samples, int block, double doppler_hz, FftwBuffer& out,
+                        Scratch& s) const;
+  // Fills s.row with the non-coherent sum over lags for one Doppler bin; cached: K spectra of that bin.
   void correlate_bin(std::span<const std::complex<float>> samples, const FftwBuffer* cached, int prn,
-                     double doppler_hz);
+                     double doppler_hz, Scratch& s) const;
   std::complex<double> correlate_time(std::span<const std::complex<float>> samples, int prn, int block,
                                       double doppler_hz, double lag_samples) const;
   double power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz, double lag_samples) const;
   AcquisitionResult search_grid(std::span<const std::complex<float>> samples, int prn,
-                                const std::vector<double>& dopplers, bool cached);
+                                const std::vector<double>& dopplers, bool cached, Scratch& s) const;
   std::vector<double> doppler_grid(std::optional<DopplerWindow> assist) const;
   void check(std::span<const std::complex<float>> samples, int prn) const;
-  std::vector<AcquisitionResult> search_each(std::span<const std::complex<float>> samples, std::span<const int> prns);
+  std::vector<AcquisitionResult> search_each(std::span<const std::complex<float>> samples, std::span<const int> prns,
+                                             WorkerPool* pool);
   // Removes a detected signal from samples (amplitude fitted per millisecond).
   void cancel(std::span<std::complex<float>> samples, const AcquisitionResult& result) const;
 
@@ -138,12 +152,9 @@ class Acquisition {
   std::size_t lags_;        // code lags searched: one code period, min(N, ceil(1023 fs / f_chip))
   double samples_per_chip_;
   FftwPlan forward_, backward_;
-  FftwBuffer mixed_, product_, correlation_, spectrum_scratch_;
+  std::vector<std::unique_ptr<Scratch>> scratch_;       // [0] always; more for parallel searches
   std::vector<std::optional<FftwBuffer>> code_spectra_;  // index prn - 1
   std::vector<FftwBuffer> spectrum_cache_;               // [bin * K + k] for a multi-PRN search
-  std::vector<float> row_, grid_;                        // one Doppler row; all rows [bin * lags + lag]
-  std::vector<double> row_noise_;                        // noise cell mean per Doppler row
-  std::array<float, 256> base_re_{}, base_im_{};         // carrier wipe-off phasors of one chunk
   std::vector<std::complex<float>> cleaned_;             // samples with confirmed signals cancelled
   std::size_t memory_budget_bytes_ = std::size_t{256} << 20;
 };

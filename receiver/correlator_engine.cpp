@@ -243,31 +243,49 @@ __attribute__((target("avx2,fma"), optimize("fp-contract=off"))) void correlate_
 
 // The instruction set is chosen once per process from the running CPU (the build targets baseline x86-64);
 // ULTRATRACK_CORRELATOR_ISA=baseline forces the portable copy (tests and benchmarks of both).
-bool use_avx2() {
+bool cpu_has_avx2() {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-  static const bool chosen = [] {
-    const char* forced = std::getenv("ULTRATRACK_CORRELATOR_ISA");
-    if (forced != nullptr && std::string(forced) == "baseline") return false;
+  static const bool has = [] {
     __builtin_cpu_init();
     return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
   }();
-  return chosen;
+  return has;
 #else
   return false;
 #endif
 }
 
+bool use_avx2(CorrelatorIsa isa) {
+  switch (isa) {
+    case CorrelatorIsa::kBaseline:
+      return false;
+    case CorrelatorIsa::kAvx2:
+      if (!cpu_has_avx2()) throw std::invalid_argument("CorrelatorEngine: AVX2+FMA kernel not available here");
+      return true;
+    case CorrelatorIsa::kAuto:
+      break;
+  }
+  static const bool chosen = [] {
+    const char* forced = std::getenv("ULTRATRACK_CORRELATOR_ISA");
+    if (forced != nullptr && std::string(forced) == "baseline") return false;
+    return cpu_has_avx2();
+  }();
+  return chosen;
+}
+
 template <int kTaps>
-CorrelatorEngine::Kernel select_kernel() {
+CorrelatorEngine::Kernel select_kernel([[maybe_unused]] bool avx2) {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-  if (use_avx2()) return &correlate_avx2<kTaps>;
+  if (avx2) return &correlate_avx2<kTaps>;
 #endif
   return &correlate_baseline<kTaps>;
 }
 
 }  // namespace
 
-CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips)
+bool correlator_avx2_available() { return cpu_has_avx2(); }
+
+CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips, CorrelatorIsa isa)
     : prn_(prn), num_taps_(static_cast<int>(tap_offsets_chips.size())) {
   if (num_taps_ < 1 || num_taps_ > kMaxTaps)
     throw std::invalid_argument("CorrelatorEngine: 1.." + std::to_string(kMaxTaps) + " taps required");
@@ -279,13 +297,14 @@ CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_
   const auto& chips = signals::ca_code(prn);  // throws std::out_of_range for a bad PRN
   table_.resize(5 * kCodeLength + 8);
   for (int i = 0; i < static_cast<int>(table_.size()); ++i) table_[i] = static_cast<float>(chips[i % kCodeLength]);
+  const bool avx2 = use_avx2(isa);
   switch (num_taps_) {
-    case 1: kernel_ = select_kernel<1>(); break;
-    case 2: kernel_ = select_kernel<2>(); break;
-    case 3: kernel_ = select_kernel<3>(); break;
-    case 4: kernel_ = select_kernel<4>(); break;
-    case 5: kernel_ = select_kernel<5>(); break;
-    default: kernel_ = select_kernel<6>(); break;
+    case 1: kernel_ = select_kernel<1>(avx2); break;
+    case 2: kernel_ = select_kernel<2>(avx2); break;
+    case 3: kernel_ = select_kernel<3>(avx2); break;
+    case 4: kernel_ = select_kernel<4>(avx2); break;
+    case 5: kernel_ = select_kernel<5>(avx2); break;
+    default: kernel_ = select_kernel<6>(avx2); break;
   }
 }
 

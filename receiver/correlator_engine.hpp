@@ -19,6 +19,12 @@ namespace ultratrack::receiver {
 
 inline constexpr int kMaxTaps = 6;
 
+// Which copy of the kernel an engine runs: the one picked from the CPU (kAuto; ULTRATRACK_CORRELATOR_ISA=baseline
+// forces the portable copy), or one named (tests comparing both in one process; kAvx2 throws
+// std::invalid_argument where the CPU or the build lacks it: see correlator_avx2_available()).
+enum class CorrelatorIsa { kAuto, kBaseline, kAvx2 };
+bool correlator_avx2_available();
+
 // The replica over one block: prompt code phase at the first sample, chips, measured from a code period start
 // and within [-1023, 2046), with at most 1023 chips covered by the block (so that every tap stays in the
 // engine's 5-period table); code step in chips per sample; carrier phase at the first sample and its step per sample in 2^-32 cycles (wrapping).
@@ -36,7 +42,7 @@ class CorrelatorEngine final {
  public:
   // tap_offsets_chips: code offset of each tap relative to prompt, chips, |offset| <= 1023 (positive = early:
   // the tap reads the code that many chips ahead of prompt). At most kMaxTaps taps. Throws std::invalid_argument.
-  CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips);
+  CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips, CorrelatorIsa isa = CorrelatorIsa::kAuto);
 
   int num_taps() const { return num_taps_; }
   int prn() const { return prn_; }

@@ -106,19 +106,29 @@ std::vector<int> ReceiverEngine::missing_prns() const {
   return out;
 }
 
-// Predicted Doppler from the last fix (position, clock drift), the receiver clock and an ephemeris.
-std::optional<DopplerWindow> ReceiverEngine::assistance(int prn, const signals::GpsTime& t, bool* below_horizon) const {
+// The orbit known for a PRN at t: its broadcast ephemeris, else its decoded almanac (within a week of toa).
+std::optional<signals::Ephemeris> ReceiverEngine::orbit_of(int prn, const signals::GpsTime& t) const {
+  if (auto eph = signals::select_ephemeris(ephemerides_, prn, t, {.include_unhealthy = true})) return *eph;
+  const auto& a = almanacs_[static_cast<std::size_t>(prn)];
+  if (a && std::abs(signals::seconds_between(t, signals::GpsTime{a->week, a->toa_s})) < signals::kSecondsPerWeek)
+    return signals::almanac_orbit(*a);
+  return std::nullopt;
+}
+
+// Whether a PRN is above assisted_elevation_min_deg at r_rx, and its predicted Doppler when the last fix (velocity,
+// clock drift) is known. nullopt with *below_horizon false: no orbit known, or no fix.
+std::optional<DopplerWindow> ReceiverEngine::assistance(int prn, const signals::GpsTime& t, const Eigen::Vector3d& r_rx,
+                                                        bool* below_horizon) const {
   *below_horizon = false;
-  if (!last_fix_) return std::nullopt;
-  const auto eph = signals::select_ephemeris(ephemerides_, prn, t, {.include_unhealthy = true});
+  const auto eph = orbit_of(prn, t);
   if (!eph) return std::nullopt;
   const auto sat = signals::satellite_state(*eph, signals::add_seconds(t, -0.075));
-  const Eigen::Vector3d& r_rx = last_fix_->r_e_m;
   const auto look = signals::look_angles(r_rx, sat.r_e_m);
   if (look.elevation_rad < options_.assisted_elevation_min_deg * signals::kPi / 180.0) {
     *below_horizon = true;
     return std::nullopt;
   }
+  if (!last_fix_) return std::nullopt;
   const Eigen::Vector3d los = (sat.r_e_m - r_rx).normalized();
   const double range_rate = los.dot(sat.v_e_mps - last_fix_->v_e_mps);
   const double c = signals::kSpeedOfLight_mps;
@@ -130,7 +140,7 @@ void ReceiverEngine::AcquisitionTask::run() {
   results.clear();
   for (const auto& [prn, window] : assisted) results.push_back(acquisition->search(samples, prn, window));
   if (!blind.empty()) {
-    auto more = acquisition->search(samples, blind);
+    auto more = acquisition->search(samples, blind, pool);
     results.insert(results.end(), more.begin(), more.end());
   }
 }
@@ -142,16 +152,26 @@ void ReceiverEngine::start_acquisition(std::int64_t end_sample) {
   search_.samples = std::span<const std::complex<float>>(snapshot_.data(), snapshot_.size());
   search_.assisted.clear();
   search_.blind.clear();
-  const bool can_assist = last_fix_ && clock_;
-  std::vector<int> blind;
+  // Predictions need the time (the receiver clock) and a position (the last fix, else the supplied rough one).
+  std::optional<Eigen::Vector3d> where;
+  if (last_fix_)
+    where = last_fix_->r_e_m;
+  else if (options_.approximate_r_e_m)
+    where = Eigen::Vector3d((*options_.approximate_r_e_m)[0], (*options_.approximate_r_e_m)[1],
+                            (*options_.approximate_r_e_m)[2]);
+  const bool can_predict = where && clock_;
+  std::vector<int> blind, hidden;
   for (int prn : missing_prns()) {
-    if (!can_assist) {
+    if (!can_predict) {
       blind.push_back(prn);
       continue;
     }
     bool below = false;
-    const auto window = assistance(prn, clock_->time_at(snapshot_first_), &below);
-    if (below) continue;
+    const auto window = assistance(prn, clock_->time_at(snapshot_first_), *where, &below);
+    if (below) {
+      hidden.push_back(prn);
+      continue;
+    }
     if (window)
       search_.assisted.emplace_back(prn, *window);
     else
@@ -170,10 +190,29 @@ void ReceiverEngine::start_acquisition(std::int64_t end_sample) {
       blind_cursor_ = (i + 1) % prns_.size();
     }
   }
+  // Now and then one PRN predicted below the horizon, in case the prediction (or the almanac) is wrong.
+  if (!hidden.empty() && snapshot_first_ >= next_hidden_check_) {
+    for (std::size_t k = 0; k < prns_.size(); ++k) {
+      const std::size_t i = (hidden_cursor_ + k) % prns_.size();
+      if (std::find(hidden.begin(), hidden.end(), prns_[i]) == hidden.end()) continue;
+      search_.blind.push_back(prns_[i]);
+      hidden_cursor_ = (i + 1) % prns_.size();
+      break;
+    }
+    next_hidden_check_ = snapshot_first_ + std::llround(options_.hidden_prn_check_interval_s * options_.fs_hz);
+  }
   // Nothing tracks during a cold start, so nothing to overlap: the satellites join at once.
   search_.apply_at = cold ? end_sample : end_sample + std::llround(options_.reacquisition_latency_s * options_.fs_hz);
   search_.pending = true;
-  pool_.start(search_);
+  if (cold) {
+    // Nothing to overlap with: the search runs now, spread over the whole pool (its result does not depend on
+    // the number of threads). finish_acquisition's wait then returns at once.
+    search_.pool = &pool_;
+    search_.run();
+  } else {
+    search_.pool = nullptr;  // beside the channels, on one worker
+    pool_.start(search_);
+  }
 }
 
 void ReceiverEngine::finish_acquisition(std::int64_t start_sample) {
@@ -234,8 +273,14 @@ void ReceiverEngine::collect_navigation(ReceiverChannel& channel) {
   NavigationDataChannel& nav = channel.navigation();
   auto& stats = stats_.satellites[static_cast<std::size_t>(channel.prn())];
   if (nav.synchronised()) stats.frame_synced = true;
-  if (!nav.take_new_ephemeris()) return;
   const auto& decoder = nav.decoder();
+  // Almanacs of every PRN, from any channel (a page every 30 s); the latest reference time wins.
+  for (std::size_t prn = 1; prn < almanacs_.size(); ++prn) {
+    const auto& a = decoder.almanacs()[prn];
+    auto& mine = almanacs_[prn];
+    if (a && (!mine || mine->week != a->week || mine->toa_s != a->toa_s)) mine = a;
+  }
+  if (!nav.take_new_ephemeris()) return;
   if (decoder.klobuchar().valid) iono_ = decoder.klobuchar();
   if (decoder.utc().valid) utc_ = decoder.utc();
   if (!decoder.ephemeris()) return;

@@ -1,6 +1,7 @@
 // The scalar receiver as a processing object: fed with contiguous blocks of complex baseband samples (any
 // size), it acquires satellites on a snapshot of the first samples (assisted by ephemeris and the last fix once
-// they exist), allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh
+// they exist; satellites predicted below the horizon by an ephemeris or a decoded almanac are searched only
+// rarely), allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh
 // snapshots, forms observables at common receive epochs (every observation_interval_s, in samples), and solves
 // PVT from them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
 // Threads (receiver/worker_pool.hpp): the channels of each block run in parallel, each sample read once and
@@ -29,6 +30,7 @@
 #include "receiver/receiver_clock.hpp"
 #include "receiver/receiver_options.hpp"
 #include "receiver/worker_pool.hpp"
+#include "signals/almanac.hpp"
 #include "signals/ephemeris.hpp"
 
 namespace ultratrack::receiver {
@@ -98,6 +100,8 @@ class ReceiverEngine {
   const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return decoded_; }
   const signals::KlobucharParameters& klobuchar() const { return iono_; }
   const signals::UtcParameters& utc() const { return utc_; }
+  // The latest almanac decoded from any channel, per PRN (index = PRN).
+  const std::array<std::optional<signals::Almanac>, 33>& almanacs() const { return almanacs_; }
   const ReceiverOptions& options() const { return options_; }
   // Time phase-locked on a PRN so far (released channels and the one tracking it now).
   double tracked_time_s(int prn) const;
@@ -109,6 +113,7 @@ class ReceiverEngine {
   // run by the pool, applied at apply_at.
   struct AcquisitionTask final : BackgroundTask {
     Acquisition* acquisition = nullptr;
+    WorkerPool* pool = nullptr;  // set for a search run inline on the caller's thread (the cold start)
     std::span<const std::complex<float>> samples;
     std::vector<std::pair<int, DopplerWindow>> assisted;
     std::vector<int> blind;
@@ -124,7 +129,9 @@ class ReceiverEngine {
   void start_acquisition(std::int64_t end_sample);
   void finish_acquisition(std::int64_t start_sample);
   std::vector<int> missing_prns() const;
-  std::optional<DopplerWindow> assistance(int prn, const signals::GpsTime& t, bool* below_horizon) const;
+  std::optional<signals::Ephemeris> orbit_of(int prn, const signals::GpsTime& t) const;
+  std::optional<DopplerWindow> assistance(int prn, const signals::GpsTime& t, const Eigen::Vector3d& r_rx,
+                                          bool* below_horizon) const;
   void feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample);
   void feed_channel(int slot);
   void collect_navigation(ReceiverChannel& channel);
@@ -142,6 +149,8 @@ class ReceiverEngine {
   AcquisitionTask search_;
   std::size_t blind_cursor_ = 0;  // round robin over prns_ for blind re-acquisitions
   std::vector<int> prns_;
+  std::size_t hidden_cursor_ = 0;        // round robin over prns_ for checks of PRNs predicted below the horizon
+  std::int64_t next_hidden_check_ = 0;   // sample from which the next such check may run
 
   bool started_ = false;
   std::int64_t next_sample_ = 0;  // expected first sample of the next block
@@ -157,6 +166,7 @@ class ReceiverEngine {
   std::optional<ReceiverClock> clock_;
   std::vector<signals::Ephemeris> ephemerides_;  // all known: supplied + decoded
   std::vector<signals::Ephemeris> decoded_;
+  std::array<std::optional<signals::Almanac>, 33> almanacs_{};
   signals::KlobucharParameters iono_;
   signals::UtcParameters utc_;
   std::optional<PvtSolution> last_fix_;

@@ -22,6 +22,8 @@ std::string ReceiverOptions::validate() const {
     return fmt::format("re-acquisition latency {} s outside [0, 10]", reacquisition_latency_s);
   if (blind_prns_per_snapshot < 0 || blind_prns_per_snapshot > 32)
     return fmt::format("blind PRNs per snapshot {} outside 0..32", blind_prns_per_snapshot);
+  if (!(hidden_prn_check_interval_s >= 1.0 && hidden_prn_check_interval_s <= 3600.0))
+    return fmt::format("hidden PRN check interval {} s outside [1, 3600]", hidden_prn_check_interval_s);
   if (threads < 0 || threads > 256) return fmt::format("threads = {}: must be within 0..256", threads);
   if (!(assisted_doppler_half_width_hz > 0.0 && assisted_doppler_half_width_hz <= 5000.0))
     return fmt::format("assisted Doppler half width {} Hz outside (0, 5000]", assisted_doppler_half_width_hz);

@@ -2,6 +2,8 @@
 // observation rate and PVT. Defaults suit real sky data at L1 C/A. Units: Hz, seconds, samples at the edge.
 #pragma once
 
+#include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,12 @@ struct ReceiverOptions {
   // snapshot, round robin (each search keeps its full sensitivity; a PRN comes round every few snapshots).
   // 0: all of them every time. The cold start always searches every PRN.
   int blind_prns_per_snapshot = 8;
+  // Satellites predicted below assisted_elevation_min_deg (from an ephemeris or a decoded almanac, at the last
+  // fix or at approximate_r_e_m before one) are not searched blindly; one of them, round robin, is checked
+  // this often in case the prediction is wrong. [1, 3600] s.
+  double hidden_prn_check_interval_s = 60.0;
+  // A rough receiver position (ECEF, metres; within ~100 km) for visibility predictions before the first fix.
+  std::optional<std::array<double, 3>> approximate_r_e_m;
   int threads = 0;                         // worker threads including the caller's, 1..256; 0 = hardware threads
   double assisted_doppler_half_width_hz = 600.0;  // assisted search window around the predicted Doppler
   double assisted_elevation_min_deg = -5.0;       // assisted search skips satellites below this

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "signals/gps_constants.hpp"
+#include "signals/lnav_fields.hpp"
 #include "signals/lnav_layout.hpp"
 #include "signals/lnav_parity.hpp"
 
@@ -84,6 +85,9 @@ LnavUpdate LnavDecoder::add(const LnavSubframe& sf) {
     sf_[sf.subframe_id - 1] = sf;
     if (sf.subframe_id == 1) sf1_week_ = week_;
     try_complete_ephemeris();
+  } else if ((sf.subframe_id == 4 && sf.page_sv_id >= 25 && sf.page_sv_id <= 32) ||
+             (sf.subframe_id == 5 && sf.page_sv_id >= 1 && sf.page_sv_id <= 24)) {
+    decode_almanac(sf);
   } else if (sf.subframe_id == 4 && sf.page_sv_id == kIonoUtcSvId) {
     const LnavDataWords& w = sf.words;
     for (int i = 0; i < 4; ++i) {
@@ -103,6 +107,32 @@ LnavUpdate LnavDecoder::add(const LnavSubframe& sf) {
     last_update_.iono_utc = true;
   }
   return last_update_;
+}
+
+// Table 20-VI: e 2^-21, toa 2^12 s, delta i 2^-19 sc (from 0.30 sc), Omega dot 2^-38 sc/s, sqrt A 2^-11,
+// Omega0 / omega / M0 2^-23 sc, af0 2^-20 s, af1 2^-38 s/s.
+void LnavDecoder::decode_almanac(const LnavSubframe& sf) {
+  const LnavDataWords& w = sf.words;
+  if (get(w, kDataId) != static_cast<std::uint32_t>(kLnavDataIdNav)) return;  // LNAV data (20.3.3.5.1.1)
+  Almanac a;
+  a.prn = sf.page_sv_id;
+  a.toa_s = static_cast<double>(get(w, kAlmToa) << kAlmToaScale);
+  const double sent = sf.start_tow_s();
+  const double dt = a.toa_s - sent;
+  a.week = week_ + (dt < -kSecondsPerWeek / 2 ? 1 : 0) - (dt > kSecondsPerWeek / 2 ? 1 : 0);
+  a.e = uns(w, kAlmE, kAlmEScale);
+  a.i_rad = (kAlmReferenceInclination_sc + sgn(w, kAlmDeltaI, kAlmDeltaIScale)) * kPi;
+  a.omega_dot_radps = sgn(w, kAlmOmegaDot, kAlmOmegaDotScale) * kPi;
+  a.health = static_cast<int>(get(w, kAlmHealth));
+  a.sqrt_a_sqrtm = uns(w, kAlmSqrtA, kAlmSqrtAScale);
+  a.omega0_rad = sgn(w, kAlmOmega0, kAlmAngleScale) * kPi;
+  a.omega_rad = sgn(w, kAlmOmega, kAlmAngleScale) * kPi;
+  a.m0_rad = sgn(w, kAlmM0, kAlmAngleScale) * kPi;
+  a.af0_s = sgn(w, kAlmAf0, kAlmAf0Scale);
+  a.af1_sps = sgn(w, kAlmAf1, kAlmAf1Scale);
+  if (!(a.sqrt_a_sqrtm > 0.0)) return;  // not an orbit
+  almanacs_[static_cast<std::size_t>(a.prn)] = a;
+  last_update_.almanac_prn = a.prn;
 }
 
 void LnavDecoder::try_complete_ephemeris() {

@@ -1,6 +1,7 @@
 // Reads the LNAV message back (IS-GPS-200 20.3): LnavDecoder collects one satellite's parity-checked
 // subframes (lnav_subframe.hpp) into an Ephemeris (SI units, full weeks), the Klobuchar and UTC
-// parameters, and the GPS time of each subframe start.
+// parameters, the almanacs of subframes 4 and 5 (any satellite's, signals/almanac.hpp), and the GPS time of
+// each subframe start.
 //
 // Use from a receiver: either push every bit from the bit synchroniser with LnavDecoder::add_bit (frame
 // sync by preamble search inside, lnav_frame_sync.hpp), or, with frame sync done elsewhere, hand each
@@ -14,6 +15,7 @@
 #include <optional>
 #include <span>
 
+#include "signals/almanac.hpp"
 #include "signals/ephemeris.hpp"
 #include "signals/gps_time.hpp"
 #include "signals/lnav_frame_sync.hpp"
@@ -25,6 +27,7 @@ namespace ultratrack::signals {
 struct LnavUpdate {
   bool ephemeris = false;  // a complete ephemeris that differs from the previous one (new IODC/IODE/toe)
   bool iono_utc = false;   // subframe 4 page 18 decoded
+  int almanac_prn = 0;     // an almanac page of this PRN decoded (0: none)
 };
 
 // One satellite's LNAV stream -> ephemeris, Klobuchar/UTC, time. Not thread-safe; one per channel.
@@ -63,6 +66,10 @@ class LnavDecoder {
   // 127 weeks of WN when a leap second is pending; otherwise, delta_t_lsf = delta_t_ls, its week is moot).
   const KlobucharParameters& klobuchar() const { return iono_; }
   const UtcParameters& utc() const { return utc_; }
+  // The latest almanac decoded for each PRN (index = PRN, 1..32; dummy-SV pages are skipped). toa's week is
+  // the one that puts toa nearest to the page's time of transmission (IS-GPS-200 20.3.4.5: toa lies within
+  // a few days of it).
+  const std::array<std::optional<Almanac>, 33>& almanacs() const { return almanacs_; }
   // GPS time at which the last accepted subframe's first bit left the satellite, and its HOW TOW count.
   // The week is the last subframe 1 WN (resolved), or the reference week before one has been read.
   std::optional<GpsTime> last_subframe_start() const { return last_start_; }
@@ -75,6 +82,7 @@ class LnavDecoder {
 
  private:
   void try_complete_ephemeris();
+  void decode_almanac(const LnavSubframe& subframe);
   void count(LnavStatus status);
 
   int prn_;
@@ -85,6 +93,7 @@ class LnavDecoder {
   std::optional<Ephemeris> ephemeris_;
   KlobucharParameters iono_;
   UtcParameters utc_;
+  std::array<std::optional<Almanac>, 33> almanacs_{};
   std::optional<GpsTime> last_start_;
   std::optional<int> last_tow_count_;
   Counters counters_;

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <random>
@@ -165,4 +166,64 @@ TEST(CorrelatorEngine, RejectsBadTapSets) {
   const double too_far[] = {2000.0};
   EXPECT_THROW(CorrelatorEngine(1, too_far), std::invalid_argument);
   EXPECT_THROW(CorrelatorEngine(33, none), std::out_of_range);
+}
+
+// The AVX2 and the portable kernels in one process on the same inputs: i8-valued noisy samples with a signal,
+// 1..6 taps (the receiver's E/P/L + noise layout among them), 1 and 3 antennas, code steps from 0.2 to 0.99
+// chips per sample, start phases in [-1023, 1023), block lengths that are not multiples of 8 or of the 256-sample
+// chunk. Same chips by construction, so the sums may differ only by float rounding: per 256-sample chunk of float
+// accumulation at most 256 * 2^-24 of the sum of |terms| (1.5e-5), plus the carrier's 3e-6: 2e-5 * sum |x|.
+// A single chip read differently would move a sum by 2 |x_k|, ~100x that bound.
+TEST(CorrelatorEngine, Avx2AndPortableKernelsAgreeOnTheSameInputs) {
+  if (!correlator_avx2_available()) GTEST_SKIP() << "no AVX2+FMA on this CPU: nothing to compare";
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 20.0f);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::vector<std::vector<double>> layouts = {
+      {0.0}, {0.5, 0.0, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0},
+      {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}, {0.5, 0.0}};
+  int compared = 0;
+  for (const auto& offsets : layouts) {
+    const CorrelatorEngine avx2(9, offsets, CorrelatorIsa::kAvx2), portable(9, offsets, CorrelatorIsa::kBaseline);
+    for (int trial = 0; trial < 12; ++trial) {
+      const int antennas = trial % 2 == 0 ? 1 : 3;
+      const int n = 500 + static_cast<int>(u(rng) * 3500);  // 500..4000 samples
+      ReplicaSegment rep;
+      rep.code_step_chips = 0.2 + 0.79 * u(rng);
+      rep.code_phase_chips = -1023.0 + 2046.0 * u(rng);
+      if (rep.code_phase_chips + rep.code_step_chips * n > 2045.0) rep.code_phase_chips -= 1023.0;
+      rep.carrier_phase_q32 = static_cast<std::uint32_t>(rng());
+      rep.carrier_step_q32 = static_cast<std::uint32_t>(rng()) / 64u;
+      std::vector<std::vector<std::complex<float>>> x(static_cast<std::size_t>(antennas));
+      std::vector<const std::complex<float>*> ptr;
+      double abs_sum = 0.0;
+      const auto& chips = signals::ca_code(9);
+      for (auto& a : x) {
+        a.resize(static_cast<std::size_t>(n));
+        for (int i = 0; i < n; ++i) {
+          const double chip = rep.code_phase_chips + rep.code_step_chips * i;
+          const int c = chips[static_cast<std::size_t>(((static_cast<long>(std::floor(chip)) % 1023) + 1023) % 1023)];
+          const float s = 25.0f * static_cast<float>(c);
+          a[static_cast<std::size_t>(i)] = {std::round(std::clamp(s + noise(rng), -127.0f, 127.0f)),
+                                            std::round(std::clamp(noise(rng), -127.0f, 127.0f))};
+          abs_sum += std::abs(a[static_cast<std::size_t>(i)]);
+        }
+        ptr.push_back(a.data());
+      }
+      std::vector<TapSums> sa(static_cast<std::size_t>(antennas)), sp(static_cast<std::size_t>(antennas));
+      for (auto& s : sa) s.fill({});
+      for (auto& s : sp) s.fill({});
+      avx2.correlate(ptr, n, rep, sa);
+      portable.correlate(ptr, n, rep, sp);
+      for (int a = 0; a < antennas; ++a)
+        for (int t = 0; t < static_cast<int>(offsets.size()); ++t) {
+          EXPECT_LE(std::abs(sa[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)] -
+                             sp[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)]),
+                    2e-5 * abs_sum / antennas)
+              << offsets.size() << " taps, tap " << t << ", antenna " << a << ", trial " << trial;
+          ++compared;
+        }
+    }
+  }
+  EXPECT_EQ(compared, 12 * 2 * (1 + 3 + 4 + 5 + 6 + 2));  // 6 trials with 1 antenna and 6 with 3 per layout
 }
