@@ -5,9 +5,72 @@
 
 namespace ultratrack::receiver {
 
+void BitSynchronizer::add_energy(std::int64_t code_period, std::complex<float> prompt) {
+  const bool consecutive = have_previous_ && code_period == previous_period_ + 1;
+  if (!consecutive) {  // a gap: windows across it are meaningless, and so is the current set
+    consecutive_ = 0;
+    window_count_ = 0;
+    have_previous_set_ = false;
+  }
+  ring_[static_cast<std::size_t>(((code_period % 20) + 20) % 20)] = std::complex<double>(prompt);
+  if (++consecutive_ < 20) return;
+  consecutive_ = 20;
+  std::complex<double> sum{};
+  for (const auto& p : ring_) sum += p;
+  // the window ends at code_period: it starts at code_period - 19, offset (code_period + 1) mod 20
+  const auto c = static_cast<std::size_t>((((code_period + 1) % 20) + 20) % 20);
+  if (window_count_ == 0 && c != 0) return;  // sets run from offset 0 to 19
+  window_[c] = std::norm(sum);
+  if (++window_count_ < 20) return;
+  window_count_ = 0;
+  ++energy_sets_;
+  for (std::size_t j = 0; j < 20; ++j) {
+    energy_[j] += window_[j];
+    for (std::size_t k = j; k < 20; ++k) cross_[j][k] += window_[j] * window_[k];
+  }
+  if (have_previous_set_) {
+    ++lag_sets_;
+    for (std::size_t j = 0; j < 20; ++j)
+      for (std::size_t k = 0; k < 20; ++k) lag_[j][k] += previous_window_[j] * window_[k];
+  }
+  previous_window_ = window_;
+  have_previous_set_ = true;
+}
+
+bool BitSynchronizer::energy_decides(int* best) const {
+  if (energy_sets_ < options_.min_energy_bits) return false;
+  const auto b = static_cast<std::size_t>(std::max_element(energy_.begin(), energy_.end()) - energy_.begin());
+  const double n = energy_sets_;
+  const auto cross = [&](std::size_t j, std::size_t k) { return j <= k ? cross_[j][k] : cross_[k][j]; };
+  if (lag_sets_ < 1) return false;
+  const double m = lag_sets_;
+  for (std::size_t k = 0; k < 20; ++k) {
+    if (k == b) continue;
+    const double d = energy_[b] - energy_[k];
+    // variance of the summed difference per set: that of window_b - window_k within a set plus twice its
+    // covariance with the next set's (Newey-West with one lag: windows more than one set apart do not overlap)
+    const double mean = d / n;
+    const double var0 = (cross(b, b) - 2.0 * cross(b, k) + cross(k, k)) / n - mean * mean;
+    const double cov1 = (lag_[b][b] - lag_[b][k] - lag_[k][b] + lag_[k][k]) / m - mean * mean;
+    const double var = var0 + 2.0 * cov1;
+    if (!(d > options_.min_energy_sigma * std::sqrt(std::max(var, 0.0) * n))) return false;
+  }
+  *best = static_cast<int>(b);
+  return true;
+}
+
 void BitSynchronizer::add(std::int64_t code_period, std::complex<float> prompt) {
   if (synchronised_) return;
   ++periods_;
+  if (options_.energy_test) {
+    add_energy(code_period, prompt);
+    int best = 0;
+    if (energy_decides(&best)) {
+      synchronised_ = true;
+      edge_ = best;
+      return;
+    }
+  }
   if (have_previous_ && code_period == previous_period_ + 1) {
     const double dot = static_cast<double>(prompt.real()) * previous_.real() + static_cast<double>(prompt.imag()) * previous_.imag();
     if (dot < 0.0) ++bins_[static_cast<std::size_t>(((code_period % 20) + 20) % 20)];

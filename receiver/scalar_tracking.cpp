@@ -1,5 +1,6 @@
 #include "receiver/scalar_tracking.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -47,10 +48,15 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.pullin_timeout_s >= 0.1 && o.pullin_timeout_s <= 30, "pullin_timeout_s", o.pullin_timeout_s, "[0.1, 30] s");
   c.check(o.fll_fine_time_s >= 0 && o.fll_fine_time_s <= 5, "fll_fine_time_s", o.fll_fine_time_s, "[0, 5] s");
   c.check(o.fll_fine_bw_hz > 0 && o.fll_fine_bw_hz <= 10, "fll_fine_bw_hz", o.fll_fine_bw_hz, "(0, 10] Hz");
-  const double pullin_min_s = o.fll_wide_time_s + o.fll_narrow_time_s + o.fll_fine_time_s + o.pli_time_constant_s +
-                              o.pullin_lock_time_s;
+  c.check(o.pullin_search_hz >= 0 && o.pullin_search_hz <= 500, "pullin_search_hz", o.pullin_search_hz, "[0, 500] Hz");
+  c.check(o.pullin_search_time_s >= 0.05 && o.pullin_search_time_s <= 0.5, "pullin_search_time_s",
+          o.pullin_search_time_s, "[0.05, 0.5] s");
+  c.check(o.pll_bw_weak_hz > 0 && o.pll_bw_weak_hz <= 50, "pll_bw_weak_hz", o.pll_bw_weak_hz, "(0, 50] Hz");
+  c.check(o.weak_cn0_dbhz >= 0 && o.weak_cn0_dbhz <= 60, "weak_cn0_dbhz", o.weak_cn0_dbhz, "[0, 60] dB-Hz");
+  const double acquire_s = o.pullin_search_hz > 0 ? o.pullin_search_time_s : o.fll_wide_time_s + o.fll_narrow_time_s;
+  const double pullin_min_s = acquire_s + o.fll_fine_time_s + o.pli_time_constant_s + o.pullin_lock_time_s;
   c.check(o.pullin_timeout_s > pullin_min_s, "pullin_timeout_s", o.pullin_timeout_s,
-          "(sum of the FLL stage times + pli_time_constant_s + pullin_lock_time_s, 30] s");
+          "(search or wide + narrow FLL time, + fine FLL time + pli_time_constant_s + pullin_lock_time_s, 30] s");
   c.check(o.dll_bw_hz > 0 && o.dll_bw_hz <= 10, "dll_bw_hz", o.dll_bw_hz, "(0, 10] Hz");
   c.check(o.dll_bw_coherent_hz > 0 && o.dll_bw_coherent_hz <= 5, "dll_bw_coherent_hz", o.dll_bw_coherent_hz, "(0, 5] Hz");
   c.check(o.early_late_offset_chips > 0 && o.early_late_offset_chips <= 0.5, "early_late_offset_chips",
@@ -64,6 +70,10 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.bit_sync.min_ratio >= 1.5 && o.bit_sync.min_ratio <= 100, "bit_sync.min_ratio", o.bit_sync.min_ratio, "[1.5, 100]");
   c.check(o.bit_sync.min_lead_sigma >= 3 && o.bit_sync.min_lead_sigma <= 100, "bit_sync.min_lead_sigma",
           o.bit_sync.min_lead_sigma, "[3, 100]");
+  c.check(o.bit_sync.min_energy_bits >= 10 && o.bit_sync.min_energy_bits <= 1000, "bit_sync.min_energy_bits",
+          o.bit_sync.min_energy_bits, "[10, 1000]");
+  c.check(o.bit_sync.min_energy_sigma >= 3 && o.bit_sync.min_energy_sigma <= 100, "bit_sync.min_energy_sigma",
+          o.bit_sync.min_energy_sigma, "[3, 100]");
   c.check(o.bit_sync.max_periods >= 200, "bit_sync.max_periods", o.bit_sync.max_periods, "[200, inf)");
   c.check(o.cn0_window_s >= 0.02 && o.cn0_window_s <= 5, "cn0_window_s", o.cn0_window_s, "[0.02, 5] s");
   c.check(o.cn0_loss_threshold_dbhz >= 0 && o.cn0_loss_threshold_dbhz <= 45, "cn0_loss_threshold_dbhz",
@@ -116,6 +126,59 @@ ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCo
       bit_sync_(options.bit_sync) {
   command_.code_phase_jump_chips = 0.0;
   command_.carrier_phase_jump_cycles = 0.0;
+  const bool search = opt_.pullin_search_hz > 0.0;
+  search_end_s_ = search ? opt_.pullin_search_time_s : 0.0;
+  wide_end_s_ = search_end_s_ + (search ? 0.0 : opt_.fll_wide_time_s);
+  narrow_end_s_ = wide_end_s_ + (search ? 0.0 : opt_.fll_narrow_time_s);
+  pll_start_s_ = narrow_end_s_ + opt_.fll_fine_time_s;
+  initial_frequency_hz_ = initial.carrier_frequency_hz;
+  pll_bw_now_hz_ = opt_.pll_bw_hz;
+}
+
+// The frequency offset of the buffered 1 ms prompts (carrier held constant while they were taken): argmax over a
+// 2.5 Hz grid of the energy of 10 ms coherent blocks summed over blocks (a block holding a bit edge loses
+// coherence but keeps its energy near the true offset), refined by a parabola through the peak and neighbours.
+double ScalarTracking::search_frequency_offset_hz() const {
+  constexpr int kBlock = 10;
+  constexpr double kStep_hz = 2.5;
+  const int blocks = search_count_ / kBlock;
+  if (blocks == 0) return 0.0;
+  const int half = static_cast<int>(std::ceil(opt_.pullin_search_hz / kStep_hz));
+  const auto energy = [&](double f_hz) {
+    const std::complex<double> step = std::polar(1.0, -kTwoPi * f_hz * 1e-3);
+    std::complex<double> rotation = 1.0;
+    double sum = 0.0;
+    for (int b = 0; b < blocks; ++b) {
+      std::complex<double> block{};
+      for (int k = 0; k < kBlock; ++k) {
+        block += std::complex<double>(search_prompts_[static_cast<std::size_t>(b * kBlock + k)]) * rotation;
+        rotation *= step;
+      }
+      sum += std::norm(block);
+    }
+    return sum;
+  };
+  int best = 0;
+  double best_e = -1.0, previous_e = 0.0, before_best = 0.0, after_best = 0.0;
+  bool need_after = false;
+  for (int i = -half; i <= half; ++i) {
+    const double e = energy(i * kStep_hz);
+    if (need_after) {
+      after_best = e;
+      need_after = false;
+    }
+    if (e > best_e) {
+      best_e = e;
+      best = i;
+      before_best = previous_e;
+      need_after = true;
+    }
+    previous_e = e;
+  }
+  if (best == -half || best == half) return best * kStep_hz;  // at the edge of the range: no parabola
+  const double den = before_best - 2.0 * best_e + after_best;
+  const double delta = den < 0.0 ? std::clamp(0.5 * (before_best - after_best) / den, -0.5, 0.5) : 0.0;
+  return (best + delta) * kStep_hz;
 }
 
 double ScalarTracking::fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz) {
@@ -168,7 +231,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   r.phase_error_cycles = costas_atan_cycles(taps.prompt);
   // Frequency error from cross and dot averaged over ~4 epochs: halves of this epoch in the wide stage, this and
   // the previous prompt (dot sign removed: bit-tolerant) afterwards.
-  const bool wide_fll = time_s_ <= opt_.fll_wide_time_s || previous_t_s_ == 0.0;
+  const bool wide_fll = (time_s_ > search_end_s_ && time_s_ <= wide_end_s_) || previous_t_s_ == 0.0;
   if (wide_fll != wide_fll_) fll_average_ = {};
   wide_fll_ = wide_fll;
   CrossDot cd = wide_fll ? cross_dot(e.prompt_halves[0], e.prompt_halves[1]) : cross_dot(previous_prompt_, taps.prompt);
@@ -191,7 +254,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   // State machine.
   if (state_ == TrackingState::kPullIn) {
     // Phase lock can only be judged once the PLL runs (after the FLL stages) and the PLI has settled on it.
-    const double pll_start_s = opt_.fll_wide_time_s + opt_.fll_narrow_time_s + opt_.fll_fine_time_s;
+    const double pll_start_s = pll_start_s_;
     if (time_s_ > pll_start_s && time_s_ - t <= pll_start_s) pli_.reset();
     const bool judged = time_s_ > pll_start_s + opt_.pli_time_constant_s;
     locked_time_s_ = judged && r.phase_locked ? locked_time_s_ + t : 0.0;
@@ -199,6 +262,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
       state_ = TrackingState::kPhaseLocked;
       ever_locked_ = true;
       carrier_.set_bandwidths(opt_.pll_bw_hz, 0.0);
+      pll_bw_now_hz_ = opt_.pll_bw_hz;
       carrier_.set_order(opt_.pll_order);
     } else if (time_s_ > opt_.pullin_timeout_s) {
       state_ = TrackingState::kLost;
@@ -237,13 +301,32 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
 
   // Loops.
   // Pull-in stages (see ScalarTrackingOptions): a first-order FLL alone, then the PLL alone.
-  const bool wide_stage = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s;
-  const bool fll_only = state_ == TrackingState::kPullIn && time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s;
-  const bool fine_stage = state_ == TrackingState::kPullIn && !fll_only &&
-                          time_s_ <= opt_.fll_wide_time_s + opt_.fll_narrow_time_s + opt_.fll_fine_time_s;
+  const bool pullin = state_ == TrackingState::kPullIn;
+  const bool search_stage = pullin && time_s_ <= search_end_s_;
+  const bool wide_stage = pullin && !search_stage && time_s_ <= wide_end_s_;
+  const bool fll_only = pullin && !search_stage && time_s_ <= narrow_end_s_;
+  const bool fine_stage = pullin && !search_stage && !fll_only && time_s_ <= pll_start_s_;
   const bool coherent = state_ == TrackingState::kBitSynced;
+  // After phase lock on 1 ms epochs: the narrower PLL while the signal is weak.
+  if (state_ == TrackingState::kPhaseLocked && e.num_code_periods == 1 && cn0_dbhz_) {
+    const double bw = *cn0_dbhz_ < opt_.weak_cn0_dbhz ? std::min(opt_.pll_bw_weak_hz, opt_.pll_bw_hz) : opt_.pll_bw_hz;
+    if (bw != pll_bw_now_hz_) {
+      carrier_.set_bandwidths(bw, 0.0);
+      pll_bw_now_hz_ = bw;
+    }
+  }
   double f = 0.0;
-  if (fll_only) {
+  if (search_stage) {
+    // hold the acquisition's frequency and buffer the prompts; estimate the offset at the stage's end
+    if (e.num_code_periods == 1 && search_count_ < kMaxSearchEpochs)
+      search_prompts_[static_cast<std::size_t>(search_count_++)] = taps.prompt;
+    f = initial_frequency_hz_;
+    if (time_s_ + t > search_end_s_) {  // the next epoch belongs to the fine FLL
+      f = initial_frequency_hz_ + search_frequency_offset_hz();
+      r.frequency_error_hz = f - initial_frequency_hz_;
+      carrier_.reset(f, 0.0);
+    }
+  } else if (fll_only) {
     f = carrier_.update_fll_only(r.frequency_error_hz, wide_stage ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz, t);
   } else if (fine_stage) {
     f = fine_fll(taps.prompt, t, &r.frequency_error_hz);

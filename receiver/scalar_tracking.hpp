@@ -1,9 +1,12 @@
-// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. FLL pull-in (wide,
-// narrow, fine stages) handing over to the Costas PLL (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
+// Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. Pull-in (a frequency
+// search on the first prompts, or wide and narrow FLL stages; then a fine FLL) handing over to the Costas PLL
+// (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
 // 1 ms epochs, then 20 ms coherent after bit sync; C/N0, phase-lock and C/N0 lock detectors; loss of lock is
 // a state (kLost), never silently tracked noise. Units: Hz, chips, cycles, seconds; C/N0 in dB-Hz at the edge.
 #pragma once
 
+#include <array>
+#include <complex>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -24,12 +27,27 @@ struct ScalarTrackingOptions {
   // Carrier loop
   int pll_order = 3;                   // 2 or 3
   double pll_bw_hz = 15.0;             // PLL noise bandwidth with 1 ms epochs; (0, 50]
+  // On 1 ms epochs after phase lock while the measured C/N0 is below weak_cn0_dbhz: a narrower PLL (thermal
+  // phase jitter sqrt(Bn / (C/N0) (1 + 1 / (2 T C/N0))): 14 deg at 15 Hz, 27 dB-Hz, against 9 deg at 6 Hz), for
+  // the second or two before bit sync; a static or vehicle receiver's line-of-sight dynamics (< 1 g) stay within
+  // a 3rd-order 6 Hz loop's reach.
+  double pll_bw_weak_hz = 6.0;         // (0, 50]
+  double weak_cn0_dbhz = 33.0;         // [0, 60]
   double pll_bw_coherent_hz = 5.0;     // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
                                        // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
   // Pull-in: (1) a wide FLL alone on the two halves of each code period (range +-1 kHz, bit-edge safe); (2) a
   // narrow FLL alone on successive 1 ms prompts (bit-tolerant, range +-250 Hz, 8x less noise); (3) the PLL alone
   // (2nd order while pulling in) until the phase lock indicator holds, then the PLL of pll_order. Both FLLs are
   // first order and average cross and dot over ~4 epochs before the arctangent.
+  // (0) When pullin_search_hz > 0 (default): instead of stages (1) and (2), a frequency search on the first
+  // pullin_search_time_s of 1 ms prompts with the carrier held at the acquisition's frequency: the energy of
+  // 10 ms coherent blocks, summed over blocks, at offsets +-pullin_search_hz (2.5 Hz grid, parabola through the
+  // peak). Its noise is that of an estimate from 0.2 s of signal (a few Hz at 27 dB-Hz), where the FLL stages
+  // wander +-20-130 Hz below ~32 dB-Hz (frequency jitter of a 1st-order FLL on 0.5-1 ms cross products): the
+  // FLL stages suit a 1 ms acquisition on strong signals (pullin_search_hz = 0), the search any acquisition
+  // whose Doppler is good to +-pullin_search_hz (refined 4-10 ms acquisitions: a few tens of Hz at worst).
+  double pullin_search_hz = 300.0;     // [0, 500]; 0 = FLL stages (1), (2)
+  double pullin_search_time_s = 0.2;   // [0.05, 0.5]
   double fll_bw_hz = 10.0;             // wide FLL; (0, 50]
   double fll_wide_time_s = 0.25;       // stage (1) length; [0.01, 5]
   double fll_narrow_bw_hz = 2.0;       // narrow FLL; (0, 20]
@@ -106,6 +124,9 @@ class ScalarTracking final {
 
  private:
   double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
+  double search_frequency_offset_hz() const;
+
+  static constexpr int kMaxSearchEpochs = 500;
 
   ScalarTrackingOptions opt_;
   TrackingState state_ = TrackingState::kPullIn;
@@ -129,6 +150,12 @@ class ScalarTracking final {
   double fine_time_s_ = 0.0;
   bool fine_have_previous_ = false;
   bool wide_fll_ = true;
+  // pull-in stage ends (s since the channel's start)
+  double search_end_s_ = 0.0, wide_end_s_ = 0.0, narrow_end_s_ = 0.0, pll_start_s_ = 0.0;
+  std::array<std::complex<float>, kMaxSearchEpochs> search_prompts_{};
+  int search_count_ = 0;
+  double initial_frequency_hz_ = 0.0;
+  double pll_bw_now_hz_ = 0.0;
   double smoothed_frequency_hz_ = 0.0;  // NCO frequency and rate low-passed while phase-locked at 1 ms
   bool smoothing_started_ = false;
   double previous_t_s_ = 0.0;

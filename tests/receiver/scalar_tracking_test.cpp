@@ -198,7 +198,7 @@ TEST(ScalarTracking, MomentsEstimatorWorksWithoutTheNoiseTap) {
   const auto sat = satellite(2, 45.0);
   ScalarTrackingOptions opt;
   opt.cn0_method = Cn0Method::kMoments;
-  const auto recs = track(sat, opt, 80.0, 0.2, 4.0, 9);
+  const auto recs = track(sat, opt, 80.0, 0.2, 6.0, 9);  // >= 5 one-second (50 x 20 ms) windows after bit sync
   std::vector<double> cn0;
   std::optional<double> last;
   for (const auto& r : recs) {
