@@ -129,9 +129,11 @@ TEST(ReceiveVisibility, SearchesOnlyPredictedVisiblePrnsOnceTheClockIsSet) {
       if (!visible.count(prn)) ++hidden_searches;
     // Every visible PRN not tracked at the end was searched on this snapshot (the satellites the simulator
     // leaves out, between -5 and 9 degrees, are missing on every snapshot).
-    for (int prn : visible)
-      if (std::find(tracked.begin(), tracked.end(), prn) == tracked.end())
+    for (int prn : visible) {
+      if (std::find(tracked.begin(), tracked.end(), prn) == tracked.end()) {
         EXPECT_NE(std::find(prns.begin(), prns.end(), prn), prns.end()) << "PRN " << prn << " visible, not searched";
+      }
+    }
   }
   EXPECT_GE(predicted_snapshots, 3);
   // 16 s of signal: one check of a hidden PRN at most (one per 60 s).
