@@ -12,6 +12,7 @@
 #include "fusion/covariance_utils.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"
+#include "fusion/innovation_gate.hpp"
 
 namespace ultratrack::fusion {
 
@@ -57,16 +58,8 @@ class Ekf {
     const Eigen::Matrix<double, Eigen::Dynamic, N> HP = H * P_;
     Eigen::MatrixXd S = HP * H.transpose() + R;
     S = 0.5 * (S + S.transpose());
-    Eigen::LLT<Eigen::MatrixXd> llt(S);
-    r.threshold = opt_.gate.enabled ? chi_square_quantile(opt_.gate.probability, r.dof)
-                                    : std::numeric_limits<double>::infinity();
-    if (llt.info() != Eigen::Success || !r.innovation.allFinite()) {
-      r.nis = std::numeric_limits<double>::infinity();
-      ++counters_.rejected;
-      return r;
-    }
-    r.nis = r.innovation.dot(llt.solve(r.innovation));
-    if (!(r.nis <= r.threshold)) {
+    Eigen::LLT<Eigen::MatrixXd> llt;
+    if (!passes_innovation_gate(opt_.gate, S, r, llt)) {
       ++counters_.rejected;
       return r;
     }

@@ -19,6 +19,7 @@
 #include "fusion/covariance_utils.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"
+#include "fusion/innovation_gate.hpp"
 
 namespace ultratrack::fusion {
 
@@ -112,16 +113,8 @@ class Ukf {
     }
     S = 0.5 * (S + S.transpose());
     r.innovation = z - zbar;
-    r.threshold = opt_.gate.enabled ? chi_square_quantile(opt_.gate.probability, k)
-                                    : std::numeric_limits<double>::infinity();
-    Eigen::LLT<Eigen::MatrixXd> llt(S);
-    if (llt.info() != Eigen::Success || !r.innovation.allFinite()) {
-      r.nis = std::numeric_limits<double>::infinity();
-      ++counters_.rejected;
-      return r;
-    }
-    r.nis = r.innovation.dot(llt.solve(r.innovation));
-    if (!(r.nis <= r.threshold)) {
+    Eigen::LLT<Eigen::MatrixXd> llt;
+    if (!passes_innovation_gate(opt_.gate, S, r, llt)) {
       ++counters_.rejected;
       return r;
     }

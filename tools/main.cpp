@@ -15,17 +15,7 @@ int main(int argc, char** argv) {
   CLI::App app{"ultratrack: GPS L1 C/A software receiver with inertial aiding"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "ultratrack 0.1.0");
-  ultratrack::tools::add_simulate_command(app);
-  ultratrack::tools::add_demo_command(app);
-  ultratrack::tools::add_acquire_command(app);
-  ultratrack::tools::add_receive_command(app);
-  ultratrack::tools::add_ins_command(app);
-  ultratrack::tools::add_imusim_command(app);
-  ultratrack::tools::add_fuse_command(app);
-  ultratrack::tools::add_covariance_command(app);
-  ultratrack::tools::add_gnsssim_command(app);
-  ultratrack::tools::add_compare_command(app);
-  ultratrack::tools::add_attitude_command(app);
+  ultratrack::tools::add_all_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

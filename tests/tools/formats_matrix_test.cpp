@@ -23,6 +23,7 @@
 #include "signals/input_error.hpp"
 #include "signals/nominal_constellation.hpp"
 #include "signals/rinex_nav.hpp"
+#include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -30,13 +31,7 @@ namespace fs = std::filesystem;
 namespace {
 
 void run(const std::string& command, std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_simulate_command(app);
-  ultratrack::tools::add_receive_command(app);
-  args.insert(args.begin(), command);
-  args.push_back("--quiet");
-  std::reverse(args.begin(), args.end());
-  app.parse(args);
+  ultratrack::test_support::run_command(command, std::move(args));
 }
 
 // A CSV with a header as rows of named text fields.

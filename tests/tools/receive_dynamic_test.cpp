@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "solution_compare.hpp"
+#include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -22,13 +23,7 @@ namespace fs = std::filesystem;
 namespace {
 
 void run(const std::string& command, std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_simulate_command(app);
-  ultratrack::tools::add_receive_command(app);
-  args.insert(args.begin(), command);
-  args.push_back("--quiet");
-  std::reverse(args.begin(), args.end());
-  app.parse(args);
+  ultratrack::test_support::run_command(command, std::move(args));
 }
 
 double json_number(const fs::path& file, const std::string& key) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -20,13 +21,7 @@ namespace fs = std::filesystem;
 namespace {
 
 void run(const std::string& command, std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_simulate_command(app);
-  ultratrack::tools::add_receive_command(app);
-  args.insert(args.begin(), command);
-  args.push_back("--quiet");
-  std::reverse(args.begin(), args.end());
-  app.parse(args);
+  ultratrack::test_support::run_command(command, std::move(args));
 }
 
 // The file without the lines that carry wall-clock time.

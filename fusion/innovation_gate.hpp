@@ -1,0 +1,30 @@
+// The innovation test both filters apply before an update: factor the innovation covariance S, compute the
+// normalised innovation squared nu' S^-1 nu and compare it with the chi-square gate (GateOptions). One copy,
+// so that the EKF and the UKF accept and reject by exactly the same rule.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <limits>
+
+#include "fusion/chi_square.hpp"
+#include "fusion/filter_types.hpp"
+
+namespace ultratrack::fusion {
+
+// Fills r.threshold and r.nis from r.innovation and S (symmetric, k x k, k = r.dof) and leaves S's Cholesky
+// factor in `llt`. True when the update may go ahead: S positive definite, the innovation finite and inside
+// the gate. r.nis is infinity when S or the innovation is unusable.
+inline bool passes_innovation_gate(const GateOptions& gate, const Eigen::MatrixXd& S, UpdateResult& r,
+                                   Eigen::LLT<Eigen::MatrixXd>& llt) {
+  r.threshold = gate.enabled ? chi_square_quantile(gate.probability, r.dof) : std::numeric_limits<double>::infinity();
+  llt.compute(S);
+  if (llt.info() != Eigen::Success || !r.innovation.allFinite()) {
+    r.nis = std::numeric_limits<double>::infinity();
+    return false;
+  }
+  r.nis = r.innovation.dot(llt.solve(r.innovation));
+  return r.nis <= r.threshold;
+}
+
+}  // namespace ultratrack::fusion
