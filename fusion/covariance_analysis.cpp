@@ -5,6 +5,7 @@
 
 #include "fusion/ekf.hpp"
 #include "fusion/ins_error_state.hpp"
+#include "fusion/iq_measurements.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/trajectory.hpp"
@@ -59,6 +60,29 @@ std::vector<SatelliteObservable> visible_satellites(const std::vector<signals::E
   return out;
 }
 
+// One measurement update at the truth (zero error): tight pseudoranges (rates), or ultra-tight I&Q taps /
+// discriminator outputs as an error-free receiver on the truth would produce them.
+template <class Filter>
+void update(Filter& filter, const CovarianceAnalysisOptions& o, const NominalState& nominal,
+            const std::vector<SatelliteObservable>& sats, const Eigen::Vector3d& w_ib_b) {
+  const Eigen::Vector3d lever = Eigen::Vector3d::Zero();
+  if (o.coupling == CovarianceCoupling::Tight) {
+    filter.update(EpochMeasurement17(nominal, sats, lever, w_ib_b, o.use_range_rate));
+    return;
+  }
+  if (o.iq_form == IqForm::Iq) {
+    const std::vector<IqTaps> taps(sats.size(), expected_iq(TrackingErrors{}, o.iq));
+    filter.update(IqEpochMeasurement17(nominal, sats, lever, w_ib_b, o.iq, taps));
+    return;
+  }
+  const DiscriminatorNoise n = discriminator_noise(o.iq, o.discriminator_squaring_loss);
+  const double sr = o.discriminator_sigma_range_m > 0.0 ? o.discriminator_sigma_range_m : n.range_sigma_m;
+  const double sv = o.discriminator_sigma_rate_mps > 0.0 ? o.discriminator_sigma_rate_mps : n.rate_sigma_mps;
+  filter.update(DiscriminatorEpochMeasurement17(nominal, sats, lever, w_ib_b,
+                                                Eigen::VectorXd::Zero(2 * static_cast<int>(sats.size())), sr, sv,
+                                                o.discriminator_use_rate));
+}
+
 template <class Filter>
 CovarianceAnalysisResult run(Filter& filter, const CovarianceAnalysisOptions& o) {
   const ins::TrajectorySpec spec = ins::profile_spec(o.trajectory, o.duration_s, o.lat_rad, o.lon_rad, o.height_m);
@@ -94,8 +118,7 @@ CovarianceAnalysisResult run(Filter& filter, const CovarianceAnalysisOptions& o)
     NominalState nominal;
     nominal.nav = now.nav();
     model.set_linearisation({now.nav(), now.f_b, now.w_ib_b});
-    const EpochMeasurement17 m(nominal, sats, Eigen::Vector3d::Zero(), now.w_ib_b, o.use_range_rate);
-    filter.update(m);
+    update(filter, o, nominal, sats, now.w_ib_b);
     filter.set_x(StateVector<17>::Zero());  // closed loop: the (zero) estimate is fed back
     std::vector<Eigen::Vector3d> los;
     const Eigen::Matrix3d C_ne = ins::C_en(now.lat_rad, now.lon_rad).transpose();
@@ -128,6 +151,15 @@ CovarianceAnalysisOptions seed001_covariance_options(const std::string& trajecto
   o.trajectory = trajectory;
   o.filter = filter;
   o.model = seed001_eq38_model();
+  return o;
+}
+
+CovarianceAnalysisOptions seed001_ultratight_options(const std::string& trajectory, FilterKind filter, IqForm form) {
+  CovarianceAnalysisOptions o = seed001_covariance_options(trajectory, filter);
+  o.coupling = CovarianceCoupling::UltraTight;
+  o.iq_form = form;
+  o.update_interval_s = o.iq.integration_time_s;
+  o.propagation_interval_s = o.iq.integration_time_s;
   return o;
 }
 

@@ -3,6 +3,12 @@
 // EKF or a UKF and updated once per second with the pseudoranges (optionally rates) of every satellite above
 // the mask, with the seed's noise settings (eq. 38). The nominal is the truth, so the innovations are zero and
 // only the covariance moves. Reports position 1-sigma (north, east, down) after each update.
+// Ultra-tight (seed 001 section IV.2, issue 7): the same filter updated every coherent integration T with the
+// I&Q of every satellite (fusion/iq_measurements.hpp: 6 taps per satellite, normalised, amplitude from C/N0)
+// or with their discriminators as range and range-rate errors. The EKF is linearised at the truth; the UKF
+// draws its sigma points around the truth with its own covariance and pushes them through the nonlinear I&Q
+// functions, so its covariance is what the UKF itself would report with a perfect estimate (the recursion of P
+// does not depend on z); its true error covariance would need a Monte Carlo.
 // Units SI; NED; times in seconds from the trajectory start.
 #pragma once
 
@@ -12,13 +18,21 @@
 
 #include "fusion/gnss_ins_integration.hpp"
 #include "fusion/ins_error_model.hpp"
+#include "fusion/iq_measurements.hpp"
 #include "fusion/ukf.hpp"
 #include "signals/ephemeris.hpp"
 #include "signals/gps_time.hpp"
 
 namespace ultratrack::fusion {
 
+enum class CovarianceCoupling { Tight, UltraTight };  // (gnss_ins_integration.hpp has the run-time Coupling)
+enum class IqForm {
+  Iq,             // the correlator taps themselves (seed 001 eqs. 11-17)
+  Discriminator,  // pre-filtered: code / frequency discriminators as range / range-rate errors
+};
+
 struct CovarianceAnalysisOptions {
+  CovarianceCoupling coupling = CovarianceCoupling::Tight;
   std::string trajectory = "straight";  // ins::profile_spec names: straight, circle, s, spiral (also land)
   FilterKind filter = FilterKind::Ekf;
   double duration_s = 150.0;
@@ -39,6 +53,13 @@ struct CovarianceAnalysisOptions {
   Eigen::Vector3d sigma_att_rad{0.03 * 3.14159265358979323846 / 180.0, 0.03 * 3.14159265358979323846 / 180.0,
                                 2.2360679774997896 * 3.14159265358979323846 / 180.0};  // 0.03, 0.03 deg; 5 deg^2
   UkfParameters ukf;
+  // Ultra-tight only (update_interval_s should then be iq.integration_time_s: one update per integration).
+  IqForm iq_form = IqForm::Iq;
+  IqSettings iq;                          // C/N0, T, tap offset; the noise is N(0, 1) per I or Q (eq. 16)
+  bool discriminator_squaring_loss = true;  // discriminator_noise's bracket; false: the first-order variances
+  double discriminator_sigma_range_m = 0.0;  // > 0 overrides the closed form (for equivalence checks)
+  double discriminator_sigma_rate_mps = 0.0;
+  bool discriminator_use_rate = true;
 };
 
 // Eq. 38: R^V = diag(0, (100 ug)^2, (0.1 deg/h)^2, 0) taken as white-noise PSDs per second on velocity and
@@ -46,6 +67,8 @@ struct CovarianceAnalysisOptions {
 // clock process noise (R^V's last entries are zero).
 InsErrorModelOptions seed001_eq38_model();
 CovarianceAnalysisOptions seed001_covariance_options(const std::string& trajectory, FilterKind filter);
+// The same with ultra-tight updates every T (propagation at T as well), 45 dB-Hz, T = 20 ms, taps at +-0.5 chip.
+CovarianceAnalysisOptions seed001_ultratight_options(const std::string& trajectory, FilterKind filter, IqForm form);
 
 struct CovarianceSample {
   double t_s = 0.0;

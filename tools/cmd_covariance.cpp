@@ -1,5 +1,6 @@
-// `ultratrack covariance`: the seed 001 covariance analysis of tightly coupled GPS/INS (17 states, eq. 38
-// noise) on a named trajectory with an EKF or a UKF; prints position 1-sigma (north, east, down) at 30 s and
+// `ultratrack covariance`: the seed 001 covariance analysis of tightly or ultra-tightly coupled GPS/INS (17
+// states, eq. 38 noise; ultra-tight: I&Q taps or their discriminators every coherent integration, noise from
+// C/N0) on a named trajectory with an EKF or a UKF; prints position 1-sigma (north, east, down) at 30 s and
 // 150 s (or the given times) and optionally writes the whole history as CSV.
 #include <fmt/core.h>
 
@@ -20,7 +21,8 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct CovarianceCommandOptions {
-  std::string trajectory, coupling = "tight", filter = "ekf", nav_file, csv_file;
+  std::string trajectory, coupling = "tight", filter = "ekf", nav_file, csv_file, iq_measurement = "iq";
+  double cn0_dbhz = 45.0, integration_ms = 20.0, spacing_chips = 1.0, ukf_alpha = 1.0;
   std::vector<double> times{30.0, 150.0};
   double duration_s = 0.0;
   bool range_rate = false;
@@ -28,8 +30,17 @@ struct CovarianceCommandOptions {
 };
 
 void run_covariance_command(const CovarianceCommandOptions& c) {
-  if (c.coupling != "tight")
-    throw io::InputError("command line", "--coupling " + c.coupling + ": the seed 001 analysis is tight only");
+  if (c.coupling != "tight" && c.coupling != "ultra-tight")
+    throw io::InputError("command line", "--coupling must be tight or ultra-tight, got '" + c.coupling + "'");
+  const bool ultra = c.coupling == "ultra-tight";
+  fusion::IqForm form = fusion::IqForm::Iq;
+  if (c.iq_measurement == "discriminator") {
+    form = fusion::IqForm::Discriminator;
+  } else if (c.iq_measurement != "iq") {
+    throw io::InputError("command line", "--iq-measurement must be iq or discriminator, got '" + c.iq_measurement + "'");
+  }
+  if (!(c.integration_ms > 0.0) || !(c.spacing_chips > 0.0) || !(c.spacing_chips <= 1.0) || !(c.ukf_alpha > 0.0))
+    throw io::InputError("command line", "--integration-ms and --ukf-alpha must be positive, --spacing-chips in (0, 1]");
   fusion::FilterKind kind;
   if (c.filter == "ekf") {
     kind = fusion::FilterKind::Ekf;
@@ -39,6 +50,18 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
     throw io::InputError("command line", "--filter must be ekf or ukf, got '" + c.filter + "'");
   }
   fusion::CovarianceAnalysisOptions o = fusion::seed001_covariance_options(c.trajectory, kind);
+  if (ultra) {
+    o.iq.cn0_dbhz = c.cn0_dbhz;
+    o.iq.integration_time_s = c.integration_ms * 1e-3;
+    o.iq.tap_offset_chips = 0.5 * c.spacing_chips;
+    o = [&] {
+      fusion::CovarianceAnalysisOptions u = fusion::seed001_ultratight_options(c.trajectory, kind, form);
+      u.iq = o.iq;
+      u.update_interval_s = u.propagation_interval_s = o.iq.integration_time_s;
+      return u;
+    }();
+  }
+  o.ukf.alpha = c.ukf_alpha;
   double last = 0.0;
   for (double t : c.times) {
     if (!(t > 0.0)) throw io::InputError("command line", "--times must be positive");
@@ -51,9 +74,21 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
   o.height_m = c.height_m;
   if (!c.nav_file.empty()) o.ephemerides = signals::read_rinex_nav(c.nav_file).ephemerides;
   const fusion::CovarianceAnalysisResult r = fusion::run_covariance_analysis(o);
-  fmt::print("covariance: {} trajectory, tight {}, {} satellites ({}), eq. 38 noise{}\n", c.trajectory, c.filter,
-             r.samples.size() > 1 ? r.samples[1].satellites : 0, c.nav_file.empty() ? "nominal constellation" : c.nav_file,
-             c.range_rate ? ", pseudorange + rate" : ", pseudorange only");
+  const int nsat = r.samples.size() > 1 ? r.samples[1].satellites : 0;
+  const std::string source = c.nav_file.empty() ? "nominal constellation" : c.nav_file;
+  if (ultra) {
+    const fusion::DiscriminatorNoise n = fusion::discriminator_noise(o.iq);
+    fmt::print("covariance: {} trajectory, ultra-tight {} ({}), {} satellites ({}), eq. 38 noise, {:.1f} dB-Hz, "
+               "T {:g} ms, E-L {:g} chip, A {:.2f}{}\n",
+               c.trajectory, c.filter, c.iq_measurement, nsat, source, c.cn0_dbhz, c.integration_ms, c.spacing_chips,
+               fusion::iq_amplitude(o.iq), c.filter == "ukf" ? fmt::format(", alpha {:g}", c.ukf_alpha) : "");
+    if (form == fusion::IqForm::Discriminator)
+      fmt::print("discriminator 1-sigma per interval: range {:.3f} m, rate {:.4f} m/s\n", n.range_sigma_m,
+                 n.rate_sigma_mps);
+  } else {
+    fmt::print("covariance: {} trajectory, tight {}, {} satellites ({}), eq. 38 noise{}\n", c.trajectory, c.filter,
+               nsat, source, c.range_rate ? ", pseudorange + rate" : ", pseudorange only");
+  }
   fmt::print("{:>8}  {:>10}  {:>10}  {:>10}\n", "t_s", "sigma_n_m", "sigma_e_m", "sigma_d_m");
   for (double t : c.times) {
     const auto s = r.at(t);
@@ -73,9 +108,14 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
 
 void add_covariance_command(CLI::App& app) {
   auto o = std::make_shared<CovarianceCommandOptions>();
-  auto* cmd = app.add_subcommand("covariance", "Seed 001 covariance analysis of tight GPS/INS (EKF or UKF)");
+  auto* cmd = app.add_subcommand("covariance", "Seed 001 covariance analysis of tight / ultra-tight GPS/INS (EKF or UKF)");
   cmd->add_option("--trajectory", o->trajectory, "straight, circle, s or spiral")->required();
-  cmd->add_option("--coupling", o->coupling, "tight (default)");
+  cmd->add_option("--coupling", o->coupling, "tight (default) or ultra-tight");
+  cmd->add_option("--iq-measurement", o->iq_measurement, "ultra-tight: iq (taps, default) or discriminator");
+  cmd->add_option("--cn0-dbhz", o->cn0_dbhz, "ultra-tight: C/N0 of every satellite (default 45)");
+  cmd->add_option("--integration-ms", o->integration_ms, "ultra-tight: coherent integration = update interval (default 20)");
+  cmd->add_option("--spacing-chips", o->spacing_chips, "ultra-tight: early-late spacing (default 1)");
+  cmd->add_option("--ukf-alpha", o->ukf_alpha, "UKF sigma-point spread alpha (default 1)");
   cmd->add_option("--filter", o->filter, "ekf or ukf (default ekf)");
   cmd->add_option("--times", o->times, "report times in seconds (default 30 150)");
   cmd->add_option("--duration", o->duration_s, "seconds simulated (default: the last report time)");
