@@ -29,6 +29,13 @@ Rot rotation_terms(double x) {
   return {s2 / (2.0 * x), sx * sx / x, std::cos(2.0 * x) / x - s2 / (2.0 * x * x), s2 / x - sx * sx / (x * x)};
 }
 
+// The same terms turned by a start phase phi: sinc(x) cos(phi + x), sinc(x) sin(phi + x).
+Rot rotate(const Rot& r, double phi) {
+  if (phi == 0.0) return r;
+  const double c = std::cos(phi), s = std::sin(phi);
+  return {r.c * c - r.s * s, r.s * c + r.c * s, r.dc * c - r.ds * s, r.ds * c + r.dc * s};
+}
+
 void check(const IqSettings& s) {
   if (!(s.integration_time_s > 0.0) || !std::isfinite(s.cn0_dbhz) || !(s.tap_offset_chips > 0.0) ||
       !(s.tap_offset_chips <= 0.5))
@@ -59,7 +66,7 @@ TrackingErrors tracking_errors(double range_error_m, double range_rate_error_mps
 IqTaps expected_iq(const TrackingErrors& e, const IqSettings& s) {
   check(s);
   const double A = iq_amplitude(s);
-  const Rot r = rotation_terms(kPi * e.frequency_hz * s.integration_time_s);
+  const Rot r = rotate(rotation_terms(kPi * e.frequency_hz * s.integration_time_s), e.phase_rad);
   const auto o = tap_offsets(s);
   IqTaps t;
   for (int k = 0; k < 3; ++k) {
@@ -70,11 +77,18 @@ IqTaps expected_iq(const TrackingErrors& e, const IqSettings& s) {
   return t;
 }
 
+Eigen::Matrix<double, 6, 1> iq_phase_derivative(const TrackingErrors& e, const IqSettings& s) {
+  const IqTaps t = expected_iq(e, s);
+  Eigen::Matrix<double, 6, 1> d;
+  d << -t.q[0], -t.q[1], -t.q[2], t.i[0], t.i[1], t.i[2];
+  return d;
+}
+
 Eigen::Matrix<double, 6, 2> iq_jacobian(const TrackingErrors& e, const IqSettings& s) {
   check(s);
   const double A = iq_amplitude(s);
   const double dx_df = kPi * s.integration_time_s;
-  const Rot r = rotation_terms(dx_df * e.frequency_hz);
+  const Rot r = rotate(rotation_terms(dx_df * e.frequency_hz), e.phase_rad);
   const auto o = tap_offsets(s);
   Eigen::Matrix<double, 6, 2> J;
   for (int k = 0; k < 3; ++k) {
@@ -168,11 +182,18 @@ IqEpochMeasurement17::IqEpochMeasurement17(const NominalState& nominal, const st
   }
 }
 
+TrackingErrors IqEpochMeasurement17::errors_of(const Eigen::VectorXd& e, int i) const {
+  TrackingErrors t = tracking_errors(e(2 * i), e(2 * i + 1));
+  // Signal minus replica phase: a shorter signal range advances its carrier as it advances its code.
+  if (settings_.absolute_carrier_phase) t.phase_rad = 2.0 * kPi * e(2 * i) / kLambda_m;
+  return t;
+}
+
 Eigen::VectorXd IqEpochMeasurement17::h(const StateVector<17>& dx) const {
   const Eigen::VectorXd e = replica_.errors(dx);
   Eigen::VectorXd out(z_.size());
   for (int i = 0; i < replica_.size(); ++i) {
-    const IqTaps t = expected_iq(tracking_errors(e(2 * i), e(2 * i + 1)), settings_);
+    const IqTaps t = expected_iq(errors_of(e, i), settings_);
     for (int k = 0; k < 3; ++k) {
       out(6 * i + k) = t.i[k];
       out(6 * i + 3 + k) = t.q[k];
@@ -189,8 +210,11 @@ MeasurementJacobian<17> IqEpochMeasurement17::H(const StateVector<17>& dx) const
   scale(0, 0) = 1.0 / kChip_m;
   scale(1, 1) = 1.0 / kLambda_m;
   for (int i = 0; i < replica_.size(); ++i) {
-    const Eigen::Matrix<double, 6, 2> J = iq_jacobian(tracking_errors(e(2 * i), e(2 * i + 1)), settings_);
+    const TrackingErrors te = errors_of(e, i);
+    const Eigen::Matrix<double, 6, 2> J = iq_jacobian(te, settings_);
     out.middleRows<6>(6 * i) = J * scale * Je.middleRows<2>(2 * i);
+    if (settings_.absolute_carrier_phase)
+      out.middleRows<6>(6 * i) += iq_phase_derivative(te, settings_) * (2.0 * kPi / kLambda_m) * Je.row(2 * i);
   }
   return out;
 }

@@ -23,12 +23,17 @@ struct IqSettings {
   double cn0_dbhz = 45.0;
   double integration_time_s = 0.020;  // coherent T (bits known / wiped off)
   double tap_offset_chips = 0.5;      // d: early and late taps at -d / +d chips (E-L spacing 2 d), 0 < d <= 0.5
+  // Seed 001 eq. 8b read literally: the phase error at the interval's start is 2 pi (range error) / lambda, i.e.
+  // the absolute carrier phase is a range measurement with a known integer ambiguity (an idealisation: the
+  // 17-state model has no ambiguity states). Default off: the NCO phase is realigned every interval.
+  bool absolute_carrier_phase = false;
 };
 
 // Signal minus replica, as receiver/discriminators.hpp: positive code error = the signal leads the replica.
 struct TrackingErrors {
   double code_chips = 0.0;
   double frequency_hz = 0.0;
+  double phase_rad = 0.0;  // carrier phase error at the interval's start (0 with the NCO realigned)
 };
 
 // Correlator taps in the order early, prompt, late; I and Q normalised (unit noise variance).
@@ -48,14 +53,15 @@ double triangle_slope(double x_chips);
 // code = e_rho / chip length, frequency = e_rhodot / L1 wavelength.
 TrackingErrors tracking_errors(double range_error_m, double range_rate_error_mps);
 
-// E[I], E[Q] of the early/prompt/late taps: with x = pi df T,
-// I_k = A R(tau - o_k) sinc(x) cos(x), Q_k = A R(tau - o_k) sinc(x) sin(x), o = (+d, 0, -d) for E, P, L
+// E[I], E[Q] of the early/prompt/late taps: with x = pi df T and phi the start phase,
+// I_k = A R(tau - o_k) sinc(x) cos(phi + x), Q_k = A R(tau - o_k) sinc(x) sin(phi + x), o = (+d, 0, -d) for E, P, L
 // (the early replica runs d chips ahead, so a leading signal, tau > 0, raises the early tap)
 // (seed 001 eq. 7 with the phase error zero at the interval's start; its I and Q are swapped by its sin/cos
 // replica convention).
 IqTaps expected_iq(const TrackingErrors& e, const IqSettings& s);
-// Jacobian of (I_E, I_P, I_L, Q_E, Q_P, Q_L) with respect to (code chips, frequency Hz).
+// Jacobian of (I_E, I_P, I_L, Q_E, Q_P, Q_L) with respect to (code chips, frequency Hz), and to the start phase.
 Eigen::Matrix<double, 6, 2> iq_jacobian(const TrackingErrors& e, const IqSettings& s);
+Eigen::Matrix<double, 6, 1> iq_phase_derivative(const TrackingErrors& e, const IqSettings& s);
 // Noise covariance of the six outputs: unit variance; taps o_j, o_k share R(o_j - o_k) (white noise through
 // the same replica shifted by the tap spacing); I and Q independent.
 Eigen::Matrix<double, 6, 6> iq_noise_covariance(const IqSettings& s);
@@ -116,6 +122,7 @@ class IqEpochMeasurement17 {
   int size() const { return static_cast<int>(z_.size()); }
 
  private:
+  TrackingErrors errors_of(const Eigen::VectorXd& replica_errors, int satellite) const;
   ReplicaErrors17 replica_;
   IqSettings settings_;
   Eigen::VectorXd z_;

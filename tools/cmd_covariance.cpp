@@ -25,7 +25,7 @@ struct CovarianceCommandOptions {
   double cn0_dbhz = 45.0, integration_ms = 20.0, spacing_chips = 1.0, ukf_alpha = 1.0;
   std::vector<double> times{30.0, 150.0};
   double duration_s = 0.0;
-  bool range_rate = false;
+  bool range_rate = false, absolute_phase = false;
   double lat_deg = 36.37, lon_deg = 127.36, height_m = 1000.0;
 };
 
@@ -54,6 +54,7 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
     o.iq.cn0_dbhz = c.cn0_dbhz;
     o.iq.integration_time_s = c.integration_ms * 1e-3;
     o.iq.tap_offset_chips = 0.5 * c.spacing_chips;
+    o.iq.absolute_carrier_phase = c.absolute_phase;
     o = [&] {
       fusion::CovarianceAnalysisOptions u = fusion::seed001_ultratight_options(c.trajectory, kind, form);
       u.iq = o.iq;
@@ -81,7 +82,9 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
     fmt::print("covariance: {} trajectory, ultra-tight {} ({}), {} satellites ({}), eq. 38 noise, {:.1f} dB-Hz, "
                "T {:g} ms, E-L {:g} chip, A {:.2f}{}\n",
                c.trajectory, c.filter, c.iq_measurement, nsat, source, c.cn0_dbhz, c.integration_ms, c.spacing_chips,
-               fusion::iq_amplitude(o.iq), c.filter == "ukf" ? fmt::format(", alpha {:g}", c.ukf_alpha) : "");
+               fusion::iq_amplitude(o.iq),
+               (c.filter == "ukf" ? fmt::format(", alpha {:g}", c.ukf_alpha) : "") +
+                   (c.absolute_phase ? ", absolute carrier phase" : ""));
     if (form == fusion::IqForm::Discriminator)
       fmt::print("discriminator 1-sigma per interval: range {:.3f} m, rate {:.4f} m/s\n", n.range_sigma_m,
                  n.rate_sigma_mps);
@@ -116,6 +119,8 @@ void add_covariance_command(CLI::App& app) {
   cmd->add_option("--integration-ms", o->integration_ms, "ultra-tight: coherent integration = update interval (default 20)");
   cmd->add_option("--spacing-chips", o->spacing_chips, "ultra-tight: early-late spacing (default 1)");
   cmd->add_option("--ukf-alpha", o->ukf_alpha, "UKF sigma-point spread alpha (default 1)");
+  cmd->add_flag("--absolute-carrier-phase", o->absolute_phase,
+                "ultra-tight iq: carrier phase error from the range error (seed eq. 8b; integer ambiguity known)");
   cmd->add_option("--filter", o->filter, "ekf or ukf (default ekf)");
   cmd->add_option("--times", o->times, "report times in seconds (default 30 150)");
   cmd->add_option("--duration", o->duration_s, "seconds simulated (default: the last report time)");

@@ -90,6 +90,20 @@ TEST(IqModel, JacobianMatchesNumericalDifferentiation) {
       }
     }
   }
+  // Start-phase derivative (the absolute-carrier-phase reading of eq. 8b).
+  const IqSettings s = settings(45.0, 0.02, 0.5);
+  for (const TrackingErrors e : {TrackingErrors{0.05, 4.0, 0.7}, TrackingErrors{-0.1, -9.0, -2.5}}) {
+    const double h = 1e-6;
+    TrackingErrors p = e, m = e;
+    p.phase_rad += h;
+    m.phase_rad -= h;
+    const Eigen::Matrix<double, 6, 1> num =
+        (taps_vector(expected_iq(p, s)) - taps_vector(expected_iq(m, s))) / (2 * h);
+    EXPECT_LT((iq_phase_derivative(e, s) - num).cwiseAbs().maxCoeff(), 1e-5 * iq_amplitude(s));
+    // and the phase turns I + jQ: the envelope is unchanged
+    const IqTaps t = expected_iq(e, s), t0 = expected_iq({e.code_chips, e.frequency_hz, 0.0}, s);
+    EXPECT_NEAR(std::hypot(t.i[1], t.q[1]), std::hypot(t0.i[1], t0.q[1]), 1e-9);
+  }
   // The prompt's corner: the one-sided slopes are -+A; the Jacobian takes their mean, 0 (what a central
   // difference, or a UKF with tiny alpha, sees).
   EXPECT_EQ(triangle_slope(0.0), 0.0);
@@ -300,6 +314,34 @@ TEST(DiscriminatorMeasurement17, RowsAreTheTightRows) {
                                                   Eigen::VectorXd::Zero(2 * n), 5.0, 0.1, false);
   EXPECT_EQ(code_only.size(), n);
   EXPECT_NEAR((code_only.H(x).row(2) + Ht.row(2)).norm(), 0.0, 1e-9);
+}
+
+// With the absolute carrier phase (eq. 8b read literally) the phase column joins the chain rule.
+TEST(IqMeasurement17, AbsolutePhaseJacobianMatchesNumericalDifferentiation) {
+  const Scene sc = scene();
+  IqSettings s = settings(45.0, 0.02, 0.5);
+  s.absolute_carrier_phase = true;
+  const std::vector<IqTaps> taps(sc.sats.size(), expected_iq(TrackingErrors{}, s));
+  const IqEpochMeasurement17 m(sc.nominal, sc.sats, sc.lever_b, sc.w_ib_b, s, taps);
+  StateVector<17> x = StateVector<17>::Zero();
+  x(15) = 0.03;  // 0.16 cycle of start phase
+  x(16) = -0.4;
+  const auto H = m.H(x);
+  for (int c : {15, 16, 3, 4}) {
+    const double step = 1e-5;
+    StateVector<17> p = x, q = x;
+    p(c) += step;
+    q(c) -= step;
+    const Eigen::VectorXd num = (m.h(p) - m.h(q)) / (2 * step);
+    for (int r = 0; r < m.size(); ++r)
+      EXPECT_NEAR(H(r, c), num(r), 1e-4 * std::max(1.0, std::abs(num(r)))) << "row " << r << " col " << c;
+  }
+  // The phase dominates the range sensitivity: the prompt turns by 2 pi / lambda per metre, so |d(I_P, Q_P)/d
+  // clock bias| = A sinc(pi df T) 2 pi / lambda = 1174 * 0.997 per metre (df = 0.4 m/s / lambda = 2.1 Hz),
+  // against A / 293 m = 0.12 per metre through the code.
+  const double x_f = kPi * (0.4 / signals::kL1Wavelength_m) * 0.02;
+  EXPECT_NEAR(std::hypot(H(1, 15), H(4, 15)),
+              iq_amplitude(s) * std::sin(x_f) / x_f * 2.0 * kPi / signals::kL1Wavelength_m, 1e-3 * 1174.0);
 }
 
 TEST(IqMeasurement17, BadSettingsAreInputErrors) {
