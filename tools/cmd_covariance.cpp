@@ -95,7 +95,7 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
   fmt::print("{:>8}  {:>10}  {:>10}  {:>10}\n", "t_s", "sigma_n_m", "sigma_e_m", "sigma_d_m");
   for (double t : c.times) {
     const auto s = r.at(t);
-    fmt::print("{:8.1f}  {:10.4f}  {:10.4f}  {:10.4f}\n", s.t_s, s.sigma_pos_ned_m.x(), s.sigma_pos_ned_m.y(),
+    fmt::print("{:8.2f}  {:10.4f}  {:10.4f}  {:10.4f}\n", s.t_s, s.sigma_pos_ned_m.x(), s.sigma_pos_ned_m.y(),
                s.sigma_pos_ned_m.z());
   }
   if (!c.csv_file.empty()) {
