@@ -22,7 +22,7 @@ namespace ultratrack::fusion {
 struct IqSettings {
   double cn0_dbhz = 45.0;
   double integration_time_s = 0.020;  // coherent T (bits known / wiped off)
-  double tap_offset_chips = 0.5;      // d: early and late taps at -d / +d chips (E-L spacing 2 d), 0 < d <= 0.5
+  double tap_offset_chips = 0.5;      // d: early / late replicas d chips ahead / behind (E-L spacing 2 d), 0 < d <= 0.5
   // Seed 001 eq. 8b read literally: the phase error at the interval's start is 2 pi (range error) / lambda, i.e.
   // the absolute carrier phase is a range measurement with a known integer ambiguity (an idealisation: the
   // 17-state model has no ambiguity states). Default off: the NCO phase is realigned every interval.
