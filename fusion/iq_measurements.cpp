@@ -219,10 +219,12 @@ MeasurementJacobian<17> IqEpochMeasurement17::H(const StateVector<17>& dx) const
   return out;
 }
 
-DiscriminatorEpochMeasurement17::DiscriminatorEpochMeasurement17(
-    const NominalState& nominal, const std::vector<SatelliteObservable>& sats, const Eigen::Vector3d& lever_arm_b,
-    const Eigen::Vector3d& w_ib_b, const Eigen::VectorXd& measured, double range_sigma_m, double rate_sigma_mps,
-    bool use_rate)
+DiscriminatorEpochMeasurement17::DiscriminatorEpochMeasurement17(const NominalState& nominal,
+                                                                 const std::vector<SatelliteObservable>& sats,
+                                                                 const Eigen::Vector3d& lever_arm_b,
+                                                                 const Eigen::Vector3d& w_ib_b,
+                                                                 const Eigen::VectorXd& measured, double range_sigma_m,
+                                                                 double rate_sigma_mps, bool use_rate)
     : replica_(nominal, sats, lever_arm_b, w_ib_b), rate_(use_rate) {
   if (measured.size() != 2 * replica_.size())
     throw io::InputError("discriminator measurement", "a range and a rate error per satellite are needed");

@@ -85,8 +85,8 @@ double frequency_discriminator_hz(const IqTaps& taps, const IqSettings& s);
 struct DiscriminatorNoise {
   double code_var_chips2 = 0.0;
   double frequency_var_hz2 = 0.0;
-  double range_sigma_m = 0.0;     // sqrt(code var) * chip length
-  double rate_sigma_mps = 0.0;    // sqrt(frequency var) * L1 wavelength
+  double range_sigma_m = 0.0;   // sqrt(code var) * chip length
+  double rate_sigma_mps = 0.0;  // sqrt(frequency var) * L1 wavelength
 };
 DiscriminatorNoise discriminator_noise(const IqSettings& s, bool squaring_loss = true);
 

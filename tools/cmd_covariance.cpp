@@ -37,10 +37,12 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
   if (c.iq_measurement == "discriminator") {
     form = fusion::IqForm::Discriminator;
   } else if (c.iq_measurement != "iq") {
-    throw io::InputError("command line", "--iq-measurement must be iq or discriminator, got '" + c.iq_measurement + "'");
+    throw io::InputError("command line",
+                         "--iq-measurement must be iq or discriminator, got '" + c.iq_measurement + "'");
   }
   if (!(c.integration_ms > 0.0) || !(c.spacing_chips > 0.0) || !(c.spacing_chips <= 1.0) || !(c.ukf_alpha > 0.0))
-    throw io::InputError("command line", "--integration-ms and --ukf-alpha must be positive, --spacing-chips in (0, 1]");
+    throw io::InputError("command line",
+                         "--integration-ms and --ukf-alpha must be positive, --spacing-chips in (0, 1]");
   fusion::FilterKind kind;
   if (c.filter == "ekf") {
     kind = fusion::FilterKind::Ekf;
@@ -50,17 +52,17 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
     throw io::InputError("command line", "--filter must be ekf or ukf, got '" + c.filter + "'");
   }
   fusion::CovarianceAnalysisOptions o = fusion::seed001_covariance_options(c.trajectory, kind);
+  if (c.absolute_phase && !(ultra && form == fusion::IqForm::Iq))
+    throw io::InputError("command line", "--absolute-carrier-phase needs --coupling ultra-tight --iq-measurement iq");
   if (ultra) {
-    o.iq.cn0_dbhz = c.cn0_dbhz;
-    o.iq.integration_time_s = c.integration_ms * 1e-3;
-    o.iq.tap_offset_chips = 0.5 * c.spacing_chips;
-    o.iq.absolute_carrier_phase = c.absolute_phase;
-    o = [&] {
-      fusion::CovarianceAnalysisOptions u = fusion::seed001_ultratight_options(c.trajectory, kind, form);
-      u.iq = o.iq;
-      u.update_interval_s = u.propagation_interval_s = o.iq.integration_time_s;
-      return u;
-    }();
+    fusion::IqSettings iq;
+    iq.cn0_dbhz = c.cn0_dbhz;
+    iq.integration_time_s = c.integration_ms * 1e-3;
+    iq.tap_offset_chips = 0.5 * c.spacing_chips;
+    iq.absolute_carrier_phase = c.absolute_phase;
+    o = fusion::seed001_ultratight_options(c.trajectory, kind, form);
+    o.iq = iq;
+    o.update_interval_s = o.propagation_interval_s = iq.integration_time_s;  // one update per integration
   }
   o.ukf.alpha = c.ukf_alpha;
   double last = 0.0;
@@ -111,12 +113,14 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
 
 void add_covariance_command(CLI::App& app) {
   auto o = std::make_shared<CovarianceCommandOptions>();
-  auto* cmd = app.add_subcommand("covariance", "Seed 001 covariance analysis of tight / ultra-tight GPS/INS (EKF or UKF)");
+  auto* cmd =
+      app.add_subcommand("covariance", "Seed 001 covariance analysis of tight / ultra-tight GPS/INS (EKF or UKF)");
   cmd->add_option("--trajectory", o->trajectory, "straight, circle, s or spiral")->required();
   cmd->add_option("--coupling", o->coupling, "tight (default) or ultra-tight");
   cmd->add_option("--iq-measurement", o->iq_measurement, "ultra-tight: iq (taps, default) or discriminator");
   cmd->add_option("--cn0-dbhz", o->cn0_dbhz, "ultra-tight: C/N0 of every satellite (default 45)");
-  cmd->add_option("--integration-ms", o->integration_ms, "ultra-tight: coherent integration = update interval (default 20)");
+  cmd->add_option("--integration-ms", o->integration_ms,
+                  "ultra-tight: coherent integration = update interval (default 20)");
   cmd->add_option("--spacing-chips", o->spacing_chips, "ultra-tight: early-late spacing (default 1)");
   cmd->add_option("--ukf-alpha", o->ukf_alpha, "UKF sigma-point spread alpha (default 1)");
   cmd->add_flag("--absolute-carrier-phase", o->absolute_phase,

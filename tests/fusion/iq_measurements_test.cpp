@@ -2,6 +2,8 @@
 // C/A code), Jacobians against numerical differentiation, the information of the linearised taps equal to the
 // first-order discriminator variances, a Monte Carlo of the discriminators against their closed-form noise,
 // and the 17-state measurement objects (chain rule, and the discriminator rows equal to the tight rows).
+#include "fusion/iq_measurements.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
@@ -9,7 +11,6 @@
 #include <cmath>
 #include <random>
 
-#include "fusion/iq_measurements.hpp"
 #include "ins/earth_model.hpp"
 #include "signals/ca_code.hpp"
 #include "signals/gps_constants.hpp"
@@ -78,12 +79,12 @@ TEST(IqModel, JacobianMatchesNumericalDifferentiation) {
                                    TrackingErrors{0.0, 0.0}, TrackingErrors{0.02, 1e-6}}) {
       const auto J = iq_jacobian(e, s);
       const double hc = 1e-6, hf = 1e-4;
-      const Eigen::Matrix<double, 6, 1> dc =
-          (taps_vector(expected_iq({e.code_chips + hc, e.frequency_hz}, s)) -
-           taps_vector(expected_iq({e.code_chips - hc, e.frequency_hz}, s))) / (2 * hc);
-      const Eigen::Matrix<double, 6, 1> df =
-          (taps_vector(expected_iq({e.code_chips, e.frequency_hz + hf}, s)) -
-           taps_vector(expected_iq({e.code_chips, e.frequency_hz - hf}, s))) / (2 * hf);
+      const Eigen::Matrix<double, 6, 1> dc = (taps_vector(expected_iq({e.code_chips + hc, e.frequency_hz}, s)) -
+                                              taps_vector(expected_iq({e.code_chips - hc, e.frequency_hz}, s))) /
+                                             (2 * hc);
+      const Eigen::Matrix<double, 6, 1> df = (taps_vector(expected_iq({e.code_chips, e.frequency_hz + hf}, s)) -
+                                              taps_vector(expected_iq({e.code_chips, e.frequency_hz - hf}, s))) /
+                                             (2 * hf);
       for (int r = 0; r < 6; ++r) {
         EXPECT_NEAR(J(r, 0), dc(r), 1e-5 * iq_amplitude(s)) << "d " << d << " row " << r << " tau " << e.code_chips;
         EXPECT_NEAR(J(r, 1), df(r), 1e-5 * iq_amplitude(s)) << "d " << d << " row " << r << " df " << e.frequency_hz;
@@ -97,8 +98,7 @@ TEST(IqModel, JacobianMatchesNumericalDifferentiation) {
     TrackingErrors p = e, m = e;
     p.phase_rad += h;
     m.phase_rad -= h;
-    const Eigen::Matrix<double, 6, 1> num =
-        (taps_vector(expected_iq(p, s)) - taps_vector(expected_iq(m, s))) / (2 * h);
+    const Eigen::Matrix<double, 6, 1> num = (taps_vector(expected_iq(p, s)) - taps_vector(expected_iq(m, s))) / (2 * h);
     EXPECT_LT((iq_phase_derivative(e, s) - num).cwiseAbs().maxCoeff(), 1e-5 * iq_amplitude(s));
     // and the phase turns I + jQ: the envelope is unchanged
     const IqTaps t = expected_iq(e, s), t0 = expected_iq({e.code_chips, e.frequency_hz, 0.0}, s);
@@ -198,10 +198,11 @@ void monte_carlo(double cn0_dbhz, double tolerance) {
   EXPECT_NEAR(vf / fvar, 1.0, tolerance) << cn0_dbhz << " dB-Hz frequency";
   const DiscriminatorNoise first = discriminator_noise(sc, false);
   // The Monte Carlo figures, for docs/validation.md.
-  std::printf("MC %.0f dB-Hz: code var ratio %.4f (closed form %.3e chip^2; first order alone %.4f), frequency var "
-              "ratio %.4f (%.3e Hz^2; first order alone %.4f)\n",
-              cn0_dbhz, vc / cvar, cvar, vc / first.code_var_chips2, vf / fvar, fvar,
-              vf / discriminator_noise(sf_, false).frequency_var_hz2);
+  std::printf(
+      "MC %.0f dB-Hz: code var ratio %.4f (closed form %.3e chip^2; first order alone %.4f), frequency var "
+      "ratio %.4f (%.3e Hz^2; first order alone %.4f)\n",
+      cn0_dbhz, vc / cvar, cvar, vc / first.code_var_chips2, vf / fvar, fvar,
+      vf / discriminator_noise(sf_, false).frequency_var_hz2);
 }
 
 TEST(IqModel, DiscriminatorNoiseMatchesClosedFormAt45DbHz) { monte_carlo(45.0, 0.03); }
@@ -274,7 +275,8 @@ TEST(IqMeasurement17, JacobianMatchesNumericalDifferentiation) {
     // |v| / R ~ 2e-5 (m/s)/m here): 1e-3 of the row's scale for those.
     const bool exact = (c >= 3 && c < 6) || (c >= 9 && c < 12) || c >= 15;
     for (int r = 0; r < m.size(); ++r)
-      EXPECT_NEAR(H(r, c), num(r), exact ? 1e-5 * std::max(1.0, std::abs(num(r))) : 1e-3 * H.row(r).cwiseAbs().maxCoeff())
+      EXPECT_NEAR(H(r, c), num(r),
+                  exact ? 1e-5 * std::max(1.0, std::abs(num(r))) : 1e-3 * H.row(r).cwiseAbs().maxCoeff())
           << "row " << r << " col " << c;
   }
   // A general error (3 m, 0.3 m/s, 3 mrad, ...): first order only, the replica Jacobian is that of the nominal;

@@ -35,9 +35,9 @@ std::vector<std::vector<double>> read_csv(const std::string& path) {
 
 TEST(CovarianceCommand, UltraTightOptionsReachTheAnalysis) {
   const std::string csv = (ultratrack::test::scratch_dir() / "ultratight_cov.csv").string();
-  run_command("covariance", {"--trajectory", "s", "--coupling", "ultra-tight", "--filter", "ukf", "--iq-measurement",
-                             "discriminator", "--cn0-dbhz", "38", "--integration-ms", "10", "--spacing-chips", "0.5",
-                             "--times", "0.5", "--csv", csv},
+  run_command("covariance",
+              {"--trajectory", "s", "--coupling", "ultra-tight", "--filter", "ukf", "--iq-measurement", "discriminator",
+               "--cn0-dbhz", "38", "--integration-ms", "10", "--spacing-chips", "0.5", "--times", "0.5", "--csv", csv},
               false);
   auto o = fusion::seed001_ultratight_options("s", fusion::FilterKind::Ukf, fusion::IqForm::Discriminator);
   o.iq.cn0_dbhz = 38.0;
@@ -56,12 +56,14 @@ TEST(CovarianceCommand, UltraTightOptionsReachTheAnalysis) {
 TEST(CovarianceCommand, BadUltraTightChoicesAreInputErrors) {
   EXPECT_THROW(run_command("covariance", {"--trajectory", "s", "--coupling", "loose"}, false),
                ultratrack::io::InputError);
-  EXPECT_THROW(run_command("covariance", {"--trajectory", "s", "--coupling", "ultra-tight", "--iq-measurement", "phase"},
-                           false),
+  EXPECT_THROW(
+      run_command("covariance", {"--trajectory", "s", "--coupling", "ultra-tight", "--iq-measurement", "phase"}, false),
+      ultratrack::io::InputError);
+  EXPECT_THROW(run_command("covariance", {"--trajectory", "s", "--absolute-carrier-phase"}, false),
                ultratrack::io::InputError);
-  EXPECT_THROW(run_command("covariance", {"--trajectory", "s", "--coupling", "ultra-tight", "--spacing-chips", "1.5"},
-                           false),
-               ultratrack::io::InputError);
+  EXPECT_THROW(
+      run_command("covariance", {"--trajectory", "s", "--coupling", "ultra-tight", "--spacing-chips", "1.5"}, false),
+      ultratrack::io::InputError);
 }
 
 }  // namespace
