@@ -18,6 +18,7 @@
 #include "ins/attitude.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/imu_error_model.hpp"
+#include "ins/nav_correction.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
@@ -382,6 +383,33 @@ TEST(AttitudeAiding, SameTimeNearVerticalInvalidAndLate) {
   ASSERT_EQ(records.size(), 2u);
   EXPECT_EQ(records[0].prn, -1);  // attitude first
   EXPECT_EQ(records[1].prn, 0);
+}
+
+// Tight coupling (17 states) takes GPS attitude the same way: with attitude alone a 2 deg heading error of a parked
+// ideal IMU is removed to the attitude's accuracy, and the observation epochs' fallback count is untouched.
+TEST(AttitudeAiding, TightCouplingTakesAttitudeToo) {
+  const ins::TrajectorySpec spec = ins::profile_spec("static", 20.0, 0.6, 2.1, 50.0);
+  const ins::SimulatedRun run = ins::simulate(spec, 100.0);
+  IntegrationOptions opt;
+  opt.coupling = Coupling::Tight;
+  opt.sigma_att_rad = Eigen::Vector3d(0.01, 0.01, 0.05);
+  ins::NavState init = run.truth[0].nav();
+  ins::correct_attitude(init, Eigen::Vector3d(0.0, 0.0, 2.0 * kDeg));
+  GnssInsIntegration integ(init, opt);
+  for (std::size_t k = 0; k + 1 < run.truth.size(); ++k) {
+    if (k % 100 == 50) {
+      GnssAttitude a;
+      a.t_s = run.truth[k].t_s + 0.003;
+      a.euler_a = ins::euler_from_quaternion(run.truth[k].q_nb);
+      a.sigma_euler_rad = Eigen::Vector3d::Constant(0.01 * kDeg);
+      integ.add_attitude(a);
+    }
+    integ.add_imu(run.imu[k]);
+  }
+  const double yaw_err = ins::attitude_error_n(integ.output().nav.q_nb, run.truth.back().q_nb).z();
+  EXPECT_LT(std::abs(yaw_err), 4.0 * 0.01 * kDeg) << yaw_err / kDeg;
+  EXPECT_EQ(integ.counters().attitude_accepted, 20);
+  EXPECT_EQ(integ.covariance().rows(), 17);
 }
 
 }  // namespace
