@@ -194,6 +194,12 @@ struct ReceiveFusion::Impl {
 
   // Counts.
   long long epochs_seen = 0, fixes_seen = 0, before_start = 0, used = 0, nav_rows = 0;
+  long long unused = 0;  // after the start: loose epochs without a fix, tight epochs without ephemerides
+  struct FixClock {
+    signals::GpsTime receive_time;  // continuous receiver clock
+    double bias_m = 0.0, drift_mps = 0.0;
+  };
+  std::optional<FixClock> last_fix_clock;
   long long epochs_below_4 = 0;
   double last_row_t_s = 0.0;  // tight epochs applied with 1-3 satellites with ephemeris
   NavSigma final_sigma;
@@ -464,6 +470,8 @@ struct ReceiveFusion::Impl {
     std::optional<signals::GpsTime> g;
     if (fix) {
       g = fix->time;
+      // The fix's clock on the continuous receiver clock, for the epochs without a fix (loose).
+      last_fix_clock = FixClock{e.receive_time, fix->clock_bias_m - kC * clock_jump_s, fix->clock_drift_mps};
     } else if (integration && is_tight()) {
       g = signals::add_seconds(e.receive_time, -integration->nominal().clock_bias_m / kC);
     } else if (is_tight() && settings.align == AlignMode::Config && settings.config.position_deg_m) {
@@ -475,9 +483,14 @@ struct ReceiveFusion::Impl {
       const Eigen::Vector3d v_e = ins::C_en(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg) *
                                   c.velocity_ned_mps.value_or(Eigen::Vector3d::Zero());
       if (const auto clock = fit_clock(e, r_e, v_e)) g = signals::add_seconds(e.receive_time, -clock->first / kC);
+    } else if (integration && last_fix_clock) {
+      // Loose, no fix this epoch: the time from the last fix's clock bias and drift; the INS runs on to it.
+      const FixClock& k = *last_fix_clock;
+      const double bias_m = k.bias_m + k.drift_mps * signals::seconds_between(e.receive_time, k.receive_time);
+      g = signals::add_seconds(e.receive_time, -bias_m / kC);
     }
     if (!g) {
-      ++before_start;
+      ++(integration ? unused : before_start);
       return;
     }
     if (!origin) set_origin(*g, e.sample_index);
@@ -504,15 +517,17 @@ struct ReceiveFusion::Impl {
     if (is_tight()) {
       const auto eph = epoch_ephemerides(e);
       if (eph.empty()) {
-        ++before_start;
-        return;
+        ++unused;
+      } else {
+        if (eph.size() < 4) ++epochs_below_4;
+        integration->add_observations(e, eph, iono());
+        ++used;
       }
-      if (eph.size() < 4) ++epochs_below_4;
-      integration->add_observations(e, eph, iono());
-      ++used;
     } else if (f) {
       integration->add_fix(*f);
       ++used;
+    } else {
+      ++unused;
     }
     advance_imu(t);
   }
@@ -587,8 +602,9 @@ std::string ReceiveFusion::summary_json() const {
                    m.integration.has_value());
   if (m.origin)
     j += fmt::format(", \"imu_time_origin_gps\": {{\"week\": {}, \"tow_s\": {:.9f}}}", m.origin->week, m.origin->tow_s);
-  j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}",
-                   m.epochs_seen, m.fixes_seen, m.before_start, m.used);
+  j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
+                   "\"epochs_unused\": {}",
+                   m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
   if (m.is_tight()) j += fmt::format(", \"epochs_fewer_than_4_satellites\": {}", m.epochs_below_4);
   j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock_jumps, m.nav_rows);
   if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", json_escape(m.not_started));
