@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <stdexcept>
 #include <variant>
 
@@ -21,7 +22,10 @@ struct PendingEpoch {
   std::vector<signals::Ephemeris> ephemerides;
   signals::KlobucharParameters iono;
 };
-using Pending = std::variant<PendingFix, PendingEpoch>;
+struct PendingAttitude {
+  GnssAttitude attitude;
+};
+using Pending = std::variant<PendingFix, PendingEpoch, PendingAttitude>;
 
 bool finite(const Pending& p) {
   if (const auto* f = std::get_if<PendingFix>(&p)) {
@@ -33,6 +37,11 @@ bool finite(const Pending& p) {
                                             x.sigma_vel_n_mps.allFinite());
     return pos_ok && vel_ok;
   }
+  if (const auto* a = std::get_if<PendingAttitude>(&p)) {
+    const GnssAttitude& x = a->attitude;
+    return std::isfinite(x.euler_a.roll_rad) && std::isfinite(x.euler_a.pitch_rad) && std::isfinite(x.euler_a.yaw_rad) &&
+           x.sigma_euler_rad.allFinite() && (x.sigma_euler_rad.array() > 0.0).all();
+  }
   return true;  // observation epochs: prepare_satellites skips non-finite pseudoranges
 }
 
@@ -43,6 +52,10 @@ void check_options(const IntegrationOptions& o) {
   if (!(o.propagation_interval_s >= 0.0)) throw std::invalid_argument("integration: negative propagation interval");
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
     throw std::invalid_argument("integration: gate probability must lie in (0, 1)");
+  if (!o.attitude.q_ba.coeffs().allFinite() || std::abs(o.attitude.q_ba.norm() - 1.0) > 1e-6)
+    throw std::invalid_argument("integration: attitude mounting q_ba must be a unit quaternion");
+  if (!(o.attitude.max_abs_pitch_rad > 0.0 && o.attitude.max_abs_pitch_rad <= 0.5 * std::numbers::pi))
+    throw std::invalid_argument("integration: attitude pitch limit must lie in (0, 90] deg");
 }
 
 }  // namespace
@@ -82,8 +95,10 @@ class Core final : public CoreBase {
       ++counters.invalid;
       return;
     }
+    const bool attitude = std::holds_alternative<PendingAttitude>(p);
     if (t_s < nominal_.nav.t_s - kTimeEpsilon_s) {
       ++counters.late;
+      if (attitude) ++counters.attitude_late;
       return;
     }
     if (t_s <= nominal_.nav.t_s + kTimeEpsilon_s) {
@@ -91,7 +106,11 @@ class Core final : public CoreBase {
       fill_output();
       return;
     }
-    pending_.emplace(t_s, std::move(p));
+    // At equal times an attitude goes before the fixes already queued there (it counts for their fallback).
+    if (attitude)
+      pending_.emplace_hint(pending_.lower_bound(t_s), t_s, std::move(p));
+    else
+      pending_.emplace(t_s, std::move(p));
   }
 
   void add_imu(const ins::ImuIncrement& inc) override {
@@ -148,28 +167,49 @@ class Core final : public CoreBase {
   }
 
   template <class M>
-  void update(const M& m, int prn) {
+  bool update(const M& m, int prn) {
     const UpdateResult r = filter_.update(m);
     if (records.size() >= kMaxRecords) records.erase(records.begin(), records.begin() + kMaxRecords / 2);
     records.push_back(UpdateRecord{nominal_.nav.t_s, prn, r});
     if (!r.accepted) {
       ++counters.rejected;
-      return;
+      return false;
     }
     ++counters.accepted;
     // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock), reset to zero.
     nominal_ = corrected<N>(nominal_, filter_.x());
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<N>::Zero());
+    return true;
   }
 
   void apply(const Pending& p) {
     propagate();  // covariance up to the measurement time
+    if (const auto* a = std::get_if<PendingAttitude>(&p)) {
+      ++counters.attitude_epochs;
+      if (!attitude_usable(a->attitude, opt_.attitude)) {
+        ++counters.attitude_unusable;
+        return;
+      }
+      if (update(AttitudeMeasurement<N>(nominal_, a->attitude, opt_.attitude), -1)) {
+        ++counters.attitude_accepted;
+        attitude_since_fix_ = true;
+      } else {
+        ++counters.attitude_rejected;
+      }
+      return;
+    }
     ++counters.epochs;
+    if (!attitude_since_fix_) ++counters.fixes_without_attitude;
+    attitude_since_fix_ = false;
     if (const auto* f = std::get_if<PendingFix>(&p)) {
       if constexpr (N == 15) {
-        if (f->fix.has_position || f->fix.has_velocity)
-          update(LooseMeasurement<N>(nominal_, f->fix, opt_.lever_arm_b, w_ib_b_), 0);
+        if (f->fix.has_position || f->fix.has_velocity) {
+          if (update(LooseMeasurement<N>(nominal_, f->fix, opt_.lever_arm_b, w_ib_b_), 0))
+            ++counters.fix_accepted;
+          else
+            ++counters.fix_rejected;
+        }
       }
       return;
     }
@@ -212,6 +252,7 @@ class Core final : public CoreBase {
   double acc_dt_ = 0.0;
   Eigen::Vector3d acc_dv_n_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d w_ib_b_ = Eigen::Vector3d::Zero();
+  bool attitude_since_fix_ = false;
 };
 
 template <int N>
@@ -259,6 +300,10 @@ void GnssInsIntegration::add_observations(const receiver::ObservationEpoch& epoc
   const double t_s = signals::seconds_between(epoch.receive_time, impl_->options.gps_time_origin) -
                      impl_->core->nominal().clock_bias_m / signals::kSpeedOfLight_mps;
   impl_->core->add_pending(t_s, PendingEpoch{epoch, ephemerides, iono});
+}
+
+void GnssInsIntegration::add_attitude(const GnssAttitude& attitude) {
+  impl_->core->add_pending(attitude.t_s, PendingAttitude{attitude});
 }
 
 void GnssInsIntegration::add_imu(const ins::ImuIncrement& inc) { impl_->core->add_imu(inc); }

@@ -6,6 +6,9 @@
 // (position, velocity, attitude via ins/nav_correction; biases into the IMU compensation; clock) and the error
 // state reset to zero. Fallback: whatever part of an epoch is present is used (position without velocity,
 // pseudoranges without Doppler, fewer than four satellites in tight mode); nothing present = pure INS.
+// GPS attitude (multi-antenna receiver, seed 003) is a third measurement type in either coupling, applied at
+// its own time: epochs with attitude, position/velocity, or both; without attitude the update falls back to
+// position/velocity only (counted: fixes_without_attitude). At equal times attitude goes first.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides. EKF or UKF.
 #pragma once
 
@@ -13,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "fusion/attitude_measurement.hpp"
 #include "fusion/ekf.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/ins_error_state.hpp"
@@ -47,6 +51,7 @@ struct IntegrationOptions {
   double propagation_interval_s = 0.05;
   ins::StrapdownOptions strapdown;
   TightOptions tight;
+  AttitudeAidingOptions attitude;  // GPS attitude: array-to-IMU mounting, pitch limit
   // Tight mode: GPS time at t_s = 0 of the run's time line. A receive time T (receiver clock) is applied at
   // t = (T - gps_time_origin) - clock_bias / c.
   signals::GpsTime gps_time_origin;
@@ -77,12 +82,21 @@ struct IntegrationCounters {
   long long late = 0;               // GNSS data older than the INS time when it came (dropped)
   long long satellites_missing_ephemeris = 0;
   long long invalid = 0;            // ignored: non-finite IMU increments or fixes, IMU times not increasing
+  // Per measurement type (the totals above include them). Loose fixes: one update each.
+  long long fix_accepted = 0, fix_rejected = 0;
+  long long attitude_epochs = 0;    // GPS attitudes applied at their time (accepted + rejected + unusable)
+  long long attitude_accepted = 0;
+  long long attitude_rejected = 0;  // refused by the innovation gate
+  long long attitude_unusable = 0;  // refused before the gate: near vertical (Euler sigmas degenerate)
+  long long attitude_late = 0;      // older than the INS time when it came (dropped)
+  // Fallback (seed 003): fixes / observation epochs with no accepted attitude since the previous one.
+  long long fixes_without_attitude = 0;
 };
 
 // Per-update diagnostics (for NIS / consistency logs).
 struct UpdateRecord {
   double t_s = 0.0;
-  int prn = 0;  // tight: satellite; loose: 0
+  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1
   UpdateResult result;
 };
 
@@ -101,6 +115,9 @@ class GnssInsIntegration {
   // Tight mode only: an epoch with the ephemeris sets to choose from (select_ephemeris per satellite).
   void add_observations(const receiver::ObservationEpoch& epoch, const std::vector<signals::Ephemeris>& ephemerides,
                         const signals::KlobucharParameters& iono = {});
+  // Either coupling: a GPS attitude (array frame, options().attitude.q_ba to the IMU) at attitude.t_s.
+  // Non-finite values or non-positive sigmas: ignored and counted (counters().invalid).
+  void add_attitude(const GnssAttitude& attitude);
 
   // One raw IMU increment covering (output().nav.t_s, inc.t_s]. Pending GNSS data with times inside the
   // interval are applied at their exact times. Increments not later than the current time, or with non-finite

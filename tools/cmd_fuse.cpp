@@ -1,10 +1,12 @@
 // `ultratrack fuse`: loosely coupled GNSS/INS from an IMU CSV and a GNSS fix CSV (EKF or UKF, closed loop),
 // after a static, in-motion or configured alignment. Writes DIR/nav.csv (nav columns + 1-sigma) and
 // DIR/summary.json (update counts, convergence, RMS against --truth); progress and a summary on stdout.
+// --attitude adds a multi-antenna receiver's GPS attitude (attitude.csv) as a measurement (seed 003).
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <numbers>
 #include <string>
@@ -13,6 +15,7 @@
 #include "commands.hpp"
 #include "fuse_run.hpp"
 #include "fused_nav_csv.hpp"
+#include "attitude_csv.hpp"
 #include "gnss_csv.hpp"
 #include "ins/imu_csv.hpp"
 #include "io/atomic_file.hpp"
@@ -26,7 +29,8 @@ namespace fs = std::filesystem;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct FuseCommandOptions {
-  std::string imu_file, gnss_file, truth_file, config_file, out_dir;
+  std::string imu_file, gnss_file, truth_file, config_file, out_dir, attitude_file;
+  std::vector<double> attitude_origin;  // WEEK TOW
   std::string coupling = "loose", filter = "ekf", align = "motion";
   std::vector<double> outage;  // START DURATION pairs
   int decimate = 1;
@@ -52,8 +56,10 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.align = AlignMode::Motion;
   } else if (o.align == "config") {
     s.align = AlignMode::Config;
+  } else if (o.align == "attitude") {
+    s.align = AlignMode::Attitude;
   } else {
-    throw io::InputError("command line", "--align must be static, motion or config, got '" + o.align + "'");
+    throw io::InputError("command line", "--align must be static, motion, config or attitude, got '" + o.align + "'");
   }
   if (o.decimate < 1) throw io::InputError("command line", "--decimate must be at least 1");
   if (o.outage.size() % 2 != 0) throw io::InputError("command line", "--outage takes START DURATION pairs");
@@ -62,6 +68,16 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.outages.emplace_back(o.outage[i], o.outage[i + 1]);
   }
   if (!o.config_file.empty()) s.config = read_fuse_config(o.config_file);
+  if (!o.attitude_origin.empty()) {
+    const double week = o.attitude_origin[0], tow = o.attitude_origin[1];
+    if (week < 0.0 || week != std::floor(week) || !(tow >= 0.0 && tow < 604800.0))
+      throw io::InputError("command line", "--attitude-origin takes WEEK (integer) TOW (seconds in [0, 604800))");
+    s.config.attitude_gps_time_at_imu_zero = signals::GpsTime{static_cast<int>(week), tow};
+  }
+  if (!o.attitude_file.empty()) {
+    s.attitude = read_attitude_csv(o.attitude_file);
+    s.attitude_file = o.attitude_file;
+  }
 
   const auto imu = ins::read_imu_csv(o.imu_file);
   const auto gnss = read_gnss_csv(o.gnss_file);
@@ -106,6 +122,11 @@ void run_fuse_command(const FuseCommandOptions& o) {
                "attitude {:.4f} deg; GNSS fixes alone {:.3f} m\n",
                r.rms_all->position_3d_m, r.rms_all->horizontal_m, r.rms_all->vertical_m, r.rms_all->velocity_mps,
                r.rms_all->attitude_deg, r.gnss_rms ? r.gnss_rms->position_3d_m : 0.0);
+  if (!s.attitude.empty())
+    fmt::print("fuse: GPS attitude: {} rows, {} fixed, {} unfixed skipped (fallback); updates accepted {}, rejected "
+               "{} (gate) + {} (near vertical); {} fixes without attitude\n",
+               r.attitude.rows, r.attitude.fixed_rows, r.attitude.unfixed_skipped, r.counters.attitude_accepted,
+               r.counters.attitude_rejected, r.counters.attitude_unusable, r.counters.fixes_without_attitude);
   for (const auto& oo : r.outages)
     fmt::print("fuse: outage {:.1f}-{:.1f} s: horizontal error at its end {:.3f} m (1-sigma {:.3f} m)\n", oo.start_s,
                oo.end_s, oo.horizontal_error_m, oo.sigma_horizontal_m);
@@ -126,7 +147,14 @@ void add_fuse_command(CLI::App& app) {
   cmd->add_option("--filter", o->filter, "ekf or ukf (default ekf)");
   cmd->add_option("--config", o->config_file, "TOML: [imu] [initial] [alignment] [gnss] [filter] [output]")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--align", o->align, "static, motion (default) or config");
+  cmd->add_option("--align", o->align, "static, motion (default), config or attitude (first fixed GPS attitude)");
+  cmd->add_option("--attitude", o->attitude_file,
+                  "GPS attitude CSV of `ultratrack attitude` (gps_week,tow_s,roll_deg,...,fixed,ratio): attitude "
+                  "updates, unfixed rows skipped")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--attitude-origin", o->attitude_origin,
+                  "WEEK TOW: GPS time of IMU t = 0 (else [attitude] gps_time_at_imu_zero)")
+      ->expected(2);
   cmd->add_option("--truth", o->truth_file, "truth/nav CSV on the IMU time line: RMS errors in summary.json")
       ->check(CLI::ExistingFile);
   cmd->add_option("--outage", o->outage, "START DURATION: drop GNSS fixes in [START, START+DURATION) (repeatable)")

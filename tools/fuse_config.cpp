@@ -1,5 +1,6 @@
 #include "fuse_config.hpp"
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
@@ -86,6 +87,24 @@ const std::map<std::string, Table>& sections() {
         {"propagation_interval_s", [](const Value& v, C& c) { c.propagation_interval_s = v.positive(); }}}},
       {"output",
        {{"convergence_heading_sigma_deg", [](const Value& v, C& c) { c.convergence_heading_sigma_deg = v.positive(); }}}},
+      {"attitude",
+       {{"gps_time_at_imu_zero",
+         [](const Value& v, C& c) {
+           const auto* a = v.node.as_array();
+           const auto week = a && a->size() == 2 ? (*a)[0].value<std::int64_t>() : std::nullopt;
+           const auto tow = a && a->size() == 2 ? (*a)[1].value<double>() : std::nullopt;
+           if (!week || !tow || *week < 0 || !(*tow >= 0.0 && *tow < 604800.0))
+             throw io::InputError(v.file, "key '" + v.key + "' must be [week, tow_s] with tow_s in [0, 604800)",
+                                  v.line());
+           c.attitude_gps_time_at_imu_zero = signals::GpsTime{static_cast<int>(*week), *tow};
+         }},
+        {"misalignment_deg", [](const Value& v, C& c) { c.attitude_misalignment_deg = v.vector3(); }},
+        {"max_pitch_deg",
+         [](const Value& v, C& c) {
+           c.attitude_max_pitch_deg = v.positive();
+           if (c.attitude_max_pitch_deg > 90.0)
+             throw io::InputError(v.file, "key '" + v.key + "' must be at most 90", v.line());
+         }}}},
   };
   return s;
 }
@@ -107,7 +126,7 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
     const auto known = sections().find(section);
     const auto* table = section_node.as_table();
     if (known == sections().end() || !table)
-      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, filter, output)",
+      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, filter, output, attitude)",
                            static_cast<int>(section_node.source().begin.line));
     for (const auto& [key_name, node] : *table) {
       const std::string key = section + "." + std::string(key_name.str());

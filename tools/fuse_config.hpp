@@ -7,6 +7,9 @@
 //   [filter]     ukf_alpha = 1, ukf_beta = 2, ukf_kappa = 0, gate = true, gate_probability = 0.9999,
 //                propagation_interval_s = 0.05
 //   [output]     convergence_heading_sigma_deg = 1
+//   [attitude]   (GPS attitude, --attitude) gps_time_at_imu_zero = [week, tow_s] (GPS time of IMU t_s = 0; the
+//                attitude file is tagged in GPS time), misalignment_deg = [roll, pitch, yaw] (antenna array ->
+//                IMU body, default 0), max_pitch_deg = 80 (beyond: refused, Euler sigmas degenerate)
 // Unknown sections or keys and wrong value types are InputErrors naming the file and line.
 #pragma once
 
@@ -16,6 +19,7 @@
 #include <string>
 
 #include "fusion/gnss_ins_integration.hpp"
+#include "signals/gps_time.hpp"
 
 namespace ultratrack::tools {
 
@@ -35,6 +39,9 @@ struct FuseConfig {
   fusion::GateOptions gate;
   double propagation_interval_s = 0.05;
   double convergence_heading_sigma_deg = 1.0;
+  std::optional<signals::GpsTime> attitude_gps_time_at_imu_zero;
+  Eigen::Vector3d attitude_misalignment_deg = Eigen::Vector3d::Zero();  // roll, pitch, yaw of array -> IMU body
+  double attitude_max_pitch_deg = 80.0;
 };
 
 // Reads the file over the defaults; throws io::InputError.

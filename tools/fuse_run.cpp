@@ -119,6 +119,47 @@ ErrorRms rms_of(const std::vector<RowError>& e, double from_t) {
   return r;
 }
 
+fusion::AttitudeAidingOptions attitude_aiding_options(const FuseConfig& c) {
+  fusion::AttitudeAidingOptions o;
+  const Eigen::Vector3d m = c.attitude_misalignment_deg * kDeg;
+  o.q_ba = ins::quaternion_from_euler({m.x(), m.y(), m.z()});
+  o.max_abs_pitch_rad = c.attitude_max_pitch_deg * kDeg;
+  return o;
+}
+
+// A fixed attitude row on the IMU time line.
+struct TimedAttitude {
+  double t_s = 0.0;
+  int line = 0;
+  fusion::GnssAttitude attitude;
+};
+
+// The fixed rows of the attitude file on the IMU time line (unfixed rows are the fallback: left out here).
+std::vector<TimedAttitude> timed_attitudes(const FuseSettings& s, double imu_start, double imu_end) {
+  std::vector<TimedAttitude> out;
+  if (s.attitude.empty()) return out;
+  const auto& origin = s.config.attitude_gps_time_at_imu_zero;
+  if (!origin)
+    throw io::InputError("configuration", "GPS attitude needs the GPS time of IMU t = 0: [attitude] "
+                                          "gps_time_at_imu_zero = [week, tow_s] or --attitude-origin WEEK TOW");
+  for (const auto& r : s.attitude) {
+    if (!r.fixed) continue;
+    TimedAttitude t;
+    t.t_s = signals::seconds_between(r.time, *origin);
+    t.line = r.line;
+    t.attitude.t_s = t.t_s;
+    t.attitude.euler_a = r.euler;
+    t.attitude.sigma_euler_rad = Eigen::Vector3d(r.sigma_roll_rad, r.sigma_pitch_rad, r.sigma_yaw_rad);
+    out.push_back(t);
+  }
+  if (!out.empty() && (out.back().t_s <= imu_start || out.front().t_s >= imu_end))
+    throw io::InputError(s.attitude_file, fmt::format("fixed attitudes ({:.3f}-{:.3f} s on the IMU time line) do not "
+                                                      "overlap the IMU data ({:.3f}-{:.3f} s): check "
+                                                      "gps_time_at_imu_zero",
+                                                      out.front().t_s, out.back().t_s, imu_start, imu_end));
+  return out;
+}
+
 std::string json_escape(const std::string& in) {
   std::string out;
   for (char ch : in) {
@@ -146,6 +187,8 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     throw io::InputError("GNSS file", fmt::format("fixes ({:.3f}-{:.3f} s) do not overlap the IMU data ({:.3f}-{:.3f} s)",
                                                   gnss.front().t_s, gnss.back().t_s, imu_start, imu.back().t_s));
   const ins::ImuErrorSpec preset = ins::imu_preset(c.imu_preset);
+  const fusion::AttitudeAidingOptions attitude_options = attitude_aiding_options(c);
+  const std::vector<TimedAttitude> attitude = timed_attitudes(s, imu_start, imu.back().t_s);
 
   // --- initial state ---
   FuseResult result;
@@ -191,6 +234,24 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     sigma_att = position_only ? Eigen::Vector3d(3.0 * kDeg, 3.0 * kDeg, 5.0 * kDeg)
                               : Eigen::Vector3d(1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg);
     result.alignment_note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
+  } else if (s.align == AlignMode::Attitude) {
+    if (attitude.empty()) throw io::InputError("command line", "--align attitude needs --attitude FILE");
+    const double from = std::max(imu_start, gnss.front().t_s);
+    const auto it = std::find_if(attitude.begin(), attitude.end(), [&](const TimedAttitude& a) {
+      return a.t_s >= from && a.t_s < imu.back().t_s && fusion::attitude_usable(a.attitude, attitude_options);
+    });
+    if (it == attitude.end())
+      throw io::InputError(s.attitude_file, fmt::format("--align attitude: no fixed attitude within the IMU and GNSS "
+                                                        "data ({:.3f}-{:.3f} s)",
+                                                        from, imu.back().t_s));
+    init.t_s = it->t_s;
+    init.q_nb = fusion::measured_q_nb(it->attitude, attitude_options.q_ba);
+    // One GPS attitude's accuracy: its Euler sigmas as NED rotation sigmas (fusion/attitude_measurement.hpp).
+    const Eigen::Matrix3d M = fusion::euler_rate_to_rotation_n(it->attitude.euler_a);
+    const Eigen::Matrix3d R = M * it->attitude.sigma_euler_rad.cwiseAbs2().asDiagonal() * M.transpose();
+    sigma_att = R.diagonal().cwiseSqrt().cwiseMax(0.01 * kDeg);
+    sigma_vel = Eigen::Vector3d::Constant(1.0);
+    result.alignment_note = fmt::format("GPS attitude at {:.3f} s (line {})", it->t_s, it->line);
   } else {
     if (!c.attitude_deg) throw io::InputError("configuration", "--align config needs [initial] attitude_deg");
     auto it = std::find_if(gnss.begin(), gnss.end(), [&](const GnssCsvRow& r) { return r.t_s >= imu_start; });
@@ -202,7 +263,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     result.alignment_note = "attitude from the configuration";
   }
   const GnssState g0 = gnss_at(gnss, init.t_s);
-  if (s.align == AlignMode::Config && g0.has_velocity) init.v_n = g0.v_n;
+  if ((s.align == AlignMode::Config || s.align == AlignMode::Attitude) && g0.has_velocity) init.v_n = g0.v_n;
   if (s.align == AlignMode::Config && c.velocity_ned_mps) init.v_n = *c.velocity_ned_mps;
   Eigen::Vector3d sigma_pos = g0.sigma_ned_m;
   if (c.position_deg_m) {
@@ -234,6 +295,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   o.gate = c.gate;
   o.ukf = c.ukf;
   o.propagation_interval_s = c.propagation_interval_s;
+  o.attitude = attitude_options;
   fusion::GnssInsIntegration integration(init, o);
 
   // --- run ---
@@ -245,6 +307,19 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   while (g < gnss.size() && gnss[g].t_s <= init.t_s) {
     ++result.fixes_before_start;
     ++g;
+  }
+  AttitudeUse& au = result.attitude;
+  au.rows = static_cast<long long>(s.attitude.size());
+  for (const auto& r : s.attitude) {
+    if (r.fixed)
+      ++au.fixed_rows;
+    else
+      ++au.unfixed_skipped;
+  }
+  std::size_t a = 0;
+  while (a < attitude.size() && attitude[a].t_s <= init.t_s) {
+    ++au.before_start;
+    ++a;
   }
   std::size_t k = 0;
   while (k < imu.size() && imu[k].t_s <= init.t_s) ++k;
@@ -288,6 +363,14 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       integration.add_fix(f);
       ++result.fixes_used;
     }
+    for (; a < attitude.size() && attitude[a].t_s <= imu[k].t_s; ++a) {
+      if (in_outage(s, attitude[a].t_s)) {
+        ++au.in_outage;
+        continue;
+      }
+      integration.add_attitude(attitude[a].attitude);
+      ++au.used;
+    }
     ins::ImuIncrement inc = imu[k];
     const double t_prev = k > 0 ? imu[k - 1].t_s : imu_start;
     if (k == k_first && t_prev < init.t_s) {  // the first interval straddles the start: keep its share
@@ -300,6 +383,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     if (on_progress && (k - k_first + 1) % static_cast<std::size_t>(progress_step) == 0)
       on_progress(double(k - k_first + 1) / double(imu.size() - k_first));
   }
+  au.after_end = static_cast<long long>(attitude.size() - a);
   result.end_s = integration.output().nav.t_s;
   result.counters = integration.counters();
   result.converged_at_s = converged_since;
@@ -341,7 +425,10 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
         e.rows, e.horizontal_m, e.vertical_m, e.position_3d_m, e.velocity_mps, e.attitude_deg, e.heading_deg,
         e.within_3sigma);
   };
-  const char* align = s.align == AlignMode::Static ? "static" : s.align == AlignMode::Motion ? "motion" : "config";
+  const char* align = s.align == AlignMode::Static   ? "static"
+                      : s.align == AlignMode::Motion ? "motion"
+                      : s.align == AlignMode::Config ? "config"
+                                                     : "attitude";
   std::string j = "{\n";
   j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", json_escape(imu_file), json_escape(gnss_file));
   if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", json_escape(truth_file));
@@ -356,6 +443,21 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
                    r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
   j += fmt::format("  \"updates_accepted\": {},\n  \"updates_rejected\": {},\n  \"fixes_late\": {},\n",
                    r.counters.accepted, r.counters.rejected, r.counters.late);
+  j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
+                   r.counters.fix_rejected);
+  if (!s.attitude.empty()) {
+    const AttitudeUse& a = r.attitude;
+    const auto& n = r.counters;
+    const Eigen::Vector3d& m = s.config.attitude_misalignment_deg;
+    j += fmt::format("  \"attitude\": {{\"file\": \"{}\", \"rows\": {}, \"fixed_rows\": {}, \"unfixed_skipped\": {}, "
+                     "\"before_start\": {}, \"after_end\": {}, \"in_outage\": {}, \"used\": {}, \"updates\": {}, "
+                     "\"updates_accepted\": {}, \"updates_rejected\": {}, \"rejected_near_vertical\": {}, \"late\": {}, "
+                     "\"fallback_fixes\": {}, \"misalignment_deg\": [{}, {}, {}], \"max_pitch_deg\": {}}},\n",
+                     json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start,
+                     a.after_end, a.in_outage, a.used, n.attitude_epochs, n.attitude_accepted, n.attitude_rejected,
+                     n.attitude_unusable, n.attitude_late, n.fixes_without_attitude, m.x(), m.y(), m.z(),
+                     s.config.attitude_max_pitch_deg);
+  }
   j += fmt::format("  \"converged\": {},\n  \"converged_at_s\": {},\n", r.converged_at_s.has_value(),
                    r.converged_at_s ? fmt::format("{}", *r.converged_at_s) : std::string("null"));
   j += fmt::format("  \"convergence_heading_sigma_deg\": {},\n", s.config.convergence_heading_sigma_deg);

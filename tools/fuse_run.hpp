@@ -3,6 +3,10 @@
 // gyrocompassing over the first seconds; motion: heading from the GNSS track, tilt from the accelerometers;
 // config: the configuration's attitude), with optional GNSS outages, and the statistics the summary reports
 // (update counts, convergence, RMS against a truth trajectory and of the GNSS fixes themselves).
+// Optional GPS attitude (seed 003, a multi-antenna receiver's attitude.csv): fixed rows are attitude updates at
+// their own times (GPS time -> IMU time by [attitude] gps_time_at_imu_zero), unfixed rows are skipped and the
+// filter falls back to position/velocity; `attitude` alignment takes the first fixed attitude (a MEMS IMU cannot
+// gyrocompass, seed 000). Attitudes inside --outage spans are dropped with the fixes.
 // Units SI inside; times on the IMU file's time line.
 #pragma once
 
@@ -13,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "attitude_csv.hpp"
 #include "fuse_config.hpp"
 #include "fused_nav_csv.hpp"
 #include "fusion/gnss_ins_integration.hpp"
@@ -22,13 +27,26 @@
 
 namespace ultratrack::tools {
 
-enum class AlignMode { Static, Motion, Config };
+enum class AlignMode { Static, Motion, Config, Attitude };
 
 struct FuseSettings {
   fusion::FilterKind filter = fusion::FilterKind::Ekf;
   AlignMode align = AlignMode::Motion;
   FuseConfig config;
   std::vector<std::pair<double, double>> outages;  // [start, start + duration): GNSS fixes dropped
+  // GPS attitude (empty: none). attitude_file names it in messages and the summary.
+  std::vector<AttitudeCsvRow> attitude;
+  std::string attitude_file;
+};
+
+// What happened to the attitude rows (all zero without --attitude).
+struct AttitudeUse {
+  long long rows = 0, fixed_rows = 0;
+  long long unfixed_skipped = 0;  // fixed = 0: fallback to position/velocity
+  long long before_start = 0;     // at or before the navigation start (the alignment's row among them)
+  long long after_end = 0;        // after the last IMU row
+  long long in_outage = 0;
+  long long used = 0;             // handed to the filter
 };
 
 struct ErrorRms {
@@ -56,6 +74,7 @@ struct FuseResult {
   std::optional<ErrorRms> rms_all, rms_converged;  // against truth
   std::optional<ErrorRms> gnss_rms;                // the fixes themselves against truth (antenna)
   std::vector<OutageResult> outages;
+  AttitudeUse attitude;
 };
 
 // Every solution row (after each IMU interval) goes to on_row. Throws io::InputError for inputs that do not

@@ -1,0 +1,105 @@
+#include "attitude_csv.hpp"
+
+#include <fmt/core.h>
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <string>
+
+#include "io/input_error.hpp"
+#include "io/numeric_csv.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr std::size_t kColumns = 11;
+
+const std::vector<std::string>& attitude_header() {
+  static const std::vector<std::string> h{"gps_week",        "tow_s",           "roll_deg",      "pitch_deg",
+                                          "yaw_deg",         "sigma_roll_deg",  "sigma_pitch_deg", "sigma_yaw_deg",
+                                          "num_sats",        "fixed",           "ratio"};
+  return h;
+}
+
+// Splits a data row into its 11 numbers (nan allowed here; the row checks decide where it is acceptable).
+std::array<double, kColumns> parse_row(const std::string& file, int line, std::string_view text) {
+  std::array<double, kColumns> v{};
+  std::size_t i = 0;
+  while (true) {
+    const std::size_t comma = text.find(',');
+    if (i >= kColumns) throw io::InputError(file, fmt::format("more than {} fields", kColumns), line);
+    const std::string_view field = io::trim(text.substr(0, comma));
+    const char* first = field.data();
+    const char* last = field.data() + field.size();
+    if (!field.empty() && *first == '+') ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, v[i]);
+    if (field.empty() || ec != std::errc() || ptr != last)
+      throw io::InputError(file, fmt::format("{} is not a number: '{}'", attitude_header()[i], field), line);
+    ++i;
+    if (comma == std::string_view::npos) break;
+    text.remove_prefix(comma + 1);
+  }
+  if (i != kColumns) throw io::InputError(file, fmt::format("expected {} fields, got {}", kColumns, i), line);
+  return v;
+}
+
+}  // namespace
+
+std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::ifstream in(file);
+  if (!in) throw io::InputError(name, "cannot open attitude file");
+  std::vector<AttitudeCsvRow> rows;
+  std::string text;
+  int line = 0;
+  bool have_header = false;
+  while (std::getline(in, text)) {
+    ++line;
+    const std::string_view t = io::trim(text);
+    if (t.empty() || t.front() == '#') continue;
+    if (!have_header) {
+      io::check_csv_header(name, line, t, attitude_header());
+      have_header = true;
+      continue;
+    }
+    const auto v = parse_row(name, line, t);
+    auto fail = [&](const std::string& what) { throw io::InputError(name, what, line); };
+    for (int i : {0, 1, 8, 9, 10})
+      if (!std::isfinite(v[static_cast<std::size_t>(i)])) fail(attitude_header()[static_cast<std::size_t>(i)] + " is not finite");
+    if (v[0] < 0.0 || v[0] != std::floor(v[0])) fail("gps_week must be a non-negative integer");
+    if (!(v[1] >= 0.0 && v[1] < 604800.0)) fail("tow_s outside [0, 604800)");
+    if (v[8] < 0.0 || v[8] != std::floor(v[8])) fail("num_sats must be a non-negative integer");
+    if (v[9] != 0.0 && v[9] != 1.0) fail("fixed must be 0 or 1");
+    AttitudeCsvRow r;
+    r.line = line;
+    r.time = signals::GpsTime{static_cast<int>(v[0]), v[1]};
+    r.euler = {v[2] * kDeg, v[3] * kDeg, v[4] * kDeg};
+    r.sigma_roll_rad = v[5] * kDeg;
+    r.sigma_pitch_rad = v[6] * kDeg;
+    r.sigma_yaw_rad = v[7] * kDeg;
+    r.num_sats = static_cast<int>(v[8]);
+    r.fixed = v[9] == 1.0;
+    r.ratio = v[10];
+    if (r.fixed) {
+      for (std::size_t i = 2; i < 8; ++i)
+        if (!std::isfinite(v[i])) fail("fixed row: " + attitude_header()[i] + " is not finite");
+      if (std::abs(v[2]) > 180.0 || std::abs(v[3]) > 90.0 || std::abs(v[4]) > 360.0)
+        fail("fixed row: angle out of range (roll +-180, pitch +-90, yaw +-360 deg)");
+      for (std::size_t i = 5; i < 8; ++i)
+        if (!(v[i] > 0.0)) fail("fixed row: " + attitude_header()[i] + " must be positive");
+    }
+    if (!rows.empty() && !(signals::seconds_between(r.time, rows.back().time) > 0.0))
+      fail(fmt::format("time {} {:.4f} not after the previous row's (line {})", r.time.week, r.time.tow_s,
+                       rows.back().line));
+    rows.push_back(r);
+  }
+  if (!have_header) throw io::InputError(name, "empty attitude file: missing header");
+  if (rows.empty()) throw io::InputError(name, "attitude file has no data rows");
+  return rows;
+}
+
+}  // namespace ultratrack::tools
