@@ -194,20 +194,25 @@ TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
 }
 
 // Tight: raw pseudoranges and Doppler per satellite (noise nearly white: the DLL's), each gated on its own. The
-// fused position must beat the PVT fixes at the same epochs.
+// fused position must beat the PVT fixes at the same epochs, with the EKF and with the UKF.
 TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
-  const auto rx = sim().dir / "rx_tight";
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "tight", "--align", "motion", "--fusion-config", motion_config().string()});
-  test_support::run_command("receive", args);
-  const Rms r = compare(rx);
-  const std::string summary = read_text(rx / "summary.json");
-  std::printf("tight EKF: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", r.epochs, r.fused_m, r.gnss_m);
-  EXPECT_GE(r.epochs, 50);
-  EXPECT_LT(r.fused_m, r.gnss_m);
-  EXPECT_EQ(json_number(summary, "epochs_fewer_than_4_satellites"), 0.0);
-  // six satellites a fix, pseudorange and rate each: one update per satellite and epoch
-  EXPECT_GE(json_number(summary, "updates_accepted"), 5.0 * r.epochs);
+  for (const std::string filter : {"ekf", "ukf"}) {
+    const auto rx = sim().dir / ("rx_tight_" + filter);
+    auto args = receive_args(rx);
+    args.insert(args.end(), {"--coupling", "tight", "--filter", filter, "--align", "motion", "--fusion-config",
+                             motion_config().string()});
+    test_support::run_command("receive", args);
+    const Rms r = compare(rx);
+    const std::string summary = read_text(rx / "summary.json");
+    std::printf("tight %s: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", filter.c_str(), r.epochs, r.fused_m,
+                r.gnss_m);
+    EXPECT_NE(summary.find("\"filter\": \"" + filter + "\""), std::string::npos);
+    EXPECT_GE(r.epochs, 50);
+    EXPECT_LT(r.fused_m, r.gnss_m) << filter;
+    EXPECT_EQ(json_number(summary, "epochs_fewer_than_4_satellites"), 0.0);
+    // six satellites a fix, pseudorange and rate each: one update per satellite and epoch
+    EXPECT_GE(json_number(summary, "updates_accepted"), 5.0 * r.epochs);
+  }
 }
 
 // A receiver clock jump while the tight filter runs: the receiver's clock starts ~7.6 ms off (initial travel time
