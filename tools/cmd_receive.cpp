@@ -5,6 +5,8 @@
 // Exit: 0 with a fix; 2 (InputError) for bad input, including a file in which no satellite is found (no
 // outputs then); 3 when satellites were tracked but the file ended before a fix (outputs written, summary
 // says "fix": false). SIGINT stops the loop and still finishes every output.
+// --imu F --coupling loose|tight: GNSS/INS integration on the way (tools/receive_fusion.hpp): nav.csv and a "fusion"
+// object in summary.json; exit 3 also when the integration never started, 0 with a fused solution but no PVT fix.
 #include <fmt/core.h>
 #include <unistd.h>
 
