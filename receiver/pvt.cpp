@@ -267,6 +267,7 @@ PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& meas, const signa
     sq += g.residual_m * g.residual_m;
   }
   sol.residual_rms_m = std::sqrt(sq / rows.size());
+  if (const LsqResult w = weighted_lsq(rows, false); w.ok) sol.covariance_m2 = w.normal_inverse;
 
   // DOPs from the unweighted geometry.
   Eigen::Matrix4d G = Eigen::Matrix4d::Zero();
@@ -290,6 +291,7 @@ PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& meas, const signa
     sol.v_e_mps = rate.dx.head<3>();
     sol.clock_drift_mps = rate.dx(3);
     sol.velocity_valid = true;
+    sol.velocity_covariance_m2ps2 = rate.normal_inverse;
     sol.v_enu_mps = frame.C_enu_to_e.transpose() * sol.v_e_mps;
   }
   return sol;

@@ -64,6 +64,11 @@ struct PvtSolution {
   std::optional<int> excluded_prn;     // removed by the residual test
   double residual_rms_m = 0.0;
   int iterations = 0;
+  // A-priori covariances of the weighted solutions (the inverse normal matrices with the elevation and C/N0
+  // sigma model above): ECEF position + c * clock bias [m^2], ECEF velocity + c * clock drift [(m/s)^2]
+  // (zero when velocity_valid is false).
+  Eigen::Matrix4d covariance_m2 = Eigen::Matrix4d::Zero();
+  Eigen::Matrix4d velocity_covariance_m2ps2 = Eigen::Matrix4d::Zero();
 };
 
 // Solves one epoch. receive_time is the epoch by the receiver's clock. initial_r_e_m seeds the iteration

@@ -94,7 +94,7 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
                sat.observations, sat.used_in_fixes, sat.frame_synced, sat.ephemeris_decoded);
     first = false;
   }
-  fmt::print(out, "\n  ]\n}}\n");
+  fmt::print(out, "\n  ]{}\n}}\n", run.extra_json.empty() ? std::string() : ",\n  " + run.extra_json);
   file.commit();
 }
 

@@ -5,6 +5,8 @@
 // Exit: 0 with a fix; 2 (InputError) for bad input, including a file in which no satellite is found (no
 // outputs then); 3 when satellites were tracked but the file ended before a fix (outputs written, summary
 // says "fix": false). SIGINT stops the loop and still finishes every output.
+// --imu F --coupling loose|tight: GNSS/INS integration on the way (tools/receive_fusion.hpp): nav.csv and a "fusion"
+// object in summary.json; exit 3 also when the integration never started, 0 with a fused solution but no PVT fix.
 #include <fmt/core.h>
 #include <unistd.h>
 
@@ -16,6 +18,7 @@
 #include <cstdio>
 #include <ctime>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +27,7 @@
 #include "commands.hpp"
 #include "format_options.hpp"
 #include "receive_config.hpp"
+#include "receive_fusion.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
@@ -50,6 +54,7 @@ struct ReceiveArgs {
   std::string input, fs, if_hz = "0", config, nav, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
   FormatArgs format;
+  ReceiveFusionArgs fusion;
   bool iq_swap = false, q_negate = false, quiet = false;
 };
 
@@ -159,8 +164,16 @@ void run_receive(const ReceiveArgs& args) {
                                                       "acquisition needs ({} x {} ms)",
                                                       to_process, needed, acq.noncoherent, acq.coherent_ms));
 
+  // GNSS/INS integration (--coupling): settings and the IMU file checked before any output exists.
+  const auto fusion_settings = parse_receive_fusion(args.fusion);
+  std::vector<ins::ImuIncrement> imu;
+  if (fusion_settings) imu = read_receive_imu(*fusion_settings);
+
   receiver::ReceiverOutputs outputs(args.out, options.fs_hz, options.observation_interval_s);
-  receiver::ReceiverEngine engine(options, outputs);
+  std::optional<ReceiveFusion> fusion;
+  if (fusion_settings) fusion.emplace(*fusion_settings, std::move(imu), outputs, args.out, options, nav.ephemerides);
+  receiver::ReceiverEngine engine(options, fusion ? static_cast<receiver::ReceiverObserver&>(*fusion) : outputs);
+  if (fusion) fusion->attach(engine);
   if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
 
   SigintGuard sigint;
@@ -199,7 +212,12 @@ void run_receive(const ReceiveArgs& args) {
   run.skip_s = skip_s;
   run.wall_time_s = wall_s;
   run.interrupted = g_interrupted != 0;
+  if (fusion) {
+    fusion->finish(engine.stats().first_sample + engine.stats().samples_processed);
+    run.extra_json = fusion->summary_json();
+  }
   outputs.finish(engine, run);
+  if (fusion) fusion->commit();
 
   const double t = receiver::processed_seconds(engine);
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
@@ -211,10 +229,15 @@ void run_receive(const ReceiveArgs& args) {
   }
   fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", tracked, used, stats.fixes,
              engine.decoded_ephemerides().size());
-  if (stats.fixes == 0)
+  if (fusion) fmt::print("{}\n", fusion->report());
+  if (fusion && !fusion->started())
+    throw CommandExit(3, fmt::format("{}: no fused solution ({}); outputs up to the end are in {}", args.input,
+                                     fusion->not_started_reason(), args.out));
+  if (stats.fixes == 0 && !(fusion && fusion->started()))
     throw CommandExit(3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} "
                                      "ephemerides decoded; --nav gives a hot start); outputs up to the end are in {}",
                                      args.input, t, tracked, engine.decoded_ephemerides().size(), args.out));
+  if (stats.fixes == 0) return;  // a fused solution without any PVT fix (tight coupling)
   const auto& s = stats;
   fmt::print("receive: first fix after {:.2f} s; mean position {:.7f} deg, {:.7f} deg, {:.2f} m; outputs in {}\n",
              receiver::ttff_seconds(engine), s.sum_lat_rad / s.fixes * 180.0 / M_PI,
@@ -245,6 +268,7 @@ void add_receive_command(CLI::App& app) {
                   "full GPS week near the recording, for the 10-bit week (default: nav file or build date)");
   cmd->add_flag("--iq-swap", args->iq_swap, "exchange I and Q (complex formats)");
   cmd->add_flag("--q-negate", args->q_negate, "negate Q (complex) / invert the spectrum (real IF)");
+  add_receive_fusion_options(cmd, args->fusion);
   cmd->add_flag("--quiet", args->quiet, "no progress display");
   cmd->callback([args] { run_receive(*args); });
 }

@@ -63,6 +63,7 @@ const std::map<std::string, Table>& sections() {
          }},
         {"sigma_position_m", [](const Value& v, C& c) { c.sigma_position_m = v.vector3(true); }},
         {"sigma_velocity_mps", [](const Value& v, C& c) { c.sigma_velocity_mps = v.vector3(true); }},
+        {"velocity_ned_mps", [](const Value& v, C& c) { c.velocity_ned_mps = v.vector3(); }},
         {"sigma_attitude_deg", [](const Value& v, C& c) { c.sigma_attitude_deg = v.vector3(true); }}}},
       {"alignment",
        {{"static_duration_s", [](const Value& v, C& c) { c.static_duration_s = v.positive(); }},

@@ -1,7 +1,7 @@
 // The `fuse` command's TOML configuration (--config). Sections and keys (all optional):
 //   [imu]        preset = "hg1700ae"  (the filter's noise model: fusion::error_model_from_preset)
 //   [initial]    attitude_deg = [roll, pitch, yaw] (needed by --align config), position_deg_m = [lat, lon, h]
-//                (else the first GNSS fix), sigma_position_m, sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
+//                (else the first GNSS fix), velocity_ned_mps = [n, e, d] (else the GNSS velocity), sigma_position_m, sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
 //   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2
 //   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z]
 //   [filter]     ukf_alpha = 1, ukf_beta = 2, ukf_kappa = 0, gate = true, gate_probability = 0.9999,
@@ -27,6 +27,7 @@ struct FuseConfig {
   std::string imu_preset = "hg1700ae";
   std::optional<Eigen::Vector3d> attitude_deg;    // roll, pitch, yaw
   std::optional<Eigen::Vector3d> position_deg_m;  // lat_deg, lon_deg, height_m
+  std::optional<Eigen::Vector3d> velocity_ned_mps;  // --align config without GNSS velocity (receive --imu)
   std::optional<Eigen::Vector3d> sigma_position_m, sigma_velocity_mps, sigma_attitude_deg;
   double static_duration_s = 60.0;
   double motion_min_speed_mps = 5.0;

@@ -264,6 +264,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   }
   const GnssState g0 = gnss_at(gnss, init.t_s);
   if ((s.align == AlignMode::Config || s.align == AlignMode::Attitude) && g0.has_velocity) init.v_n = g0.v_n;
+  if (s.align == AlignMode::Config && c.velocity_ned_mps) init.v_n = *c.velocity_ned_mps;
   Eigen::Vector3d sigma_pos = g0.sigma_ned_m;
   if (c.position_deg_m) {
     init.lat_rad = c.position_deg_m->x() * kDeg;

@@ -2,6 +2,7 @@
 // position, velocity and clock with an independent light-time iteration, then solved for.
 #include "receiver/pvt.hpp"
 
+#include <Eigen/Cholesky>
 #include <GeographicLib/Geocentric.hpp>
 #include <gtest/gtest.h>
 
@@ -231,4 +232,34 @@ TEST(Pvt, ChiSquareQuantileMatchesPublishedTable) {
   EXPECT_NEAR(receiver::chi_square_upper_quantile(4, 0.001), 18.467, 0.02 * 18.467);
   EXPECT_NEAR(receiver::chi_square_upper_quantile(10, 0.01), 23.209, 0.01 * 23.209);
   EXPECT_NEAR(receiver::chi_square_upper_quantile(30, 0.05), 43.773, 0.005 * 43.773);
+}
+
+// The a-priori covariances (new with the GNSS/INS integration, which weights the fixes by them): the weights
+// 1 / sigma_i^2 with sigma_i = sigma_zenith / sin(el_i) at 45 dB-Hz lie between those of the lowest and the
+// highest satellite, so N = sum w_i h h^T lies between w_min G and w_max G (G the unweighted normal matrix, whose
+// inverse gives the DOPs) and trace(position covariance) between PDOP^2 / w_max and PDOP^2 / w_min. The rate rows
+// share the geometry with sigmas scaled by sigma_doppler / sigma_zenith: the velocity covariance is the position
+// covariance times that ratio squared.
+TEST(Pvt, CovarianceLiesBetweenTheDopBoundsOfItsWeights) {
+  Receiver rx = make_receiver(35.274016, 137.013759, 100.0);
+  const auto meas = visible_measurements(rx, true);
+  receiver::PvtOptions opt;
+  opt.elevation_mask_rad = 0.0;
+  const auto sol = receiver::solve_pvt(meas, receiver_clock_time(rx), sample_iono(), opt);
+  ASSERT_TRUE(sol.valid && sol.velocity_valid);
+  double el_min = M_PI, el_max = 0.0;
+  for (const auto& s : sol.satellites) {
+    el_min = std::min(el_min, s.elevation_rad);
+    el_max = std::max(el_max, s.elevation_rad);
+  }
+  ASSERT_LT(el_min + 0.1, el_max);
+  const double w_min = std::pow(std::sin(el_min) / opt.sigma_zenith_m, 2);
+  const double w_max = std::pow(std::sin(el_max) / opt.sigma_zenith_m, 2);
+  const double trace = sol.covariance_m2.topLeftCorner<3, 3>().trace();
+  EXPECT_GT(trace, sol.pdop * sol.pdop / w_max);
+  EXPECT_LT(trace, sol.pdop * sol.pdop / w_min);
+  EXPECT_LT((sol.covariance_m2 - sol.covariance_m2.transpose()).norm(), 1e-9 * sol.covariance_m2.norm());
+  EXPECT_EQ(Eigen::LLT<Eigen::Matrix4d>(sol.covariance_m2).info(), Eigen::Success);  // positive definite
+  const double ratio2 = std::pow(opt.sigma_doppler_mps / opt.sigma_zenith_m, 2);
+  EXPECT_LT((sol.velocity_covariance_m2ps2 - ratio2 * sol.covariance_m2).norm(), 1e-6 * ratio2 * sol.covariance_m2.norm());
 }

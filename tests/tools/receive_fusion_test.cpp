@@ -1,0 +1,327 @@
+// `ultratrack receive --imu --coupling loose|tight` end to end: one `simulate` run (a land vehicle on a circle of
+// radius 100 m at 30 km/h, HG1700AE IMU at 100 Hz, nominal constellation, 2.0 MHz i8, a few seconds) writes the IF
+// samples, imu.csv and truth.csv from ONE trajectory; the receiver starts hot from a RINEX file of the scenario's
+// own ephemerides (no ../shared needed). Checked against the simulator's truth: the fused position (nav.csv, IMU =
+// antenna here: no lever arm) against the PVT fixes (solution.csv) at the same epochs; tight coupling with only
+// three satellites (no PVT fix at all) stays on the truth; bad IMU input is one InputError naming the file and
+// leaves no outputs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "command_exit.hpp"
+#include "fused_nav_csv.hpp"
+#include "ins/earth_model.hpp"
+#include "io/input_error.hpp"
+#include "run_command.hpp"
+#include "scenario.hpp"
+#include "signals/rinex_nav.hpp"
+#include "simulation.hpp"
+#include "solution_compare.hpp"
+#include "support/test_data.hpp"
+
+namespace fs = std::filesystem;
+using namespace ultratrack;
+
+namespace {
+
+constexpr double kStartTow_s = 518776.0;  // subframe 518778-518784 arrives at 2.07-8.07 s: first fix ~8.1 s
+constexpr double kDuration_s = 16.0;
+constexpr double kC = 299792458.0;
+
+struct Sim {
+  fs::path dir, sim, nav;
+  std::vector<tools::TruthPoint> truth;
+  std::vector<int> prns_by_elevation;  // highest first
+};
+
+Sim& sim() {
+  static Sim s = [] {
+    Sim r;
+    r.dir = test::scratch_dir();
+    r.sim = r.dir / "sim";
+    std::ofstream(r.dir / "circle.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
+                                          "16.0,0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
+    std::ofstream(r.dir / "circle.toml")
+        << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " << kDuration_s
+        << "\ncn0_dbhz = 45.0\nseed = 4\n[time]\ngps_week = 2190\ntow_s = " << kStartTow_s
+        << "\n[navigation]\nconstellation = \"nominal\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+           "[trajectory]\nfile = \"circle.csv\"\nspeed_mps = 8.333333333\nheading_deg = 0.0\nimu_rate_hz = 100.0\n"
+           "[imu]\npreset = \"hg1700ae\"\nseed = 7\n[atmosphere]\nionosphere = true\ntroposphere = true\n";
+    test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
+    // The scenario's own broadcast data as a RINEX file: the receiver's hot start.
+    const tools::NavigationSource nav = tools::load_navigation(tools::read_scenario(r.dir / "circle.toml"));
+    signals::RinexNavData data;
+    data.ephemerides = nav.ephemerides;
+    data.klobuchar = nav.klobuchar;
+    data.utc = nav.utc;
+    r.nav = r.dir / "nominal.rnx";
+    signals::write_rinex_nav_304(r.nav, data);
+    r.truth = tools::read_simulation_truth_csv(r.sim / "truth.csv");
+    std::ifstream sats(r.sim / "satellites.csv");
+    std::string line;
+    std::getline(sats, line);
+    std::vector<std::pair<double, int>> el;
+    while (std::getline(sats, line)) {
+      std::stringstream ss(line);
+      std::string prn, elev;
+      std::getline(ss, prn, ',');
+      std::getline(ss, elev, ',');
+      el.emplace_back(std::stod(elev), std::stoi(prn));
+    }
+    std::sort(el.rbegin(), el.rend());
+    for (const auto& [e, p] : el) r.prns_by_elevation.push_back(p);
+    return r;
+  }();
+  return s;
+}
+
+// Truth ECEF position at a true GPS time of week (linear between the 10 Hz rows; the 100 m circle at 8.3 m/s
+// bends by 0.35 mm over 0.1 s).
+Eigen::Vector3d truth_at(const std::vector<tools::TruthPoint>& truth, double tow_s) {
+  auto it = std::lower_bound(truth.begin(), truth.end(), tow_s,
+                             [](const tools::TruthPoint& p, double t) { return p.tow_s < t; });
+  if (it == truth.begin()) return it->r_e_m;
+  if (it == truth.end()) return truth.back().r_e_m;
+  const auto& b = *it;
+  const auto& a = *(it - 1);
+  const double w = (tow_s - a.tow_s) / (b.tow_s - a.tow_s);
+  return a.r_e_m + w * (b.r_e_m - a.r_e_m);
+}
+
+Eigen::Vector3d nav_at(const std::vector<tools::FusedNavRow>& nav, double t_s) {
+  auto it = std::lower_bound(nav.begin(), nav.end(), t_s,
+                             [](const tools::FusedNavRow& r, double t) { return r.nav.t_s < t; });
+  auto pos = [](const tools::FusedNavRow& r) {
+    return ins::ecef_from_geodetic(r.nav.lat_rad, r.nav.lon_rad, r.nav.height_m);
+  };
+  if (it == nav.begin()) return pos(*it);
+  if (it == nav.end()) return pos(nav.back());
+  const double w = (t_s - (it - 1)->nav.t_s) / (it->nav.t_s - (it - 1)->nav.t_s);
+  return pos(*(it - 1)) + w * (pos(*it) - pos(*(it - 1)));
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 3));
+}
+
+struct Rms {
+  int epochs = 0;
+  double fused_m = 0.0, gnss_m = 0.0;
+  // sqrt(mean over epochs k of the mean squared fix error of the fixes up to k, the start's included): what a
+  // filter that averages the fixes so far could reach at worst (|mean e_i|^2 <= mean |e_i|^2).
+  double running_mean_bound_m = 0.0;
+};
+
+// Fused (nav.csv) and PVT (solution.csv) 3-D position errors at the fixes made after the fused start.
+Rms compare(const fs::path& rx) {
+  const auto& s = sim();
+  const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
+  const auto fixes = tools::read_solution_csv(rx / "solution.csv");
+  Rms r;
+  double f2 = 0.0, g2 = 0.0, since_start = 0.0, bound2 = 0.0;
+  int n_since_start = 0;
+  for (const auto& f : fixes) {
+    const double tow = f.tow_s - f.clock_bias_m / kC;  // true GPS time of the fix
+    const double t = tow - kStartTow_s;                 // IMU time (sample 0 = the scenario start)
+    if (nav.empty() || t < nav.front().nav.t_s - 1e-6 || t > nav.back().nav.t_s) continue;
+    const Eigen::Vector3d truth = truth_at(s.truth, tow);
+    since_start += (f.r_e_m - truth).squaredNorm();
+    ++n_since_start;
+    if (t <= nav.front().nav.t_s + 1e-6) continue;  // the start's own fix
+    f2 += (nav_at(nav, t) - truth).squaredNorm();
+    g2 += (f.r_e_m - truth).squaredNorm();
+    bound2 += since_start / n_since_start;
+    ++r.epochs;
+  }
+  if (r.epochs) {
+    r.fused_m = std::sqrt(f2 / r.epochs);
+    r.gnss_m = std::sqrt(g2 / r.epochs);
+    r.running_mean_bound_m = std::sqrt(bound2 / r.epochs);
+  }
+  return r;
+}
+
+std::vector<std::string> receive_args(const fs::path& rx) {
+  const auto& s = sim();
+  return {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string(),
+          "--imu", (s.sim / "imu.csv").string(), "--out", rx.string()};
+}
+
+fs::path motion_config() {
+  const auto file = sim().dir / "motion.toml";
+  std::ofstream(file) << "[alignment]\nmotion_window_s = 1.0\n";
+  return file;
+}
+
+}  // namespace
+
+// Loose: each PVT fix (with its own a-priori covariance) updates the filter. The fixes are carrier-smoothed
+// pseudorange solutions whose errors vary slowly (metres at first, settling as the Hatch filters converge), so
+// over the 7 s after the alignment the filter, which treats them as white and in effect averages them, cannot
+// beat them; its honest bound is the running-mean bound of the fixes themselves (Rms above). A time-tag error
+// of 0.1 s (0.8 m along the track) or a wrong measurement covariance breaks it. (60 s figures: validation.md.)
+TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
+  const auto rx = sim().dir / "rx_loose";
+  auto args = receive_args(rx);
+  args.insert(args.end(), {"--coupling", "loose", "--filter", "ekf", "--align", "motion", "--fusion-config",
+                           motion_config().string()});
+  test_support::run_command("receive", args);
+  const Rms r = compare(rx);
+  const std::string summary = read_text(rx / "summary.json");
+  std::printf("loose EKF: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m, running-mean bound %.3f m\n", r.epochs,
+              r.fused_m, r.gnss_m, r.running_mean_bound_m);
+  EXPECT_NE(summary.find("\"fusion\": {\"coupling\": \"loose\""), std::string::npos);
+  EXPECT_GE(r.epochs, 50);  // 16 s file, first fix ~8.1 s, alignment after 1 s of motion
+  EXPECT_LE(r.fused_m, r.running_mean_bound_m);
+  // one update per fix; the last fix may lie a hair beyond the IMU's last row and stay queued
+  EXPECT_GE(json_number(summary, "updates_accepted"), r.epochs - 1);
+  EXPECT_EQ(json_number(summary, "updates_rejected"), 0.0);
+}
+
+// Tight: raw pseudoranges and Doppler per satellite (noise nearly white: the DLL's), each gated on its own. The
+// fused position must beat the PVT fixes at the same epochs, with the EKF and with the UKF.
+TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
+  for (const std::string filter : {"ekf", "ukf"}) {
+    const auto rx = sim().dir / ("rx_tight_" + filter);
+    auto args = receive_args(rx);
+    args.insert(args.end(), {"--coupling", "tight", "--filter", filter, "--align", "motion", "--fusion-config",
+                             motion_config().string()});
+    test_support::run_command("receive", args);
+    const Rms r = compare(rx);
+    const std::string summary = read_text(rx / "summary.json");
+    std::printf("tight %s: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", filter.c_str(), r.epochs, r.fused_m,
+                r.gnss_m);
+    EXPECT_NE(summary.find("\"filter\": \"" + filter + "\""), std::string::npos);
+    EXPECT_GE(r.epochs, 50);
+    EXPECT_LT(r.fused_m, r.gnss_m) << filter;
+    EXPECT_EQ(json_number(summary, "epochs_fewer_than_4_satellites"), 0.0);
+    // six satellites a fix, pseudorange and rate each: one update per satellite and epoch
+    EXPECT_GE(json_number(summary, "updates_accepted"), 5.0 * r.epochs);
+  }
+}
+
+// A receiver clock jump while the tight filter runs: the receiver's clock starts ~7.6 ms off (initial travel time
+// 75 ms instead of ~67 ms) and is corrected by a jump at the first fix (threshold 10 us), after the INS has started
+// from the configuration at t = 0 and taken the first epoch. The jump must be taken out of the pseudoranges and
+// epoch times (without that, 2280 km steps: the gate rejects nearly every later update).
+TEST(ReceiveFusion, TightCouplingCarriesItsClockThroughAReceiverClockJump) {
+  const auto& s = sim();
+  const auto rx_config = s.dir / "jump.toml";
+  std::ofstream(rx_config) << "[receiver]\nclock_jump_threshold_s = 1e-5\ninitial_travel_time_s = 0.075\n";
+  const auto config = s.dir / "start.toml";
+  std::ofstream(config) << "[initial]\nattitude_deg = [0, 0, 0]\nposition_deg_m = [35.274016, 137.013759, 100.0]\n"
+                           "velocity_ned_mps = [8.333333333, 0, 0]\nsigma_position_m = [3, 3, 3]\n";
+  const auto rx = s.dir / "rx_jump";
+  auto args = receive_args(rx);
+  args.insert(args.end(), {"--coupling", "tight", "--align", "config", "--fusion-config", config.string(), "--config",
+                           rx_config.string()});
+  test_support::run_command("receive", args);
+  const std::string summary = read_text(rx / "summary.json");
+  EXPECT_EQ(json_number(summary, "clock_jumps"), 1.0);
+  EXPECT_EQ(json_number(summary, "clock_jumps_removed"), 1.0);
+  EXPECT_EQ(json_number(summary, "epochs_before_start"), 0.0);  // the filter ran before and after the jump
+  EXPECT_EQ(json_number(summary, "updates_rejected"), 0.0);
+  const Rms r = compare(rx);
+  std::printf("tight EKF through a clock jump: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", r.epochs, r.fused_m,
+              r.gnss_m);
+  EXPECT_LT(r.fused_m, r.gnss_m);
+}
+
+// Tight with three satellites (--prn): the PVT never fixes, the INS starts from the configuration (the
+// trajectory's start, 20 m east of the truth on purpose, sigma 20 m) and runs alone until the first epoch; the
+// three pseudoranges and rates must then pull the horizontal error to the noise (what stays unobservable with
+// three satellites is one position/clock combination, here mostly vertical: its sigma grows, as it must).
+TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCannotFix) {
+  const auto& s = sim();
+  ASSERT_GE(s.prns_by_elevation.size(), 3u);
+  const auto config = s.dir / "three.toml";
+  std::ofstream(config) << "[initial]\nattitude_deg = [0, 0, 0]\n"
+                           "position_deg_m = [35.274016, 137.01397883, 100.0]\n"  // 20.0 m east of the start
+                           "velocity_ned_mps = [8.333333333, 0, 0]\nsigma_position_m = [20, 20, 20]\n";
+  const auto rx = s.dir / "rx_three";
+  auto args = receive_args(rx);
+  args.insert(args.end(), {"--coupling", "tight", "--align", "config", "--fusion-config", config.string(), "--prn",
+                           std::to_string(s.prns_by_elevation[0]) + "," + std::to_string(s.prns_by_elevation[1]) + "," +
+                               std::to_string(s.prns_by_elevation[2])});
+  test_support::run_command("receive", args);
+  const std::string summary = read_text(rx / "summary.json");
+  EXPECT_EQ(json_number(summary, "fixes"), 0.0);
+  const std::string solution = read_text(rx / "solution.csv");
+  EXPECT_EQ(std::count(solution.begin(), solution.end(), '\n'), 1) << "solution.csv: header only";
+  EXPECT_GE(json_number(summary, "epochs_fewer_than_4_satellites"), 50.0);
+  const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
+  ASSERT_FALSE(nav.empty());
+  EXPECT_NEAR(nav.back().nav.t_s, kDuration_s, 0.02);
+  double worst_late_m = 0.0;
+  int outside_3sigma = 0, rows = 0;
+  for (const auto& row : nav) {
+    if (row.nav.t_s < kDuration_s - 5.0) continue;  // the last 5 s: 3 s and more after the first epoch
+    const Eigen::Vector3d r = ins::ecef_from_geodetic(row.nav.lat_rad, row.nav.lon_rad, row.nav.height_m);
+    const Eigen::Vector3d e_n =
+        ins::C_en(row.nav.lat_rad, row.nav.lon_rad).transpose() * (r - truth_at(s.truth, kStartTow_s + row.nav.t_s));
+    worst_late_m = std::max(worst_late_m, e_n.head<2>().norm());
+    outside_3sigma += (e_n.cwiseAbs().array() > 3.0 * row.sigma.position_ned_m.array()).any();
+    ++rows;
+  }
+  const double sigma_h_end = nav.back().sigma.position_ned_m.head<2>().norm();
+  std::printf("tight, 3 satellites: horizontal error over the last 5 s at most %.2f m (start 20 m), final "
+              "horizontal 1-sigma %.2f m, vertical %.2f m\n", worst_late_m, sigma_h_end,
+              nav.back().sigma.position_ned_m.z());
+  EXPECT_LT(worst_late_m, 5.0);   // the 20 m start error removed to the pseudorange noise level
+  EXPECT_LT(sigma_h_end, 10.0);   // and the filter knows it: bounded, not growing like a free INS
+  EXPECT_EQ(outside_3sigma, 0) << "of " << rows << " rows";
+}
+
+// Bad IMU input: one InputError naming the IMU file, and no outputs under their final names.
+TEST(ReceiveFusion, BadImuInputIsOneInputErrorNamingTheFileAndLeavesNoOutputs) {
+  const auto& s = sim();
+  auto expect_error = [&](const std::string& name, const fs::path& imu, std::vector<std::string> extra,
+                          const std::string& words) {
+    const auto rx = s.dir / ("bad_" + name);
+    auto args = receive_args(rx);
+    args[std::find(args.begin(), args.end(), "--imu") - args.begin() + 1] = imu.string();
+    args.insert(args.end(), {"--coupling", "tight"});
+    args.insert(args.end(), extra.begin(), extra.end());
+    try {
+      test_support::run_command("receive", args);
+      ADD_FAILURE() << name << ": no error";
+    } catch (const io::InputError& e) {
+      EXPECT_EQ(e.file(), imu.string()) << name << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << name << ": " << e.what();
+    }
+    for (const char* f : {"summary.json", "nav.csv", "solution.csv", "observations.rnx"})
+      EXPECT_FALSE(fs::exists(rx / f)) << name << ": " << f;
+  };
+  expect_error("missing", s.dir / "no_such_imu.csv", {}, "not found");
+  {
+    std::ifstream in(s.sim / "imu.csv");
+    std::ofstream out(s.dir / "nan_imu.csv");
+    std::string line;
+    for (int i = 0; std::getline(in, line); ++i) {
+      if (i == 5) line = line.substr(0, line.find(',')) + ",nan" + line.substr(line.find(',', line.find(',') + 1));
+      out << line << "\n";
+    }
+  }
+  expect_error("nan", s.dir / "nan_imu.csv", {}, "");
+  // The IMU's times taken as seconds since tow 518000: the signal lies ~776 s after the IMU's 16 s.
+  expect_error("not_covering", s.sim / "imu.csv", {"--imu-time-origin", "518000"}, "does not cover the signal");
+  EXPECT_THROW(test_support::run_command("receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8",
+                                                     "--fs", "2.0e6", "--coupling", "loose", "--out",
+                                                     (s.dir / "bad_no_imu").string()}),
+               io::InputError);
+}

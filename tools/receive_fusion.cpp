@@ -1,0 +1,641 @@
+#include "receive_fusion.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+
+#include "cli_parse.hpp"
+#include "fused_nav_csv.hpp"
+#include "fusion/fuse_motion_alignment.hpp"
+#include "fusion/tight_measurements.hpp"
+#include "ins/attitude.hpp"
+#include "ins/coarse_alignment.hpp"
+#include "ins/earth_model.hpp"
+#include "ins/imu_csv.hpp"
+#include "ins/imu_error_model.hpp"
+#include "ins/strapdown.hpp"
+#include "io/input_error.hpp"
+#include "signals/ephemeris_selection.hpp"
+#include "signals/gps_constants.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kG = 9.80665;
+constexpr double kC = signals::kSpeedOfLight_mps;
+constexpr double kWeek_s = 604800.0;
+constexpr double kClockJumpDetect_s = 1e-7;  // receiver clock offsets change only by jumps (>= 1 ms in practice)
+
+std::string json_escape(const std::string& in) {
+  std::string out;
+  for (char ch : in) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    if (static_cast<unsigned char>(ch) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
+      continue;
+    }
+    out += ch;
+  }
+  return out;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// A PVT fix as a loose measurement at t_s: NED sigmas from the PVT's a-priori covariance (the off-diagonal
+// terms are dropped: GnssFix carries per-axis sigmas).
+fusion::GnssFix fix_measurement(const receiver::PvtSolution& f, double t_s) {
+  fusion::GnssFix m;
+  m.t_s = t_s;
+  m.lat_rad = f.lat_rad;
+  m.lon_rad = f.lon_rad;
+  m.height_m = f.height_m;
+  const Eigen::Matrix3d C_en = ins::C_en(f.lat_rad, f.lon_rad);
+  const Eigen::Matrix3d P = C_en.transpose() * f.covariance_m2.topLeftCorner<3, 3>() * C_en;
+  m.sigma_pos_ned_m = P.diagonal().cwiseMax(0.0).cwiseSqrt();
+  m.has_position = (m.sigma_pos_ned_m.array() > 0.0).all() && m.sigma_pos_ned_m.allFinite();
+  if (f.velocity_valid) {
+    const Eigen::Matrix3d V = C_en.transpose() * f.velocity_covariance_m2ps2.topLeftCorner<3, 3>() * C_en;
+    m.v_n_mps = C_en.transpose() * f.v_e_mps;
+    m.sigma_vel_n_mps = V.diagonal().cwiseMax(0.0).cwiseSqrt();
+    m.has_velocity = (m.sigma_vel_n_mps.array() > 0.0).all() && m.sigma_vel_n_mps.allFinite();
+  }
+  return m;
+}
+
+}  // namespace
+
+ReceiveCoupling parse_receive_coupling(const std::string& text) {
+  if (text == "none") return ReceiveCoupling::None;
+  if (text == "loose") return ReceiveCoupling::Loose;
+  if (text == "tight") return ReceiveCoupling::Tight;
+  throw io::InputError("command line", "--coupling must be none, loose or tight, got '" + text + "'");
+}
+
+std::string to_string(ReceiveCoupling coupling) {
+  switch (coupling) {
+    case ReceiveCoupling::None: return "none";
+    case ReceiveCoupling::Loose: return "loose";
+    case ReceiveCoupling::Tight: return "tight";
+  }
+  return "?";
+}
+
+void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
+  cmd->add_option("--imu", a.imu, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps) for GNSS/INS integration (--coupling)");
+  cmd->add_option("--coupling", a.coupling,
+                  "none (default: the scalar receiver alone), loose (PVT fixes) or tight (pseudoranges and rates) "
+                  "GNSS/INS integration with --imu");
+  cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
+  cmd->add_option("--align", a.align, "with --coupling: static, motion (default) or config");
+  cmd->add_option("--fusion-config", a.config,
+                  "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
+  cmd->add_option("--imu-time-origin", a.time_origin,
+                  "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
+                  "the GPS time of week) or a GPS time of week in seconds");
+}
+
+std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& a) {
+  ReceiveFusionSettings s;
+  s.coupling = parse_receive_coupling(a.coupling);
+  if (s.coupling == ReceiveCoupling::None) {
+    if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
+      throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
+                                           "--coupling loose or tight");
+    return std::nullopt;
+  }
+  if (a.imu.empty()) throw io::InputError("command line", "--coupling " + a.coupling + " needs --imu FILE");
+  s.imu_file = a.imu;
+  const std::string filter = a.filter.empty() ? "ekf" : a.filter;
+  if (filter == "ekf") {
+    s.filter = fusion::FilterKind::Ekf;
+  } else if (filter == "ukf") {
+    s.filter = fusion::FilterKind::Ukf;
+  } else {
+    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + filter + "'");
+  }
+  const std::string align = a.align.empty() ? "motion" : a.align;
+  if (align == "static") {
+    s.align = AlignMode::Static;
+  } else if (align == "motion") {
+    s.align = AlignMode::Motion;
+  } else if (align == "config") {
+    s.align = AlignMode::Config;
+  } else {
+    throw io::InputError("command line", "--align must be static, motion or config, got '" + align + "'");
+  }
+  if (!a.config.empty()) s.config = read_fuse_config(a.config);
+  (void)ins::imu_preset(s.config.imu_preset);  // an unknown preset fails here, before any output
+  if (s.align == AlignMode::Config && !s.config.attitude_deg)
+    throw io::InputError(a.config.empty() ? "command line" : a.config,
+                         "--align config needs [initial] attitude_deg in --fusion-config");
+  if (a.time_origin.empty() || a.time_origin == "sample0") {
+    s.time_origin.kind = ImuTimeOrigin::Kind::Sample0;
+  } else if (a.time_origin == "tow") {
+    s.time_origin.kind = ImuTimeOrigin::Kind::WeekStart;
+  } else {
+    s.time_origin.kind = ImuTimeOrigin::Kind::Tow;
+    s.time_origin.tow_s = parse_double_option("--imu-time-origin", a.time_origin);
+    if (!(s.time_origin.tow_s >= 0.0 && s.time_origin.tow_s < kWeek_s))
+      throw io::InputError("command line", "--imu-time-origin: a GPS time of week lies in [0, 604800) s");
+  }
+  return s;
+}
+
+std::vector<ins::ImuIncrement> read_receive_imu(const ReceiveFusionSettings& s) {
+  std::error_code ec;
+  if (!fs::is_regular_file(s.imu_file, ec)) throw io::InputError(s.imu_file, "IMU file not found");
+  auto imu = ins::read_imu_csv(s.imu_file);
+  if (imu.size() < 2) throw io::InputError(s.imu_file, "the IMU file needs at least two rows");
+  return imu;
+}
+
+// ---------------------------------------------------------------------------------------------------------
+
+struct ReceiveFusion::Impl {
+  ReceiveFusionSettings settings;
+  std::vector<ins::ImuIncrement> imu;
+  receiver::ReceiverObserver* downstream = nullptr;
+  const receiver::ReceiverEngine* engine = nullptr;
+  double fs_hz = 0.0;
+  fusion::TightOptions tight;
+  std::vector<signals::Ephemeris> nav_ephemerides, all_ephemerides;
+  std::size_t decoded_seen = 0;
+  FusedNavCsvWriter nav;
+
+  // Time line.
+  std::optional<signals::GpsTime> origin;  // GPS time of IMU t_s = 0
+  std::optional<signals::GpsTime> clock_ref;
+  double clock_base_offset_s = 0.0, clock_jump_s = 0.0;
+  int clock_jumps = 0;
+  double last_epoch_t_s = 0.0;
+  std::int64_t last_epoch_sample = 0;
+  bool have_epoch_time = false;
+
+  // Alignment input and the filter.
+  std::vector<fusion::GnssVelocitySample> velocities;
+  std::vector<fusion::GnssFix> fixes;  // on the IMU time line
+  std::optional<fusion::GnssInsIntegration> integration;
+  std::size_t next_imu = 0;
+  double first_share = 1.0;  // of imu[next_imu] when the start falls inside its interval
+  std::string alignment_note, not_started = "no GNSS epoch yet";
+  ins::EulerAngles initial_attitude;
+  double start_s = 0.0;
+
+  std::optional<receiver::ObservationEpoch> held;  // waits for its fix (on_fix follows on_observations)
+
+  // Counts.
+  long long epochs_seen = 0, fixes_seen = 0, before_start = 0, used = 0, nav_rows = 0;
+  long long unused = 0;  // after the start: loose epochs without a fix, tight epochs without ephemerides
+  struct FixClock {
+    signals::GpsTime receive_time;  // continuous receiver clock
+    double bias_m = 0.0, drift_mps = 0.0;
+  };
+  std::optional<FixClock> last_fix_clock;
+  long long epochs_below_4 = 0;
+  double last_row_t_s = 0.0;  // tight epochs applied with 1-3 satellites with ephemeris
+  NavSigma final_sigma;
+
+  Impl(const ReceiveFusionSettings& s, std::vector<ins::ImuIncrement> i, receiver::ReceiverObserver& d,
+       const fs::path& out_dir, const receiver::ReceiverOptions& ro, std::vector<signals::Ephemeris> eph)
+      : settings(s), imu(std::move(i)), downstream(&d), fs_hz(ro.fs_hz), nav_ephemerides(std::move(eph)),
+        all_ephemerides(nav_ephemerides), nav(out_dir / "nav.csv") {
+    tight.elevation_mask_rad = ro.pvt.elevation_mask_rad;
+    tight.ionosphere = ro.pvt.ionosphere;
+    tight.troposphere = ro.pvt.troposphere;
+    tight.sigma_range_zenith_m = ro.pvt.sigma_zenith_m;
+    tight.sigma_rate_zenith_mps = ro.pvt.sigma_doppler_mps;
+  }
+
+  bool is_tight() const { return settings.coupling == ReceiveCoupling::Tight; }
+
+  const std::vector<signals::Ephemeris>& ephemerides() {
+    if (engine && engine->decoded_ephemerides().size() != decoded_seen) {
+      const auto& d = engine->decoded_ephemerides();
+      all_ephemerides.insert(all_ephemerides.end(), d.begin() + static_cast<std::ptrdiff_t>(decoded_seen), d.end());
+      decoded_seen = d.size();
+    }
+    return all_ephemerides;
+  }
+  signals::KlobucharParameters iono() const { return engine ? engine->klobuchar() : signals::KlobucharParameters{}; }
+
+  // The epoch with receiver clock jumps undone (receive time and pseudoranges continuous).
+  receiver::ObservationEpoch continuous(const receiver::ObservationEpoch& e) {
+    if (!clock_ref) {
+      clock_ref = e.receive_time;
+      clock_base_offset_s = -static_cast<double>(e.sample_index) / fs_hz;
+    }
+    const double offset =
+        signals::seconds_between(e.receive_time, *clock_ref) - static_cast<double>(e.sample_index) / fs_hz;
+    const double jump = offset - clock_base_offset_s;  // -(sum of the corrections applied so far)
+    if (std::abs(jump - clock_jump_s) > kClockJumpDetect_s) ++clock_jumps;
+    clock_jump_s = jump;
+    receiver::ObservationEpoch out = e;
+    out.receive_time = signals::add_seconds(e.receive_time, -jump);
+    for (auto& o : out.observations) o.pseudorange_m -= kC * jump;
+    return out;
+  }
+
+  // Ephemerides of the epoch's satellites at its time (one set per PRN).
+  std::vector<signals::Ephemeris> epoch_ephemerides(const receiver::ObservationEpoch& e) {
+    std::vector<signals::Ephemeris> out;
+    const auto& all = ephemerides();
+    for (const auto& o : e.observations)
+      if (auto eph = signals::select_ephemeris(all, o.prn, e.receive_time)) out.push_back(*eph);
+    return out;
+  }
+
+  // Receiver clock bias and drift (m, m/s) from an epoch at a known antenna position/velocity: medians of the
+  // pseudorange and rate residuals with zero clock. Nothing without a usable satellite.
+  std::optional<std::pair<double, double>> fit_clock(const receiver::ObservationEpoch& e, const Eigen::Vector3d& r_e,
+                                                     const Eigen::Vector3d& v_e) {
+    const auto sats = fusion::prepare_satellites(e, epoch_ephemerides(e), iono(), r_e, tight);
+    std::vector<double> b, d;
+    for (const auto& s : sats) {
+      b.push_back(s.pseudorange_m - fusion::predicted_pseudorange_m(s, r_e, 0.0));
+      if (s.has_rate) d.push_back(s.range_rate_mps - fusion::predicted_range_rate_mps(s, r_e, v_e, 0.0));
+    }
+    if (b.empty()) return std::nullopt;
+    return std::make_pair(median(b), d.empty() ? 0.0 : median(d));
+  }
+
+  void set_origin(const signals::GpsTime& g, std::int64_t sample) {
+    switch (settings.time_origin.kind) {
+      case ImuTimeOrigin::Kind::Sample0: origin = signals::add_seconds(g, -static_cast<double>(sample) / fs_hz); break;
+      case ImuTimeOrigin::Kind::WeekStart: origin = signals::GpsTime{g.week, 0.0}; break;
+      case ImuTimeOrigin::Kind::Tow: {
+        signals::GpsTime o{g.week, settings.time_origin.tow_s};
+        const double d = signals::seconds_between(g, o);
+        if (d < -0.5 * kWeek_s) o.week -= 1;
+        if (d > 0.5 * kWeek_s) o.week += 1;
+        origin = o;
+        break;
+      }
+    }
+  }
+
+  std::string origin_text() const {
+    switch (settings.time_origin.kind) {
+      case ImuTimeOrigin::Kind::Sample0: return "sample0";
+      case ImuTimeOrigin::Kind::WeekStart: return "tow";
+      case ImuTimeOrigin::Kind::Tow: return fmt::format("{}", settings.time_origin.tow_s);
+    }
+    return "?";
+  }
+
+  void check_covered(double t, const signals::GpsTime& g) const {
+    if (t >= imu.front().t_s && t <= imu.back().t_s + 1e-6) return;
+    throw io::InputError(settings.imu_file,
+                         fmt::format("does not cover the signal: the epoch at GPS week {} tow {:.3f} s is IMU time "
+                                     "{:.3f} s (--imu-time-origin {}), the IMU rows span {:.3f}-{:.3f} s",
+                                     g.week, g.tow_s, t, origin_text(), imu.front().t_s, imu.back().t_s));
+  }
+
+  void emit() {
+    const auto& out = integration->output();
+    final_sigma = NavSigma{out.sigma_pos_ned_m, out.sigma_vel_n_mps, out.sigma_att_rad};
+    if (nav_rows > 0 && !(out.nav.t_s > last_row_t_s)) return;  // an increment too short to step
+    last_row_t_s = out.nav.t_s;
+    nav.write(out.nav, final_sigma);
+    ++nav_rows;
+  }
+
+  // Feeds IMU rows until the INS reaches t (or, with `at_most`, the last row not after t).
+  void advance_imu(double t, bool at_most = false) {
+    while (next_imu < imu.size() && integration->output().nav.t_s < t - 1e-9) {
+      if (at_most && imu[next_imu].t_s > t + 1e-9) break;
+      ins::ImuIncrement inc = imu[next_imu++];
+      if (first_share < 1.0) {
+        inc.dtheta_b *= first_share;
+        inc.dv_b *= first_share;
+        first_share = 1.0;
+      }
+      integration->add_imu(inc);
+      emit();
+    }
+  }
+
+  // The fix (stored) nearest to t.
+  const fusion::GnssFix* fix_near(double t) const {
+    const fusion::GnssFix* best = nullptr;
+    for (const auto& f : fixes)
+      if (f.has_position && (!best || std::abs(f.t_s - t) < std::abs(best->t_s - t))) best = &f;
+    return best;
+  }
+
+  // Tries to start the INS + filter at this epoch (time t; fix = this epoch's, if any).
+  bool try_start(double t, const receiver::ObservationEpoch& e, const std::optional<fusion::GnssFix>& fix) {
+    const FuseConfig& c = settings.config;
+    const ins::ImuErrorSpec preset = ins::imu_preset(c.imu_preset);
+    ins::NavState init;
+    Eigen::Vector3d sigma_att, sigma_vel = Eigen::Vector3d::Constant(1.0);
+    const fusion::GnssFix* pos_fix = nullptr;
+    if (settings.align == AlignMode::Config) {
+      if (!c.position_deg_m && !fix) {
+        not_started = "--align config: waiting for a fix ([initial] position_deg_m gives the position without one)";
+        return false;
+      }
+      // A configured position is the vehicle's at the IMU's first sample: the INS starts there (and runs alone
+      // until the first epoch); without one, at this epoch's fix.
+      init.t_s = c.position_deg_m ? imu.front().t_s - (imu[1].t_s - imu.front().t_s) : t;
+      init.q_nb = ins::quaternion_from_euler(
+          {c.attitude_deg->x() * kDeg, c.attitude_deg->y() * kDeg, c.attitude_deg->z() * kDeg});
+      sigma_att = Eigen::Vector3d(1.0, 1.0, 5.0) * kDeg;
+      if (fix && fix->has_velocity) init.v_n = fix->v_n_mps;
+      if (c.velocity_ned_mps) init.v_n = *c.velocity_ned_mps;
+      if (fix) pos_fix = &*fix;
+      alignment_note = "attitude from the configuration";
+    } else if (settings.align == AlignMode::Static) {
+      const double t0 = imu.front().t_s;
+      std::size_t end = 0;
+      while (end < imu.size() && imu[end].t_s <= t0 + c.static_duration_s + 1e-9) ++end;
+      if (end < 2 || end == imu.size())
+        throw io::InputError(settings.imu_file, fmt::format("the static alignment span ({} s) needs IMU data beyond it",
+                                                            c.static_duration_s));
+      pos_fix = fix_near(imu[end - 1].t_s);  // at rest over the span: any fix is the position there
+      if (!pos_fix && !c.position_deg_m) {
+        not_started = "--align static: waiting for a fix";
+        return false;
+      }
+      if (t < imu[end - 1].t_s) {
+        not_started = "--align static: the static span has not ended";
+        return false;
+      }
+      const double lat = pos_fix ? pos_fix->lat_rad : c.position_deg_m->x() * kDeg;
+      // As `fuse` (tools/fuse_run.cpp): levelling + gyrocompassing, residual-bias error margins (seed 002).
+      const ins::AlignmentResult a = ins::coarse_align(std::span(imu).first(end), t0, lat);
+      init.t_s = imu[end - 1].t_s;
+      init.q_nb = a.q_nb;
+      sigma_vel = Eigen::Vector3d::Constant(0.1);
+      const Eigen::Vector3d noise = ins::alignment_noise_sigma(preset, a.duration_s, lat, kG);
+      const double tilt = std::hypot(preset.accel.bias_sigma / kG, noise.x());
+      const double heading = std::hypot(preset.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(lat)), noise.z());
+      sigma_att = {std::max(2.0 * tilt, 0.05 * kDeg), std::max(2.0 * tilt, 0.05 * kDeg),
+                   std::clamp(2.0 * heading, 0.5 * kDeg, 60.0 * kDeg)};
+      alignment_note = fmt::format("static over {:.1f} s", a.duration_s);
+    } else {
+      const auto a = fusion::align_in_motion(imu, velocities, {c.motion_min_speed_mps, c.motion_window_s});
+      if (!a) {
+        not_started = fmt::format("--align motion: the fixes never showed {} m/s for {} s", c.motion_min_speed_mps,
+                                  c.motion_window_s);
+        return false;
+      }
+      init.t_s = a->t_s;
+      init.q_nb = a->q_nb;
+      init.v_n = a->v_n;
+      sigma_vel = Eigen::Vector3d::Constant(c.velocity_sigma_mps * 2.0);
+      sigma_att = Eigen::Vector3d(1.0, 1.0, 3.0) * kDeg;
+      pos_fix = fix_near(a->t_s);
+      alignment_note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
+    }
+    Eigen::Vector3d sigma_pos = Eigen::Vector3d::Constant(10.0);
+    if (c.position_deg_m) {
+      init.lat_rad = c.position_deg_m->x() * kDeg;
+      init.lon_rad = c.position_deg_m->y() * kDeg;
+      init.height_m = c.position_deg_m->z();
+    } else {
+      // the fix is the antenna's: move to the IMU by the lever arm
+      const Eigen::Vector3d l_n = init.q_nb * c.lever_arm_b;
+      const ins::Radii r = ins::radii_of_curvature(pos_fix->lat_rad);
+      init.lat_rad = pos_fix->lat_rad - l_n.x() / (r.meridian_m + pos_fix->height_m);
+      init.lon_rad = pos_fix->lon_rad - l_n.y() / ((r.transverse_m + pos_fix->height_m) * std::cos(pos_fix->lat_rad));
+      init.height_m = pos_fix->height_m + l_n.z();
+      sigma_pos = pos_fix->sigma_pos_ned_m;
+    }
+    if (c.sigma_position_m) sigma_pos = *c.sigma_position_m;
+    if (c.sigma_velocity_mps) sigma_vel = *c.sigma_velocity_mps;
+    if (c.sigma_attitude_deg) sigma_att = *c.sigma_attitude_deg * kDeg;
+
+    fusion::IntegrationOptions o;
+    o.coupling = is_tight() ? fusion::Coupling::Tight : fusion::Coupling::Loose;
+    o.filter = settings.filter;
+    o.model = fusion::error_model_from_preset(preset);
+    o.lever_arm_b = c.lever_arm_b;
+    o.sigma_pos_ned_m = sigma_pos;
+    o.sigma_vel_n_mps = sigma_vel;
+    o.sigma_att_rad = sigma_att;
+    o.gate = c.gate;
+    o.ukf = c.ukf;
+    o.propagation_interval_s = c.propagation_interval_s;
+    if (is_tight()) {
+      // Clock from this epoch at the INS antenna position and velocity there (the INS alone from the start to
+      // the epoch), carried back to the start.
+      ins::Strapdown alone(init, o.strapdown);
+      for (const auto& inc : imu) {
+        if (inc.t_s <= init.t_s + 1e-6) continue;
+        if (inc.t_s > t) break;
+        alone.step(inc);
+      }
+      const ins::NavState& at = alone.state();
+      const Eigen::Vector3d r_e = fusion::antenna_position_e(at, c.lever_arm_b);
+      const Eigen::Vector3d v_e = ins::C_en(at.lat_rad, at.lon_rad) * at.v_n;
+      const auto clock = fit_clock(e, r_e, v_e);
+      if (!clock) {
+        not_started = "tight: no satellite with ephemeris above the mask yet";
+        return false;
+      }
+      o.tight = tight;
+      o.gps_time_origin = *origin;
+      o.initial_clock_drift_mps = clock->second;
+      o.initial_clock_bias_m = clock->first - clock->second * (t - init.t_s);
+      // The fit's error follows the position and velocity errors (a few metres, m/s), not the receiver's ms.
+      o.model.clock.bias_sigma_m = 3.0 * sigma_pos.norm() + 10.0;
+      o.model.clock.drift_sigma_mps = 3.0 * sigma_vel.norm() + 1.0;
+    }
+    integration.emplace(init, o);
+    initial_attitude = ins::euler_from_quaternion(init.q_nb);
+    start_s = init.t_s;
+    next_imu = 0;
+    // Rows ending within 1 us of the start are skipped (the integration ignores steps below 1 ns anyway).
+    while (next_imu < imu.size() && imu[next_imu].t_s <= init.t_s + 1e-6) ++next_imu;
+    if (next_imu > 0 && next_imu < imu.size())
+      first_share = (imu[next_imu].t_s - init.t_s) / (imu[next_imu].t_s - imu[next_imu - 1].t_s);
+    emit();
+    return true;
+  }
+
+  // One epoch with its fix (if the PVT made one).
+  void process(const receiver::ObservationEpoch& raw, const receiver::PvtSolution* fix) {
+    ++epochs_seen;
+    if (fix) ++fixes_seen;
+    const receiver::ObservationEpoch e = continuous(raw);
+    std::optional<signals::GpsTime> g;
+    if (fix) {
+      g = fix->time;
+      // The fix's clock on the continuous receiver clock, for the epochs without a fix (loose).
+      last_fix_clock = FixClock{e.receive_time, fix->clock_bias_m - kC * clock_jump_s, fix->clock_drift_mps};
+    } else if (integration && is_tight()) {
+      g = signals::add_seconds(e.receive_time, -integration->nominal().clock_bias_m / kC);
+    } else if (is_tight() && settings.align == AlignMode::Config && settings.config.position_deg_m) {
+      // No fix (fewer than four satellites): the clock from the configured position (only to map this epoch's
+      // time: an error of tens of metres there is tens of nanoseconds).
+      const FuseConfig& c = settings.config;
+      const Eigen::Vector3d r_e =
+          ins::ecef_from_geodetic(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg, c.position_deg_m->z());
+      const Eigen::Vector3d v_e = ins::C_en(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg) *
+                                  c.velocity_ned_mps.value_or(Eigen::Vector3d::Zero());
+      if (const auto clock = fit_clock(e, r_e, v_e)) g = signals::add_seconds(e.receive_time, -clock->first / kC);
+    } else if (integration && last_fix_clock) {
+      // Loose, no fix this epoch: the time from the last fix's clock bias and drift; the INS runs on to it.
+      const FixClock& k = *last_fix_clock;
+      const double bias_m = k.bias_m + k.drift_mps * signals::seconds_between(e.receive_time, k.receive_time);
+      g = signals::add_seconds(e.receive_time, -bias_m / kC);
+    }
+    if (!g) {
+      ++(integration ? unused : before_start);
+      return;
+    }
+    if (!origin) set_origin(*g, e.sample_index);
+    const double t = signals::seconds_between(*g, *origin);
+    check_covered(t, *g);
+    last_epoch_t_s = t;
+    last_epoch_sample = e.sample_index;
+    have_epoch_time = true;
+
+    std::optional<fusion::GnssFix> f;
+    if (fix) {
+      f = fix_measurement(*fix, t);
+      fixes.push_back(*f);
+      if (f->has_velocity) velocities.push_back({t, f->lat_rad, f->height_m, f->v_n_mps});
+    }
+    if (!integration && !try_start(t, e, f)) {
+      ++before_start;
+      return;
+    }
+    if (t <= start_s + 1e-9) {  // used for the start itself
+      ++before_start;
+      return;
+    }
+    if (is_tight()) {
+      const auto eph = epoch_ephemerides(e);
+      if (eph.empty()) {
+        ++unused;
+      } else {
+        if (eph.size() < 4) ++epochs_below_4;
+        integration->add_observations(e, eph, iono());
+        ++used;
+      }
+    } else if (f) {
+      integration->add_fix(*f);
+      ++used;
+    } else {
+      ++unused;
+    }
+    advance_imu(t);
+  }
+
+  void flush() {
+    if (held) {
+      const receiver::ObservationEpoch e = std::move(*held);
+      held.reset();
+      process(e, nullptr);
+    }
+  }
+};
+
+ReceiveFusion::ReceiveFusion(const ReceiveFusionSettings& settings, std::vector<ins::ImuIncrement> imu,
+                             receiver::ReceiverObserver& downstream, const std::filesystem::path& out_dir,
+                             const receiver::ReceiverOptions& receiver_options,
+                             std::vector<signals::Ephemeris> nav_ephemerides)
+    : impl_(std::make_unique<Impl>(settings, std::move(imu), downstream, out_dir, receiver_options,
+                                   std::move(nav_ephemerides))) {}
+
+ReceiveFusion::~ReceiveFusion() = default;
+
+void ReceiveFusion::attach(const receiver::ReceiverEngine& engine) { impl_->engine = &engine; }
+
+void ReceiveFusion::on_tracking(const receiver::TrackingRecord& r) { impl_->downstream->on_tracking(r); }
+void ReceiveFusion::on_acquisition(std::int64_t first, const std::vector<receiver::AcquisitionResult>& r) {
+  impl_->downstream->on_acquisition(first, r);
+}
+void ReceiveFusion::on_antenna_phases(const receiver::AntennaPhaseEpoch& e) { impl_->downstream->on_antenna_phases(e); }
+
+void ReceiveFusion::on_observations(const receiver::ObservationEpoch& epoch) {
+  impl_->downstream->on_observations(epoch);
+  impl_->flush();  // the previous epoch had no fix
+  impl_->held = epoch;
+}
+
+void ReceiveFusion::on_fix(const receiver::PvtSolution& fix, const receiver::ObservationEpoch& epoch) {
+  impl_->downstream->on_fix(fix, epoch);
+  if (impl_->held && impl_->held->sample_index == epoch.sample_index) {
+    const receiver::ObservationEpoch e = std::move(*impl_->held);
+    impl_->held.reset();
+    impl_->process(e, &fix);
+  } else {
+    impl_->flush();
+    impl_->process(epoch, &fix);
+  }
+}
+
+void ReceiveFusion::finish(std::int64_t end_sample) {
+  Impl& m = *impl_;
+  m.flush();
+  if (m.integration && m.have_epoch_time) {
+    const double t_end = m.last_epoch_t_s + static_cast<double>(end_sample - m.last_epoch_sample) / m.fs_hz;
+    m.advance_imu(std::min(t_end, m.imu.back().t_s), true);
+  }
+}
+
+bool ReceiveFusion::started() const { return impl_->integration.has_value(); }
+std::string ReceiveFusion::not_started_reason() const { return impl_->not_started; }
+void ReceiveFusion::commit() { impl_->nav.commit(); }
+
+std::string ReceiveFusion::summary_json() const {
+  const Impl& m = *impl_;
+  const char* align = m.settings.align == AlignMode::Static   ? "static"
+                      : m.settings.align == AlignMode::Motion ? "motion"
+                                                              : "config";
+  std::string j = "\"fusion\": {";
+  j += fmt::format("\"coupling\": \"{}\", \"filter\": \"{}\", \"align\": \"{}\", \"imu_file\": \"{}\", "
+                   "\"imu_time_origin\": \"{}\", \"imu_preset\": \"{}\", \"started\": {}",
+                   to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align,
+                   json_escape(m.settings.imu_file), m.origin_text(), json_escape(m.settings.config.imu_preset),
+                   m.integration.has_value());
+  if (m.origin)
+    j += fmt::format(", \"imu_time_origin_gps\": {{\"week\": {}, \"tow_s\": {:.9f}}}", m.origin->week, m.origin->tow_s);
+  j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
+                   "\"epochs_unused\": {}",
+                   m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
+  if (m.is_tight()) j += fmt::format(", \"epochs_fewer_than_4_satellites\": {}", m.epochs_below_4);
+  j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock_jumps, m.nav_rows);
+  if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", json_escape(m.not_started));
+  const auto& k = m.integration->counters();
+  const auto& e = m.initial_attitude;
+  j += fmt::format(", \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
+                   "\"yaw_deg\": {:.6f}}}",
+                   json_escape(m.alignment_note), m.start_s, e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+  j += fmt::format(", \"start_s\": {}, \"end_s\": {}, \"imu_steps\": {}, \"updates_accepted\": {}, "
+                   "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
+                   m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
+                   k.satellites_missing_ephemeris);
+  const NavSigma& g = m.final_sigma;
+  j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
+                   "\"vel_mps\": {:.6g}, \"heading_deg\": {:.6g}}}}}",
+                   g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
+                   g.attitude_ned_rad.z() / kDeg);
+  return j;
+}
+
+std::string ReceiveFusion::report() const {
+  const Impl& m = *impl_;
+  if (!m.integration)
+    return fmt::format("receive: {} integration not started: {}", to_string(m.settings.coupling), m.not_started);
+  const auto& k = m.integration->counters();
+  return fmt::format(
+      "receive: {} {} integration, aligned {} at {:.3f} s; {} epochs used ({} before the start), updates accepted "
+      "{}, rejected {}; final 1-sigma horizontal {:.2f} m, vertical {:.2f} m; {} nav rows",
+      to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "EKF" : "UKF", m.alignment_note,
+      m.start_s, m.used, m.before_start, k.accepted, k.rejected, m.final_sigma.position_ned_m.head<2>().norm(),
+      m.final_sigma.position_ned_m.z(), m.nav_rows);
+}
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,98 @@
+// `ultratrack receive --imu imu.csv --coupling loose|tight`: GNSS/INS integration fed by the running receiver.
+// ReceiveFusion sits between the ReceiverEngine and the receiver's own outputs (it forwards every call) and feeds
+// fusion::GnssInsIntegration: loose: each PVT fix (position and Doppler velocity with the PVT's a-priori
+// covariance) -> GnssFix; tight: each observation epoch (raw pseudoranges and Doppler; ephemerides from --nav and
+// the decoded ones; the PVT's elevation mask, atmosphere switches and elevation/C/N0 sigma model) -> pseudorange
+// and rate updates, also with fewer than four satellites. The INS starts after the alignment (--align static:
+// levelling + gyrocompassing over the first seconds; motion: from the fixes' velocities; config: the
+// configuration's attitude, position and velocity) and writes DIR/nav.csv in `fuse`'s columns (IMU position).
+// Time: the IMU's t_s is seconds of GPS time since an origin (--imu-time-origin): sample0 = the GPS time of the
+// input file's first sample (what `simulate` writes), tow = t_s is the GPS time of week, or a number = the GPS
+// time of week at t_s = 0. Receiver clock jumps are taken out of the tight filter's pseudoranges and epoch times,
+// so its clock states stay continuous. Units SI; angles in degrees only in the configuration and the JSON.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fuse_config.hpp"
+#include "fuse_run.hpp"
+#include "fusion/gnss_ins_integration.hpp"
+#include "ins/nav_state.hpp"
+#include "receiver/receiver_engine.hpp"
+#include "signals/ephemeris.hpp"
+
+namespace ultratrack::tools {
+
+// --coupling of `receive`. A new kind of receiver/filter coupling is one more value here and in
+// parse_receive_coupling / to_string.
+enum class ReceiveCoupling { None, Loose, Tight };
+ReceiveCoupling parse_receive_coupling(const std::string& text);  // InputError for an unknown value
+std::string to_string(ReceiveCoupling coupling);
+
+struct ImuTimeOrigin {
+  enum class Kind { Sample0, WeekStart, Tow } kind = Kind::Sample0;
+  double tow_s = 0.0;  // Kind::Tow
+};
+
+// The command-line text of the fusion options (parsed by parse_receive_fusion).
+struct ReceiveFusionArgs {
+  std::string imu, coupling = "none", filter, align, config, time_origin;
+};
+void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
+
+struct ReceiveFusionSettings {
+  ReceiveCoupling coupling = ReceiveCoupling::None;
+  fusion::FilterKind filter = fusion::FilterKind::Ekf;
+  AlignMode align = AlignMode::Motion;
+  FuseConfig config;  // `fuse`'s configuration keys (--fusion-config)
+  std::string imu_file;
+  ImuTimeOrigin time_origin;
+};
+
+// Checks and parses the options (InputError naming the option or the configuration file). Nothing for
+// --coupling none (then no other fusion option may be given).
+std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& args);
+// The IMU file: InputError naming it when missing, malformed, non-finite or shorter than two rows.
+std::vector<ins::ImuIncrement> read_receive_imu(const ReceiveFusionSettings& settings);
+
+class ReceiveFusion final : public receiver::ReceiverObserver {
+ public:
+  // Opens DIR/nav.csv (committed by commit()). receiver_options: the PVT's mask, atmosphere and sigma settings
+  // and the sample rate; nav_ephemerides: the --nav file's (the decoded ones come from the attached engine).
+  ReceiveFusion(const ReceiveFusionSettings& settings, std::vector<ins::ImuIncrement> imu,
+                receiver::ReceiverObserver& downstream, const std::filesystem::path& out_dir,
+                const receiver::ReceiverOptions& receiver_options, std::vector<signals::Ephemeris> nav_ephemerides);
+  ~ReceiveFusion() override;
+
+  // The engine whose decoded ephemerides and Klobuchar parameters the tight filter uses (must outlive this).
+  void attach(const receiver::ReceiverEngine& engine);
+
+  void on_tracking(const receiver::TrackingRecord& r) override;
+  void on_acquisition(std::int64_t snapshot_first_sample, const std::vector<receiver::AcquisitionResult>& r) override;
+  // Throw io::InputError naming the IMU file when an epoch's time lies outside the IMU data.
+  void on_observations(const receiver::ObservationEpoch& epoch) override;
+  void on_fix(const receiver::PvtSolution& fix, const receiver::ObservationEpoch& epoch) override;
+  void on_antenna_phases(const receiver::AntennaPhaseEpoch& e) override;
+
+  // Processes the last epoch and runs the INS to end_sample (the receiver's next unprocessed sample).
+  void finish(std::int64_t end_sample);
+  // The "fusion" member of summary.json (after finish).
+  std::string summary_json() const;
+  // One or two lines for stdout.
+  std::string report() const;
+  bool started() const;
+  std::string not_started_reason() const;
+  void commit();  // nav.csv
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ultratrack::tools
