@@ -4,6 +4,10 @@
 
 #include <cstdlib>
 #include <string>
+#include <system_error>
+#include <vector>
+
+#include <unistd.h>
 
 namespace ultratrack::test {
 
@@ -17,10 +21,36 @@ std::optional<std::filesystem::path> shared_data_dir() {
   return std::nullopt;
 }
 
+namespace {
+
+// Folders made for a whole test suite (SetUpTestSuite) are private to this process: ctest runs each test in its
+// own process, in parallel, and two processes of one suite must not share (and delete) each other's files.
+// They are removed when the process ends.
+std::vector<std::filesystem::path>& suite_dirs() {
+  static std::vector<std::filesystem::path> dirs;
+  return dirs;
+}
+
+void remove_suite_dirs() {
+  std::error_code ignored;
+  for (const auto& dir : suite_dirs()) std::filesystem::remove_all(dir, ignored);
+}
+
+}  // namespace
+
 std::filesystem::path scratch_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "ultratrack";
-  auto dir = std::filesystem::temp_directory_path() / "ultratrack_tests" / name;
+  auto* unit = ::testing::UnitTest::GetInstance();
+  const auto* info = unit->current_test_info();
+  const auto root = std::filesystem::temp_directory_path() / "ultratrack_tests";
+  std::filesystem::path dir;
+  if (info) {
+    dir = root / (std::string(info->test_suite_name()) + "." + info->name());
+  } else {
+    const auto* suite = unit->current_test_suite();
+    dir = root / ((suite ? std::string(suite->name()) : std::string("suite")) + ".pid" + std::to_string(::getpid()));
+    if (suite_dirs().empty()) std::atexit(remove_suite_dirs);
+    suite_dirs().push_back(dir);
+  }
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
