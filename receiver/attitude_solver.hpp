@@ -1,7 +1,8 @@
 // Carrier-phase attitude of a rigid antenna array (2..4 antennas, antenna 0 the master) from AntennaPhaseEpochs:
 // double differences between antennas and satellites, integer ambiguities by LAMBDA with the known baseline
-// lengths and angles as constraints, a ratio test, attitude by a Wahba (SVD) fit of the fixed baselines, and the
-// fixed ambiguities kept across epochs. Units: m, rad, cycles of L1; body frame x forward, y right, z down; C_nb
+// lengths and angles as constraints, ratio and difference tests (on one epoch, or on the summed fits of several
+// when one is not enough), attitude by a Wahba (SVD) fit of the fixed baselines, and the fixed ambiguities kept
+// across epochs. Units: m, rad, cycles of L1; body frame x forward, y right, z down; C_nb
 // is body to the local NED frame at the master antenna (WGS-84); Euler angles z-y-x (yaw, pitch, roll).
 //
 // Sign convention (RINEX, phase grows with range): for satellite s with unit line of sight u_s (master -> sat, ECEF)
