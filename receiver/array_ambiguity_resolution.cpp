@@ -76,6 +76,7 @@ struct Search {
   double best = std::numeric_limits<double>::infinity(), second = std::numeric_limits<double>::infinity();
   Eigen::VectorXd best_integers;
   ArrayFit best_fit;
+  std::vector<ArrayCandidate> all;  // every rigid candidate with a fit
 
   bool distances_consistent(std::size_t level) const {
     const Kept& a = sets[level].kept[choice[level]];
@@ -96,6 +97,7 @@ struct Search {
     if (level == sets.size()) {
       const ArrayFit fit = fitter->fit(integers);
       if (!fit.ok) return;
+      all.push_back({integers, fit.chi2});
       if (fit.chi2 < best) {
         second = best;
         best = fit.chi2;
@@ -169,6 +171,15 @@ AmbiguityResolution resolve_array_ambiguities(const ArrayFitter& fitter,
   out.fit = s.best_fit;
   out.ratio = s.second / std::max(s.best, 1e-12);
   out.difference = s.second - s.best;
+  std::sort(s.all.begin(), s.all.end(), [](const auto& a, const auto& b) { return a.chi2 < b.chi2; });
+  for (const ArrayCandidate& c : s.all) {
+    if (c.chi2 > s.best + o.keep_margin) break;
+    if (static_cast<int>(out.candidates.size()) == o.max_kept) {
+      out.kept_truncated = true;
+      break;
+    }
+    out.candidates.push_back(c);
+  }
   const double chi2_max = chi_square_quantile(std::max(out.fit.dof, 1), o.residual_test_pfa);
   out.fixed = out.fit.ok && out.fit.chi2 <= chi2_max && out.ratio >= o.ratio_threshold &&
               out.difference >= o.difference_threshold;

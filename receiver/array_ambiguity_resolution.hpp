@@ -27,6 +27,16 @@ struct AmbiguityResolutionOptions {
   double difference_threshold = 15.0;  // J2 - J1 (constrained method only)
   double residual_test_pfa = 1e-4;    // absolute chi-square test of the best fit
   int max_candidates_per_baseline = 4000;
+  // Constrained method: rigid-array candidates kept in AmbiguityResolution::candidates (for a multi-epoch test):
+  // those with chi-square below the best's + keep_margin, at most max_kept (best first).
+  double keep_margin = 60.0;
+  int max_kept = 40;
+};
+
+// One integer candidate of every DD row and its rigid-array fit chi-square this epoch.
+struct ArrayCandidate {
+  Eigen::VectorXd integers;
+  double chi2 = 0.0;
 };
 
 struct AmbiguityResolution {
@@ -38,6 +48,10 @@ struct AmbiguityResolution {
   int candidates_enumerated = 0;     // LAMBDA candidates over all baselines
   int candidates_kept = 0;           // after the length and residual gates
   bool truncated = false;            // a baseline's enumeration hit max_candidates_per_baseline
+  // Constrained method: the best rigid-array candidates (see keep_margin), best first; kept_truncated: more were
+  // within the margin than max_kept.
+  std::vector<ArrayCandidate> candidates;
+  bool kept_truncated = false;
 };
 
 // body_baselines[k]: antenna k's lever arm minus the master's, body frame ([0] unused). Every baseline present in the

@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "receiver/array_ambiguity_resolution.hpp"
@@ -14,6 +15,7 @@
 #include "receiver/attitude_geometry.hpp"
 #include "receiver/chi_square.hpp"
 #include "receiver/phase_differences.hpp"
+#include "receiver/wahba_rotation.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::receiver {
@@ -44,6 +46,8 @@ std::string validation_error(const AttitudeSolverOptions& o) {
   if (!(o.length_tolerance_m >= 0.0)) return "length_tolerance_m must not be negative";
   if (!(o.residual_test_pfa > 0.0 && o.residual_test_pfa < 1.0)) return "residual_test_pfa must be in (0, 1)";
   if (o.max_candidates_per_baseline < 2) return "max_candidates_per_baseline must be at least 2";
+  if (!(o.multi_epoch_difference_threshold >= 0.0)) return "multi_epoch_difference_threshold must not be negative";
+  if (o.multi_epoch_max_epochs < 2) return "multi_epoch_max_epochs must be at least 2";
   return "";
 }
 
@@ -60,6 +64,9 @@ void AttitudeSolver::reset() {
   bias_m2_.assign(n, 0.0);
   bias_count_.assign(n, 0);
   last_ratio_ = 0.0;
+  pending_.clear();
+  pending_rows_.clear();
+  pending_epochs_ = pending_dof_ = 0;
   have_attitude_ = false;
   last_R_eb_.setIdentity();
 }
@@ -74,6 +81,39 @@ const SdAmbiguity* find_ambiguity(const std::vector<SdAmbiguity>& v, int antenna
 }
 
 double wrap_half(double x) { return x - std::floor(x + 0.5); }
+
+// Whether the same integers also fit a clearly different attitude almost as well (within margin of chi-square).
+// With few satellites a baseline's float can be weak along one direction; its mirror image across the plane normal
+// to that direction has the same length, and the rigid fit started there can land in a second minimum. Both are
+// tried for every baseline (all combinations but the fit's own): a second minimum means no unique attitude.
+bool attitude_ambiguous(const ArrayFitter& fitter, const Eigen::VectorXd& z, const ArrayFit& fit,
+                        const std::vector<Eigen::Vector3d>& body, double margin) {
+  const DoubleDifferences& dd = fitter.dd();
+  std::vector<Eigen::Vector3d> l, fitted, mirrored;
+  for (int k = 1; k < dd.num_antennas; ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    if (dd.baseline_count[ku] == 0) continue;
+    const BaselineFloat f = fitter.baseline_float(k, z);
+    if (!f.ok) continue;
+    const Eigen::Vector3d w = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(f.covariance).eigenvectors().col(2);
+    const Eigen::Vector3d b = fit.R_eb * body[ku];
+    l.push_back(body[ku]);
+    fitted.push_back(b);
+    mirrored.push_back(b - 2.0 * b.dot(w) * w);
+  }
+  const double sigma = std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(fit.covariance_e).eigenvalues()(2));
+  const std::size_t n = l.size();
+  for (std::size_t mask = 1; mask < (std::size_t{1} << n); ++mask) {
+    std::vector<Eigen::Vector3d> v(n);
+    for (std::size_t i = 0; i < n; ++i) v[i] = (mask >> i) & 1 ? mirrored[i] : fitted[i];
+    const Eigen::Matrix3d start = wahba_rotation(l, v, std::vector<double>(n, 1.0));
+    const ArrayFit other = fitter.fit(z, &start);
+    if (!other.ok || other.chi2 > fit.chi2 + margin) continue;
+    const double angle = Eigen::AngleAxisd(other.R_eb * fit.R_eb.transpose()).angle();
+    if (angle > std::max(6.0 * sigma, 1e-3)) return true;
+  }
+  return false;
+}
 
 }  // namespace
 
@@ -282,32 +322,86 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
   ro.difference_threshold = options_.difference_threshold;
   ro.residual_test_pfa = options_.residual_test_pfa;
   ro.max_candidates_per_baseline = options_.max_candidates_per_baseline;
-  const AmbiguityResolution res = resolve_array_ambiguities(fitter, body, ro);
-  sol.ratio = std::isfinite(res.ratio) ? res.ratio : 0.0;
-  if (!res.fixed) return sol;
+  // The DD rows and whether any of their satellites carries a slip flag (for the multi-epoch candidates).
+  std::vector<RowKey> rows;
+  bool slip = false;
+  for (const DdRow& r : dd.rows) {
+    rows.push_back({r.antenna, r.prn, r.ref_prn});
+    const auto k = static_cast<std::size_t>(r.antenna);
+    slip = slip || sats[r.sat]->slip[0] || sats[r.sat]->slip[k] || sats[r.ref_sat]->slip[0] || sats[r.ref_sat]->slip[k];
+  }
+  const bool multi = options_.use_length_constraint && options_.multi_epoch;
+  const bool continue_pending = multi && !pending_.empty() && rows == pending_rows_ && !slip &&
+                                pending_epochs_ < options_.multi_epoch_max_epochs;
+  Eigen::VectorXd integers;
+  ArrayFit fit;
+  double ratio = 0.0;
+  if (continue_pending) {
+    // 4. Multi-epoch: the candidates carried so far scored on this epoch (their integers stand while the phases
+    // are continuous); the first epoch's search already holds every candidate worth a score.
+    for (Hypothesis& h : pending_) {
+      const ArrayFit f = fitter.fit(h.integers);
+      h.chi2_sum += f.ok ? f.chi2 : std::numeric_limits<double>::infinity();
+    }
+    ++pending_epochs_;
+    pending_dof_ += static_cast<int>(rows.size()) - 3;
+    std::sort(pending_.begin(), pending_.end(), [](const auto& a, const auto& b) { return a.chi2_sum < b.chi2_sum; });
+    const double j1 = pending_.front().chi2_sum;
+    const double j2 = pending_.size() > 1 ? pending_[1].chi2_sum : std::numeric_limits<double>::infinity();
+    sol.ratio = std::isfinite(j2) ? j2 / std::max(j1, 1e-12) : 1e9;
+    if (j1 <= chi_square_quantile(pending_dof_, pfa) && j2 - j1 >= options_.multi_epoch_difference_threshold) {
+      const ArrayFit f = fitter.fit(pending_.front().integers);
+      if (passes(f)) {
+        integers = pending_.front().integers;
+        fit = f;
+        ratio = sol.ratio;
+      }
+    }
+  } else {
+    const AmbiguityResolution res = resolve_array_ambiguities(fitter, body, ro);
+    sol.ratio = std::isfinite(res.ratio) ? res.ratio : 0.0;
+    pending_.clear();
+    pending_epochs_ = pending_dof_ = 0;
+    if (res.fixed) {
+      integers = res.integers;
+      fit = res.fit;
+      ratio = std::isfinite(res.ratio) ? res.ratio : 1e9;
+    } else if (multi && !res.kept_truncated && !res.candidates.empty()) {
+      // Not validated this epoch: its candidates start a multi-epoch test (a truncated list may have lost the
+      // right candidate: wait for a better epoch to start from).
+      for (const ArrayCandidate& c : res.candidates) pending_.push_back({c.integers, c.chi2});
+      pending_rows_ = std::move(rows);
+      pending_epochs_ = 1;
+      pending_dof_ = static_cast<int>(pending_rows_.size()) - 3;
+    }
+  }
+  if (integers.size() == 0) return sol;
+  if (attitude_ambiguous(fitter, integers, fit, body, options_.difference_threshold)) return sol;
+  pending_.clear();
+  pending_epochs_ = pending_dof_ = 0;
   // The integers of one antenna get the datum that keeps its line bias where the calibration has it.
   for (int k = 1; k < na; ++k) {
     const auto ku = static_cast<std::size_t>(k);
     const int begin = dd.baseline_begin[ku];
     const int cnt = dd.baseline_count[ku];
     if (cnt == 0) continue;
-    const Eigen::Vector3d b_e = res.fit.R_eb * body[ku];
+    const Eigen::Vector3d b_e = fit.R_eb * body[ku];
     const std::size_t r = dd.rows[static_cast<std::size_t>(begin)].ref_sat;
     double sum = single_difference_cycles(*sats[r], k) - single_difference_geometry(*sats[r]).dot(b_e);
     for (int i = begin; i < begin + cnt; ++i) {
       const DdRow& row = dd.rows[static_cast<std::size_t>(i)];
       sum += single_difference_cycles(*sats[row.sat], k) - single_difference_geometry(*sats[row.sat]).dot(b_e) -
-             res.integers(i);
+             integers(i);
     }
     const double mean = sum / (cnt + 1);
     const double c = bias_count_[ku] > 0 ? std::round(mean - bias_mean_[ku]) : std::round(mean);
     fixed_.push_back({k, sats[r]->prn, static_cast<long>(c)});
     for (int i = begin; i < begin + cnt; ++i) {
-      fixed_.push_back({k, dd.rows[static_cast<std::size_t>(i)].prn, static_cast<long>(res.integers(i) + c)});
+      fixed_.push_back({k, dd.rows[static_cast<std::size_t>(i)].prn, static_cast<long>(integers(i) + c)});
     }
   }
-  last_ratio_ = std::isfinite(res.ratio) ? res.ratio : 1e9;
-  emit(dd, res.fit, true);
+  last_ratio_ = ratio;
+  emit(dd, fit, true);
   return sol;
 }
 

@@ -1,7 +1,8 @@
 // Carrier-phase attitude of a rigid antenna array (2..4 antennas, antenna 0 the master) from AntennaPhaseEpochs:
 // double differences between antennas and satellites, integer ambiguities by LAMBDA with the known baseline
-// lengths and angles as constraints, a ratio test, attitude by a Wahba (SVD) fit of the fixed baselines, and the
-// fixed ambiguities kept across epochs. Units: m, rad, cycles of L1; body frame x forward, y right, z down; C_nb
+// lengths and angles as constraints, ratio and difference tests (on one epoch, or on the summed fits of several
+// when one is not enough), attitude by a Wahba (SVD) fit of the fixed baselines, and the fixed ambiguities kept
+// across epochs. Units: m, rad, cycles of L1; body frame x forward, y right, z down; C_nb
 // is body to the local NED frame at the master antenna (WGS-84); Euler angles z-y-x (yaw, pitch, roll).
 //
 // Sign convention (RINEX, phase grows with range): for satellite s with unit line of sight u_s (master -> sat, ECEF)
@@ -49,6 +50,17 @@ struct AttitudeSolverOptions {
   // Residual check of carried ambiguities each epoch: chi-square of the rigid fit, as a false-alarm probability.
   double residual_test_pfa = 1e-4;
   int max_candidates_per_baseline = 4000;  // LAMBDA enumeration cap (keeps the search bounded at 5 satellites)
+  // Multi-epoch resolution (constrained method), while no single epoch validates: the integer candidates of the
+  // rigid array that fit the first epoch within 60 of the best (at most 40) are scored again on every following
+  // epoch with the same satellites and no slip flag (the DD integers stay the same while the phases are
+  // continuous; the attitude is free per epoch), their chi-squares summed. The best sum is fixed when it passes the
+  // chi-square test of all those epochs and the second best sum exceeds it by multi_epoch_difference_threshold
+  // (a difference test on all the epochs: twice the log likelihood ratio of the two hypotheses). The threshold is
+  // twice the single-epoch one because epoch-to-epoch correlated phase noise (e.g. multipath, a 0.1 s
+  // Gauss-Markov at 10 Hz) makes the summed chi-squares overstate the evidence. At most multi_epoch_max_epochs.
+  bool multi_epoch = true;
+  double multi_epoch_difference_threshold = 30.0;
+  int multi_epoch_max_epochs = 600;
 };
 
 // "" when the options are usable, else the first problem in words.
@@ -110,6 +122,18 @@ class AttitudeSolver {
   std::vector<double> bias_mean_, bias_m2_;    // running line-bias calibration per antenna (Welford)
   std::vector<int> bias_count_;
   double last_ratio_ = 0.0;
+  // Multi-epoch resolution in progress: the candidates' summed chi-squares, and the DD rows they were formed on.
+  struct Hypothesis {
+    Eigen::VectorXd integers;
+    double chi2_sum = 0.0;
+  };
+  struct RowKey {
+    int antenna = 0, prn = 0, ref_prn = 0;
+    bool operator==(const RowKey&) const = default;
+  };
+  std::vector<Hypothesis> pending_;
+  std::vector<RowKey> pending_rows_;
+  int pending_epochs_ = 0, pending_dof_ = 0;
   bool have_attitude_ = false;
   Eigen::Matrix3d last_R_eb_ = Eigen::Matrix3d::Identity();
 };

@@ -82,6 +82,14 @@ TrackingChannel::TrackingChannel(const ChannelConfig& config, const ChannelStart
   nco_sample_ = start.sample_index;
   epoch_.prn = config.prn;
   epoch_.num_antennas = config.num_antennas;
+  if (config_.num_antennas > 1 && config_.layout.slaves_prompt_and_noise_only) {
+    std::vector<double> slave_offsets{0.0};
+    if (config_.layout.noise) {
+      slave_tap_n_ = 1;
+      slave_offsets.push_back(noise_tap_offset_chips(config_.prn));
+    }
+    slave_engine_.emplace(config_.prn, slave_offsets);
+  }
 }
 
 ReplicaState TrackingChannel::replica() const {
@@ -166,6 +174,12 @@ void TrackingChannel::finish_epoch() {
     const TapSums& s0 = sums_[0][a];
     const TapSums& s1 = sums_[1][a];
     CorrelatorTaps& t = epoch_.antenna[a];
+    if (a > 0 && slave_engine_) {
+      t = CorrelatorTaps{};
+      t.prompt = tap(s0, s1, 0);
+      t.noise = tap(s0, s1, slave_tap_n_);
+      continue;
+    }
     t.very_early = tap(s0, s1, tap_ve_);
     t.early = tap(s0, s1, tap_e_);
     t.prompt = tap(s0, s1, tap_p_);
@@ -220,8 +234,13 @@ TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, 
   rep.carrier_step_q32 = carrier_.step_q32();
   std::array<const std::complex<float>*, kMaxAntennas> ptr{};
   for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = block.antenna[a] + offset;
-  engine_.correlate(std::span(ptr.data(), config_.num_antennas), m, rep,
-                    std::span(sums_[half].data(), config_.num_antennas));
+  // One pass over the block per engine: the master with every tap, then the slaves with prompt (and noise).
+  const auto engine_antennas = static_cast<std::size_t>(slave_engine_ ? 1 : config_.num_antennas);
+  engine_.correlate(std::span(ptr.data(), engine_antennas), m, rep, std::span(sums_[half].data(), engine_antennas));
+  if (slave_engine_) {
+    const auto slaves = static_cast<std::size_t>(config_.num_antennas - 1);
+    slave_engine_->correlate(std::span(ptr.data() + 1, slaves), m, rep, std::span(sums_[half].data() + 1, slaves));
+  }
   advance(m);
   if (nco_sample_ == epoch_end_) {
     finish_epoch();

@@ -8,6 +8,7 @@
 #include <array>
 #include <complex>
 #include <cstdint>
+#include <optional>
 
 #include "receiver/correlation_epoch.hpp"
 #include "receiver/correlator_engine.hpp"
@@ -22,6 +23,9 @@ struct CorrelatorLayout {
   bool very_early_late = false;          // VE/VL taps (multipath monitoring, BOC-style discriminators)
   double very_early_late_offset_chips = 1.0;  // (early_late_offset_chips, 2]
   bool noise = true;                     // off-peak noise tap (noise_tap_offset_chips), for C/N0 and lock tests
+  // Antennas 1.. (slaves) get only the prompt and the noise tap (what the between-antenna phase and its C/N0 need),
+  // from a second engine over the same replica; their other taps read zero. false: every antenna every tap.
+  bool slaves_prompt_and_noise_only = true;
 };
 
 struct ChannelConfig {
@@ -108,6 +112,10 @@ class TrackingChannel final {
   // Tap index in the engine for each role, -1 when off (declared before engine_, whose initialiser sets them).
   int tap_ve_ = -1, tap_e_ = -1, tap_p_ = -1, tap_l_ = -1, tap_vl_ = -1, tap_n_ = -1;
   CorrelatorEngine engine_;
+  // The slaves' engine (prompt, then noise when on) when they are correlated apart from the master; its taps'
+  // sums sit in sums_[half][a] for a >= 1 in that order.
+  std::optional<CorrelatorEngine> slave_engine_;
+  int slave_tap_n_ = -1;
 
   CodePhase code_;        // chips since the channel's start reference (continuous)
   CarrierPhase carrier_;  // cycles since the channel's start (continuous)

@@ -91,10 +91,14 @@ AntennaConfig read_antenna_config(const std::filesystem::path& path) {
           const auto v = n.as_boolean();
           if (!v) fail(file, n, key, "expected true or false");
           c.solver.use_length_constraint = v->get();
+        } else if (k.str() == "multi_epoch") {
+          const auto v = n.as_boolean();
+          if (!v) fail(file, n, key, "expected true or false");
+          c.solver.multi_epoch = v->get();
         } else {
           fail(file, n, key,
                "unknown key in [solver] (phase_sigma_m, elevation_mask_deg, ratio_threshold, min_satellites, "
-               "use_length_constraint)");
+               "use_length_constraint, multi_epoch)");
         }
       }
     } else {

@@ -7,7 +7,7 @@
 //                                                from its phase before the solver; phase_noise_m is accepted and
 //                                                ignored (a scenario's [[antenna]] tables can be copied as they are)
 //   [solver]     phase_sigma_m = 0.003  elevation_mask_deg = 10.0  ratio_threshold = 2.0  min_satellites = 5
-//                use_length_constraint = true
+//                use_length_constraint = true  multi_epoch = true
 #pragma once
 
 #include <filesystem>

@@ -40,7 +40,7 @@ struct SigintGuard {
 
 struct AttitudeArgs {
   std::vector<std::string> inputs;
-  std::string format, fs, if_hz = "0", antennas, nav, out, duration, reference_week, interval, prns;
+  std::string format, fs, if_hz = "0", antennas, nav, out, duration, reference_week, interval, prns, threads;
   bool quiet = false;
 };
 
@@ -60,6 +60,7 @@ void run_attitude(const AttitudeArgs& args) {
   options.fs_hz = source_options.fs_hz;
   options.num_antennas = static_cast<int>(n_ant);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
+  if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.interval.empty()) options.observation_interval_s = parse_double_option("--interval", args.interval);
   signals::RinexNavData nav;
   if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
@@ -123,8 +124,8 @@ void run_attitude(const AttitudeArgs& args) {
 
   const double t = receiver::processed_seconds(engine);
   const auto& s = outputs.stats();
-  fmt::print("attitude: {:.1f} s of signal, {} antennas, in {:.1f} s ({:.1f}x real time)\n", t, n_ant, wall_s,
-             wall_s > 0 ? t / wall_s : 0.0);
+  fmt::print("attitude: {:.1f} s of signal, {} antennas, in {:.1f} s ({:.1f}x real time, {} threads)\n", t, n_ant,
+             wall_s, wall_s > 0 ? t / wall_s : 0.0, engine.threads());
   fmt::print("attitude: epochs {}, with attitude {}, fixed {} ({:.1f} %); outputs in {}\n", s.epochs, s.attitude_epochs,
              s.fixed_epochs, s.epochs ? 100.0 * s.fixed_epochs / s.epochs : 0.0, args.out);
   if (s.attitude_epochs == 0)
@@ -147,6 +148,7 @@ void add_attitude_command(CLI::App& app) {
   cmd->add_option("--duration", args->duration, "seconds of signal to process (default: to the end)");
   cmd->add_option("--interval", args->interval, "attitude epoch interval, s (default 0.1)");
   cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15 (default all)");
+  cmd->add_option("--threads", args->threads, "worker threads including the main one (default: all cores)");
   cmd->add_flag("--quiet", args->quiet, "no progress lines");
   cmd->callback([args] { run_attitude(*args); });
 }

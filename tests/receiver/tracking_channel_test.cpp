@@ -195,25 +195,37 @@ TEST(TrackingChannel, AntennasShareTheReplica) {
   const auto x0 = test::generate({sat}, {kFs, true, 11}, 0, 12000);
   const auto x2 = test::generate({offset}, {kFs, false, 11}, 0, 12000);
   const auto clean = test::generate({sat}, {kFs, false, 11}, 0, 12000);
-  ChannelConfig cfg{14, kFs, 4, {}};
-  TrackingChannel ch(cfg, start_at_truth(sat, 0));
-  SampleBlockView v;
-  v.first_sample = 0;
-  v.num_samples = 12000;
-  v.num_antennas = 4;
-  v.antenna = {x0.data(), x0.data(), clean.data(), x2.data()};
-  int n = 0;
-  for (int off = 0; off < v.num_samples;) {
-    const auto r = ch.feed(v, off);
-    off += r.consumed;
-    if (!r.epoch_ready) continue;
-    ++n;
-    const auto& e = ch.epoch();
-    EXPECT_EQ(e.antenna[0].prompt, e.antenna[1].prompt);
-    EXPECT_EQ(e.antenna[0].early, e.antenna[1].early);
-    EXPECT_NEAR(std::arg(e.antenna[3].prompt * std::conj(e.antenna[2].prompt)) / (2 * M_PI), -0.15, 1e-5);
+  // Default: the slaves get prompt and noise only (their own engine); false: every tap on every antenna. The
+  // sums of a tap do not depend on which engine ran it: antenna 1 (the master's own samples) reads the same bits.
+  for (const bool prompt_only : {true, false}) {
+    ChannelConfig cfg{14, kFs, 4, {}};
+    cfg.layout.slaves_prompt_and_noise_only = prompt_only;
+    TrackingChannel ch(cfg, start_at_truth(sat, 0));
+    SampleBlockView v;
+    v.first_sample = 0;
+    v.num_samples = 12000;
+    v.num_antennas = 4;
+    v.antenna = {x0.data(), x0.data(), clean.data(), x2.data()};
+    int n = 0;
+    for (int off = 0; off < v.num_samples;) {
+      const auto r = ch.feed(v, off);
+      off += r.consumed;
+      if (!r.epoch_ready) continue;
+      ++n;
+      const auto& e = ch.epoch();
+      EXPECT_EQ(e.antenna[0].prompt, e.antenna[1].prompt);
+      EXPECT_EQ(e.antenna[0].noise, e.antenna[1].noise);
+      EXPECT_NE(e.antenna[1].noise, std::complex<float>{});
+      if (prompt_only) {
+        EXPECT_EQ(e.antenna[1].early, std::complex<float>{});
+        EXPECT_EQ(e.antenna[3].late, std::complex<float>{});
+      } else {
+        EXPECT_EQ(e.antenna[0].early, e.antenna[1].early);
+      }
+      EXPECT_NEAR(std::arg(e.antenna[3].prompt * std::conj(e.antenna[2].prompt)) / (2 * M_PI), -0.15, 1e-5);
+    }
+    EXPECT_GE(n, 2);
   }
-  EXPECT_GE(n, 2);
 }
 
 TEST(TrackingChannel, StartsFromAnAcquisitionCodeStart) {
