@@ -17,6 +17,7 @@ struct RunDescription {
   double skip_s = 0.0;        // signal skipped at the file's start
   double wall_time_s = 0.0;
   bool interrupted = false;   // stopped by SIGINT before the end
+  std::string coupling = "scalar";  // how the tracking loops are closed (scalar, vector)
 };
 
 // Seconds of signal processed by the engine.

@@ -24,6 +24,7 @@
 #include "commands.hpp"
 #include "format_options.hpp"
 #include "receive_config.hpp"
+#include "receive_vector.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
@@ -49,6 +50,7 @@ struct SigintGuard {
 struct ReceiveArgs {
   std::string input, fs, if_hz = "0", config, nav, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
+  std::string coupling = "scalar";
   FormatArgs format;
   bool iq_swap = false, q_negate = false, quiet = false;
 };
@@ -162,6 +164,10 @@ void run_receive(const ReceiveArgs& args) {
   receiver::ReceiverOutputs outputs(args.out, options.fs_hz, options.observation_interval_s);
   receiver::ReceiverEngine engine(options, outputs);
   if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
+  if (args.coupling != "scalar" && args.coupling != "vector")
+    throw signals::InputError("command line", "--coupling: '" + args.coupling + "' is neither scalar nor vector");
+  std::unique_ptr<ReceiveVector> vector;  // --coupling vector: the vector tracking filter closes the code loops
+  if (args.coupling == "vector") (vector = std::make_unique<ReceiveVector>(options, args.out))->attach(engine);
 
   SigintGuard sigint;
   Progress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
@@ -199,7 +205,13 @@ void run_receive(const ReceiveArgs& args) {
   run.skip_s = skip_s;
   run.wall_time_s = wall_s;
   run.interrupted = g_interrupted != 0;
+  run.coupling = args.coupling;
+  if (vector) vector->finish();
   outputs.finish(engine, run);
+  if (vector)
+    fmt::print("receive: vector tracking: {} epochs with channels in vector mode ({} channel-epochs), filter started "
+               "{} times, reset {} times\n", vector->vector_epochs(), vector->vector_channel_epochs(),
+               vector->filter().initialisations(), vector->filter().resets());
 
   const double t = receiver::processed_seconds(engine);
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
@@ -243,6 +255,7 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--skip", args->skip, "seconds of signal to skip at the start");
   cmd->add_option("--reference-week", args->reference_week,
                   "full GPS week near the recording, for the 10-bit week (default: nav file or build date)");
+  cmd->add_option("--coupling", args->coupling, "scalar|vector: per-channel loops, or one vector filter")->capture_default_str();
   cmd->add_flag("--iq-swap", args->iq_swap, "exchange I and Q (complex formats)");
   cmd->add_flag("--q-negate", args->q_negate, "negate Q (complex) / invert the spectrum (real IF)");
   cmd->add_flag("--quiet", args->quiet, "no progress display");
