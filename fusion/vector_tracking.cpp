@@ -280,6 +280,7 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     commands[i].vector = true;
     commands[i].code_rate_chips_per_s = p.code_rate_chips_per_s;
     commands[i].code_phase_jump_chips = jump;
+    if (opt_.carrier_aiding) commands[i].carrier_frequency_hz = p.doppler_hz;
     log.vector = true;
     ++vector;
   }

@@ -89,6 +89,7 @@ struct VectorTrackingOptions {
   bool ionosphere = true, troposphere = true;  // as the receiver's PVT (the filter's clock absorbs the rest)
   double code_spacing_chips = 1.0;    // E-L spacing of the channels (2 x early_late_offset_chips)
   bool use_doppler = true;            // pseudorange-rate rows
+  bool carrier_aiding = true;         // the predicted Doppler's changes aid each vector channel's PLL
   int join_after_updates = 25;        // accepted pseudorange updates (20 ms each) before a channel is commanded
   int max_rejections = 10;            // consecutive gate rejections that return a channel to scalar
   double max_jump_chips = 0.3;        // a prediction further than this from the replica returns it to scalar

@@ -48,6 +48,18 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   vector_ = command;
   if (vector_.vector && loop_.state() != TrackingState::kBitSynced) vector_ = {};
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
+  // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
+  // the command already computed for the next epoch (between epochs) gets it too.
+  if (vector_.vector && std::isfinite(vector_.carrier_frequency_hz)) {
+    if (std::isfinite(previous_aid_hz_)) {
+      const double delta = vector_.carrier_frequency_hz - previous_aid_hz_;
+      loop_.aid_frequency(delta);
+      last_scalar_.carrier_frequency_hz += delta;
+    }
+    previous_aid_hz_ = vector_.carrier_frequency_hz;
+  } else {
+    previous_aid_hz_ = NAN;
+  }
   // Between epochs the next one starts at once: replace the command it would start with.
   if ((vector_.vector || was_vector) && channel_.next_epoch_sample() == channel_.next_sample())
     channel_.command(merged_command());

@@ -75,7 +75,10 @@ class ReceiverChannel {
         const CorrelationEpoch& e = channel_.epoch();
         const TrackingReport report = loop_.update(e);
         last_scalar_ = report.command;
-        if (report.state != TrackingState::kBitSynced) vector_ = {};  // vector mode only while bit-synced
+        if (report.state != TrackingState::kBitSynced) {  // vector mode only while bit-synced
+          vector_ = {};
+          previous_aid_hz_ = NAN;
+        }
         channel_.command(merged_command());
         if (report.set_coherent) channel_.set_coherent_periods(report.coherent_periods, report.aligned_period);
         after_epoch(e, report);
@@ -132,6 +135,7 @@ class ReceiverChannel {
   bool last_epoch_new_ = false;
   VectorChannelCommand vector_;
   bool vector_jump_pending_ = false;
+  double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
 
   double fs_hz_;

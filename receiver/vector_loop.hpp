@@ -68,6 +68,9 @@ struct VectorChannelCommand {
   bool vector = false;
   double code_rate_chips_per_s = 0.0;  // including code Doppler
   double code_phase_jump_chips = 0.0;  // applied once at next_epoch_sample; positive advances the replica
+  // Carrier aiding: the predicted carrier Doppler at next_epoch_sample, Hz; its change from one command to the
+  // next is added to the channel's PLL (ScalarTracking::aid_frequency). NaN: no aiding.
+  double carrier_frequency_hz = NAN;
 };
 
 class VectorLoop {
