@@ -55,6 +55,8 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
       const double delta = vector_.carrier_frequency_hz - previous_aid_hz_;
       loop_.aid_frequency(delta);
       last_scalar_.carrier_frequency_hz += delta;
+    } else {
+      loop_.start_aiding();
     }
     previous_aid_hz_ = vector_.carrier_frequency_hz;
   } else {

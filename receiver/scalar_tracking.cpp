@@ -208,6 +208,11 @@ void ScalarTracking::aid_frequency(double delta_hz) {
   command_.carrier_frequency_hz += delta_hz;
 }
 
+void ScalarTracking::start_aiding() {
+  if (state_ != TrackingState::kBitSynced) return;
+  carrier_.reset(carrier_.frequency_hz(), 0.0);
+}
+
 TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   TrackingReport r;
   const double t = e.integration_time_s;
