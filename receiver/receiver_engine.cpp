@@ -331,7 +331,10 @@ void ReceiverEngine::process_master(std::span<const std::complex<float>> samples
   while (s < end) {
     if (search_.pending && search_.apply_at <= s) finish_acquisition(s);  // only after a gap in the samples
     std::int64_t stop = std::min(end, next_observation_);
-    if (vector_loop_) stop = std::min(stop, next_vector_);
+    if (vector_loop_) {
+      if (next_vector_ <= s) next_vector_ += ((s - next_vector_) / vector_step_ + 1) * vector_step_;  // start, gaps
+      stop = std::min(stop, next_vector_);
+    }
     if (snapshot_active_) stop = std::min(stop, s + static_cast<std::int64_t>(snapshot_.size() - snapshot_have_));
     if (search_.pending) stop = std::min(stop, search_.apply_at);
     const auto part = samples.subspan(static_cast<std::size_t>(s - first_sample), static_cast<std::size_t>(stop - s));
