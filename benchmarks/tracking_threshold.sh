@@ -23,7 +23,7 @@
 #
 #   benchmarks/tracking_threshold.sh [--levels "24 26 28 30 32"] [--files 4] [--duration 60] [--fs 2.6e6]
 #       [--seed0 100] [--out DIR] [--ultratrack build/tools/ultratrack] [--receive-args "..."]
-#       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep]
+#       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep] [--coupling scalar|vector]
 # Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3 (the report). CPU: about 15 s per file at
 # 2.6 MHz on one core. Files are deleted after their receive unless --keep.
 set -euo pipefail
@@ -42,6 +42,7 @@ while [ $# -gt 0 ]; do
     --out) out=$2; shift 2 ;;
     --ultratrack) ultratrack=$2; shift 2 ;;
     --receive-args) receive_args=$2; shift 2 ;;
+    --coupling) receive_args="$receive_args --coupling $2"; shift 2 ;;  # scalar (default) or vector (issue 7)
     --nav) nav=$2; shift 2 ;;
     --lock-deadline) lock_deadline_s=$2; shift 2 ;;
     --config-extra) extra_config=$(realpath "$2"); shift 2 ;;

@@ -30,7 +30,96 @@ ReceiverChannel::ReceiverChannel(int prn, const ChannelStart& start, double fs_h
       loop_(options, channel_.current_command()),
       nav_(prn, reference_week),
       record_periods_(record_periods < 1 ? 1 : record_periods) {
+  last_scalar_ = channel_.current_command();
   if (num_antennas > 1) antenna_phases_.emplace(num_antennas);
+}
+
+NcoCommand ReceiverChannel::merged_command() {
+  NcoCommand cmd = last_scalar_;
+  if (!vector_.vector) return cmd;
+  cmd.code_rate_chips_per_s = vector_.code_rate_chips_per_s;
+  if (vector_jump_pending_) cmd.code_phase_jump_chips = vector_.code_phase_jump_chips;
+  vector_jump_pending_ = false;
+  return cmd;
+}
+
+void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
+  const bool was_vector = vector_.vector;
+  vector_ = command;
+  if (vector_.vector && loop_.state() != TrackingState::kBitSynced) vector_ = {};
+  vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
+  // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
+  // the command already computed for the next epoch (between epochs) gets it too.
+  if (vector_.vector && std::isfinite(vector_.carrier_frequency_hz)) {
+    if (std::isfinite(previous_aid_hz_)) {
+      const double delta = vector_.carrier_frequency_hz - previous_aid_hz_;
+      loop_.aid_frequency(delta);
+      last_scalar_.carrier_frequency_hz += delta;
+    } else {
+      loop_.start_aiding();
+    }
+    previous_aid_hz_ = vector_.carrier_frequency_hz;
+  } else {
+    previous_aid_hz_ = NAN;
+  }
+  // Between epochs the next one starts at once: replace the command it would start with.
+  if ((vector_.vector || was_vector) && channel_.next_epoch_sample() == channel_.next_sample())
+    channel_.command(merged_command());
+}
+
+VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int slot) {
+  VectorChannelInput in;
+  in.slot = slot;
+  in.prn = prn();
+  in.vector_mode = vector_.vector;
+  in.cn0_dbhz = loop_.cn0_dbhz().value_or(NAN);
+  in.code_rate_chips_per_s = channel_.current_command().code_rate_chips_per_s;
+  in.carrier_frequency_hz = channel_.current_command().carrier_frequency_hz;
+  in.next_epoch_sample = channel_.next_epoch_sample();
+  in.synchronised = synchronised() && (week_trusted_ || nav_.decoder().week_known());
+  const bool fresh = last_epoch_new_;
+  last_epoch_new_ = false;
+  if (!in.synchronised) return in;
+  const TransmitTimeTag& tag = *nav_.time_tag();
+  // Pseudorange of the replica at a sample where it is `chips` into code period `period` (any number of chips:
+  // 1023 chips are one code period, 1 ms of transmit time, whatever the Doppler).
+  const double tag_age_s = signals::seconds_between(clock.base(), tag.transmit_time);
+  const auto pseudorange = [&](std::int64_t sample, std::int64_t period, double chips) {
+    const double since_tag = static_cast<double>(period - tag.code_period) * signals::kCaCodePeriod_s +
+                             chips / signals::kCaChipRate_hz;
+    return signals::kSpeedOfLight_mps * (tag_age_s + clock.seconds_since_base(sample) - since_tag);
+  };
+  const ReplicaState replica = channel_.replica();
+  in.replica_pseudorange_m = pseudorange(replica.sample_index, replica.code_period, replica.code_phase_chips);
+  const EpochSummary& e = last_epoch_;
+  if (!fresh || !e.valid || !e.bit_synced || e.num_code_periods < 2) return in;
+  const int half = e.num_samples / 2;
+  in.has_measurement = true;
+  in.measurement_sample = e.first_sample + half;
+  in.integration_time_s = e.num_samples / fs_hz_;
+  in.code_error_chips = e.code_error_chips;
+  in.replica_pseudorange_mid_m =
+      pseudorange(in.measurement_sample, e.first_code_period, e.code_phase_start_chips + e.code_rate_chips_per_s * half / fs_hz_);
+  constexpr double kChip_m = signals::kSpeedOfLight_mps / signals::kCaChipRate_hz;
+  in.measured_pseudorange_m = in.replica_pseudorange_mid_m - e.code_error_chips * kChip_m;
+  const EpochSummary& p = previous_epoch_;
+  if (p.valid && p.bit_synced && p.num_code_periods == e.num_code_periods &&
+      p.first_sample + p.num_samples == e.first_sample) {
+    const int p_half = p.num_samples / 2;
+    const auto middle_phase = [](const EpochSummary& s, int h) {
+      return s.carrier_phase_start_cycles + (s.carrier_phase_end_cycles - s.carrier_phase_start_cycles) * h / s.num_samples;
+    };
+    // Costas phases are bit-insensitive, within +-1/4 cycle: their change is taken within +-1/4 cycle.
+    double dphi = costas_atan_cycles(e.prompt) - costas_atan_cycles(p.prompt);
+    if (dphi > 0.25) dphi -= 0.5;
+    if (dphi <= -0.25) dphi += 0.5;
+    const std::int64_t p_mid = p.first_sample + p_half;
+    in.doppler_interval_s = static_cast<double>(in.measurement_sample - p_mid) / fs_hz_;
+    in.measured_doppler_hz = (middle_phase(e, half) - middle_phase(p, p_half) + dphi) / in.doppler_interval_s;
+    in.doppler_sample = (p_mid + in.measurement_sample) / 2;
+    in.has_doppler = true;
+  }
+  return in;
 }
 
 void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingReport& report) {
@@ -41,6 +130,21 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
     tracked_s_ += e.integration_time_s;
   }
   if (report.bit) nav_.add_bit(report.bit->soft, report.bit->first_code_period);
+  previous_epoch_ = last_epoch_;
+  EpochSummary& s = last_epoch_;
+  s.valid = true;
+  s.bit_synced = report.state == TrackingState::kBitSynced;
+  s.first_sample = e.first_sample;
+  s.num_samples = e.num_samples;
+  s.num_code_periods = e.num_code_periods;
+  s.first_code_period = e.first_code_period;
+  s.code_phase_start_chips = e.code_phase_start_chips;
+  s.code_rate_chips_per_s = e.code_rate_chips_per_s;
+  s.carrier_phase_start_cycles = e.carrier_phase_start_cycles;
+  s.carrier_phase_end_cycles = e.carrier_phase_end_cycles;
+  s.prompt = e.master().prompt;
+  s.code_error_chips = report.code_error_chips;
+  last_epoch_new_ = true;
 }
 
 TrackingRecord ReceiverChannel::record(const CorrelationEpoch& e, const TrackingReport& report) const {

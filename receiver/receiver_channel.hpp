@@ -13,8 +13,10 @@
 #include "receiver/acquisition.hpp"
 #include "receiver/antenna_phase_tracker.hpp"
 #include "receiver/navigation_data_channel.hpp"
+#include "receiver/receiver_clock.hpp"
 #include "receiver/scalar_tracking.hpp"
 #include "receiver/tracking_channel.hpp"
+#include "receiver/vector_loop.hpp"
 #include "signals/gps_time.hpp"
 
 namespace ultratrack::receiver {
@@ -72,7 +74,12 @@ class ReceiverChannel {
       if (r.epoch_ready) {
         const CorrelationEpoch& e = channel_.epoch();
         const TrackingReport report = loop_.update(e);
-        channel_.command(report.command);
+        last_scalar_ = report.command;
+        if (report.state != TrackingState::kBitSynced) {  // vector mode only while bit-synced
+          vector_ = {};
+          previous_aid_hz_ = NAN;
+        }
+        channel_.command(merged_command());
         if (report.set_coherent) channel_.set_coherent_periods(report.coherent_periods, report.aligned_period);
         after_epoch(e, report);
         const std::int64_t p0 = e.first_code_period;
@@ -95,6 +102,13 @@ class ReceiverChannel {
   NavigationDataChannel& navigation() { return nav_; }
   const NavigationDataChannel& navigation() const { return nav_; }
   double tracked_time_s() const { return tracked_s_; }
+  // Vector tracking (receiver/vector_loop.hpp), between blocks on the engine's thread. vector_input: the
+  // channel at the sample it has reached, with the latest correlation epoch's measurements if not yet handed
+  // over (then marked handed over). set_vector_command: in vector mode the loop's code rate replaces the DLL's
+  // from the next epoch start on, and its code phase jump is applied there once.
+  VectorChannelInput vector_input(const ReceiverClock& clock, int slot);
+  void set_vector_command(const VectorChannelCommand& command);
+  bool vector_mode() const { return vector_.vector; }
   // The between-antenna phases (nullptr with one antenna).
   AntennaPhaseTracker* antenna_phases() { return antenna_phases_ ? &*antenna_phases_ : nullptr; }
 
@@ -102,6 +116,27 @@ class ReceiverChannel {
   static std::int64_t floor_div(std::int64_t a, std::int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
   void after_epoch(const CorrelationEpoch& e, const TrackingReport& report);
   TrackingRecord record(const CorrelationEpoch& e, const TrackingReport& report) const;
+  NcoCommand merged_command();
+
+  // What vector tracking needs of a completed epoch.
+  struct EpochSummary {
+    bool valid = false;
+    bool bit_synced = false;
+    std::int64_t first_sample = 0;
+    int num_samples = 0;
+    int num_code_periods = 1;
+    std::int64_t first_code_period = 0;
+    double code_phase_start_chips = 0.0, code_rate_chips_per_s = 0.0;
+    double carrier_phase_start_cycles = 0.0, carrier_phase_end_cycles = 0.0;
+    std::complex<float> prompt{};
+    double code_error_chips = 0.0;
+  };
+  EpochSummary last_epoch_, previous_epoch_;
+  bool last_epoch_new_ = false;
+  VectorChannelCommand vector_;
+  bool vector_jump_pending_ = false;
+  double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
+  NcoCommand last_scalar_;
 
   double fs_hz_;
   bool week_trusted_;  // the reference week is the signal's: time tags usable before subframe 1

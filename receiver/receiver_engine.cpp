@@ -331,6 +331,10 @@ void ReceiverEngine::process_master(std::span<const std::complex<float>> samples
   while (s < end) {
     if (search_.pending && search_.apply_at <= s) finish_acquisition(s);  // only after a gap in the samples
     std::int64_t stop = std::min(end, next_observation_);
+    if (vector_loop_) {
+      if (next_vector_ <= s) next_vector_ += ((s - next_vector_) / vector_step_ + 1) * vector_step_;  // start, gaps
+      stop = std::min(stop, next_vector_);
+    }
     if (snapshot_active_) stop = std::min(stop, s + static_cast<std::int64_t>(snapshot_.size() - snapshot_have_));
     if (search_.pending) stop = std::min(stop, search_.apply_at);
     const auto part = samples.subspan(static_cast<std::size_t>(s - first_sample), static_cast<std::size_t>(stop - s));
@@ -342,6 +346,10 @@ void ReceiverEngine::process_master(std::span<const std::complex<float>> samples
     s = stop;
     if (snapshot_active_ && snapshot_have_ == snapshot_.size()) start_acquisition(s);
     if (search_.pending && search_.apply_at == s) finish_acquisition(s);
+    if (vector_loop_ && s == next_vector_) {
+      vector_epoch(s);
+      next_vector_ += vector_step_;
+    }
     if (s == next_observation_) {
       observation_epoch(s);
       next_observation_ += observation_step_;
@@ -451,13 +459,58 @@ void ReceiverEngine::solve(const ObservationEpoch& epoch) {
   observer_.on_fix(fix, epoch);
   // Keep the receiver clock within clock_jump_threshold_s of GPS time: a jump, as RINEX allows (the
   // pseudoranges of later epochs drop by c * bias; carrier phases are unaffected).
+  fix_clock_corrections_s_ = clock_corrections_s_;
   const double bias_s = fix.clock_bias_m / signals::kSpeedOfLight_mps;
   if (std::abs(bias_s) > options_.clock_jump_threshold_s) {
     clock_->correct(bias_s);
+    clock_corrections_s_ += bias_s;
     smoothing_.clock_jump(bias_s);
     ++stats_.clock_jumps;
   }
   last_fix_ = std::move(fix);
+}
+
+void ReceiverEngine::set_vector_loop(VectorLoop* loop, double interval_s) {
+  if (!(interval_s >= 0.001 && interval_s <= 1.0)) throw std::invalid_argument("ReceiverEngine: vector interval outside [0.001, 1] s");
+  if (!loop)
+    for (auto& channel : channels_)
+      if (channel) channel->set_vector_command({});
+  vector_loop_ = loop;
+  vector_step_ = std::max<std::int64_t>(1, std::llround(interval_s * options_.fs_hz));
+  next_vector_ = (started_ ? next_sample_ : stats_.first_sample) + vector_step_;
+}
+
+// The vector loop's turn: every channel's state and latest measurements in slot order, its commands back.
+void ReceiverEngine::vector_epoch(std::int64_t sample) {
+  vector_in_.clear();
+  for (std::size_t slot = 0; slot < channels_.size(); ++slot) {
+    auto& channel = channels_[slot];
+    if (!channel) continue;
+    if (clock_) {
+      vector_in_.push_back(channel->vector_input(*clock_, static_cast<int>(slot)));
+    } else {  // no receive time yet: nothing can be measured
+      VectorChannelInput in;
+      in.slot = static_cast<int>(slot);
+      in.prn = channel->prn();
+      vector_in_.push_back(in);
+    }
+  }
+  vector_out_.assign(vector_in_.size(), VectorChannelCommand{});
+  VectorEpochInput epoch;
+  epoch.sample = sample;
+  epoch.fs_hz = options_.fs_hz;
+  if (clock_) epoch.receive_time = clock_->time_at(sample);
+  epoch.clock_corrections_s = clock_corrections_s_;
+  epoch.ephemerides = &ephemerides_;
+  epoch.iono = &iono_;
+  epoch.last_fix = last_fix_ ? &*last_fix_ : nullptr;
+  epoch.last_fix_clock_corrections_s = fix_clock_corrections_s_;
+  epoch.channels = vector_in_;
+  if (clock_) vector_loop_->update(epoch, vector_out_);
+  for (std::size_t i = 0; i < vector_in_.size(); ++i) {
+    const bool ok = vector_in_[i].synchronised;
+    channels_[static_cast<std::size_t>(vector_in_[i].slot)]->set_vector_command(ok ? vector_out_[i] : VectorChannelCommand{});
+  }
 }
 
 }  // namespace ultratrack::receiver

@@ -29,6 +29,7 @@
 #include "receiver/receiver_channel.hpp"
 #include "receiver/receiver_clock.hpp"
 #include "receiver/receiver_options.hpp"
+#include "receiver/vector_loop.hpp"
 #include "receiver/worker_pool.hpp"
 #include "signals/almanac.hpp"
 #include "signals/ephemeris.hpp"
@@ -91,6 +92,12 @@ class ReceiverEngine {
   // master) is the one acquired on. Throws std::invalid_argument when the spans do not match the options.
   void process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample);
 
+  // Vector tracking: from now on, every interval_s (rounded to samples; 0.001..1 s) the loop is called on the
+  // caller's thread, after the channels' parallel work, with every channel (receiver/vector_loop.hpp); nullptr
+  // detaches it (channels go back to scalar). The loop must outlive its use. Throws std::invalid_argument for a
+  // bad interval.
+  void set_vector_loop(VectorLoop* loop, double interval_s = 0.02);
+
   const ReceiverStats& stats() const { return stats_; }
   const std::optional<PvtSolution>& last_fix() const { return last_fix_; }
   int channels_in_use() const;
@@ -138,6 +145,7 @@ class ReceiverEngine {
   void release_lost_channels();
   void observation_epoch(std::int64_t sample);
   void solve(const ObservationEpoch& epoch);
+  void vector_epoch(std::int64_t sample);
 
   ReceiverOptions options_;
   ReceiverObserver& observer_;
@@ -182,6 +190,13 @@ class ReceiverEngine {
   std::array<const std::complex<float>*, kMaxAntennas> antenna_block_{};
   std::int64_t antenna_block_first_ = 0;
   AntennaPhaseEpoch antenna_epoch_;
+  // Vector tracking (set_vector_loop).
+  VectorLoop* vector_loop_ = nullptr;
+  std::int64_t vector_step_ = 0, next_vector_ = 0;
+  double clock_corrections_s_ = 0.0;
+  double fix_clock_corrections_s_ = 0.0;  // clock_corrections_s_ when last_fix_ was solved
+  std::vector<VectorChannelInput> vector_in_;
+  std::vector<VectorChannelCommand> vector_out_;
 };
 
 }  // namespace ultratrack::receiver

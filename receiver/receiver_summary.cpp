@@ -60,6 +60,7 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
   fmt::print(out, "  \"duration_s\": {:.6f},\n  \"wall_time_s\": {:.3f},\n  \"realtime_factor\": {:.3f},\n", duration,
              run.wall_time_s, run.wall_time_s > 0.0 ? duration / run.wall_time_s : 0.0);
   fmt::print(out, "  \"interrupted\": {},\n", run.interrupted);
+  fmt::print(out, "  \"coupling\": \"{}\",\n", run.coupling);
   const bool fix = s.fixes > 0;
   fmt::print(out, "  \"fix\": {},\n  \"ttff_s\": {},\n", fix, fix ? fmt::format("{:.3f}", ttff_seconds(engine)) : "null");
   fmt::print(out, "  \"fixes\": {},\n  \"observation_epochs\": {},\n  \"clock_jumps\": {},\n", s.fixes,

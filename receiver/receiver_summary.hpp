@@ -17,6 +17,7 @@ struct RunDescription {
   double skip_s = 0.0;        // signal skipped at the file's start
   double wall_time_s = 0.0;
   bool interrupted = false;   // stopped by SIGINT before the end
+  std::string coupling = "scalar";  // how the loops are closed: scalar, vector, loose, tight
   std::string extra_json;     // further top-level members, formatted ("\"name\": value"), written last
 };
 

@@ -202,6 +202,17 @@ double ScalarTracking::fine_fll(std::complex<float> prompt, double t_s, double* 
   return frequency;
 }
 
+void ScalarTracking::aid_frequency(double delta_hz) {
+  if (state_ != TrackingState::kBitSynced || !std::isfinite(delta_hz)) return;
+  carrier_.reset(carrier_.frequency_hz() + delta_hz, carrier_.frequency_rate_hzps());
+  command_.carrier_frequency_hz += delta_hz;
+}
+
+void ScalarTracking::start_aiding() {
+  if (state_ != TrackingState::kBitSynced) return;
+  carrier_.reset(carrier_.frequency_hz(), 0.0);
+}
+
 TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   TrackingReport r;
   const double t = e.integration_time_s;

@@ -116,6 +116,13 @@ class ScalarTracking final {
 
   TrackingReport update(const CorrelationEpoch& epoch);
   TrackingState state() const { return state_; }
+  // External carrier aiding (vector tracking): shifts the carrier loop's frequency integrator, and the command it
+  // gives next, by delta_hz (the predicted change of the Doppler since the previous aid), so that the PLL only
+  // tracks what the prediction misses. Only while bit-synced; ignored otherwise.
+  void aid_frequency(double delta_hz);
+  // At the start of aiding: the loop's frequency-rate integrator (3rd order) holds the line-of-sight dynamics it
+  // learnt alone; the aiding brings them from now on, so the integrator is cleared (else they count twice).
+  void start_aiding();
   std::optional<double> cn0_dbhz() const { return cn0_dbhz_; }
   double pli() const { return pli_.value(); }
   // Bit sync result (valid once state is kBitSynced or bit_synchronised()).

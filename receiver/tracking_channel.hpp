@@ -99,6 +99,9 @@ class TrackingChannel final {
   const CorrelatorLayout& layout() const { return config_.layout; }
   // Sample index the NCO state refers to (the next sample the channel expects).
   std::int64_t next_sample() const { return nco_sample_; }
+  // Sample at which a command given now takes effect: the end of the epoch in progress, else next_sample() (after
+  // a gap the epoch actually starts at the next code-period start).
+  std::int64_t next_epoch_sample() const { return in_epoch_ ? epoch_end_ : nco_sample_; }
   // The replica's exact NCO state at next_sample() (a pending command is not yet applied).
   ReplicaState replica() const;
 

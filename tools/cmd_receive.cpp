@@ -5,6 +5,7 @@
 // Exit: 0 with a fix; 2 (InputError) for bad input, including a file in which no satellite is found (no
 // outputs then); 3 when satellites were tracked but the file ended before a fix (outputs written, summary
 // says "fix": false). SIGINT stops the loop and still finishes every output.
+// --coupling vector: one vector filter closes the channels' code loops (tools/receive_vector.hpp).
 // --imu F --coupling loose|tight: GNSS/INS integration on the way (tools/receive_fusion.hpp): nav.csv and a "fusion"
 // object in summary.json; exit 3 also when the integration never started, 0 with a fused solution but no PVT fix.
 #include <fmt/core.h>
@@ -28,6 +29,7 @@
 #include "format_options.hpp"
 #include "receive_config.hpp"
 #include "receive_fusion.hpp"
+#include "receive_vector.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
@@ -175,6 +177,9 @@ void run_receive(const ReceiveArgs& args) {
   receiver::ReceiverEngine engine(options, fusion ? static_cast<receiver::ReceiverObserver&>(*fusion) : outputs);
   if (fusion) fusion->attach(engine);
   if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
+  const ReceiveCoupling coupling = parse_receive_coupling(args.fusion.coupling);
+  std::unique_ptr<ReceiveVector> vector;  // --coupling vector: the vector tracking filter closes the code loops
+  if (coupling == ReceiveCoupling::Vector) (vector = std::make_unique<ReceiveVector>(options, args.out))->attach(engine);
 
   SigintGuard sigint;
   Progress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
@@ -212,12 +217,18 @@ void run_receive(const ReceiveArgs& args) {
   run.skip_s = skip_s;
   run.wall_time_s = wall_s;
   run.interrupted = g_interrupted != 0;
+  run.coupling = to_string(coupling);
   if (fusion) {
     fusion->finish(engine.stats().first_sample + engine.stats().samples_processed);
     run.extra_json = fusion->summary_json();
   }
+  if (vector) vector->finish();
   outputs.finish(engine, run);
   if (fusion) fusion->commit();
+  if (vector)
+    fmt::print("receive: vector tracking: {} epochs with channels in vector mode ({} channel-epochs), filter started "
+               "{} times, reset {} times\n", vector->vector_epochs(), vector->vector_channel_epochs(),
+               vector->filter().initialisations(), vector->filter().resets());
 
   const double t = receiver::processed_seconds(engine);
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,

@@ -74,15 +74,17 @@ fusion::GnssFix fix_measurement(const receiver::PvtSolution& f, double t_s) {
 }  // namespace
 
 ReceiveCoupling parse_receive_coupling(const std::string& text) {
-  if (text == "none") return ReceiveCoupling::None;
+  if (text == "scalar" || text == "none") return ReceiveCoupling::Scalar;
+  if (text == "vector") return ReceiveCoupling::Vector;
   if (text == "loose") return ReceiveCoupling::Loose;
   if (text == "tight") return ReceiveCoupling::Tight;
-  throw io::InputError("command line", "--coupling must be none, loose or tight, got '" + text + "'");
+  throw io::InputError("command line", "--coupling must be scalar, vector, loose or tight, got '" + text + "'");
 }
 
 std::string to_string(ReceiveCoupling coupling) {
   switch (coupling) {
-    case ReceiveCoupling::None: return "none";
+    case ReceiveCoupling::Scalar: return "scalar";
+    case ReceiveCoupling::Vector: return "vector";
     case ReceiveCoupling::Loose: return "loose";
     case ReceiveCoupling::Tight: return "tight";
   }
@@ -92,8 +94,8 @@ std::string to_string(ReceiveCoupling coupling) {
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   cmd->add_option("--imu", a.imu, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps) for GNSS/INS integration (--coupling)");
   cmd->add_option("--coupling", a.coupling,
-                  "none (default: the scalar receiver alone), loose (PVT fixes) or tight (pseudoranges and rates) "
-                  "GNSS/INS integration with --imu");
+                  "scalar (default: per-channel loops), vector (one vector filter closes the code loops), or "
+                  "GNSS/INS integration with --imu: loose (PVT fixes) or tight (pseudoranges and rates)");
   cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
   cmd->add_option("--align", a.align, "with --coupling: static, motion (default) or config");
   cmd->add_option("--fusion-config", a.config,
@@ -106,7 +108,7 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
 std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& a) {
   ReceiveFusionSettings s;
   s.coupling = parse_receive_coupling(a.coupling);
-  if (s.coupling == ReceiveCoupling::None) {
+  if (s.coupling == ReceiveCoupling::Scalar || s.coupling == ReceiveCoupling::Vector) {
     if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
       throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
                                            "--coupling loose or tight");

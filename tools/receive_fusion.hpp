@@ -29,9 +29,10 @@
 
 namespace ultratrack::tools {
 
-// --coupling of `receive`. A new kind of receiver/filter coupling is one more value here and in
+// --coupling of `receive`: scalar (per-channel loops; "none" is accepted too), vector (tools/receive_vector.hpp),
+// loose or tight (GNSS/INS integration, this file). A new kind of coupling is one more value here and in
 // parse_receive_coupling / to_string.
-enum class ReceiveCoupling { None, Loose, Tight };
+enum class ReceiveCoupling { Scalar, Vector, Loose, Tight };
 ReceiveCoupling parse_receive_coupling(const std::string& text);  // InputError for an unknown value
 std::string to_string(ReceiveCoupling coupling);
 
@@ -42,12 +43,12 @@ struct ImuTimeOrigin {
 
 // The command-line text of the fusion options (parsed by parse_receive_fusion).
 struct ReceiveFusionArgs {
-  std::string imu, coupling = "none", filter, align, config, time_origin;
+  std::string imu, coupling = "scalar", filter, align, config, time_origin;
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 
 struct ReceiveFusionSettings {
-  ReceiveCoupling coupling = ReceiveCoupling::None;
+  ReceiveCoupling coupling = ReceiveCoupling::Scalar;
   fusion::FilterKind filter = fusion::FilterKind::Ekf;
   AlignMode align = AlignMode::Motion;
   FuseConfig config;  // `fuse`'s configuration keys (--fusion-config)
@@ -56,7 +57,7 @@ struct ReceiveFusionSettings {
 };
 
 // Checks and parses the options (InputError naming the option or the configuration file). Nothing for
-// --coupling none (then no other fusion option may be given).
+// --coupling scalar or vector (then no other fusion option may be given).
 std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& args);
 // The IMU file: InputError naming it when missing, malformed, non-finite or shorter than two rows.
 std::vector<ins::ImuIncrement> read_receive_imu(const ReceiveFusionSettings& settings);

@@ -1,0 +1,297 @@
+#include "fusion/vector_tracking.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "signals/gps_constants.hpp"
+
+namespace ultratrack::fusion {
+namespace {
+
+using signals::kSpeedOfLight_mps;
+constexpr double kChip_m = kSpeedOfLight_mps / signals::kCaChipRate_hz;
+
+double ratio_hz(double cn0_dbhz) { return std::pow(10.0, cn0_dbhz / 10.0); }
+
+// The observable dt seconds of receive time later: the satellite (as seen in the receive-time frame) moves at its
+// apparent velocity and its clock at its drift; over tens of milliseconds the neglected acceleration terms are
+// below a millimetre.
+SatelliteObservable shifted(SatelliteObservable sat, double dt) {
+  sat.r_sat_e += dt * sat.v_sat_e;
+  sat.sv_clock_m += dt * sat.sv_drift_mps;
+  return sat;
+}
+
+}  // namespace
+
+double code_discriminator_variance_chips2(double cn0_hz, double t_s, double spacing_chips) {
+  const double bn = 1.0 / (2.0 * t_s);
+  return bn * spacing_chips / (2.0 * cn0_hz) * (1.0 + 2.0 / ((2.0 - spacing_chips) * t_s * cn0_hz));
+}
+
+double costas_phase_variance_cycles2(double cn0_hz, double t_s) {
+  const double bn = 1.0 / (2.0 * t_s);
+  const double rad2 = bn / cn0_hz * (1.0 + 1.0 / (2.0 * t_s * cn0_hz));
+  return rad2 / (4.0 * M_PI * M_PI);
+}
+
+VectorState propagate(const VectorState& x, double dt) {
+  VectorState y = x;
+  y.segment<3>(vx::kPos) += dt * x.segment<3>(vx::kVel);
+  y(vx::kBias) += dt * x(vx::kDrift);
+  return y;
+}
+
+VectorState VectorProcessModel::f(const VectorState& x, double dt) const { return propagate(x, dt); }
+
+StateMatrix<8> VectorProcessModel::F(const VectorState&) const {
+  StateMatrix<8> F = StateMatrix<8>::Zero();
+  F.block<3, 3>(vx::kPos, vx::kVel).setIdentity();
+  F(vx::kBias, vx::kDrift) = 1.0;
+  return F;
+}
+
+Eigen::Matrix<double, 8, 5> VectorProcessModel::G(const VectorState&) const {
+  Eigen::Matrix<double, 8, 5> G = Eigen::Matrix<double, 8, 5>::Zero();
+  G.block<3, 3>(vx::kVel, 0).setIdentity();
+  G(vx::kBias, 3) = 1.0;
+  G(vx::kDrift, 4) = 1.0;
+  return G;
+}
+
+Eigen::Matrix<double, 5, 5> VectorProcessModel::Qc() const {
+  Eigen::Matrix<double, 5, 5> Q = Eigen::Matrix<double, 5, 5>::Zero();
+  const double c2 = kSpeedOfLight_mps * kSpeedOfLight_mps;
+  Q(0, 0) = Q(1, 1) = Q(2, 2) = noise.accel_psd_m2ps3;
+  Q(3, 3) = c2 * noise.h0 / 2.0;
+  Q(4, 4) = c2 * 2.0 * M_PI * M_PI * noise.h_minus2;
+  return Q;
+}
+
+VectorRangeMeasurement::VectorRangeMeasurement(const SatelliteObservable& sat, double delta_s, bool rate, double z,
+                                               double sigma)
+    : sat_(sat), delta_s_(delta_s), rate_(rate), z_(z), sigma_(sigma) {}
+
+Eigen::VectorXd VectorRangeMeasurement::h(const VectorState& x) const {
+  const VectorState m = propagate(x, -delta_s_);
+  const Eigen::Vector3d r = m.segment<3>(vx::kPos);
+  const double v = rate_ ? predicted_range_rate_mps(sat_, r, m.segment<3>(vx::kVel), m(vx::kDrift))
+                         : predicted_pseudorange_m(sat_, r, m(vx::kBias));
+  return Eigen::VectorXd::Constant(1, v);
+}
+
+MeasurementJacobian<8> VectorRangeMeasurement::H(const VectorState& x) const {
+  const VectorState m = propagate(x, -delta_s_);
+  const Eigen::Vector3d r = m.segment<3>(vx::kPos), v = m.segment<3>(vx::kVel);
+  const Eigen::Vector3d los = sat_.r_sat_e - r;
+  const double rho = los.norm();
+  const Eigen::Vector3d u = los / rho;
+  MeasurementJacobian<8> H = MeasurementJacobian<8>::Zero(1, 8);
+  Eigen::RowVector3d d_r, d_v;  // with respect to the back-propagated position and velocity
+  if (!rate_) {
+    d_r = -u.transpose();
+    d_v.setZero();
+    H(0, vx::kBias) = 1.0;
+    H(0, vx::kDrift) = -delta_s_;
+  } else {
+    // h = u.v_sat + (u.v)(u.w)/c - u.v + d - sv drift, w = v_sat + omega x r_sat (predicted_range_rate_mps).
+    const Eigen::Vector3d omega(0.0, 0.0, signals::kEarthRotationRate_radps);
+    const Eigen::Vector3d w = sat_.v_sat_e + omega.cross(sat_.r_sat_e);
+    const double c = kSpeedOfLight_mps;
+    const Eigen::Vector3d g = sat_.v_sat_e + (u.dot(w) / c) * v + (u.dot(v) / c) * w - v;  // dh/du
+    d_r = -(g.transpose() * (Eigen::Matrix3d::Identity() - u * u.transpose())) / rho;
+    d_v = (u * (u.dot(w) / c) - u).transpose();
+    H(0, vx::kDrift) = 1.0;
+  }
+  // Back-propagation: r_m = r - v delta, b_m = b - d delta.
+  H.block<1, 3>(0, vx::kPos) = d_r;
+  H.block<1, 3>(0, vx::kVel) = d_v - delta_s_ * d_r;
+  return H;
+}
+
+ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorState& x) {
+  ReplicaPrediction p;
+  const Eigen::Vector3d r = x.segment<3>(vx::kPos);
+  p.pseudorange_m = predicted_pseudorange_m(sat, r, x(vx::kBias));
+  p.pseudorange_rate_mps = predicted_range_rate_mps(sat, r, x.segment<3>(vx::kVel), x(vx::kDrift));
+  p.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 - p.pseudorange_rate_mps / kSpeedOfLight_mps);
+  p.doppler_hz = -p.pseudorange_rate_mps / signals::kL1Wavelength_m;
+  return p;
+}
+
+VectorTrackingFilter::VectorTrackingFilter(const VectorTrackingOptions& options) : opt_(options) {
+  model_.noise = opt_.process;
+}
+
+std::optional<SatelliteObservable> VectorTrackingFilter::observable(const receiver::VectorEpochInput& in, int prn,
+                                                                    std::int64_t sample, double pseudorange_m) const {
+  receiver::ObservationEpoch epoch;
+  epoch.receive_time = signals::add_seconds(in.receive_time, static_cast<double>(sample - in.sample) / in.fs_hz);
+  epoch.sample_index = sample;
+  receiver::Observation o;
+  o.prn = prn;
+  o.pseudorange_m = pseudorange_m;
+  o.doppler_hz = NAN;
+  o.cn0_dbhz = 45.0;
+  epoch.observations.push_back(o);
+  TightOptions t;
+  t.elevation_mask_rad = opt_.elevation_mask_rad;
+  t.ionosphere = opt_.ionosphere;
+  t.troposphere = opt_.troposphere;
+  t.use_range_rate = false;
+  static const signals::KlobucharParameters no_iono{};
+  const auto sats = prepare_satellites(epoch, *in.ephemerides, in.iono ? *in.iono : no_iono,
+                                       ekf_->x().segment<3>(vx::kPos), t);
+  if (sats.empty()) return std::nullopt;
+  return sats.front();
+}
+
+bool VectorTrackingFilter::initialise(const receiver::VectorEpochInput& in) {
+  const receiver::PvtSolution* fix = in.last_fix;
+  if (!fix || !fix->valid || !fix->velocity_valid) return false;
+  // The fix's bias against the clock as it reads now (the engine may have jumped it since the fix), and the fix's
+  // epoch by that clock: its GPS time plus that bias.
+  const double bias_m =
+      fix->clock_bias_m - kSpeedOfLight_mps * (in.clock_corrections_s - in.last_fix_clock_corrections_s);
+  const double dt = signals::seconds_between(in.receive_time, fix->time) - bias_m / kSpeedOfLight_mps;
+  if (!(std::abs(dt) < 1.0)) return false;
+  VectorState x;
+  x.segment<3>(vx::kPos) = fix->r_e_m + dt * fix->v_e_mps;
+  x.segment<3>(vx::kVel) = fix->v_e_mps;
+  x(vx::kBias) = bias_m + dt * fix->clock_drift_mps;
+  x(vx::kDrift) = fix->clock_drift_mps;
+  Eigen::Matrix<double, 8, 1> s;
+  s << Eigen::Vector3d::Constant(opt_.initial_sigma_pos_m), Eigen::Vector3d::Constant(opt_.initial_sigma_vel_mps),
+      opt_.initial_sigma_bias_m, opt_.initial_sigma_drift_mps;
+  EkfOptions e;
+  e.gate = opt_.gate;
+  ekf_.emplace(x, StateMatrix<8>(s.array().square().matrix().asDiagonal()), e);
+  sample_ = in.sample;
+  clock_corrections_s_ = in.clock_corrections_s;
+  starved_s_ = 0.0;
+  prn_.fill({});
+  ++initialisations_;
+  return true;
+}
+
+void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
+                                  std::span<receiver::VectorChannelCommand> commands) {
+  for (auto& c : commands) c = {};
+  if (!in.ephemerides) return;
+  double step_s = 0.0;
+  if (!ekf_) {
+    if (!initialise(in)) return;
+  } else {
+    if (in.clock_corrections_s != clock_corrections_s_) {  // the engine's clock jumped: so does the bias
+      VectorState x = ekf_->x();
+      x(vx::kBias) -= kSpeedOfLight_mps * (in.clock_corrections_s - clock_corrections_s_);
+      ekf_->set_x(x);
+      clock_corrections_s_ = in.clock_corrections_s;
+    }
+    const double dt = static_cast<double>(in.sample - sample_) / in.fs_hz;
+    if (dt > 0.0) ekf_->predict(model_, dt);
+    step_s = std::max(dt, 0.0);
+    sample_ = in.sample;
+  }
+  log_epoch_.channels.assign(in.channels.size(), VectorChannelLog{});
+
+  // Measurement updates, channel by channel (each gated on its own), in slot order.
+  int used = 0;
+  for (std::size_t i = 0; i < in.channels.size(); ++i) {
+    const receiver::VectorChannelInput& ch = in.channels[i];
+    VectorChannelLog& log = log_epoch_.channels[i];
+    log.prn = ch.prn;
+    log.cn0_dbhz = ch.cn0_dbhz;
+    log.replica_code_rate_chips_per_s = ch.code_rate_chips_per_s;
+    PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
+    const bool strong = std::isfinite(ch.cn0_dbhz) && ch.cn0_dbhz >= opt_.min_cn0_dbhz;
+    if (!ch.synchronised || !strong) st = {};
+    if (!ch.synchronised || !strong || !ch.has_measurement) continue;
+    const double cn0 = ratio_hz(ch.cn0_dbhz);
+    const auto now = observable(in, ch.prn, in.sample, ch.replica_pseudorange_m);
+    if (!now) {
+      st = {};
+      continue;
+    }
+    const double delta = static_cast<double>(in.sample - ch.measurement_sample) / in.fs_hz;
+    const SatelliteObservable sat = shifted(*now, -delta);
+    const double sigma_pr =
+        kChip_m * std::sqrt(code_discriminator_variance_chips2(cn0, ch.integration_time_s, opt_.code_spacing_chips));
+    const UpdateResult r = ekf_->update(VectorRangeMeasurement(sat, delta, false, ch.measured_pseudorange_m, sigma_pr));
+    log.pr_innovation_m = r.innovation.size() ? r.innovation(0) : NAN;
+    log.pr_sigma_m = sigma_pr;
+    log.pr_used = r.accepted;
+    if (r.accepted) {
+      ++st.accepted;
+      st.rejections = 0;
+      ++used;
+    } else {
+      ++st.rejections;
+    }
+    if (opt_.use_doppler && ch.has_doppler) {
+      {
+        const double delta_d = static_cast<double>(in.sample - ch.doppler_sample) / in.fs_hz;
+        const double sigma_hz = std::sqrt(2.0 * costas_phase_variance_cycles2(cn0, ch.integration_time_s)) /
+                                ch.doppler_interval_s;
+        const double sigma_rate = signals::kL1Wavelength_m * sigma_hz;
+        const double z = -signals::kL1Wavelength_m * ch.measured_doppler_hz;
+        const UpdateResult rr = ekf_->update(VectorRangeMeasurement(shifted(*now, -delta_d), delta_d, true, z, sigma_rate));
+        log.rate_innovation_mps = rr.innovation.size() ? rr.innovation(0) : NAN;
+        log.rate_sigma_mps = sigma_rate;
+        log.rate_used = rr.accepted;
+        log.measured_doppler_hz = ch.measured_doppler_hz;
+      }
+    }
+  }
+
+  // Too few satellites for an observable filter: after reset_after_s, restart from the next fix.
+  starved_s_ = used >= opt_.min_satellites ? 0.0 : starved_s_ + step_s;
+  log_epoch_.sample = in.sample;
+  if (starved_s_ > opt_.reset_after_s) {
+    ekf_.reset();
+    ++resets_;
+    return;  // every channel scalar
+  }
+
+  // Commands: the replica each channel should run from its next epoch start on.
+  int vector = 0;
+  for (std::size_t i = 0; i < in.channels.size(); ++i) {
+    const receiver::VectorChannelInput& ch = in.channels[i];
+    VectorChannelLog& log = log_epoch_.channels[i];
+    PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
+    if (!ch.synchronised || !std::isfinite(ch.cn0_dbhz) || ch.cn0_dbhz < opt_.min_cn0_dbhz) continue;
+    const double delta_e = static_cast<double>(ch.next_epoch_sample - in.sample) / in.fs_hz;
+    const auto now = observable(in, ch.prn, in.sample, ch.replica_pseudorange_m);
+    if (!now) continue;
+    const ReplicaPrediction p = predict_replica(shifted(*now, delta_e), propagate(ekf_->x(), delta_e));
+    log.predicted_doppler_hz = p.doppler_hz;
+    log.predicted_code_rate_chips_per_s = p.code_rate_chips_per_s;
+    if (st.rejections >= opt_.max_rejections) st.accepted = 0;  // back to scalar; it re-joins after new updates
+    if (st.accepted < opt_.join_after_updates) continue;
+    // The replica at its next epoch start, if left at its current code rate.
+    const double replica_m =
+        ch.replica_pseudorange_m + kSpeedOfLight_mps * (1.0 - ch.code_rate_chips_per_s / signals::kCaChipRate_hz) * delta_e;
+    const double jump = (replica_m - p.pseudorange_m) / kChip_m;  // replica too far away: advance it
+    log.code_jump_chips = jump;
+    if (!(std::abs(jump) <= opt_.max_jump_chips)) {
+      st.accepted = 0;
+      continue;
+    }
+    commands[i].vector = true;
+    commands[i].code_rate_chips_per_s = p.code_rate_chips_per_s;
+    commands[i].code_phase_jump_chips = jump;
+    if (opt_.carrier_aiding) commands[i].carrier_frequency_hz = p.doppler_hz;
+    log.vector = true;
+    ++vector;
+  }
+  if (log_) {
+    log_epoch_.receive_time = in.receive_time;
+    log_epoch_.x = ekf_->x();
+    log_epoch_.sigma = ekf_->P().diagonal().cwiseSqrt();
+    log_epoch_.used = used;
+    log_epoch_.vector = vector;
+    log_(log_epoch_);
+  }
+}
+
+}  // namespace ultratrack::fusion

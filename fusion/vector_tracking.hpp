@@ -1,0 +1,159 @@
+// Vector tracking without an IMU: an 8-state EKF (ECEF position, velocity, receiver clock bias and drift, in m,
+// m/s, m, m/s) with a constant-velocity process model (white acceleration) and a crystal clock model (Allan h0,
+// h-2), updated with every channel's code discriminator as a pseudorange error and its carrier Doppler as a
+// pseudorange rate, chi-square gated, noise from each channel's C/N0. From the state it predicts each channel's
+// replica (code rate incl. code Doppler, code phase at the next epoch start, carrier Doppler) from the
+// satellite's broadcast orbit and clock, and commands the channels through receiver::VectorLoop.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "fusion/ekf.hpp"
+#include "fusion/tight_measurements.hpp"
+#include "receiver/vector_loop.hpp"
+
+namespace ultratrack::fusion {
+
+namespace vx {  // state indices
+inline constexpr int kPos = 0, kVel = 3, kBias = 6, kDrift = 7;
+}  // namespace vx
+using VectorState = StateVector<8>;
+
+// Closed-form discriminator variances for one coherent integration of T seconds at carrier-to-noise density
+// cn0_hz (ratio-Hz). Both are the loop-jitter formulas of Kaplan & Hegarty (Understanding GPS, 2nd ed., ch. 5:
+// DLL sigma^2 = Bn d / (2 C/N0) (1 + 2 / ((2 - d) T C/N0)) chips^2 for the noncoherent early-minus-late
+// discriminator with E-L spacing d chips; PLL sigma^2 = Bn / (C/N0) (1 + 1 / (2 T C/N0)) rad^2 for the Costas
+// arctangent) with one independent discriminator output per T, i.e. Bn = 1 / (2 T).
+double code_discriminator_variance_chips2(double cn0_hz, double t_s, double spacing_chips);
+double costas_phase_variance_cycles2(double cn0_hz, double t_s);
+
+// White-acceleration PSD per ECEF axis and the clock's power-law coefficients (fractional frequency).
+struct VectorProcessNoise {
+  double accel_psd_m2ps3 = 2.0;  // ~1.4 m/s^2 rms over 1 s: a road or air vehicle's manoeuvres
+  // TCXO (Brown & Hwang, Introduction to Random Signals and Applied Kalman Filtering, table 9.2 / Groves 9.4.2):
+  // bias PSD c^2 h0 / 2, drift PSD c^2 2 pi^2 h-2.
+  double h0 = 2e-19;
+  double h_minus2 = 2e-20;
+};
+
+// xdot = F x + G w: r' = v, v' = a, b' = d + w_b, d' = w_d (exact discretisation, Ekf's Van Loan).
+struct VectorProcessModel {
+  static constexpr int kNoiseSize = 5;
+  VectorProcessNoise noise;
+  VectorState f(const VectorState& x, double dt) const;
+  StateMatrix<8> F(const VectorState&) const;
+  Eigen::Matrix<double, 8, 5> G(const VectorState&) const;
+  Eigen::Matrix<double, 5, 5> Qc() const;
+};
+
+// The state propagated by dt seconds (constant velocity and drift).
+VectorState propagate(const VectorState& x, double dt);
+
+// One pseudorange (rate = false) or pseudorange-rate (rate = true) measurement of a satellite (observable
+// prepared for the measurement's receive time), taken delta_s seconds before the state's time: the state is
+// propagated back by delta_s inside h. z in m or m/s, sigma its 1-sigma.
+class VectorRangeMeasurement {
+ public:
+  VectorRangeMeasurement(const SatelliteObservable& sat, double delta_s, bool rate, double z, double sigma);
+  Eigen::VectorXd z() const { return Eigen::VectorXd::Constant(1, z_); }
+  Eigen::VectorXd h(const VectorState& x) const;
+  MeasurementJacobian<8> H(const VectorState& x) const;
+  Eigen::MatrixXd R() const { return Eigen::MatrixXd::Constant(1, 1, sigma_ * sigma_); }
+
+ private:
+  SatelliteObservable sat_;
+  double delta_s_;
+  bool rate_;
+  double z_, sigma_;
+};
+
+// The replica a state implies for a satellite: pseudorange, its rate, and the code rate and carrier Doppler at
+// baseband (code rate 1.023 MHz (1 - rate / c), Doppler -rate / lambda_L1).
+struct ReplicaPrediction {
+  double pseudorange_m = 0.0;
+  double pseudorange_rate_mps = 0.0;
+  double code_rate_chips_per_s = 0.0;
+  double doppler_hz = 0.0;
+};
+ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorState& x);
+
+struct VectorTrackingOptions {
+  VectorProcessNoise process;
+  GateOptions gate{true, 0.9999};
+  double min_cn0_dbhz = 25.0;         // channels below are neither used nor commanded
+  double elevation_mask_rad = 5.0 * 3.14159265358979 / 180.0;
+  bool ionosphere = true, troposphere = true;  // as the receiver's PVT (the filter's clock absorbs the rest)
+  double code_spacing_chips = 1.0;    // E-L spacing of the channels (2 x early_late_offset_chips)
+  bool use_doppler = true;            // pseudorange-rate rows
+  bool carrier_aiding = true;         // the predicted Doppler's changes aid each vector channel's PLL
+  int join_after_updates = 25;        // accepted pseudorange updates (20 ms each) before a channel is commanded
+  int max_rejections = 10;            // consecutive gate rejections that return a channel to scalar
+  double max_jump_chips = 0.3;        // a prediction further than this from the replica returns it to scalar
+  int min_satellites = 4;             // fewer accepted channels for reset_after_s restarts the filter
+  double reset_after_s = 1.0;
+  double initial_sigma_pos_m = 10.0, initial_sigma_vel_mps = 0.5;
+  double initial_sigma_bias_m = 10.0, initial_sigma_drift_mps = 0.5;
+};
+
+// One channel's view of a vector epoch, for logs (vector.csv) and tests.
+struct VectorChannelLog {
+  int prn = 0;
+  bool vector = false;               // commanded in vector mode this epoch
+  bool pr_used = false, rate_used = false;  // measurement updates accepted
+  double pr_innovation_m = NAN, rate_innovation_mps = NAN;
+  double pr_sigma_m = NAN, rate_sigma_mps = NAN;
+  double measured_doppler_hz = NAN, predicted_doppler_hz = NAN;
+  double replica_code_rate_chips_per_s = NAN, predicted_code_rate_chips_per_s = NAN;
+  double code_jump_chips = NAN;
+  double cn0_dbhz = NAN;
+};
+struct VectorEpochLog {
+  std::int64_t sample = 0;
+  signals::GpsTime receive_time;
+  VectorState x = VectorState::Zero();
+  Eigen::Matrix<double, 8, 1> sigma = Eigen::Matrix<double, 8, 1>::Zero();
+  int used = 0;     // channels with an accepted pseudorange
+  int vector = 0;   // channels commanded
+  std::vector<VectorChannelLog> channels;
+};
+
+class VectorTrackingFilter final : public receiver::VectorLoop {
+ public:
+  explicit VectorTrackingFilter(const VectorTrackingOptions& options = {});
+
+  void update(const receiver::VectorEpochInput& epoch, std::span<receiver::VectorChannelCommand> commands) override;
+
+  bool initialised() const { return ekf_.has_value(); }
+  const VectorState& x() const { return ekf_->x(); }
+  const StateMatrix<8>& P() const { return ekf_->P(); }
+  int resets() const { return resets_; }
+  int initialisations() const { return initialisations_; }
+  // Called at the end of every update once the filter runs.
+  void set_log(std::function<void(const VectorEpochLog&)> log) { log_ = std::move(log); }
+
+ private:
+  struct PrnState {
+    int accepted = 0;     // pseudorange updates accepted since it (re)joined
+    int rejections = 0;   // consecutive rejections
+  };
+  std::optional<SatelliteObservable> observable(const receiver::VectorEpochInput& in, int prn, std::int64_t sample,
+                                                double pseudorange_m) const;
+  bool initialise(const receiver::VectorEpochInput& in);
+
+  VectorTrackingOptions opt_;
+  VectorProcessModel model_;
+  std::optional<Ekf<8>> ekf_;
+  std::int64_t sample_ = 0;
+  double clock_corrections_s_ = 0.0;
+  double starved_s_ = 0.0;
+  int resets_ = 0, initialisations_ = 0;
+  std::array<PrnState, 33> prn_{};
+  VectorEpochLog log_epoch_;
+  std::function<void(const VectorEpochLog&)> log_;
+};
+
+}  // namespace ultratrack::fusion

@@ -1,0 +1,84 @@
+// The seam for an external (vector) loop: at fixed sample boundaries (the vector epochs) the receiver engine hands
+// a VectorLoop every channel's latest correlation results, as pseudorange and Doppler measurements on the
+// receiver's clock, and the replica's state; the loop answers one VectorChannelCommand per channel, which the
+// channel applies through its NcoCommand at the start of its next epoch (code rate and a code phase jump; the
+// carrier stays with the channel's Costas PLL). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "receiver/pvt.hpp"
+#include "signals/ephemeris.hpp"
+#include "signals/gps_time.hpp"
+
+namespace ultratrack::receiver {
+
+// One channel as the engine sees it at a vector epoch.
+struct VectorChannelInput {
+  int slot = 0;
+  int prn = 0;
+  // Bit-synced (20 ms epochs), not lost, frame-synced with a transmit-time tag whose week is known: the replica's
+  // pseudorange can be formed. A channel that is not synchronised must be left scalar (VectorChannelCommand{}).
+  bool synchronised = false;
+  bool vector_mode = false;  // its code loop is closed by the VectorLoop now
+  double cn0_dbhz = NAN;     // NaN before the first estimate
+
+  // The replica at the epoch's sample: its pseudorange c (t_rx - t_tx) by the receiver clock and its code rate.
+  double replica_pseudorange_m = 0.0;
+  double code_rate_chips_per_s = 0.0;
+  double carrier_frequency_hz = 0.0;
+  // Receiver sample at which a command given now takes effect (the channel's next epoch start, >= the epoch's
+  // sample).
+  std::int64_t next_epoch_sample = 0;
+
+  // The latest correlation epoch completed since the previous vector epoch (has_measurement false: none).
+  bool has_measurement = false;
+  std::int64_t measurement_sample = 0;  // the middle of that correlation epoch
+  double integration_time_s = 0.0;
+  double code_error_chips = 0.0;         // early-minus-late discriminator: signal minus replica code phase
+  double replica_pseudorange_mid_m = 0.0;  // the replica's pseudorange at measurement_sample
+  double measured_pseudorange_m = 0.0;   // replica - code error x chip length
+  // Carrier Doppler over the two latest contiguous epochs (middle to middle): the replica's mean frequency plus
+  // the Costas phase change. Centred at doppler_sample; absent before two contiguous 20 ms epochs.
+  bool has_doppler = false;
+  double measured_doppler_hz = 0.0;
+  std::int64_t doppler_sample = 0;
+  double doppler_interval_s = 0.0;       // middle-to-middle time of the two epochs
+};
+
+struct VectorEpochInput {
+  std::int64_t sample = 0;           // the vector epoch, receiver sample index
+  double fs_hz = 0.0;
+  signals::GpsTime receive_time;     // by the receiver clock at `sample`
+  // Sum of the clock jumps the engine applied so far (ReceiverClock::correct): pseudoranges of later epochs are
+  // c x this shorter than before the jumps.
+  double clock_corrections_s = 0.0;
+  const std::vector<signals::Ephemeris>* ephemerides = nullptr;  // all known (supplied + decoded)
+  const signals::KlobucharParameters* iono = nullptr;
+  const PvtSolution* last_fix = nullptr;  // nullptr before the first fix
+  double last_fix_clock_corrections_s = 0.0;  // clock_corrections_s when last_fix was solved (before its jump)
+  std::span<const VectorChannelInput> channels;
+};
+
+// What the loop tells one channel. vector false: the channel's own DLL closes its code loop (scalar).
+struct VectorChannelCommand {
+  bool vector = false;
+  double code_rate_chips_per_s = 0.0;  // including code Doppler
+  double code_phase_jump_chips = 0.0;  // applied once at next_epoch_sample; positive advances the replica
+  // Carrier aiding: the predicted carrier Doppler at next_epoch_sample, Hz; its change from one command to the
+  // next is added to the channel's PLL (ScalarTracking::aid_frequency). NaN: no aiding.
+  double carrier_frequency_hz = NAN;
+};
+
+class VectorLoop {
+ public:
+  virtual ~VectorLoop() = default;
+  // Called on the engine's caller thread at every vector epoch with every occupied channel (in slot order);
+  // `commands` has one entry per input channel, default-initialised (scalar).
+  virtual void update(const VectorEpochInput& epoch, std::span<VectorChannelCommand> commands) = 0;
+};
+
+}  // namespace ultratrack::receiver

@@ -1,0 +1,282 @@
+// `ultratrack receive --coupling vector` end to end (issue 7, vector tracking without an IMU), short for CI:
+// `ultratrack simulate` writes 16 s of a static receiver at 45 dB-Hz (10 satellites, brdc0010.22n); both
+// receivers start hot with a nav file from which PRN 20's ephemeris is removed. The scalar run is the reference;
+// in the vector run every other channel must be handed to the filter after frame sync and the first fix and stay
+// in vector mode to the end, PRN 20 (no ephemeris) must stay scalar, no satellite may be lost, and the fixes and
+// the filter's own position must agree with the simulator's truth; one thread and several give the same bytes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+#include "solution_compare.hpp"
+#include "support/test_data.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+void run(const std::string& command, std::vector<std::string> args) {
+  ultratrack::test_support::run_command(command, std::move(args));
+}
+
+std::string slurp(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string f;
+  while (std::getline(s, f, ',')) out.push_back(f);
+  return out;
+}
+
+// A RINEX 2 nav file without one PRN's records (8 lines each, the PRN in columns 1-2 of the first).
+void drop_prn(const fs::path& in_path, const fs::path& out_path, int prn) {
+  std::ifstream in(in_path);
+  std::ofstream out(out_path);
+  std::string line;
+  bool header = true;
+  int skip = 0;
+  while (std::getline(in, line)) {
+    if (header) {
+      out << line << '\n';
+      header = line.find("END OF HEADER") == std::string::npos;
+      continue;
+    }
+    if (skip > 0) {
+      --skip;
+      continue;
+    }
+    const bool record_start = line.size() > 2 && line[1] != ' ';  // continuation lines start with spaces
+    if (record_start && std::stoi(line.substr(0, 2)) == prn) {
+      skip = 7;
+      continue;
+    }
+    out << line << '\n';
+  }
+}
+
+}  // namespace
+
+// Bounds. Scalar fixes at 45 dB-Hz are good to ~1 m (docs/validation.md); the vector-tracked pseudoranges carry
+// the filter's prediction errors (its position sigma ~0.6 m 3-D here) plus the code discriminator noise, so
+// 2 m 3-D RMS (issue 3's fix tolerance) and no more than 1 m above the scalar run (the scalar RMS over these
+// ~4 s of fixes varies by ~0.5 m with the noise seed). The filter's own position: 2 m RMS from 13.5 s on.
+TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsScalar) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "static.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 16.0\n"
+                                        "cn0_dbhz = 45.0\nseed = 4\n"
+                                        "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                        "[navigation]\nrinex = \""
+                                     << brdc.generic_string()
+                                     << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+                                        "[atmosphere]\nionosphere = true\ntroposphere = false\n";
+  const auto sim = dir / "sim", scalar = dir / "scalar", vector = dir / "vector";
+  run("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
+  constexpr int kNoEphemeris = 20;
+  drop_prn(brdc, dir / "nav.22n", kNoEphemeris);
+  for (const auto& [out, coupling] : {std::pair{scalar, "scalar"}, std::pair{vector, "vector"}})
+    run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
+                    (dir / "nav.22n").string(), "--troposphere", "off", "--coupling", coupling, "--out", out.string()});
+  // The vector loop runs on the caller's thread after the channels' parallel work: one thread gives the same bytes.
+  const auto one_thread = dir / "vector1";
+  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
+                  (dir / "nav.22n").string(), "--troposphere", "off", "--coupling", "vector", "--threads", "1", "--out",
+                  one_thread.string()});
+  fs::remove(sim / "antenna0.i8.bin");
+  for (const char* file : {"vector.csv", "vector_state.csv", "solution.csv", "tracking.csv"})
+    EXPECT_EQ(slurp(vector / file), slurp(one_thread / file)) << file << " differs between 1 thread and the default";
+
+  EXPECT_NE(slurp(vector / "summary.json").find("\"coupling\": \"vector\""), std::string::npos);
+  EXPECT_NE(slurp(scalar / "summary.json").find("\"coupling\": \"scalar\""), std::string::npos);
+
+  // Every satellite of the file acquired once and never lost, in both runs.
+  std::vector<int> prns;
+  {
+    std::ifstream sats(sim / "satellites.csv");
+    std::string line;
+    std::getline(sats, line);
+    while (std::getline(sats, line)) prns.push_back(std::stoi(line.substr(0, line.find(','))));
+  }
+  ASSERT_GE(prns.size(), 8u);
+  ASSERT_NE(std::find(prns.begin(), prns.end(), kNoEphemeris), prns.end());
+  for (const auto& out : {scalar, vector}) {
+    const std::string summary = slurp(out / "summary.json");
+    for (int prn : prns) {
+      const auto at = summary.find("{\"prn\": " + std::to_string(prn) + ",");
+      ASSERT_NE(at, std::string::npos) << out << " PRN " << prn << " not acquired";
+      EXPECT_EQ(summary.find("\"losses\": 0,", at), summary.find("\"losses\":", at)) << out << " PRN " << prn << " lost";
+    }
+  }
+
+  // vector.csv: per PRN, the first time in vector mode and whether it left vector mode afterwards.
+  std::map<int, double> first_vector;
+  std::map<int, bool> dropped;
+  std::map<int, int> rows;
+  {
+    std::ifstream in(vector / "vector.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      const auto f = split(line);
+      const double t = std::stod(f[1]);
+      const int prn = std::stoi(f[2]);
+      const bool v = f[3] == "1";
+      ++rows[prn];
+      if (v && !first_vector.count(prn)) first_vector[prn] = t;
+      if (!v && first_vector.count(prn)) dropped[prn] = true;
+    }
+  }
+  for (int prn : prns) {
+    EXPECT_GT(rows[prn], 0) << "PRN " << prn << " never handed to the filter";
+    if (prn == kNoEphemeris) {
+      EXPECT_EQ(first_vector.count(prn), 0u) << "PRN " << prn << " has no ephemeris but went vector";
+      continue;
+    }
+    ASSERT_TRUE(first_vector.count(prn)) << "PRN " << prn << " never in vector mode";
+    EXPECT_LT(first_vector[prn], 13.5) << "PRN " << prn;  // the first fix comes at ~12.1 s
+    EXPECT_FALSE(dropped[prn]) << "PRN " << prn << " fell back to scalar";
+  }
+
+  using namespace ultratrack::tools;
+  const auto truth = read_simulation_truth_csv(sim / "truth.csv");
+  const SolutionComparison s = compare_solution(read_solution_csv(scalar / "solution.csv"), truth);
+  const SolutionComparison v = compare_solution(read_solution_csv(vector / "solution.csv"), truth);
+  std::printf("static 45 dB-Hz, 16 s hot: scalar %d fixes, 3-D RMS %.3f m; vector %d fixes, 3-D RMS %.3f m\n", s.fixes,
+              s.rms_3d_m, v.fixes, v.rms_3d_m);
+  EXPECT_GE(v.fixes, 30);
+  EXPECT_LE(v.rms_3d_m, 2.0);
+  EXPECT_LE(v.rms_3d_m, s.rms_3d_m + 1.0);
+
+  // The filter's own position (vector_state.csv) against the static truth.
+  std::ifstream truth_in(sim / "truth.csv");
+  std::string line;
+  std::getline(truth_in, line);
+  std::getline(truth_in, line);
+  const auto t0 = split(line);
+  const double tx = std::stod(t0[3]), ty = std::stod(t0[4]), tz = std::stod(t0[5]);
+  std::ifstream state(vector / "vector_state.csv");
+  std::getline(state, line);
+  double sum2 = 0.0;
+  int n = 0;
+  while (std::getline(state, line)) {
+    const auto f = split(line);
+    if (std::stod(f[1]) < 13.5) continue;
+    const double dx = std::stod(f[4]) - tx, dy = std::stod(f[5]) - ty, dz = std::stod(f[6]) - tz;
+    sum2 += dx * dx + dy * dy + dz * dz;
+    ++n;
+  }
+  ASSERT_GT(n, 100);
+  std::printf("vector filter position: 3-D RMS %.3f m over %d epochs\n", std::sqrt(sum2 / n), n);
+  EXPECT_LE(std::sqrt(sum2 / n), 2.0);
+}
+
+// Dynamics (the issue's "keeps lock where scalar loops with their default bandwidths lose it"): 139 m/s straight,
+// then at 15 s a 2 g turn (8.09 deg/s) entered as a step. The step puts up to 19.6 m/s^2 (103 Hz/s) on the lines
+// of sight at once: the 5 Hz third-order PLL on 20 ms epochs needs several cycles of transient for that and every
+// scalar channel slips and is declared lost. In vector mode (handed over at ~13 s) each PLL is aided by the
+// filter's predicted Doppler, which all channels' measurements pull onto the turn within a few epochs: no
+// satellite may be lost and fixes must continue to the end, within 2 m 3-D RMS of the truth.
+TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "turn.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
+                                     "15.0,0.0,0.0,0.0,0.0\n5.0,0.0,8.09,0.0,0.0\n";
+  std::ofstream(dir / "turn.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 20.0\n"
+                                      "cn0_dbhz = 45.0\nseed = 4\n"
+                                      "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                      "[navigation]\nrinex = \""
+                                   << brdc.generic_string()
+                                   << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 1000.0]\n"
+                                      "[atmosphere]\nionosphere = true\ntroposphere = false\n"
+                                      "[trajectory]\nfile = \"turn.csv\"\nspeed_mps = 138.9\nheading_deg = 0.0\n";
+  const auto sim = dir / "sim", scalar = dir / "scalar", vector = dir / "vector";
+  run("simulate", {"--scenario", (dir / "turn.toml").string(), "--out", sim.string()});
+  for (const auto& [out, coupling] : {std::pair{scalar, "scalar"}, std::pair{vector, "vector"}})
+    run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
+                    brdc.string(), "--troposphere", "off", "--coupling", coupling, "--out", out.string()});
+  fs::remove(sim / "antenna0.i8.bin");
+
+  const auto losses = [](const fs::path& out) {
+    const std::string summary = slurp(out / "summary.json");
+    int total = 0, satellites = 0;
+    for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1)) {
+      total += std::stoi(summary.substr(at + 10));
+      ++satellites;
+    }
+    return std::pair{total, satellites};
+  };
+  const auto [scalar_losses, scalar_sats] = losses(scalar);
+  const auto [vector_losses, vector_sats] = losses(vector);
+  using namespace ultratrack::tools;
+  const auto truth = read_simulation_truth_csv(sim / "truth.csv");
+  const auto s_fixes = read_solution_csv(scalar / "solution.csv");
+  const auto v_fixes = read_solution_csv(vector / "solution.csv");
+  const SolutionComparison v = compare_solution(v_fixes, truth);
+  std::printf("2 g turn step at 15 s: scalar %d losses over %d satellites, %zu fixes; vector %d losses over %d "
+              "satellites, %zu fixes, 3-D RMS %.3f m\n",
+              scalar_losses, scalar_sats, s_fixes.size(), vector_losses, vector_sats, v_fixes.size(), v.rms_3d_m);
+  EXPECT_GE(vector_sats, 8);
+  EXPECT_GE(scalar_losses, scalar_sats / 2);  // the case is hard for the scalar loops
+  EXPECT_EQ(vector_losses, 0);
+  // Fixes at 10 Hz from ~12.1 s: the scalar ones stop in the turn, the vector ones continue to the end.
+  EXPECT_LT(s_fixes.size(), 55u);
+  EXPECT_GE(v_fixes.size(), 75u);
+  EXPECT_LE(v.rms_3d_m, 2.0);
+}
+
+// Hand-over in a turn: the 500 km/h circle of scenarios/circle_imu.toml (4.4 m/s^2 centripetal from the start),
+// which the scalar loops track without a loss. Each third-order PLL's frequency-rate integrator holds the line-of-
+// sight acceleration when its channel joins the vector loop; from then on the aiding brings it, so the integrator
+// must be cleared at the hand-over (counted twice, it lost 7 of 10 satellites within a second). Every satellite
+// kept to the end, fixes at 10 Hz from ~12.1 s, within 2 m 3-D RMS.
+TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "circle.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 20.0\n"
+                                        "cn0_dbhz = 45.0\nseed = 1\n"
+                                        "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                        "[navigation]\nrinex = \""
+                                     << brdc.generic_string()
+                                     << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 1000.0]\n"
+                                        "[atmosphere]\nionosphere = true\ntroposphere = false\n"
+                                        "[trajectory]\nprofile = \"circle\"\nduration_s = 20.0\nimu_rate_hz = 100.0\n";
+  const auto sim = dir / "sim", vector = dir / "vector";
+  run("simulate", {"--scenario", (dir / "circle.toml").string(), "--out", sim.string()});
+  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
+                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
+  fs::remove(sim / "antenna0.i8.bin");
+  const std::string summary = slurp(vector / "summary.json");
+  int satellites = 0;
+  for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1)) {
+    EXPECT_EQ(std::stoi(summary.substr(at + 10)), 0) << summary.substr(at - 200, 220);
+    ++satellites;
+  }
+  EXPECT_GE(satellites, 8);
+  using namespace ultratrack::tools;
+  const auto fixes = read_solution_csv(vector / "solution.csv");
+  const SolutionComparison v = compare_solution(fixes, read_simulation_truth_csv(sim / "truth.csv"));
+  std::printf("circle 500 km/h, vector: %zu fixes, 3-D RMS %.3f m\n", fixes.size(), v.rms_3d_m);
+  EXPECT_GE(fixes.size(), 75u);
+  EXPECT_LE(v.rms_3d_m, 2.0);
+}
+
+TEST(ReceiveVector, RejectsAnUnknownCoupling) {
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "x.bin", std::ios::binary) << std::string(400000, '\0');
+  EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
+                                   "--coupling", "ultra", "--out", (dir / "rx").string()}));
+}
