@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "scenario.hpp"
+#include "signals/input_error.hpp"
 #include "simulation.hpp"
 #include "support/test_data.hpp"
 
@@ -209,6 +210,23 @@ TEST(UltratightScenarios, TunnelBlockageSilencesTheReceiver) {
     else
       EXPECT_GT(power, 0.0) << "ms " << ms;
   }
+}
+
+// The segment-file keys the 10 g turn needs: echoed by to_toml, refused with a profile.
+TEST(UltratightScenarios, CoordinatedTurnsAndRampAreSegmentFileKeys) {
+  const Scenario s = read_scenario(scenarios_dir() / "ultratight_10g_turn.toml");
+  EXPECT_TRUE(s.coordinated_turns);
+  EXPECT_DOUBLE_EQ(s.ramp_s, 1.83);
+  const ins::TrajectorySpec spec = trajectory_spec(s);
+  EXPECT_TRUE(spec.coordinated_turns);
+  EXPECT_DOUBLE_EQ(spec.ramp_s, 1.83);
+  const Scenario echo = parse_scenario(to_toml(s), s.source);
+  EXPECT_TRUE(echo.coordinated_turns);
+  EXPECT_DOUBLE_EQ(echo.ramp_s, 1.83);
+  EXPECT_THROW(parse_scenario("[trajectory]\nprofile = \"circle\"\nduration_s = 10.0\nramp_s = 2.0\n", "x.toml"),
+               signals::InputError);
+  EXPECT_THROW(parse_scenario("[trajectory]\nfile = \"a.csv\"\nramp_s = -1.0\n", "x.toml"), signals::InputError);
+  EXPECT_THROW(parse_scenario("[trajectory]\nfile = \"a.csv\"\ncoordinated_turns = 1.0\n", "x.toml"), signals::InputError);
 }
 
 }  // namespace
