@@ -352,6 +352,13 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
           s.start_heading_deg = r.number(n, name);
           check_range(r, n, name, std::abs(s.start_heading_deg) <= 360, "must be within +-360 deg");
           start_state_given = true;
+        } else if (key == "coordinated_turns") {
+          s.coordinated_turns = r.boolean(n, name);
+          start_state_given = true;
+        } else if (key == "ramp_s") {
+          s.ramp_s = r.number(n, name);
+          check_range(r, n, name, s.ramp_s >= 0 && s.ramp_s <= 600, "must be within 0..600 s");
+          start_state_given = true;
         } else if (key == "odometer") {
           s.odometer = r.boolean(n, name);
         } else if (key == "odometer_scale_factor_error") {
@@ -409,7 +416,7 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
     if (!s.trajectory_file.empty() && duration_given)
       fail_file("key trajectory.duration_s: a segment file sets its own duration");
     if (s.trajectory_file.empty() && start_state_given)
-      fail_file("keys trajectory.speed_mps / heading_deg: only with a segment file");
+      fail_file("keys trajectory.speed_mps / heading_deg / coordinated_turns / ramp_s: only with a segment file");
     if (!s.trajectory.empty()) fail_file("key receiver.trajectory: not with a [trajectory] section");
     if (offsets_given)
       fail_file("key receiver.antenna_offsets_enu_m: with [trajectory] use [[antenna]] lever_arm_body_m");
@@ -521,8 +528,9 @@ std::string to_toml(const Scenario& s) {
       out += fmt::format("profile = {}\nduration_s = {}\n", toml_string(s.trajectory_profile),
                          toml_float(s.trajectory_duration_s));
     } else {
-      out += fmt::format("file = {}\nspeed_mps = {}\nheading_deg = {}\n", abs(s.trajectory_file),
-                         toml_float(s.start_speed_mps), toml_float(s.start_heading_deg));
+      out += fmt::format("file = {}\nspeed_mps = {}\nheading_deg = {}\ncoordinated_turns = {}\nramp_s = {}\n",
+                         abs(s.trajectory_file), toml_float(s.start_speed_mps), toml_float(s.start_heading_deg),
+                         s.coordinated_turns, toml_float(s.ramp_s));
     }
     out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                        s.odometer, toml_float(s.odometer_scale_factor_error));

@@ -18,7 +18,9 @@
 // Inertial scenarios (one trajectory drives the IMU data, the truth and the IF synthesiser's antennas):
 //   [trajectory]  profile = "circle"  (static, straight, circle, s, spiral, land)  or  file = "segments.csv"
 //                 (ins/trajectory.hpp's segment CSV, relative to the scenario; then speed_mps = 0.0 and
-//                 heading_deg = 0.0 give the start state and the file sets the duration)
+//                 heading_deg = 0.0 give the start state and the file sets the duration; coordinated_turns =
+//                 false banks into turns like an aircraft, ramp_s = 1.0 is the command blend time: a quintic
+//                 blend, so the peak jerk of a step da in acceleration is 15/8 da / ramp_s)
 //                 duration_s = 120.0 (profiles; must cover [signal] duration_s)  imu_rate_hz = 100.0 (50..1000)
 //                 odometer = false  odometer_scale_factor_error = 0.0   (odometer.csv; the land profile's use)
 //                 The start position is [receiver] llh_deg_m; t = 0 of the trajectory is the [time] start.
@@ -105,6 +107,8 @@ struct Scenario {
   double imu_rate_hz = 100.0;
   double start_speed_mps = 0.0;    // segment files only
   double start_heading_deg = 0.0;  // segment files only
+  bool coordinated_turns = false;  // segment files only: bank into turns (aircraft)
+  double ramp_s = 1.0;             // segment files only: command blend time at segment starts
   bool odometer = false;
   double odometer_scale_factor_error = 0.0;
 

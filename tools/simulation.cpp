@@ -121,6 +121,8 @@ ins::TrajectorySpec trajectory_spec(const Scenario& s) {
     start.height0_m = h;
     start.speed0_mps = s.start_speed_mps;
     start.heading0_rad = s.start_heading_deg * kDeg;
+    start.coordinated_turns = s.coordinated_turns;
+    start.ramp_s = s.ramp_s;
     const auto file = resolve_path(s, s.trajectory_file);
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
