@@ -204,8 +204,10 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log.cn0_dbhz = ch.cn0_dbhz;
     log.replica_code_rate_chips_per_s = ch.code_rate_chips_per_s;
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
-    const bool strong = std::isfinite(ch.cn0_dbhz) && ch.cn0_dbhz >= opt_.min_cn0_dbhz;
-    if (!ch.synchronised || !strong) st = {};
+    const bool strong = std::isfinite(ch.cn0_dbhz) && ch.cn0_dbhz >= opt_.min_cn0_dbhz && !ch.coasting;
+    // A faded channel the filter commands keeps its standing (it coasts, commanded below); others restart.
+    const bool joined = st.accepted >= opt_.join_after_updates && ch.vector_mode;
+    if (!ch.synchronised || (!strong && !joined)) st = {};
     if (!ch.synchronised || !strong || !ch.has_measurement) continue;
     const double cn0 = ratio_hz(ch.cn0_dbhz);
     const auto now = observable(in, ch.prn, in.sample, ch.replica_pseudorange_m);
@@ -247,7 +249,12 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
   // Too few satellites for an observable filter: after reset_after_s, restart from the next fix.
   starved_s_ = used >= opt_.min_satellites ? 0.0 : starved_s_ + step_s;
   log_epoch_.sample = in.sample;
-  if (starved_s_ > opt_.reset_after_s) {
+  // Channels coasting on the prediction: the filter propagates (their coast limits end it) rather than restart.
+  const bool holding = std::any_of(in.channels.begin(), in.channels.end(), [&](const receiver::VectorChannelInput& c) {
+    const PrnState& st = prn_[static_cast<std::size_t>(c.prn)];
+    return c.synchronised && c.vector_mode && st.accepted >= opt_.join_after_updates && st.coast_s < opt_.max_coast_s;
+  });
+  if (starved_s_ > opt_.reset_after_s && !holding) {
     ekf_.reset();
     ++resets_;
     return;  // every channel scalar
@@ -259,7 +266,13 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     const receiver::VectorChannelInput& ch = in.channels[i];
     VectorChannelLog& log = log_epoch_.channels[i];
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
-    if (!ch.synchronised || !std::isfinite(ch.cn0_dbhz) || ch.cn0_dbhz < opt_.min_cn0_dbhz) continue;
+    const bool strong = std::isfinite(ch.cn0_dbhz) && ch.cn0_dbhz >= opt_.min_cn0_dbhz && !ch.coasting;
+    if (!ch.synchronised || (!strong && st.accepted < opt_.join_after_updates)) continue;
+    // Coasting: no measurement to keep it honest, only the prediction (bounded in time and uncertainty).
+    const bool coasting = !strong || !log.pr_used;
+    st.coast_s = coasting ? st.coast_s + step_s : 0.0;
+    log.coasting = !strong;
+    log.coast_s = st.coast_s;
     const double delta_e = static_cast<double>(ch.next_epoch_sample - in.sample) / in.fs_hz;
     const auto now = observable(in, ch.prn, in.sample, ch.replica_pseudorange_m);
     if (!now) continue;
@@ -268,6 +281,17 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log.predicted_code_rate_chips_per_s = p.code_rate_chips_per_s;
     if (st.rejections >= opt_.max_rejections) st.accepted = 0;  // back to scalar; it re-joins after new updates
     if (st.accepted < opt_.join_after_updates) continue;
+    {  // predicted pseudorange 1-sigma: H = [-u 0 1 0]
+      const Eigen::Vector3d u = (now->r_sat_e - ekf_->x().segment<3>(vx::kPos)).normalized();
+      Eigen::Matrix<double, 1, 8> H = Eigen::Matrix<double, 1, 8>::Zero();
+      H.segment<3>(vx::kPos) = -u.transpose();
+      H(vx::kBias) = 1.0;
+      log.predicted_sigma_chips = std::sqrt((H * ekf_->P() * H.transpose())(0, 0)) / kChip_m;
+    }
+    if (!strong && (st.coast_s > opt_.max_coast_s || !(log.predicted_sigma_chips <= opt_.max_coast_sigma_chips))) {
+      st = {};  // coasted too long or too uncertain: released to re-acquisition
+      continue;
+    }
     // The replica at its next epoch start, if left at its current code rate.
     const double replica_m =
         ch.replica_pseudorange_m + kSpeedOfLight_mps * (1.0 - ch.code_rate_chips_per_s / signals::kCaChipRate_hz) * delta_e;

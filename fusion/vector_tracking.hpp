@@ -95,6 +95,13 @@ struct VectorTrackingOptions {
   double max_jump_chips = 0.3;        // a prediction further than this from the replica returns it to scalar
   int min_satellites = 4;             // fewer accepted channels for reset_after_s restarts the filter
   double reset_after_s = 1.0;
+  // Coasting: a channel in vector mode whose signal fades (C/N0 below min_cn0_dbhz, or the channel reports
+  // coasting) keeps being commanded from the prediction, without measurement updates, for at most max_coast_s
+  // and while the predicted pseudorange's 1-sigma (from the covariance) stays below max_coast_sigma_chips; then
+  // it is dropped (a coasting channel is then released to re-acquisition). While channels coast, a filter with
+  // fewer than min_satellites updates propagates instead of restarting.
+  double max_coast_s = 30.0;
+  double max_coast_sigma_chips = 0.5;
   double initial_sigma_pos_m = 10.0, initial_sigma_vel_mps = 0.5;
   double initial_sigma_bias_m = 10.0, initial_sigma_drift_mps = 0.5;
 };
@@ -110,6 +117,9 @@ struct VectorChannelLog {
   double replica_code_rate_chips_per_s = NAN, predicted_code_rate_chips_per_s = NAN;
   double code_jump_chips = NAN;
   double cn0_dbhz = NAN;
+  bool coasting = false;             // commanded from the prediction alone (faded or coasting)
+  double coast_s = 0.0;              // time since it last had a usable measurement while commanded
+  double predicted_sigma_chips = NAN;  // 1-sigma of the predicted pseudorange
 };
 struct VectorEpochLog {
   std::int64_t sample = 0;
@@ -139,6 +149,7 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   struct PrnState {
     int accepted = 0;     // pseudorange updates accepted since it (re)joined
     int rejections = 0;   // consecutive rejections
+    double coast_s = 0.0;  // commanded without a usable measurement (faded, coasting) this long
   };
   std::optional<SatelliteObservable> observable(const receiver::VectorEpochInput& in, int prn, std::int64_t sample,
                                                 double pseudorange_m) const;

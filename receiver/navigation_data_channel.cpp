@@ -7,6 +7,7 @@ NavigationDataChannel::NavigationDataChannel(int prn, int reference_week) : deco
 void NavigationDataChannel::reset() {
   frame_sync_.reset();
   tag_.reset();
+  holding_ = false;
 }
 
 bool NavigationDataChannel::take_new_ephemeris() {
@@ -20,9 +21,10 @@ void NavigationDataChannel::add_bit(float soft, std::int64_t first_code_period) 
   const auto out = frame_sync_.push(soft < 0.0f ? 1 : 0);
   if (!out) return;
   if (out->result.status != signals::LnavStatus::kOk) {
-    if (!frame_sync_.locked()) tag_.reset();
+    if (!frame_sync_.locked() && !holding_) tag_.reset();
     return;
   }
+  holding_ = false;
   decoder_.add(out->result.subframe);
   if (decoder_.last_update().ephemeris) new_ephemeris_ = true;
   polarity_ = out->result.subframe.inverted ? -1 : 1;

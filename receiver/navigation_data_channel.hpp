@@ -31,7 +31,10 @@ class NavigationDataChannel {
   // Forget the bit history (after loss of lock or a bit slip); the decoded data are kept.
   void reset();
 
-  bool synchronised() const { return frame_sync_.locked() && tag_.has_value(); }
+  // While held (the channel coasts on a vector loop's replica, whose code-period count keeps the bit timing),
+  // the time tag survives failed subframes and a dropped frame lock; the next good subframe renews it.
+  void hold_time_tag(bool hold) { if (hold) holding_ = true; }
+  bool synchronised() const { return (frame_sync_.locked() || holding_) && tag_.has_value(); }
   const std::optional<TransmitTimeTag>& time_tag() const { return tag_; }
   // +1 if the received bits are upright, -1 if inverted (resolves the Costas loop's half-cycle ambiguity).
   int polarity() const { return polarity_; }
@@ -47,6 +50,7 @@ class NavigationDataChannel {
   std::optional<TransmitTimeTag> tag_;
   int polarity_ = 1;
   bool new_ephemeris_ = false;
+  bool holding_ = false;
 };
 
 }  // namespace ultratrack::receiver

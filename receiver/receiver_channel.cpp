@@ -46,7 +46,10 @@ NcoCommand ReceiverChannel::merged_command() {
 void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   const bool was_vector = vector_.vector;
   vector_ = command;
-  if (vector_.vector && loop_.state() != TrackingState::kBitSynced) vector_ = {};
+  if (vector_.vector && loop_.state() != TrackingState::kBitSynced && !loop_.coasting()) vector_ = {};
+  // Only a channel whose replica the vector loop drives may coast; dropped from it while coasting, it is lost.
+  loop_.allow_coasting(vector_.vector);
+  nav_.hold_time_tag(loop_.coasting());
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
   // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
   // the command already computed for the next epoch (between epochs) gets it too.
@@ -72,6 +75,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   in.slot = slot;
   in.prn = prn();
   in.vector_mode = vector_.vector;
+  in.coasting = loop_.coasting();
   in.cn0_dbhz = loop_.cn0_dbhz().value_or(NAN);
   in.code_rate_chips_per_s = channel_.current_command().code_rate_chips_per_s;
   in.carrier_frequency_hz = channel_.current_command().carrier_frequency_hz;
@@ -92,7 +96,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   const ReplicaState replica = channel_.replica();
   in.replica_pseudorange_m = pseudorange(replica.sample_index, replica.code_period, replica.code_phase_chips);
   const EpochSummary& e = last_epoch_;
-  if (!fresh || !e.valid || !e.bit_synced || e.num_code_periods < 2) return in;
+  if (!fresh || !e.valid || !e.bit_synced || !e.signal_present || e.num_code_periods < 2) return in;
   const int half = e.num_samples / 2;
   in.has_measurement = true;
   in.measurement_sample = e.first_sample + half;
@@ -144,6 +148,17 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
   s.carrier_phase_end_cycles = e.carrier_phase_end_cycles;
   s.prompt = e.master().prompt;
   s.code_error_chips = report.code_error_chips;
+  // A fade shows in one epoch's prompt long before the C/N0 estimate (0.2 s window) follows: vector tracking
+  // takes no measurement from an epoch whose |P|^2 / mean |noise|^2 is below 1 + 10^(2.5) T (25 dB-Hz; noise
+  // alone passes with probability exp(-7.3) = 0.07 % at T = 20 ms; a 45 dB-Hz signal sits ~19 dB above it).
+  const double n2 = std::norm(std::complex<double>(e.master().noise));
+  if (e.num_code_periods != noise_periods_ || noise_power_ <= 0.0) {
+    noise_periods_ = e.num_code_periods;
+    noise_power_ = n2;
+  } else {
+    noise_power_ += 0.05 * (n2 - noise_power_);
+  }
+  s.signal_present = std::norm(std::complex<double>(s.prompt)) > (1.0 + 316.0 * e.integration_time_s) * noise_power_;
   last_epoch_new_ = true;
 }
 
@@ -165,6 +180,10 @@ TrackingRecord ReceiverChannel::record(const CorrelationEpoch& e, const Tracking
 
 std::optional<ChannelMeasurement> ReceiverChannel::measure() {
   if (!synchronised() || !(week_trusted_ || nav_.decoder().week_known())) return std::nullopt;
+  if (loop_.coasting()) {  // no signal: nothing measured; the track resumes as a new one (loss of lock)
+    reported_ = false;
+    return std::nullopt;
+  }
   const TransmitTimeTag& tag = *nav_.time_tag();
   const ReplicaState replica = channel_.replica();
   ChannelMeasurement m;

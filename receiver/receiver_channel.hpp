@@ -75,7 +75,8 @@ class ReceiverChannel {
         const CorrelationEpoch& e = channel_.epoch();
         const TrackingReport report = loop_.update(e);
         last_scalar_ = report.command;
-        if (report.state != TrackingState::kBitSynced) {  // vector mode only while bit-synced
+        // vector mode only while bit-synced or coasting on the vector loop's prediction
+        if (report.state != TrackingState::kBitSynced && report.state != TrackingState::kCoasting) {
           vector_ = {};
           previous_aid_hz_ = NAN;
         }
@@ -95,7 +96,12 @@ class ReceiverChannel {
   std::int64_t next_sample() const { return channel_.next_sample(); }
   std::optional<double> cn0_dbhz() const { return loop_.cn0_dbhz(); }
   // Synchronised: bit sync, frame sync and a transmit-time tag; measurement() is then available.
-  bool synchronised() const { return loop_.state() == TrackingState::kBitSynced && nav_.synchronised(); }
+  // Coasting channels stay synchronised (their bit edges and time tag are kept) but give no measurements.
+  bool synchronised() const {
+    return (loop_.state() == TrackingState::kBitSynced || loop_.state() == TrackingState::kCoasting) &&
+           nav_.synchronised();
+  }
+  bool coasting() const { return loop_.coasting(); }
   // The measurement at next_sample(); nothing unless synchronised() and the time tag's week is known.
   // Marks the track as reported.
   std::optional<ChannelMeasurement> measure();
@@ -130,7 +136,10 @@ class ReceiverChannel {
     double carrier_phase_start_cycles = 0.0, carrier_phase_end_cycles = 0.0;
     std::complex<float> prompt{};
     double code_error_chips = 0.0;
+    bool signal_present = false;  // this epoch's prompt power well above the noise tap's (see after_epoch)
   };
+  double noise_power_ = 0.0;  // running mean of |noise tap|^2 for the current epoch length
+  int noise_periods_ = 0;
   EpochSummary last_epoch_, previous_epoch_;
   bool last_epoch_new_ = false;
   VectorChannelCommand vector_;

@@ -104,6 +104,7 @@ const char* to_string(TrackingState s) {
     case TrackingState::kPhaseLocked: return "phase-locked";
     case TrackingState::kBitSynced: return "bit-synced";
     case TrackingState::kLost: return "lost";
+    case TrackingState::kCoasting: return "coasting";
   }
   return "?";
 }
@@ -203,7 +204,7 @@ double ScalarTracking::fine_fll(std::complex<float> prompt, double t_s, double* 
 }
 
 void ScalarTracking::aid_frequency(double delta_hz) {
-  if (state_ != TrackingState::kBitSynced || !std::isfinite(delta_hz)) return;
+  if ((state_ != TrackingState::kBitSynced && state_ != TrackingState::kCoasting) || !std::isfinite(delta_hz)) return;
   carrier_.reset(carrier_.frequency_hz() + delta_hz, carrier_.frequency_rate_hzps());
   command_.carrier_frequency_hz += delta_hz;
 }
@@ -211,6 +212,14 @@ void ScalarTracking::aid_frequency(double delta_hz) {
 void ScalarTracking::start_aiding() {
   if (state_ != TrackingState::kBitSynced) return;
   carrier_.reset(carrier_.frequency_hz(), 0.0);
+}
+
+void ScalarTracking::allow_coasting(bool allowed) {
+  coasting_allowed_ = allowed;
+  if (!allowed && state_ == TrackingState::kCoasting) {
+    state_ = TrackingState::kLost;
+    relocking_ = false;
+  }
 }
 
 TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
@@ -262,6 +271,8 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
     return r;
   }
 
+  if (state_ == TrackingState::kCoasting) return coast_epoch(e, r, true);
+
   // State machine.
   if (state_ == TrackingState::kPullIn) {
     // Phase lock can only be judged once the PLL runs (after the FLL stages) and the PLI has settled on it.
@@ -303,7 +314,12 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   const bool low_cn0 = cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
   const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
-  if (loss_time_s_ >= opt_.loss_of_lock_time_s) state_ = TrackingState::kLost;
+  if (loss_time_s_ >= opt_.loss_of_lock_time_s) {
+    const bool coast = coasting_allowed_ && state_ == TrackingState::kBitSynced;
+    state_ = coast ? TrackingState::kCoasting : TrackingState::kLost;
+    loss_time_s_ = 0.0;
+    if (coast) return coast_epoch(e, r, false);
+  }
   r.state = state_;
   if (state_ == TrackingState::kLost) {
     r.command = command_;  // coast on the last frequencies
@@ -353,6 +369,41 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   command_.carrier_frequency_hz = f;
   command_.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 + f / signals::kL1Frequency_hz) +
                                    dll_rate_correction_chips_per_s(r.code_error_chips, dll_bw);
+  r.command = command_;
+  return r;
+}
+
+// Coasting: the carrier holds the aided (predicted) frequency and the code the nominal rate at that frequency (the
+// vector loop's commands replace it) while the signal is gone; once the C/N0 estimate is back above the loss
+// threshold plus relock_margin_dbhz, an FLL-assisted Costas PLL starts from that frequency, and a PLI held for
+// pullin_lock_time_s ends coasting. Bits keep being assembled on the known bit edges (noise while faded).
+TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingReport& r, bool add_bit) {
+  const double t = e.integration_time_s;
+  const bool strong = cn0_dbhz_ && *cn0_dbhz_ >= opt_.cn0_loss_threshold_dbhz + opt_.relock_margin_dbhz;
+  if (strong && !relocking_) {
+    relocking_ = true;
+    locked_time_s_ = 0.0;
+    carrier_.reset(command_.carrier_frequency_hz, 0.0);
+    carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, opt_.relock_fll_bw_hz);
+    pli_.reset();
+  } else if (!strong && relocking_) {
+    relocking_ = false;  // faded again: hold the frequency the PLL reached
+  }
+  double f = command_.carrier_frequency_hz;
+  if (relocking_) {
+    f = carrier_.update(r.phase_error_cycles, r.frequency_error_hz, t);
+    locked_time_s_ = r.phase_locked ? locked_time_s_ + t : 0.0;
+    if (locked_time_s_ >= opt_.pullin_lock_time_s) {
+      state_ = TrackingState::kBitSynced;
+      relocking_ = false;
+      loss_time_s_ = 0.0;
+      carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
+    }
+  }
+  if (bits_ && add_bit) r.bit = bits_->add(e);
+  command_.carrier_frequency_hz = f;
+  command_.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 + f / signals::kL1Frequency_hz);
+  r.state = state_;
   r.command = command_;
   return r;
 }

@@ -76,6 +76,11 @@ struct ScalarTrackingOptions {
   double pli_lock_threshold = 0.7;     // PLI (cos 2 dphi) above this = phase locked; (0, 1)
   double pli_loss_threshold = 0.3;     // PLI below this (after lock) counts toward loss; [-1, pli_lock_threshold)
   double loss_of_lock_time_s = 0.3;    // continuous time with a loss condition before kLost; [0.02, 10]
+  // Coasting (allow_coasting): re-lock starts when the C/N0 estimate is this far above cn0_loss_threshold_dbhz;
+  // an FLL of relock_fll_bw_hz (20 ms cross/dot, +-12.5 Hz) assists the PLL until the PLI holds for
+  // pullin_lock_time_s.
+  double relock_margin_dbhz = 3.0;
+  double relock_fll_bw_hz = 2.0;
 };
 
 // Empty when the options are valid, else a message naming the first bad field, its value and its range.
@@ -89,6 +94,10 @@ enum class TrackingState {
   kPhaseLocked,  // Costas PLL, 1 ms epochs, bit sync running
   kBitSynced,    // 20 ms (coherent_ms) epochs, bits flowing
   kLost,         // lock lost: the command only coasts; re-acquire
+  // Lock lost while an external (vector) loop drives the replica: the carrier follows the loop's predicted
+  // Doppler (aid_frequency), the code its commands; bits keep their timing; when the C/N0 returns a Costas PLL
+  // with a frequency-error assist re-locks from the predicted frequency and the state goes back to kBitSynced.
+  kCoasting,
 };
 const char* to_string(TrackingState state);
 
@@ -123,6 +132,11 @@ class ScalarTracking final {
   // At the start of aiding: the loop's frequency-rate integrator (3rd order) holds the line-of-sight dynamics it
   // learnt alone; the aiding brings them from now on, so the integrator is cleared (else they count twice).
   void start_aiding();
+  // Coasting (vector tracking): while allowed, a loss of lock in kBitSynced enters kCoasting instead of kLost.
+  // Disallowing it while coasting declares the channel lost.
+  void allow_coasting(bool allowed);
+  bool coasting() const { return state_ == TrackingState::kCoasting; }
+  bool relocking() const { return relocking_; }
   std::optional<double> cn0_dbhz() const { return cn0_dbhz_; }
   double pli() const { return pli_.value(); }
   // Bit sync result (valid once state is kBitSynced or bit_synchronised()).
@@ -132,6 +146,7 @@ class ScalarTracking final {
  private:
   double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
   double search_frequency_offset_hz() const;
+  TrackingReport coast_epoch(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
 
   static constexpr int kMaxSearchEpochs = 500;
 
@@ -150,6 +165,7 @@ class ScalarTracking final {
   bool coherent_requested_ = false;
   double time_s_ = 0.0, locked_time_s_ = 0.0, loss_time_s_ = 0.0;
   bool ever_locked_ = false;
+  bool coasting_allowed_ = false, relocking_ = false;
   std::complex<float> previous_prompt_{};
   CrossDot fll_average_{};
   std::complex<double> fine_sum_{}, fine_previous_{};

@@ -24,6 +24,9 @@ struct VectorChannelInput {
   // pseudorange can be formed. A channel that is not synchronised must be left scalar (VectorChannelCommand{}).
   bool synchronised = false;
   bool vector_mode = false;  // its code loop is closed by the VectorLoop now
+  // Lock lost in vector mode: the replica follows the loop's commands alone (no measurements) until the signal
+  // returns and the channel re-locks, or the loop stops commanding it (it is then released as lost).
+  bool coasting = false;
   double cn0_dbhz = NAN;     // NaN before the first estimate
 
   // The replica at the epoch's sample: its pseudorange c (t_rx - t_tx) by the receiver clock and its code rate.

@@ -222,13 +222,16 @@ void run_receive(const ReceiveArgs& args) {
     fusion->finish(engine.stats().first_sample + engine.stats().samples_processed);
     run.extra_json = fusion->summary_json();
   }
-  if (vector) vector->finish();
+  if (vector) {
+    vector->finish();
+    run.extra_json = vector->summary_json();
+  }
   outputs.finish(engine, run);
   if (fusion) fusion->commit();
   if (vector)
     fmt::print("receive: vector tracking: {} epochs with channels in vector mode ({} channel-epochs), filter started "
-               "{} times, reset {} times\n", vector->vector_epochs(), vector->vector_channel_epochs(),
-               vector->filter().initialisations(), vector->filter().resets());
+               "{} times, reset {} times; {} channel-epochs coasting\n", vector->vector_epochs(), vector->vector_channel_epochs(),
+               vector->filter().initialisations(), vector->filter().resets(), vector->coasting_channel_epochs());
 
   const double t = receiver::processed_seconds(engine);
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,

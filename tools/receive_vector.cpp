@@ -21,7 +21,8 @@ ReceiveVector::ReceiveVector(const receiver::ReceiverOptions& options, const std
       state_(dir / "vector_state.csv") {
   channels_.stream() << "sample,time_s,prn,vector,cn0_dbhz,pr_used,pr_innovation_m,pr_sigma_m,rate_used,"
                         "rate_innovation_mps,rate_sigma_mps,measured_doppler_hz,predicted_doppler_hz,"
-                        "replica_code_rate_chips_per_s,predicted_code_rate_chips_per_s,code_jump_chips\n";
+                        "replica_code_rate_chips_per_s,predicted_code_rate_chips_per_s,code_jump_chips,coasting,coast_s,"
+                        "predicted_sigma_chips\n";
   state_.stream() << "sample,time_s,week,tow_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,clock_bias_m,clock_drift_mps,"
                      "sigma_x_m,sigma_y_m,sigma_z_m,sigma_vx_mps,sigma_vy_mps,sigma_vz_mps,sigma_bias_m,"
                      "sigma_drift_mps,used,vector\n";
@@ -35,10 +36,12 @@ void ReceiveVector::attach(receiver::ReceiverEngine& engine, double interval_s) 
 void ReceiveVector::log(const fusion::VectorEpochLog& e) {
   const double t = static_cast<double>(e.sample) / fs_hz_;
   for (const auto& c : e.channels)
-    fmt::print(channels_.stream(), "{},{:.3f},{},{:d},{:.2f},{:d},{:.3f},{:.3f},{:d},{:.4f},{:.4f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f}\n",
+    fmt::print(channels_.stream(), "{},{:.3f},{},{:d},{:.2f},{:d},{:.3f},{:.3f},{:d},{:.4f},{:.4f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:d},{:.3f},{:.4f}\n",
                e.sample, t, c.prn, c.vector, c.cn0_dbhz, c.pr_used, c.pr_innovation_m, c.pr_sigma_m, c.rate_used,
                c.rate_innovation_mps, c.rate_sigma_mps, c.measured_doppler_hz, c.predicted_doppler_hz,
-               c.replica_code_rate_chips_per_s, c.predicted_code_rate_chips_per_s, c.code_jump_chips);
+               c.replica_code_rate_chips_per_s, c.predicted_code_rate_chips_per_s, c.code_jump_chips, c.coasting,
+               c.coast_s, c.predicted_sigma_chips);
+  for (const auto& c : e.channels) coasting_channel_epochs_ += c.vector && c.coasting;
   const auto& x = e.x;
   const auto& s = e.sigma;
   fmt::print(state_.stream(),
@@ -48,6 +51,13 @@ void ReceiveVector::log(const fusion::VectorEpochLog& e) {
              s(1), s(2), s(3), s(4), s(5), s(6), s(7), e.used, e.vector);
   if (e.vector > 0) ++vector_epochs_;
   vector_channel_epochs_ += e.vector;
+}
+
+std::string ReceiveVector::summary_json() const {
+  return fmt::format("\"vector\": {{\"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
+                     "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}}}",
+                     vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_, filter_.initialisations(),
+                     filter_.resets());
 }
 
 void ReceiveVector::finish() {

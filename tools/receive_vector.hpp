@@ -30,6 +30,10 @@ class ReceiveVector {
   // Vector epochs so far with at least one channel in vector mode, and channel-epochs in vector mode.
   long long vector_epochs() const { return vector_epochs_; }
   long long vector_channel_epochs() const { return vector_channel_epochs_; }
+  // Channel-epochs commanded while coasting (faded: from the prediction alone).
+  long long coasting_channel_epochs() const { return coasting_channel_epochs_; }
+  // summary.json member: "vector": {epochs, channel-epochs in vector mode and coasting, filter starts, resets}.
+  std::string summary_json() const;
 
  private:
   void log(const fusion::VectorEpochLog& e);
@@ -37,7 +41,7 @@ class ReceiveVector {
   double fs_hz_;
   fusion::VectorTrackingFilter filter_;
   io::AtomicFile channels_, state_;
-  long long vector_epochs_ = 0, vector_channel_epochs_ = 0;
+  long long vector_epochs_ = 0, vector_channel_epochs_ = 0, coasting_channel_epochs_ = 0;
 };
 
 }  // namespace ultratrack::tools
