@@ -398,6 +398,7 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
       relocking_ = false;
       loss_time_s_ = 0.0;
       carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
+      carrier_.reset(carrier_.frequency_hz(), 0.0);  // the aiding brings the dynamics; pull-in noise goes
     }
   }
   if (bits_ && add_bit) r.bit = bits_->add(e);
