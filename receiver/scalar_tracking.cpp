@@ -384,15 +384,32 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
     relocking_ = true;
     locked_time_s_ = 0.0;
     carrier_.reset(command_.carrier_frequency_hz, 0.0);
-    carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, opt_.relock_fll_bw_hz);
+    carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
     pli_.reset();
+    relock_fll_ = {};
+    relock_s_ = 0.0;
   } else if (!strong && relocking_) {
     relocking_ = false;  // faded again: hold the frequency the PLL reached
   }
   double f = command_.carrier_frequency_hz;
   if (relocking_) {
-    f = carrier_.update(r.phase_error_cycles, r.frequency_error_hz, t);
-    locked_time_s_ = r.phase_locked ? locked_time_s_ + t : 0.0;
+    // Frequency error from the epoch's two halves (bit-edge free: +-1 / t, i.e. +-50 Hz at 20 ms, where the
+    // successive-epoch discriminator is bit-ambiguous beyond +-1 / (4 t) and would let the PLL lock 1 / t off).
+    const CrossDot cd = cross_dot(e.prompt_halves[0], e.prompt_halves[1]);
+    relock_fll_.cross += 0.5 * (cd.cross - relock_fll_.cross);
+    relock_fll_.dot += 0.5 * (cd.dot - relock_fll_.dot);
+    r.frequency_error_hz = std::atan2(relock_fll_.cross, relock_fll_.dot) / (kTwoPi * 0.5 * t);
+    relock_s_ += t;
+    if (relock_s_ <= opt_.relock_fll_time_s) {  // FLL alone first, then the PLL alone (as the pull-in)
+      f = carrier_.update_fll_only(r.frequency_error_hz, opt_.relock_fll_bw_hz, t);
+      if (relock_s_ + t > opt_.relock_fll_time_s) pli_.reset();
+    } else {
+      if (carrier_.fll_bw_hz() != opt_.relock_assist_bw_hz) carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, opt_.relock_assist_bw_hz);
+      f = carrier_.update(r.phase_error_cycles, r.frequency_error_hz, t);
+    }
+    // locked: the PLI holds and the frequency discriminator agrees (a PLL can hold a Costas lock 1 / t off)
+    const bool on_frequency = std::abs(r.frequency_error_hz) < 0.25 / t;
+    locked_time_s_ = relock_s_ > opt_.relock_fll_time_s && r.phase_locked && on_frequency ? locked_time_s_ + t : 0.0;
     if (locked_time_s_ >= opt_.pullin_lock_time_s) {
       state_ = TrackingState::kBitSynced;
       relocking_ = false;

@@ -77,10 +77,13 @@ struct ScalarTrackingOptions {
   double pli_loss_threshold = 0.3;     // PLI below this (after lock) counts toward loss; [-1, pli_lock_threshold)
   double loss_of_lock_time_s = 0.3;    // continuous time with a loss condition before kLost; [0.02, 10]
   // Coasting (allow_coasting): re-lock starts when the C/N0 estimate is this far above cn0_loss_threshold_dbhz;
-  // an FLL of relock_fll_bw_hz (20 ms cross/dot, +-12.5 Hz) assists the PLL until the PLI holds for
-  // pullin_lock_time_s.
+  // a first-order FLL of relock_fll_bw_hz (cross/dot of each epoch's two halves: +-50 Hz at 20 ms) alone for
+  // relock_fll_time_s, then the PLL assisted by that FLL at relock_assist_bw_hz until the PLI holds, with the
+  // FLL's error below 1 / (4 T), for pullin_lock_time_s.
   double relock_margin_dbhz = 3.0;
-  double relock_fll_bw_hz = 2.0;
+  double relock_fll_bw_hz = 6.0;
+  double relock_fll_time_s = 0.2;
+  double relock_assist_bw_hz = 2.0;
 };
 
 // Empty when the options are valid, else a message naming the first bad field, its value and its range.
@@ -166,6 +169,8 @@ class ScalarTracking final {
   double time_s_ = 0.0, locked_time_s_ = 0.0, loss_time_s_ = 0.0;
   bool ever_locked_ = false;
   bool coasting_allowed_ = false, relocking_ = false;
+  CrossDot relock_fll_{};
+  double relock_s_ = 0.0;
   std::complex<float> previous_prompt_{};
   CrossDot fll_average_{};
   std::complex<double> fine_sum_{}, fine_previous_{};
