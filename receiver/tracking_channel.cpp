@@ -218,10 +218,17 @@ TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, 
   rep.code_step_chips = code_.step();
   rep.carrier_phase_q32 = carrier_.fraction_q32();
   rep.carrier_step_q32 = carrier_.step_q32();
-  std::array<const std::complex<float>*, kMaxAntennas> ptr{};
-  for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = block.antenna[a] + offset;
-  engine_.correlate(std::span(ptr.data(), config_.num_antennas), m, rep,
-                    std::span(sums_[half].data(), config_.num_antennas));
+  if (block.i16_gain > 0.0) {
+    std::array<PlanarI16, kMaxAntennas> ptr{};
+    for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = {block.antenna_i16[a].re + offset, block.antenna_i16[a].im + offset};
+    engine_.correlate_i16(std::span(ptr.data(), config_.num_antennas), m, rep, 1.0 / block.i16_gain,
+                          std::span(sums_[half].data(), config_.num_antennas));
+  } else {
+    std::array<const std::complex<float>*, kMaxAntennas> ptr{};
+    for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = block.antenna[a] + offset;
+    engine_.correlate(std::span(ptr.data(), config_.num_antennas), m, rep,
+                      std::span(sums_[half].data(), config_.num_antennas));
+  }
   advance(m);
   if (nco_sample_ == epoch_end_) {
     finish_epoch();
