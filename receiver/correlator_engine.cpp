@@ -250,19 +250,21 @@ __attribute__((target("avx2,fma"), optimize("fp-contract=off"))) void correlate_
 // m = (n - 1) / 2 the chunk's centre and phi_c = phi0 + s m the NCO's phase there, so nothing accumulates
 // across chunks or calls. The table's step s_t is the NCO step s rounded to 2^-19 cycles per sample (a table
 // is rebuilt only when that moves, not every epoch): inside a chunk the replica's phase departs from the NCO's
-// by |s - s_t| |i - m| <= 2^-20 * 128 = 1.2e-4 cycles, zero at the centre (loss ~1e-7 dB). Loss from
+// by |s - s_t| |i - m| <= 2^-20 * 512 = 4.9e-4 cycles, zero at the centre (loss ~1e-6 dB). Loss from
 // quantisation: the table's rounding (0.5 / 32767 of amplitude) and the wipe-off's rounding to int16 (0.5 of a
 // sample scaled to ~2^11 rms) are noise ~70 dB below the input noise: < 0.01 dB measured on a clean signal
 // (test: CorrelatorEngine.IntegerKernelFollowsDirichletAndLosesUnder0p01Db), ~1e-6 dB in noise.
-// Code: chip index of tap t at sample i of a chunk = whole_t + ((F_t + S i) >> 24), F_t the 24-bit fraction of
-// the tap's code phase at the chunk start, S = round(step * 2^24) (< 2^24 * 0.99). Taps a whole number of chips
+// Code: chip index of tap t at sample i of a chunk = whole_t + ((F_t + S i) >> 22), F_t the 22-bit fraction of
+// the tap's code phase at the chunk start, S = round(step * 2^22) <= 0.99 * 2^22, so F_t + S i < 2^22 (1 + 0.99 *
+// 1023) < 2^32 over a 1024-sample chunk (index error < 1024 * 2^-23 = 1.2e-4 chips, reset each chunk). Taps a whole number of chips
 // apart (early/late at +-0.5; prompt and the noise tap) have the same F_t and share one index computation.
 // Sums: w * chip with |w| <= 32767 per component (saturating wipe-off), so one chunk's int32 lane sums stay
-// below 16 * 2 * 32768 = 2^20 (AVX2: 16 pmaddwd per lane per chunk) and the int64 totals below 2^23: no
+// below 64 * 2 * 32768 = 2^22 (AVX2: 64 pmaddwd per lane per chunk) and the int64 totals below 2^25: no
 // overflow. Integer sums are exact, so both copies give bit-identical results (the double finish is shared).
 
 constexpr int kChunkI16 = CorrelatorEngine::Rotation::kChunk;
-constexpr double kQ24 = 16777216.0;
+constexpr int kFracBits = 22;
+constexpr double kQ24 = 4194304.0;  // 2^kFracBits
 constexpr std::uint32_t kTableStepQuantum = 1u << 13;  // 2^-19 cycles per sample, in 2^-32 units
 
 std::uint32_t table_step(std::uint32_t step_q32) {
@@ -292,7 +294,7 @@ __attribute__((noinline)) void build_rotation(std::uint32_t step_q32, Correlator
   r.valid = true;
 }
 
-// Per chunk and tap: the whole chip index (into the table) and the 24-bit fraction at the chunk's first sample.
+// Per chunk and tap: the whole chip index (into the table) and the 22-bit fraction at the chunk's first sample.
 __attribute__((noinline)) void chunk_taps(const ReplicaSegment& rep, const double* offsets, int num_taps, int start,
                                           int* whole, std::uint32_t* frac_q24) {
   const double code0 = rep.code_phase_chips + rep.code_step_chips * start + 2 * kCodeLength;  // table origin
@@ -325,7 +327,7 @@ ULTRATRACK_ALWAYS_INLINE void mac_sample(std::int32_t xr, std::int32_t xi, std::
   const std::int32_t wr = sat16(mulhrs(xr, rr) + mulhrs(xi, ri));  // x * conj(r)
   const std::int32_t wi = sat16(mulhrs(xi, rr) - mulhrs(xr, ri));
   for (int t = 0; t < num_taps; ++t) {
-    const std::int32_t chip = table[whole[t] + static_cast<int>((frac[t] + step_q24 * static_cast<std::uint32_t>(i)) >> 24)];
+    const std::int32_t chip = table[whole[t] + static_cast<int>((std::uint64_t{frac[t]} + std::uint64_t{step_q24} * static_cast<std::uint64_t>(i)) >> kFracBits)];  // 64-bit: any step
     re[t] += wr * chip;
     im[t] += wi * chip;
   }
@@ -405,10 +407,10 @@ __attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* t
             first[t] = first[leader[t]];
           } else {
             const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
-            first[t] = static_cast<int>(p >> 24);
-            const __m256i q = _mm256_set1_epi32(static_cast<int>(p & 0xFFFFFFu));
-            const __m256i lo = _mm256_srli_epi32(_mm256_add_epi32(q, lanes_lo), 24);
-            const __m256i hi = _mm256_srli_epi32(_mm256_add_epi32(q, lanes_hi), 24);
+            first[t] = static_cast<int>(p >> kFracBits);
+            const __m256i q = _mm256_set1_epi32(static_cast<int>(p & ((1u << kFracBits) - 1)));
+            const __m256i lo = _mm256_srli_epi32(_mm256_add_epi32(q, lanes_lo), kFracBits);
+            const __m256i hi = _mm256_srli_epi32(_mm256_add_epi32(q, lanes_hi), kFracBits);
             const __m256i w16 = _mm256_permute4x64_epi64(_mm256_packus_epi32(lo, hi), 0xD8);  // natural order
             rel[t] = _mm_packus_epi16(_mm256_castsi256_si128(w16), _mm256_extracti128_si256(w16, 1));
           }

@@ -76,7 +76,7 @@ class CorrelatorEngine final {
   // The carrier rotation over one chunk of the integer kernel, Q15, for one carrier step (cached: the two
   // halves of an epoch and every antenna share it).
   struct Rotation {
-    static constexpr int kChunk = 256;
+    static constexpr int kChunk = 1024;
     alignas(32) std::int16_t re[kChunk];
     alignas(32) std::int16_t im[kChunk];
     std::uint32_t step_q32 = 0;
