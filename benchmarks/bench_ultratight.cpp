@@ -26,6 +26,7 @@ void run(benchmark::State& state, fusion::FilterKind filter, fusion::UltraTightF
   opt.model = fusion::error_model_from_preset(ins::imu_preset("hg1700ae"));
   opt.gps_time_origin = origin;
   opt.gate.enabled = false;
+  opt.tight.elevation_mask_rad = 0.0;  // enough satellites for 8 at this place and time
   fusion::UltraTightIntegration probe(nav, constellation.ephemerides, opt);
   std::vector<signals::Ephemeris> eph;
   for (const auto& r : probe.start_period(0.02))
