@@ -35,6 +35,11 @@ void expect_closed_loop(const CorrelationRunResult& r, const char* what) {
   for (int a = 0; a < 3; ++a) EXPECT_LT(std::abs(r.pos_err_m.back()(a)), 4.0 * r.sigma_pos_m.back()(a)) << what;
   // Nearly every update passes the innovation gate (a few may be refused in the first periods).
   EXPECT_GE(r.counters.accepted, r.counters.updates * 99 / 100) << what;
+  double ss = 0.0;
+  int n = 0;
+  for (std::size_t i = 0; i < r.t_s.size(); ++i)
+    if (r.t_s[i] >= 1.0) ss += r.pos_err_m[i].squaredNorm(), ++n;
+  std::printf("%s: 3-D position RMS after 1 s %.3f m\n", what, std::sqrt(ss / std::max(n, 1)));
   std::printf("%s: sats %d, code max %.4f chip, freq max %.3f Hz, pos err %.3f m (sigma %.3f m), cpu %.3f s\n", what,
               r.satellites, max_from(r.max_code_err_chips, r.t_s, 0.2), max_from(r.max_freq_err_hz, r.t_s, 0.2),
               r.pos_err_m.back().norm(), r.sigma_pos_m.back().norm(), r.cpu_s);
