@@ -38,7 +38,10 @@ void expect_closed_loop(const CorrelationRunResult& r, const char* what) {
   double ss = 0.0;
   int n = 0;
   for (std::size_t i = 0; i < r.t_s.size(); ++i)
-    if (r.t_s[i] >= 1.0) ss += r.pos_err_m[i].squaredNorm(), ++n;
+    if (r.t_s[i] >= 1.0) {
+      ss += r.pos_err_m[i].squaredNorm();
+      ++n;
+    }
   std::printf("%s: 3-D position RMS after 1 s %.3f m\n", what, std::sqrt(ss / std::max(n, 1)));
   std::printf("%s: sats %d, code max %.4f chip, freq max %.3f Hz, pos err %.3f m (sigma %.3f m), cpu %.3f s\n", what,
               r.satellites, max_from(r.max_code_err_chips, r.t_s, 0.2), max_from(r.max_freq_err_hz, r.t_s, 0.2),
@@ -66,7 +69,7 @@ void nees_monte_carlo(FilterKind f, int runs) {
   for (int k = 0; k < runs; ++k) {
     CorrelationSimConfig cfg;
     cfg.filter = f;
-    cfg.duration_s = 4.0;
+    cfg.duration_s = std::getenv("ULTRATRACK_NEES_DURATION_S") ? std::atof(std::getenv("ULTRATRACK_NEES_DURATION_S")) : 4.0;
     cfg.seed = 100 + k;
     sum += run_correlation_simulation(cfg).nees.back();
   }
@@ -86,7 +89,7 @@ int nees_runs() {
 // KNOWN FAILURE, disabled so CI stays green (run with --gtest_also_run_disabled_tests): the filter is
 // overconfident by about 1.5x (mean NEES ~26 for 17 dof; docs/validation.md, issue 7 section). Cause not yet
 // found (suspects: mm/s-level range-rate terms the model leaves out against the ~5 mm/s velocity sigma the
-// I&Q frequency information reaches; the initial transient in 4 s runs).
+// I&Q frequency information reaches; NEES grows with run length: 19.7 at 1 s, 26 at 4 s, 43 at 8 s).
 TEST(UltraTight, DISABLED_NeesMonteCarloEkf) { nees_monte_carlo(FilterKind::Ekf, nees_runs()); }
 TEST(UltraTight, DISABLED_NeesMonteCarloUkf) { nees_monte_carlo(FilterKind::Ukf, nees_runs()); }
 
@@ -133,7 +136,9 @@ TEST(UltraTight, WeakSignalLockAtCorrelationLevel) {
     const bool lock = code < 0.5 && freq < 25.0;
     std::printf("C/N0 %.0f dB-Hz: code max %.3f chip, freq max %.2f Hz, pos err %.2f m -> %s\n", cn0, code, freq,
                 r.pos_err_m.back().norm(), lock ? "lock" : "lost");
-    if (cn0 >= 25.0) EXPECT_TRUE(lock) << cn0;
+    if (cn0 >= 25.0) {
+      EXPECT_TRUE(lock) << cn0;
+    }
   }
 }
 
