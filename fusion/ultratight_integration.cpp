@@ -202,10 +202,16 @@ class UltraTightCore final : public UltraTightCoreBase {
       // prediction over the period: range at mid-period and mean rate, the rate taken as varying linearly
       // between the start prediction and this one (line-of-sight acceleration: up to ~0.2 Hz over 10 ms at
       // 4 m/s^2, not negligible against the 0.45 Hz I&Q frequency noise at 45 dB-Hz).
+      // The prediction with the nominal as it stands now (earlier satellites of this period have updated it).
+      const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
+      const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
+                                    antenna_velocity_n(nominal_.nav, w_ib_b_, opt_.lever_arm_b);
+      const double pr_now = predicted_pseudorange_m(*s, r_ant, nominal_.clock_bias_m);
+      const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
       const double back = nominal_.nav.t_s - (r.t_start_s + 0.5 * T_);
-      const double mean_rate = 0.5 * (r.range_rate_mps + s->range_rate_mps);
+      const double mean_rate = 0.5 * (r.range_rate_mps + rr_now);
       const Eigen::Vector2d offset(r.pseudorange_m + r.range_rate_mps * 0.5 * T_ -
-                                       (s->pseudorange_m - 0.5 * (mean_rate + s->range_rate_mps) * back),
+                                       (pr_now - 0.5 * (mean_rate + rr_now) * back),
                                    r.range_rate_mps - mean_rate);
       IqSettings is;
       is.cn0_dbhz = c->cn0_dbhz;
