@@ -5,6 +5,9 @@
 // No allocation, no exceptions per call. Two copies chosen once at run time from the CPU's features: portable
 // C++ written for auto-vectorisation (baseline x86-64), and AVX2+FMA intrinsics with the code fill fused into the
 // multiply-accumulate loop (same chip indices as the portable copy; sums equal to float rounding).
+// An integer copy (correlate_i16) takes planar int16 samples: int16 carrier wipe-off against a Q15 rotation
+// table, +-1 chips from one index computation per group of taps a whole number of chips apart, pmaddwd-style
+// multiply-adds into int32, and the chunk's exact carrier phase applied to the sums afterwards (see the .cpp).
 #pragma once
 
 #include <array>
@@ -38,6 +41,12 @@ struct ReplicaSegment {
 // Sums per tap (in the order of the engine's offsets) for one antenna.
 using TapSums = std::array<std::complex<double>, kMaxTaps>;
 
+// One antenna's block of samples as planar int16 (in-phase and quadrature arrays), for the integer kernel.
+struct PlanarI16 {
+  const std::int16_t* re = nullptr;
+  const std::int16_t* im = nullptr;
+};
+
 class CorrelatorEngine final {
  public:
   // tap_offsets_chips: code offset of each tap relative to prompt, chips, |offset| <= 1023 (positive = early:
@@ -52,18 +61,45 @@ class CorrelatorEngine final {
   void correlate(std::span<const std::complex<float>* const> antennas, int num_samples, const ReplicaSegment& replica,
                  std::span<TapSums> sums) const;
 
+  // The integer kernel: the same correlations from int16 samples, added to sums times `scale` (1 / the gain
+  // that made the int16 samples, so the sums are in the float kernel's units). Loss against the float kernel
+  // < 0.01 dB (Q15 carrier, see the .cpp); AVX2 and portable copies give bit-identical sums. Samples should
+  // stay within +-16384 per component (larger ones saturate in the wipe-off, never wrap).
+  // Not safe to call concurrently on one engine (a carrier rotation table is cached per carrier step).
+  void correlate_i16(std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& replica, double scale,
+                     std::span<TapSums> sums) const;
+
  public:
   // One instruction-set-specific copy of the kernel for this engine's tap count, picked at construction.
   using Kernel = void (*)(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
                           int num_samples, const ReplicaSegment& replica, std::span<TapSums> sums);
+  // The carrier rotation over one chunk of the integer kernel, Q15, for one carrier step (cached: the two
+  // halves of an epoch and every antenna share it).
+  struct Rotation {
+    static constexpr int kChunk = 1024;
+    alignas(32) std::int16_t re[kChunk];
+    alignas(32) std::int16_t im[kChunk];
+    std::uint32_t step_q32 = 0;
+    bool valid = false;
+  };
+  using KernelI16 = void (*)(const std::int8_t* table, const double* offsets, int num_taps,
+                             std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& replica,
+                             const Rotation& rotation, double scale, std::span<TapSums> sums);
 
  private:
   int prn_;
   int num_taps_;
   std::array<double, kMaxTaps> offsets_{};
   std::vector<float> table_;  // 5 code periods of +1/-1 chips (float: no conversion per sample): index = chip + 2046
+  std::vector<std::int8_t> table_i8_;  // the same chips as int8 (the integer kernel's byte shuffles)
   Kernel kernel_ = nullptr;
+  KernelI16 kernel_i16_ = nullptr;
+  mutable Rotation rotation_;
 };
+
+// Converts complex float samples to planar int16: round(x * gain), saturated to int16. AVX2 where the CPU has
+// it (same results as the portable loop: round to nearest even in both). Allocates nothing.
+void convert_to_planar_i16(const std::complex<float>* in, int n, float gain, std::int16_t* re, std::int16_t* im);
 
 // A lag (chips, -723..-300: the noise replica lags prompt) where this PRN's periodic autocorrelation is -1/1023 at that lag and its two neighbours
 // on each side: a replica shifted by it sees noise only, whatever the fractional code error. Throws for bad PRNs.

@@ -189,6 +189,11 @@ class ReceiverEngine {
   // Multi-antenna: the other antennas' samples of the block being processed, and the phases of each epoch.
   std::array<const std::complex<float>*, kMaxAntennas> antenna_block_{};
   std::int64_t antenna_block_first_ = 0;
+  // Integer correlator: the gain to int16 (0 until the cold start's snapshot fixes it) and the int16 copy of
+  // the part being fed (I then Q per antenna; grown once to the largest part).
+  float i16_gain_ = 0.0f;
+  std::vector<std::int16_t> i16_block_;
+  void convert_part_to_i16(int n);
   AntennaPhaseEpoch antenna_epoch_;
   // Vector tracking (set_vector_loop).
   VectorLoop* vector_loop_ = nullptr;

@@ -232,14 +232,24 @@ TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, 
   rep.code_step_chips = code_.step();
   rep.carrier_phase_q32 = carrier_.fraction_q32();
   rep.carrier_step_q32 = carrier_.step_q32();
-  std::array<const std::complex<float>*, kMaxAntennas> ptr{};
-  for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = block.antenna[a] + offset;
   // One pass over the block per engine: the master with every tap, then the slaves with prompt (and noise).
   const auto engine_antennas = static_cast<std::size_t>(slave_engine_ ? 1 : config_.num_antennas);
-  engine_.correlate(std::span(ptr.data(), engine_antennas), m, rep, std::span(sums_[half].data(), engine_antennas));
-  if (slave_engine_) {
-    const auto slaves = static_cast<std::size_t>(config_.num_antennas - 1);
-    slave_engine_->correlate(std::span(ptr.data() + 1, slaves), m, rep, std::span(sums_[half].data() + 1, slaves));
+  const auto slaves = static_cast<std::size_t>(config_.num_antennas - 1);
+  if (block.i16_gain > 0.0) {
+    std::array<PlanarI16, kMaxAntennas> ptr{};
+    for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = {block.antenna_i16[a].re + offset, block.antenna_i16[a].im + offset};
+    const double scale = 1.0 / block.i16_gain;
+    engine_.correlate_i16(std::span(ptr.data(), engine_antennas), m, rep, scale,
+                          std::span(sums_[half].data(), engine_antennas));
+    if (slave_engine_)
+      slave_engine_->correlate_i16(std::span(ptr.data() + 1, slaves), m, rep, scale,
+                                   std::span(sums_[half].data() + 1, slaves));
+  } else {
+    std::array<const std::complex<float>*, kMaxAntennas> ptr{};
+    for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = block.antenna[a] + offset;
+    engine_.correlate(std::span(ptr.data(), engine_antennas), m, rep, std::span(sums_[half].data(), engine_antennas));
+    if (slave_engine_)
+      slave_engine_->correlate(std::span(ptr.data() + 1, slaves), m, rep, std::span(sums_[half].data() + 1, slaves));
   }
   advance(m);
   if (nco_sample_ == epoch_end_) {

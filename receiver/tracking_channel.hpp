@@ -68,6 +68,10 @@ struct SampleBlockView {
   int num_samples = 0;
   int num_antennas = 1;
   std::array<const std::complex<float>*, kMaxAntennas> antenna{};
+  // The same samples as planar int16 times i16_gain, when i16_gain > 0: the channel then uses the integer
+  // correlator (CorrelatorEngine::correlate_i16) on them instead of the float samples.
+  std::array<PlanarI16, kMaxAntennas> antenna_i16{};
+  double i16_gain = 0.0;
 };
 
 class TrackingChannel final {

@@ -21,6 +21,11 @@ std::optional<std::filesystem::path> shared_data_dir() {
   return std::nullopt;
 }
 
+std::filesystem::path scenarios_dir() {
+  if (const char* env = std::getenv("ULTRATRACK_SCENARIOS"); env && *env) return env;
+  return ULTRATRACK_SCENARIOS_DIR;
+}
+
 namespace {
 
 // Folders made for a whole test suite (SetUpTestSuite) are private to this process: ctest runs each test in its

@@ -8,6 +8,8 @@ namespace ultratrack::test {
 
 // The folder of shared real recordings (../shared/data), or nothing when it is absent.
 std::optional<std::filesystem::path> shared_data_dir();
+// The checkout's scenarios/ folder (ULTRATRACK_SCENARIOS in the environment overrides).
+std::filesystem::path scenarios_dir();
 // A fresh empty folder under the system temp dir, unique to the calling test; called outside a test (in
 // SetUpTestSuite) unique to the suite and this process, and removed when the process exits.
 std::filesystem::path scratch_dir();

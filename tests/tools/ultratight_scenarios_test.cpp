@@ -25,11 +25,7 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 constexpr double kG0 = 9.80665;
 
-// The checkout's scenarios/ folder: the test binary lives in <checkout>/<build>/tests/.
-std::filesystem::path scenarios_dir() {
-  if (const char* env = std::getenv("ULTRATRACK_SCENARIOS"); env && *env) return env;
-  return std::filesystem::canonical("/proc/self/exe").parent_path() / ".." / ".." / "scenarios";
-}
+using ultratrack::test::scenarios_dir;
 
 struct Csv {
   std::map<std::string, std::size_t> col;

@@ -1,0 +1,380 @@
+#include "fusion/ultratight_integration.hpp"
+
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "ins/earth_model.hpp"
+#include "signals/gps_constants.hpp"
+
+namespace ultratrack::fusion {
+namespace {
+
+constexpr double kC = signals::kSpeedOfLight_mps;
+constexpr double kLambda_m = signals::kL1Wavelength_m;
+constexpr double kChip_m = kC / signals::kCaChipRate_hz;
+
+// One satellite's I&Q (6 rows) with the replica actually held over the period: the replica errors of the
+// nominal at the update time plus the known offset between that nominal's prediction and the replica used
+// (range at mid-period, rate), so h(dx) is the I&Q of the replica that really ran.
+class PeriodIqMeasurement {
+ public:
+  PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
+                      const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
+                      const IqTaps& measured, double prior_code_sigma_chips)
+      : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), R_(iq_noise_covariance(s)),
+        code_sigma_(prior_code_sigma_chips) {
+    z_.resize(6);
+    for (int k = 0; k < 3; ++k) {
+      z_(k) = measured.i[k];
+      z_(3 + k) = measured.q[k];
+    }
+  }
+  Eigen::VectorXd z() const { return z_; }
+  Eigen::VectorXd h(const StateVector<17>& dx) const {
+    const IqTaps t = expected_iq(errors(dx), s_);
+    Eigen::VectorXd out(6);
+    for (int k = 0; k < 3; ++k) {
+      out(k) = t.i[k];
+      out(3 + k) = t.q[k];
+    }
+    return out;
+  }
+  MeasurementJacobian<17> H(const StateVector<17>& dx) const {
+    const TrackingErrors te = errors(dx);
+    Eigen::Matrix<double, 6, 2> J = iq_jacobian(te, s_);
+    // The prompt sits on the triangle's peak, where R = 1 - |tau| has a kink: its local slope (+-1) would
+    // claim to measure tau with the sign of the current guess. Statistical linearisation over the prior
+    // (tau ~ N(guess, sigma^2)): the expected slope is the local one times erf(|guess| / (sqrt 2 sigma)).
+    if (code_sigma_ > 0.0) {
+      const double w = std::erf(std::abs(te.code_chips) / (std::sqrt(2.0) * code_sigma_));
+      J(1, 0) *= w;
+      J(4, 0) *= w;
+    }
+    const Eigen::Matrix<double, 2, 2> D = Eigen::Vector2d(1.0 / kChip_m, 1.0 / kLambda_m).asDiagonal();
+    return J * D * replica_.jacobian();
+  }
+  Eigen::MatrixXd R() const { return R_; }
+
+ private:
+  TrackingErrors errors(const StateVector<17>& dx) const {
+    const Eigen::VectorXd e = replica_.errors(dx);
+    return tracking_errors(e(0) + offset_(0), e(1) + offset_(1));
+  }
+  ReplicaErrors17 replica_;
+  IqSettings s_;
+  Eigen::Vector2d offset_;
+  Eigen::VectorXd z_;
+  Eigen::MatrixXd R_;
+  double code_sigma_ = 0.0;
+};
+
+// Discriminator form: range and rate errors of the replica that ran, h(dx) = replica errors + offset.
+class PeriodDiscriminatorMeasurement {
+ public:
+  PeriodDiscriminatorMeasurement(const NominalState& nominal, const SatelliteObservable& sat,
+                                 const Eigen::Vector3d& lever_b, const Eigen::Vector3d& w_ib_b,
+                                 const Eigen::Vector2d& offset, const Eigen::Vector2d& measured,
+                                 const DiscriminatorNoise& noise)
+      : replica_(nominal, {sat}, lever_b, w_ib_b), offset_(offset), z_(measured), R_(Eigen::MatrixXd::Zero(2, 2)) {
+    R_(0, 0) = noise.range_sigma_m * noise.range_sigma_m;
+    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps;
+  }
+  Eigen::VectorXd z() const { return z_; }
+  Eigen::VectorXd h(const StateVector<17>& dx) const { return replica_.errors(dx) + offset_; }
+  MeasurementJacobian<17> H(const StateVector<17>&) const { return replica_.jacobian(); }
+  Eigen::MatrixXd R() const { return R_; }
+
+ private:
+  ReplicaErrors17 replica_;
+  Eigen::VectorXd offset_;
+  Eigen::VectorXd z_;
+  Eigen::MatrixXd R_;
+};
+
+void check_options(const UltraTightOptions& o) {
+  auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
+  if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
+    throw std::invalid_argument("ultra-tight: initial sigmas must be positive");
+  if (!(o.tap_offset_chips > 0.0 && o.tap_offset_chips <= 0.5))
+    throw std::invalid_argument("ultra-tight: tap offset must lie in (0, 0.5] chip");
+  if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
+    throw std::invalid_argument("ultra-tight: gate probability must lie in (0, 1)");
+  if (!std::isfinite(o.coast_cn0_dbhz)) throw std::invalid_argument("ultra-tight: coasting threshold not finite");
+}
+
+}  // namespace
+
+struct UltraTightCoreBase {
+  virtual ~UltraTightCoreBase() = default;
+  virtual void add_imu(const ins::ImuIncrement& inc) = 0;
+  virtual void start_period(double T) = 0;
+  virtual void finish_period(const std::vector<ChannelCorrelation>& c) = 0;
+  virtual NominalState nominal() const = 0;
+  virtual Eigen::MatrixXd covariance() const = 0;
+  std::vector<ReplicaCommand> replicas;
+  IntegrationOutput output;
+  UltraTightCounters counters;
+};
+
+namespace {
+
+struct ChannelState {
+  double carrier_phase_cycles = 0.0;
+  bool coasting = false;
+};
+
+template <class Filter>
+class UltraTightCore final : public UltraTightCoreBase {
+ public:
+  UltraTightCore(const ins::NavState& initial, std::vector<signals::Ephemeris> eph, const UltraTightOptions& o,
+                 Filter filter)
+      : opt_(o), eph_(std::move(eph)), ins_(initial, o.strapdown), model_(o.model), filter_(std::move(filter)) {
+    nominal_.nav = ins_.state();
+    nominal_.clock_bias_m = o.initial_clock_bias_m;
+    nominal_.clock_drift_mps = o.initial_clock_drift_mps;
+    InsLinearisation lin;
+    lin.nav = nominal_.nav;
+    lin.f_b = nominal_.nav.q_nb.conjugate() * Eigen::Vector3d(0.0, 0.0, -9.80665);
+    model_.set_linearisation(lin);
+    fill_output();
+  }
+
+  void add_imu(const ins::ImuIncrement& inc) override {
+    const double dt = inc.t_s - nominal_.nav.t_s;
+    if (!(dt > 0.0) || !std::isfinite(inc.t_s) || !inc.dtheta_b.allFinite() || !inc.dv_b.allFinite()) return;
+    const Eigen::Vector3d dth = inc.dtheta_b - nominal_.gyro_bias_b * dt;
+    const Eigen::Vector3d dv = inc.dv_b - nominal_.accel_bias_b * dt;
+    const Eigen::Quaterniond q0 = ins_.state().q_nb;
+    ins_.step(dth, dv, dt);
+    nominal_.nav = ins_.state();
+    nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
+    acc_dt_ += dt;
+    acc_dv_n_ += q0.slerp(0.5, nominal_.nav.q_nb) * dv;
+    w_ib_b_ = dth / dt;
+    fill_output();
+  }
+
+  void start_period(double T) override {
+    if (!(T >= 1e-3 - 1e-12 && T <= 0.020 + 1e-12))
+      throw std::invalid_argument("ultra-tight: integration time must lie in [1, 20] ms");
+    T_ = T;
+    predict_satellites(sats_start_);
+    replicas.clear();
+    for (const SatelliteObservable& s : sats_start_) {
+      ChannelState& ch = channels_[s.prn];
+      ReplicaCommand r;
+      r.prn = s.prn;
+      r.t_start_s = nominal_.nav.t_s;
+      r.pseudorange_m = s.pseudorange_m;
+      r.range_rate_mps = s.range_rate_mps;
+      r.nco.carrier_frequency_hz = -s.range_rate_mps / kLambda_m;
+      r.nco.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 - s.range_rate_mps / kC);
+      r.carrier_phase_cycles = ch.carrier_phase_cycles;
+      r.elevation_rad = s.elevation_rad;
+      r.coasting = ch.coasting;
+      replicas.push_back(r);
+    }
+  }
+
+  void finish_period(const std::vector<ChannelCorrelation>& corr) override {
+    ++counters.periods;
+    propagate();
+    std::vector<SatelliteObservable> now;
+    predict_satellites(now);
+    for (ReplicaCommand& r : replicas) {
+      ChannelState& ch = channels_[r.prn];
+      ch.carrier_phase_cycles = r.carrier_phase_cycles + r.nco.carrier_frequency_hz * T_;  // keeps running
+      const ChannelCorrelation* c = nullptr;
+      for (const auto& x : corr)
+        if (x.prn == r.prn) c = &x;
+      const SatelliteObservable* s = nullptr;
+      for (const auto& x : now)
+        if (x.prn == r.prn) s = &x;
+      const bool usable = c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
+                          std::abs(c->integration_time_s - T_) < 1e-9;
+      if (!usable) {
+        ch.coasting = true;
+        ++counters.coasting;
+        continue;
+      }
+      // Offset of the replica that ran (its mid-period range, its constant rate) from this nominal's signal
+      // prediction over the period: range at mid-period and mean rate, the rate taken as varying linearly
+      // between the start prediction and this one (line-of-sight acceleration: up to ~0.2 Hz over 10 ms at
+      // 4 m/s^2, not negligible against the 0.45 Hz I&Q frequency noise at 45 dB-Hz).
+      // The prediction with the nominal as it stands now (earlier satellites of this period have updated it).
+      const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
+      const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
+                                    antenna_velocity_n(nominal_.nav, w_ib_b_, opt_.lever_arm_b);
+      const double pr_now = predicted_pseudorange_m(*s, r_ant, nominal_.clock_bias_m);
+      const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
+      const double back = nominal_.nav.t_s - (r.t_start_s + 0.5 * T_);
+      const double mean_rate = 0.5 * (r.range_rate_mps + rr_now);
+      const Eigen::Vector2d offset(r.pseudorange_m + r.range_rate_mps * 0.5 * T_ -
+                                       (pr_now - 0.5 * (mean_rate + rr_now) * back),
+                                   r.range_rate_mps - mean_rate);
+      IqSettings is;
+      is.cn0_dbhz = c->cn0_dbhz;
+      is.integration_time_s = T_;
+      is.tap_offset_chips = opt_.tap_offset_chips;
+      bool ok = false;
+      if (opt_.form == UltraTightForm::Iq) {
+        const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, w_ib_b_);
+        const Eigen::Matrix<double, 1, 17> h_range = rep.jacobian().row(0);
+        const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
+        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, w_ib_b_, is, offset, c->taps, sigma_code));
+      } else {
+        const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
+                                frequency_discriminator_hz(c->taps, is) * kLambda_m);
+        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, w_ib_b_, offset, z,
+                                                   discriminator_noise(is)));
+      }
+      ch.coasting = !ok;
+      if (!ok) ++counters.coasting;
+    }
+    fill_output();
+  }
+
+  NominalState nominal() const override { return nominal_; }
+  Eigen::MatrixXd covariance() const override { return filter_.P(); }
+
+ private:
+  // Satellites above the mask predicted from the current nominal (antenna position, clock): two passes of
+  // the transmit-time iteration through prepare_satellites, the pseudorange and rate then being predictions.
+  void predict_satellites(std::vector<SatelliteObservable>& out) const {
+    const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
+    const Eigen::Vector3d v_ant =
+        ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) * antenna_velocity_n(nominal_.nav, w_ib_b_, opt_.lever_arm_b);
+    receiver::ObservationEpoch epoch;
+    epoch.receive_time =
+        signals::add_seconds(opt_.gps_time_origin, nominal_.nav.t_s + nominal_.clock_bias_m / kC);
+    for (const auto& e : eph_) {
+      receiver::Observation ob;
+      ob.prn = e.prn;
+      ob.pseudorange_m = 0.075 * kC + nominal_.clock_bias_m;
+      ob.doppler_hz = 0.0;
+      epoch.observations.push_back(ob);
+    }
+    TightOptions t = opt_.tight;
+    t.use_range_rate = true;
+    for (int pass = 0; pass < 2; ++pass) {
+      out = prepare_satellites(epoch, eph_, signals::KlobucharParameters{}, r_ant, t);
+      epoch.observations.clear();
+      for (const auto& s : out) {
+        receiver::Observation ob;
+        ob.prn = s.prn;
+        ob.pseudorange_m = predicted_pseudorange_m(s, r_ant, nominal_.clock_bias_m);
+        ob.doppler_hz = 0.0;
+        epoch.observations.push_back(ob);
+      }
+    }
+    for (auto& s : out) {
+      s.pseudorange_m = predicted_pseudorange_m(s, r_ant, nominal_.clock_bias_m);
+      s.range_rate_mps = predicted_range_rate_mps(s, r_ant, v_ant, nominal_.clock_drift_mps);
+      s.has_rate = true;
+    }
+  }
+
+  void propagate() {
+    if (acc_dt_ <= 0.0) return;
+    InsLinearisation lin;
+    lin.nav = nominal_.nav;
+    lin.f_b = nominal_.nav.q_nb.conjugate() * (acc_dv_n_ / acc_dt_);
+    lin.w_ib_b = w_ib_b_;
+    model_.set_linearisation(lin);
+    filter_.predict(model_, acc_dt_);
+    acc_dt_ = 0.0;
+    acc_dv_n_.setZero();
+  }
+
+  template <class M>
+  bool update(const M& m) {
+    ++counters.updates;
+    const UpdateResult r = filter_.update(m);
+    if (!r.accepted) {
+      ++counters.rejected;
+      return false;
+    }
+    ++counters.accepted;
+    nominal_ = corrected<17>(nominal_, filter_.x());
+    ins_.set_state(nominal_.nav);
+    filter_.set_x(StateVector<17>::Zero());
+    return true;
+  }
+
+  void fill_output() {
+    IntegrationOutput& o = output;
+    o.nav = nominal_.nav;
+    const StateVector<17> sd = filter_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
+    o.sigma_pos_ned_m = sd.segment<3>(ix::kPos);
+    o.sigma_vel_n_mps = sd.segment<3>(ix::kVel);
+    o.sigma_att_rad = sd.segment<3>(ix::kAtt);
+    o.accel_bias_b = nominal_.accel_bias_b;
+    o.gyro_bias_b = nominal_.gyro_bias_b;
+    o.sigma_accel_bias_b = sd.segment<3>(ix::kAccelBias);
+    o.sigma_gyro_bias_b = sd.segment<3>(ix::kGyroBias);
+    o.clock_bias_m = nominal_.clock_bias_m;
+    o.clock_drift_mps = nominal_.clock_drift_mps;
+    o.sigma_clock_bias_m = sd(ix::kClockBias);
+    o.sigma_clock_drift_mps = sd(ix::kClockDrift);
+  }
+
+  UltraTightOptions opt_;
+  std::vector<signals::Ephemeris> eph_;
+  ins::Strapdown ins_;
+  InsErrorModel<17> model_;
+  Filter filter_;
+  NominalState nominal_;
+  std::vector<SatelliteObservable> sats_start_;
+  std::map<int, ChannelState> channels_;
+  double T_ = 0.020;
+  double acc_dt_ = 0.0;
+  Eigen::Vector3d acc_dv_n_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d w_ib_b_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace
+
+struct UltraTightIntegration::Impl {
+  UltraTightOptions options;
+  std::unique_ptr<UltraTightCoreBase> core;
+};
+
+UltraTightIntegration::UltraTightIntegration(const ins::NavState& initial, std::vector<signals::Ephemeris> eph,
+                                             const UltraTightOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  check_options(options);
+  impl_->options = options;
+  InsErrorModelOptions mo = options.model;
+  mo.discretisation = options.discretisation;
+  impl_->options.model = mo;
+  const InsErrorModel<17> model(mo);
+  const StateMatrix<17> P0 =
+      model.initial_covariance(options.sigma_pos_ned_m, options.sigma_vel_n_mps, options.sigma_att_rad);
+  const StateVector<17> x0 = StateVector<17>::Zero();
+  if (options.filter == FilterKind::Ekf)
+    impl_->core = std::make_unique<UltraTightCore<Ekf<17>>>(initial, std::move(eph), impl_->options,
+                                                          Ekf<17>(x0, P0, EkfOptions{mo.discretisation, options.gate}));
+  else
+    impl_->core = std::make_unique<UltraTightCore<Ukf<17>>>(
+        initial, std::move(eph), impl_->options, Ukf<17>(x0, P0, UkfOptions{options.ukf, mo.discretisation, options.gate}));
+}
+
+UltraTightIntegration::~UltraTightIntegration() = default;
+UltraTightIntegration::UltraTightIntegration(UltraTightIntegration&&) noexcept = default;
+UltraTightIntegration& UltraTightIntegration::operator=(UltraTightIntegration&&) noexcept = default;
+
+void UltraTightIntegration::add_imu(const ins::ImuIncrement& inc) { impl_->core->add_imu(inc); }
+const std::vector<ReplicaCommand>& UltraTightIntegration::start_period(double T) {
+  impl_->core->start_period(T);
+  return impl_->core->replicas;
+}
+void UltraTightIntegration::finish_period(const std::vector<ChannelCorrelation>& c) { impl_->core->finish_period(c); }
+const std::vector<ReplicaCommand>& UltraTightIntegration::replicas() const { return impl_->core->replicas; }
+const IntegrationOutput& UltraTightIntegration::output() const { return impl_->core->output; }
+NominalState UltraTightIntegration::nominal() const { return impl_->core->nominal(); }
+Eigen::MatrixXd UltraTightIntegration::covariance() const { return impl_->core->covariance(); }
+const UltraTightCounters& UltraTightIntegration::counters() const { return impl_->core->counters; }
+const UltraTightOptions& UltraTightIntegration::options() const { return impl_->options; }
+
+}  // namespace ultratrack::fusion

@@ -1,0 +1,102 @@
+// Closed-loop ultra-tight GPS/INS driver (seed 001): the INS (ins::Strapdown on bias-compensated IMU samples) and
+// the 17-state error filter (EKF or UKF) predict every satellite's replica for each integration period T
+// (code phase/rate, carrier frequency, running carrier phase: the "INS-predicted replica", as NcoCommands), then
+// update from the E/P/L correlations measured over that period, either the seed's I&Q model directly (eqs.
+// 11-17) or the discriminator ("pre-filtered") form, with noise from the measured C/N0; the estimated errors
+// are fed back to the INS, the IMU compensation and the clock. Satellites without a usable measurement (blocked,
+// C/N0 below the threshold) keep being predicted and are reported as coasting.
+// Time line: t_s of the IMU samples (GPS time minus gps_time_origin). Metres, m/s, chips, Hz, cycles.
+// Model assumption (iq_measurements.hpp): data bits known/wiped off, carrier NCO phase realigned at the start
+// of every period (the phase error inside a period is 2 pi df s).
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "fusion/gnss_ins_integration.hpp"
+#include "fusion/iq_measurements.hpp"
+#include "receiver/nco_command.hpp"
+#include "signals/ephemeris.hpp"
+
+namespace ultratrack::fusion {
+
+enum class UltraTightForm { Iq, Discriminator };
+
+struct UltraTightOptions {
+  FilterKind filter = FilterKind::Ekf;
+  UltraTightForm form = UltraTightForm::Iq;
+  InsErrorModelOptions model;
+  Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_pos_ned_m = Eigen::Vector3d::Constant(3.0);
+  Eigen::Vector3d sigma_vel_n_mps = Eigen::Vector3d::Constant(0.1);
+  Eigen::Vector3d sigma_att_rad = Eigen::Vector3d::Constant(0.01);
+  GateOptions gate;
+  UkfParameters ukf;
+  Discretisation discretisation = Discretisation::SecondOrderSeries;
+  ins::StrapdownOptions strapdown;
+  TightOptions tight;               // elevation mask, troposphere (ionosphere: no Klobuchar parameters given)
+  double tap_offset_chips = 0.5;    // early/late offset d
+  double coast_cn0_dbhz = 18.0;     // below: no update, the channel coasts on the INS
+  signals::GpsTime gps_time_origin;
+  double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;
+};
+
+// The replica of one satellite for the period starting at t_start_s, held constant-rate over the period.
+struct ReplicaCommand {
+  int prn = 0;
+  double t_start_s = 0.0;
+  receiver::NcoCommand nco;       // code rate (with code Doppler) and carrier frequency (Doppler)
+  double pseudorange_m = 0.0;     // replica code phase at t_start as a pseudorange (chips = m / chip length)
+  double range_rate_mps = 0.0;    // replica pseudorange rate (= -lambda * carrier frequency)
+  double carrier_phase_cycles = 0.0;  // running replica carrier phase at t_start (continuous, integral of nco)
+  double elevation_rad = 0.0;
+  bool coasting = false;          // no accepted measurement in the last period
+};
+
+// Measured correlations of one satellite over one period (normalised: unit noise variance per I or Q).
+struct ChannelCorrelation {
+  int prn = 0;
+  IqTaps taps;
+  double cn0_dbhz = 0.0;           // the channel's C/N0 estimate
+  double integration_time_s = 0.020;
+  bool data_wiped = true;          // false: this period is not used (sign ambiguity)
+};
+
+struct UltraTightCounters {
+  long long periods = 0;
+  long long updates = 0, accepted = 0, rejected = 0;
+  long long coasting = 0;  // satellite-periods without a usable measurement
+};
+
+class UltraTightIntegration {
+ public:
+  // Throws std::invalid_argument for bad options (sigmas, tap offset, gate probability).
+  UltraTightIntegration(const ins::NavState& initial, std::vector<signals::Ephemeris> ephemerides,
+                        const UltraTightOptions& options);
+  ~UltraTightIntegration();
+  UltraTightIntegration(UltraTightIntegration&&) noexcept;
+  UltraTightIntegration& operator=(UltraTightIntegration&&) noexcept;
+
+  // One IMU increment over (current t, inc.t_s]; non-finite or non-increasing ones are ignored.
+  void add_imu(const ins::ImuIncrement& inc);
+  // Predict the replicas of every satellite above the mask for the period [now, now + T), 1 ms <= T <= 20 ms
+  // (std::invalid_argument otherwise). Channels keep their running carrier phase.
+  const std::vector<ReplicaCommand>& start_period(double integration_time_s);
+  // The correlations of the period opened by start_period; call when the INS has reached its end (t_start + T).
+  // Satellites missing from `correlations`, with C/N0 below the threshold or data not wiped: coasting.
+  void finish_period(const std::vector<ChannelCorrelation>& correlations);
+
+  const std::vector<ReplicaCommand>& replicas() const;
+  const IntegrationOutput& output() const;
+  NominalState nominal() const;
+  Eigen::MatrixXd covariance() const;  // 17 x 17
+  const UltraTightCounters& counters() const;
+  const UltraTightOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace ultratrack::fusion
