@@ -56,6 +56,11 @@ void check_options(const IntegrationOptions& o) {
     throw std::invalid_argument("integration: attitude mounting q_ba must be a unit quaternion");
   if (!(o.attitude.max_abs_pitch_rad > 0.0 && o.attitude.max_abs_pitch_rad <= 0.5 * std::numbers::pi))
     throw std::invalid_argument("integration: attitude pitch limit must lie in (0, 90] deg");
+  const HeightAidingOptions& h = o.height_aiding;
+  if (!(h.sigma0_m > 0.0) || !(h.growth_mps >= 0.0) || !std::isfinite(h.sigma0_m) || !std::isfinite(h.growth_mps) ||
+      !(h.min_interval_s >= 0.0) ||
+      (h.fixed_height_m && !std::isfinite(*h.fixed_height_m)))
+    throw std::invalid_argument("integration: height aiding needs a positive sigma, growth >= 0, a finite height");
 }
 
 }  // namespace
@@ -79,6 +84,9 @@ class Core final : public CoreBase {
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
       : opt_(opt), ins_(initial, opt.strapdown), model_(opt.model), filter_(std::move(filter)) {
     nominal_.nav = ins_.state();
+    held_height_ = initial.height_m;
+    held_sigma_m_ = opt.sigma_pos_ned_m.z();
+    held_t_s_ = initial.t_s;
     if constexpr (N == 17) {
       nominal_.clock_bias_m = opt.initial_clock_bias_m;
       nominal_.clock_drift_mps = opt.initial_clock_drift_mps;
@@ -219,8 +227,30 @@ class Core final : public CoreBase {
       const auto sats = prepare_satellites(e.epoch, e.ephemerides, e.iono,
                                            antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight, &stats);
       counters.satellites_missing_ephemeris += stats.missing_ephemeris;
+      const HeightAidingOptions& ha = opt_.height_aiding;
+      const bool few = static_cast<int>(sats.size()) < ha.min_satellites;
+      if (few) ++counters.epochs_few_satellites;
+      // Height first: the satellites' rows are then linearised about the aided height.
+      if (few && ha.enabled && nominal_.nav.t_s - last_aid_t_s_ >= 0.99 * ha.min_interval_s) {
+        const double ref = ha.fixed_height_m ? *ha.fixed_height_m : held_height_;
+        const double held_sigma = ha.fixed_height_m ? 0.0 : held_sigma_m_;
+        const double dt = ha.fixed_height_m ? 0.0 : nominal_.nav.t_s - held_t_s_;
+        ++aids_since_held_;  // (0.99: epochs come on the receiver clock, slightly off 1 s in true time)
+        const double sigma = height_aiding_sigma_m(ha, held_sigma, dt) * std::sqrt(double(aids_since_held_));
+        last_aid_t_s_ = nominal_.nav.t_s;
+        if (update(HeightMeasurement<N>(nominal_, ref, sigma), -2))
+          ++counters.height_accepted;
+        else
+          ++counters.height_rejected;
+      }
       for (const auto& s : sats)
         update(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, w_ib_b_, opt_.tight.use_range_rate), s.prn);
+      if (!few) {  // full geometry: hold this epoch's height for later epochs with fewer satellites
+        held_height_ = nominal_.nav.height_m;
+        held_sigma_m_ = std::sqrt(std::max(filter_.P()(ix::kPos + 2, ix::kPos + 2), 0.0));
+        held_t_s_ = nominal_.nav.t_s;
+        aids_since_held_ = 0;
+      }
     }
   }
 
@@ -253,6 +283,10 @@ class Core final : public CoreBase {
   Eigen::Vector3d acc_dv_n_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d w_ib_b_ = Eigen::Vector3d::Zero();
   bool attitude_since_fix_ = false;
+  // Height aiding: IMU height at the last full-geometry epoch (at first: the initial state's), aids since then.
+  double held_height_ = 0.0, held_sigma_m_ = 0.0, held_t_s_ = 0.0;
+  double last_aid_t_s_ = -1e300;
+  long long aids_since_held_ = 0;
 };
 
 template <int N>

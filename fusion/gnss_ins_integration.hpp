@@ -9,6 +9,7 @@
 // GPS attitude (multi-antenna receiver, seed 003) is a third measurement type in either coupling, applied at
 // its own time: epochs with attitude, position/velocity, or both; without attitude the update falls back to
 // position/velocity only (counted: fixes_without_attitude). At equal times attitude goes first.
+// Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides. EKF or UKF.
 #pragma once
 
@@ -18,6 +19,7 @@
 
 #include "fusion/attitude_measurement.hpp"
 #include "fusion/ekf.hpp"
+#include "fusion/height_aiding.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/ins_error_state.hpp"
 #include "fusion/loose_measurements.hpp"
@@ -51,6 +53,8 @@ struct IntegrationOptions {
   double propagation_interval_s = 0.05;
   ins::StrapdownOptions strapdown;
   TightOptions tight;
+  // Tight mode: height pseudo-measurement in epochs with fewer than 4 usable satellites (off by default).
+  HeightAidingOptions height_aiding;
   AttitudeAidingOptions attitude;  // GPS attitude: array-to-IMU mounting, pitch limit
   // Tight mode: GPS time at t_s = 0 of the run's time line. A receive time T (receiver clock) is applied at
   // t = (T - gps_time_origin) - clock_bias / c.
@@ -91,12 +95,16 @@ struct IntegrationCounters {
   long long attitude_late = 0;      // older than the INS time when it came (dropped)
   // Fallback (seed 003): fixes / observation epochs with no accepted attitude since the previous one.
   long long fixes_without_attitude = 0;
+  // Tight mode: epochs with fewer than height_aiding.min_satellites usable satellites, and the height
+  // pseudo-measurements applied there (accepted / refused by the gate; none before a height is known).
+  long long epochs_few_satellites = 0;
+  long long height_accepted = 0, height_rejected = 0;
 };
 
 // Per-update diagnostics (for NIS / consistency logs).
 struct UpdateRecord {
   double t_s = 0.0;
-  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1
+  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1; height aiding: -2
   UpdateResult result;
 };
 

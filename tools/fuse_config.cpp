@@ -85,6 +85,38 @@ const std::map<std::string, Table>& sections() {
              throw io::InputError(v.file, "key '" + v.key + "' must be in (0, 1)", v.line());
          }},
         {"propagation_interval_s", [](const Value& v, C& c) { c.propagation_interval_s = v.positive(); }}}},
+      {"clock",
+       {{"oscillator",
+         [](const Value& v, C& c) {
+           const auto p = fusion::oscillator_preset(v.text());
+           if (!p) throw io::InputError(v.file, "key '" + v.key + "' must be \"tcxo\" or \"ocxo\"", v.line());
+           c.clock_oscillator = v.text();
+           c.clock_allan = *p;
+         }},
+        {"h0", [](const Value& v, C& c) { c.clock_allan_h0 = v.positive(); }},
+        {"h_minus2", [](const Value& v, C& c) { c.clock_allan_hm2 = v.positive(); }}}},
+      {"height_aiding",
+       {{"mode",
+         [](const Value& v, C& c) {
+           const std::string m = v.text();
+           if (m != "auto" && m != "off")
+             throw io::InputError(v.file, "key '" + v.key + "' must be \"auto\" or \"off\"", v.line());
+           c.height_aiding.enabled = m == "auto";
+         }},
+        {"sigma_m", [](const Value& v, C& c) { c.height_aiding.sigma0_m = v.positive(); }},
+        {"growth_mps",
+         [](const Value& v, C& c) {
+           c.height_aiding.growth_mps = v.number();
+           if (!(c.height_aiding.growth_mps >= 0.0))
+             throw io::InputError(v.file, "key '" + v.key + "' must not be negative", v.line());
+         }},
+        {"height_m", [](const Value& v, C& c) { c.height_aiding.fixed_height_m = v.number(); }},
+        {"interval_s",
+         [](const Value& v, C& c) {
+           c.height_aiding.min_interval_s = v.number();
+           if (!(c.height_aiding.min_interval_s >= 0.0))
+             throw io::InputError(v.file, "key '" + v.key + "' must not be negative", v.line());
+         }}}},
       {"output",
        {{"convergence_heading_sigma_deg", [](const Value& v, C& c) { c.convergence_heading_sigma_deg = v.positive(); }}}},
       {"attitude",
@@ -126,7 +158,7 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
     const auto known = sections().find(section);
     const auto* table = section_node.as_table();
     if (known == sections().end() || !table)
-      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, filter, output, attitude)",
+      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, clock, height_aiding, filter, output, attitude)",
                            static_cast<int>(section_node.source().begin.line));
     for (const auto& [key_name, node] : *table) {
       const std::string key = section + "." + std::string(key_name.str());
@@ -136,6 +168,9 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
       setter->second(Value{file, key, node}, c);
     }
   }
+  // h0 / h_minus2 override the oscillator preset whatever their order in the file.
+  if (c.clock_allan_h0) c.clock_allan.h0 = *c.clock_allan_h0;
+  if (c.clock_allan_hm2) c.clock_allan.h_minus2 = *c.clock_allan_hm2;
   return c;
 }
 

@@ -4,6 +4,12 @@
 //                (else the first GNSS fix), velocity_ned_mps = [n, e, d] (else the GNSS velocity), sigma_position_m, sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
 //   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2
 //   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z]
+//   [clock]      (tight) oscillator = "tcxo"|"ocxo" (fusion/clock_model presets; default tcxo), h0, h_minus2
+//                (override the preset's Allan coefficients)
+//   [height_aiding] (tight) mode = "off"|"auto" (default off: aircraft; auto: land vehicles, a height pseudo-
+//                measurement in epochs with < 4 satellites), sigma_m = 2, growth_mps = 0.1, height_m (a fixed IMU
+//                ellipsoidal height instead of the one held from the last epoch with >= 4 satellites), interval_s = 1
+//                (at most one height update per interval)
 //   [filter]     ukf_alpha = 1, ukf_beta = 2, ukf_kappa = 0, gate = true, gate_probability = 0.9999,
 //                propagation_interval_s = 0.05
 //   [output]     convergence_heading_sigma_deg = 1
@@ -18,6 +24,7 @@
 #include <optional>
 #include <string>
 
+#include "fusion/clock_model.hpp"
 #include "fusion/gnss_ins_integration.hpp"
 #include "signals/gps_time.hpp"
 
@@ -42,6 +49,10 @@ struct FuseConfig {
   std::optional<signals::GpsTime> attitude_gps_time_at_imu_zero;
   Eigen::Vector3d attitude_misalignment_deg = Eigen::Vector3d::Zero();  // roll, pitch, yaw of array -> IMU body
   double attitude_max_pitch_deg = 80.0;
+  std::string clock_oscillator = "tcxo";
+  fusion::OscillatorAllan clock_allan = *fusion::oscillator_preset("tcxo");  // preset, then h0 / h_minus2
+  std::optional<double> clock_allan_h0, clock_allan_hm2;  // as given in the file
+  fusion::HeightAidingOptions height_aiding;
 };
 
 // Reads the file over the defaults; throws io::InputError.

@@ -9,6 +9,7 @@
 
 #include "cli_parse.hpp"
 #include "fused_nav_csv.hpp"
+#include "fusion/clock_model.hpp"
 #include "fusion/fuse_motion_alignment.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "ins/attitude.hpp"
@@ -451,6 +452,8 @@ struct ReceiveFusion::Impl {
       // The fit's error follows the position and velocity errors (a few metres, m/s), not the receiver's ms.
       o.model.clock.bias_sigma_m = 3.0 * sigma_pos.norm() + 10.0;
       o.model.clock.drift_sigma_mps = 3.0 * sigma_vel.norm() + 1.0;
+      o.model.clock = fusion::clock_noise_from_allan(c.clock_allan, o.model.clock);
+      o.height_aiding = c.height_aiding;
     }
     integration.emplace(init, o);
     initial_attitude = ins::euler_from_quaternion(init.q_nb);
@@ -619,6 +622,13 @@ std::string ReceiveFusion::summary_json() const {
                    "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
                    m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
                    k.satellites_missing_ephemeris);
+  if (m.is_tight())
+    j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
+                     "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "
+                     "\"rejected\": {}}}",
+                     m.settings.config.clock_oscillator, m.settings.config.clock_allan.h0,
+                     m.settings.config.clock_allan.h_minus2, m.settings.config.height_aiding.enabled ? "auto" : "off",
+                     k.epochs_few_satellites, k.height_accepted, k.height_rejected);
   const NavSigma& g = m.final_sigma;
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
                    "\"vel_mps\": {:.6g}, \"heading_deg\": {:.6g}}}}}",

@@ -125,7 +125,7 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   const signals::NominalConstellation constellation = signals::nominal_constellation(origin);
 
   // Receiver clock truth (tight) with the filter's default noise densities.
-  fusion::ClockNoiseModel clock_model;
+  fusion::ClockNoiseModel clock_model = fusion::clock_noise_from_allan(cfg.oscillator);
   ClockTruth clock;
   clock.dt = 1.0 / cfg.imu_rate_hz;
   {
@@ -145,6 +145,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   opt.coupling = coupling;
   opt.filter = filter;
   opt.model = fusion::error_model_from_preset(imu_spec);
+  opt.model.clock = clock_model;
+  opt.height_aiding = cfg.height_aiding;
   opt.model.clock.bias_sigma_m = 30.0;
   opt.model.clock.drift_sigma_mps = 1.0;
   opt.lever_arm_b = cfg.lever_arm_b;
@@ -280,6 +282,7 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
       }
       res.t_s.push_back(t_end);
       res.pos_err_m.push_back(e.segment<3>(0));
+      res.sigma_pos_m.push_back(integ.output().sigma_pos_ned_m);
       res.nees.push_back(e.dot(P.ldlt().solve(e)));
       const Eigen::VectorXd e9 = e.head(9);
       const Eigen::MatrixXd P9 = P.topLeftCorner(9, 9);
@@ -288,6 +291,7 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   }
   res.accepted = integ.counters().accepted;
   res.rejected = integ.counters().rejected;
+  res.counters = integ.counters();
   (void)epochs;
   return res;
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fusion/clock_model.hpp"
 #include "fusion/gnss_ins_integration.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "receiver/observables.hpp"
@@ -39,6 +40,9 @@ struct SimConfig {
   double reduce_after_s = 0.0;
   double sigma_range_m = 1.0;
   double sigma_rate_mps = 0.05;
+  // Tight: the receiver oscillator (truth clock and filter model alike) and the height aiding options.
+  fusion::OscillatorAllan oscillator;  // default: TCXO
+  fusion::HeightAidingOptions height_aiding;
 };
 
 struct RunResult {
@@ -51,6 +55,8 @@ struct RunResult {
   double outage_sigma_h_m = 0.0;           // filter's horizontal 1-sigma there
   long long accepted = 0, rejected = 0;
   int state_size = 15;
+  std::vector<Eigen::Vector3d> sigma_pos_m;  // filter's NED 1-sigma at the recorded times
+  fusion::IntegrationCounters counters;
 };
 
 // Loose: GnssFix at t = offset + k period; tight: ObservationEpochs from the nominal constellation.
