@@ -37,39 +37,44 @@ void check_csv_header(const std::string& file, int line, std::string_view text, 
   }
 }
 
-void parse_numeric_row(const std::string& file, int line, std::string_view text, std::span<double> out) {
-  std::string_view rest = text;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const std::size_t comma = rest.find(',');
-    if (comma == std::string_view::npos && i + 1 < out.size())
-      throw InputError(file, "expected " + std::to_string(out.size()) + " fields, got " + std::to_string(i + 1), line);
-    const std::string_view field = trim(rest.substr(0, comma));
-    double v = 0.0;
-    const char* first = field.data();
-    const char* last = field.data() + field.size();
-    if (!field.empty() && *first == '+') ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, v);
-    if (field.empty() || ec != std::errc() || ptr != last)
-      throw InputError(file, "field " + std::to_string(i + 1) + " is not a number: '" + std::string(field) + "'", line);
-    if (!std::isfinite(v))
-      throw InputError(file, "field " + std::to_string(i + 1) + " is not finite: '" + std::string(field) + "'", line);
-    out[i] = v;
-    if (comma == std::string_view::npos) {
-      rest = {};
-    } else {
-      rest.remove_prefix(comma + 1);
-    }
-    if (i + 1 == out.size() && comma != std::string_view::npos)
-      throw InputError(file, "more than " + std::to_string(out.size()) + " fields", line);
+namespace {
+
+// Splits a data row into exactly fields.size() trimmed fields.
+void split_row(const std::string& file, int line, std::string_view text, std::span<std::string_view> fields) {
+  std::size_t n = 0;
+  while (true) {
+    const std::size_t comma = text.find(',');
+    if (n == fields.size()) throw InputError(file, "more than " + std::to_string(fields.size()) + " fields", line);
+    fields[n++] = trim(text.substr(0, comma));
+    if (comma == std::string_view::npos) break;
+    text.remove_prefix(comma + 1);
   }
+  if (n != fields.size())
+    throw InputError(file, "expected " + std::to_string(fields.size()) + " fields, got " + std::to_string(n), line);
 }
 
-int read_numeric_csv(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
-                     const NumericRowHandler& row) {
+}  // namespace
+
+std::optional<double> parse_csv_number(const std::string& file, int line, std::string_view column,
+                                       std::string_view field) {
+  field = trim(field);
+  if (field.empty()) return std::nullopt;
+  const char* first = field.data();
+  const char* last = field.data() + field.size();
+  if (*first == '+') ++first;
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec != std::errc() || ptr != last)
+    throw InputError(file, std::string(column) + " is not a number: '" + std::string(field) + "'", line);
+  return v;
+}
+
+int read_csv_rows(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
+                  const CsvFieldsHandler& row) {
   const std::string name = file.string();
   std::ifstream in(file);
   if (!in) throw InputError(name, "cannot open " + std::string(what));
-  std::vector<double> values(columns.size());
+  std::vector<std::string_view> fields(columns.size());
   std::string line;
   int line_no = 0, rows = 0;
   bool have_header = false;
@@ -82,13 +87,32 @@ int read_numeric_csv(const std::filesystem::path& file, std::string_view what, c
       have_header = true;
       continue;
     }
-    parse_numeric_row(name, line_no, t, values);
-    row(line_no, values);
+    split_row(name, line_no, t, fields);
+    row(line_no, fields);
     ++rows;
   }
   if (!have_header) throw InputError(name, "empty " + std::string(what) + ": missing header");
   if (rows == 0) throw InputError(name, std::string(what) + " has no data rows");
   return rows;
+}
+
+int read_numeric_csv(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
+                     const NumericRowHandler& row) {
+  const std::string name = file.string();
+  std::vector<double> values(columns.size());
+  std::vector<std::string> field_names;  // errors name fields by position
+  for (std::size_t i = 0; i < columns.size(); ++i) field_names.push_back("field " + std::to_string(i + 1));
+  return read_csv_rows(file, what, columns, [&](int line, std::span<const std::string_view> fields) {
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      const std::string& column = field_names[i];
+      const auto v = parse_csv_number(name, line, column, fields[i]);
+      if (!v) throw InputError(name, column + " is not a number: ''", line);
+      if (!std::isfinite(*v))
+        throw InputError(name, column + " is not finite: '" + std::string(fields[i]) + "'", line);
+      values[i] = *v;
+    }
+    row(line, values);
+  });
 }
 
 }  // namespace ultratrack::io

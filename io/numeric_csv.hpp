@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -20,9 +21,20 @@ using NumericRowHandler = std::function<void(int line, std::span<const double> v
 int read_numeric_csv(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
                      const NumericRowHandler& row);
 
+// The same reading with the fields left as text, for formats with their own field rules (empty or nan fields
+// allowed in some columns): each data row is split into exactly columns.size() fields (trimmed), else an
+// InputError. Same header, comment, empty-file and no-rows rules; returns the number of data rows.
+using CsvFieldsHandler = std::function<void(int line, std::span<const std::string_view> fields)>;
+int read_csv_rows(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
+                  const CsvFieldsHandler& row);
+
+// One field as a number ('+' allowed; nan and inf parse, finiteness is the caller's rule): nothing for an empty
+// field; an InputError "<column> is not a number: '<field>'" for anything else that is not a number.
+std::optional<double> parse_csv_number(const std::string& file, int line, std::string_view column,
+                                       std::string_view field);
+
 // The building blocks, for formats that wrap them.
 std::string_view trim(std::string_view s);
 void check_csv_header(const std::string& file, int line, std::string_view text, const std::vector<std::string>& names);
-void parse_numeric_row(const std::string& file, int line, std::string_view text, std::span<double> out);
 
 }  // namespace ultratrack::io

@@ -3,10 +3,9 @@
 #include <fmt/core.h>
 
 #include <array>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <numbers>
+#include <span>
 #include <string>
 
 #include "io/input_error.hpp"
@@ -25,25 +24,14 @@ const std::vector<std::string>& attitude_header() {
   return h;
 }
 
-// Splits a data row into its 11 numbers (nan allowed here; the row checks decide where it is acceptable).
-std::array<double, kColumns> parse_row(const std::string& file, int line, std::string_view text) {
+// A data row's 11 numbers (nan allowed here; the row checks decide where it is acceptable).
+std::array<double, kColumns> parse_row(const std::string& file, int line, std::span<const std::string_view> fields) {
   std::array<double, kColumns> v{};
-  std::size_t i = 0;
-  while (true) {
-    const std::size_t comma = text.find(',');
-    if (i >= kColumns) throw io::InputError(file, fmt::format("more than {} fields", kColumns), line);
-    const std::string_view field = io::trim(text.substr(0, comma));
-    const char* first = field.data();
-    const char* last = field.data() + field.size();
-    if (!field.empty() && *first == '+') ++first;
-    const auto [ptr, ec] = std::from_chars(first, last, v[i]);
-    if (field.empty() || ec != std::errc() || ptr != last)
-      throw io::InputError(file, fmt::format("{} is not a number: '{}'", attitude_header()[i], field), line);
-    ++i;
-    if (comma == std::string_view::npos) break;
-    text.remove_prefix(comma + 1);
+  for (std::size_t i = 0; i < kColumns; ++i) {
+    const auto x = io::parse_csv_number(file, line, attitude_header()[i], fields[i]);
+    if (!x) throw io::InputError(file, fmt::format("{} is not a number: ''", attitude_header()[i]), line);
+    v[i] = *x;
   }
-  if (i != kColumns) throw io::InputError(file, fmt::format("expected {} fields, got {}", kColumns, i), line);
   return v;
 }
 
@@ -51,22 +39,9 @@ std::array<double, kColumns> parse_row(const std::string& file, int line, std::s
 
 std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
-  std::ifstream in(file);
-  if (!in) throw io::InputError(name, "cannot open attitude file");
   std::vector<AttitudeCsvRow> rows;
-  std::string text;
-  int line = 0;
-  bool have_header = false;
-  while (std::getline(in, text)) {
-    ++line;
-    const std::string_view t = io::trim(text);
-    if (t.empty() || t.front() == '#') continue;
-    if (!have_header) {
-      io::check_csv_header(name, line, t, attitude_header());
-      have_header = true;
-      continue;
-    }
-    const auto v = parse_row(name, line, t);
+  io::read_csv_rows(file, "attitude file", attitude_header(), [&](int line, std::span<const std::string_view> fields) {
+    const auto v = parse_row(name, line, fields);
     auto fail = [&](const std::string& what) { throw io::InputError(name, what, line); };
     for (int i : {0, 1, 8, 9, 10})
       if (!std::isfinite(v[static_cast<std::size_t>(i)])) fail(attitude_header()[static_cast<std::size_t>(i)] + " is not finite");
@@ -96,9 +71,7 @@ std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file)
       fail(fmt::format("time {} {:.4f} not after the previous row's (line {})", r.time.week, r.time.tow_s,
                        rows.back().line));
     rows.push_back(r);
-  }
-  if (!have_header) throw io::InputError(name, "empty attitude file: missing header");
-  if (rows.empty()) throw io::InputError(name, "attitude file has no data rows");
+  });
   return rows;
 }
 

@@ -3,10 +3,9 @@
 #include <fmt/core.h>
 
 #include <array>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <numbers>
+#include <span>
 #include <string>
 
 #include "io/atomic_file.hpp"
@@ -27,16 +26,11 @@ const std::vector<std::string>& gnss_header() {
 
 // One field: empty -> false; a finite number -> true; anything else throws.
 bool parse_field(const std::string& file, int line, int column, std::string_view field, double& out) {
-  field = io::trim(field);
-  if (field.empty()) return false;
-  const char* first = field.data();
-  const char* last = field.data() + field.size();
-  if (*first == '+') ++first;
-  const auto [ptr, ec] = std::from_chars(first, last, out);
-  if (ec != std::errc() || ptr != last)
-    throw io::InputError(file, fmt::format("{} is not a number: '{}'", gnss_header()[column], field), line);
-  if (!std::isfinite(out))
-    throw io::InputError(file, fmt::format("{} is not finite: '{}'", gnss_header()[column], field), line);
+  const auto& name = gnss_header()[static_cast<std::size_t>(column)];
+  const auto v = io::parse_csv_number(file, line, name, field);
+  if (!v) return false;
+  if (!std::isfinite(*v)) throw io::InputError(file, fmt::format("{} is not finite: '{}'", name, io::trim(field)), line);
+  out = *v;
   return true;
 }
 
@@ -44,32 +38,8 @@ bool parse_field(const std::string& file, int line, int column, std::string_view
 
 std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
-  std::ifstream in(file);
-  if (!in) throw io::InputError(name, "cannot open GNSS file");
   std::vector<GnssCsvRow> fixes;
-  std::string text;
-  int line = 0;
-  bool have_header = false;
-  while (std::getline(in, text)) {
-    ++line;
-    const std::string_view t = io::trim(text);
-    if (t.empty() || t.front() == '#') continue;
-    if (!have_header) {
-      io::check_csv_header(name, line, t, gnss_header());
-      have_header = true;
-      continue;
-    }
-    std::array<std::string_view, kColumns> fields;
-    std::string_view rest = t;
-    int n = 0;
-    while (true) {
-      const std::size_t comma = rest.find(',');
-      if (n == kColumns) throw io::InputError(name, fmt::format("more than {} fields", kColumns), line);
-      fields[n++] = rest.substr(0, comma);
-      if (comma == std::string_view::npos) break;
-      rest.remove_prefix(comma + 1);
-    }
-    if (n != kColumns) throw io::InputError(name, fmt::format("expected {} fields, got {}", kColumns, n), line);
+  io::read_csv_rows(file, "GNSS file", gnss_header(), [&](int line, std::span<const std::string_view> fields) {
     std::array<double, kColumns> v{};
     std::array<bool, kColumns> present{};
     for (int i = 0; i < kColumns; ++i) present[i] = parse_field(name, line, i, fields[i], v[i]);
@@ -95,9 +65,7 @@ std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file) {
     if (f.has_velocity) f.v_n = {v[4], v[5], v[6]};
     f.sigma_ned_m = {v[7], v[8], v[9]};
     fixes.push_back(f);
-  }
-  if (!have_header) throw io::InputError(name, "empty GNSS file: missing header");
-  if (fixes.empty()) throw io::InputError(name, "GNSS file has no data rows");
+  });
   return fixes;
 }
 
