@@ -6,24 +6,10 @@
 #include <cmath>
 
 #include "io/atomic_file.hpp"
+#include "io/json_text.hpp"
 
 namespace ultratrack::receiver {
 namespace {
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 std::string prn_list(const std::vector<int>& prns) {
   std::string out = "[";
@@ -56,7 +42,7 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
   io::AtomicFile file(path);
   auto& out = file.stream();
   fmt::print(out, "{{\n  \"input\": {{\"file\": {}, \"format\": {}, \"fs_hz\": {}, \"if_hz\": {}, \"skip_s\": {}}},\n",
-             json_string(run.input), json_string(run.format), run.fs_hz, run.if_hz, run.skip_s);
+             io::json_string(run.input), io::json_string(run.format), run.fs_hz, run.if_hz, run.skip_s);
   fmt::print(out, "  \"duration_s\": {:.6f},\n  \"wall_time_s\": {:.3f},\n  \"realtime_factor\": {:.3f},\n", duration,
              run.wall_time_s, run.wall_time_s > 0.0 ? duration / run.wall_time_s : 0.0);
   fmt::print(out, "  \"interrupted\": {},\n", run.interrupted);

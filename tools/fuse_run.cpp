@@ -14,6 +14,7 @@
 #include "ins/imu_error_model.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
+#include "io/json_text.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -157,19 +158,6 @@ std::vector<TimedAttitude> timed_attitudes(const FuseSettings& s, double imu_sta
                                                       "overlap the IMU data ({:.3f}-{:.3f} s): check "
                                                       "gps_time_at_imu_zero",
                                                       out.front().t_s, out.back().t_s, imu_start, imu_end));
-  return out;
-}
-
-std::string json_escape(const std::string& in) {
-  std::string out;
-  for (char ch : in) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
-      continue;
-    }
-    out += ch;
-  }
   return out;
 }
 
@@ -430,13 +418,13 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
                       : s.align == AlignMode::Config ? "config"
                                                      : "attitude";
   std::string j = "{\n";
-  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", json_escape(imu_file), json_escape(gnss_file));
-  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", json_escape(truth_file));
+  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", io::json_escape(imu_file), io::json_escape(gnss_file));
+  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", io::json_escape(truth_file));
   j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
                    s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
   j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
                    "\"yaw_deg\": {:.6f}}},\n",
-                   json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
+                   io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
                    r.initial_attitude.pitch_rad / kDeg, r.initial_attitude.yaw_rad / kDeg);
   j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
   j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
@@ -453,7 +441,7 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
                      "\"before_start\": {}, \"after_end\": {}, \"in_outage\": {}, \"used\": {}, \"updates\": {}, "
                      "\"updates_accepted\": {}, \"updates_rejected\": {}, \"rejected_near_vertical\": {}, \"late\": {}, "
                      "\"fallback_fixes\": {}, \"misalignment_deg\": [{}, {}, {}], \"max_pitch_deg\": {}}},\n",
-                     json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start,
+                     io::json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start,
                      a.after_end, a.in_outage, a.used, n.attitude_epochs, n.attitude_accepted, n.attitude_rejected,
                      n.attitude_unusable, n.attitude_late, n.fixes_without_attitude, m.x(), m.y(), m.z(),
                      s.config.attitude_max_pitch_deg);

@@ -21,6 +21,7 @@
 #include "io/input_error.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
+#include "io/json_text.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -31,19 +32,6 @@ constexpr double kG = 9.80665;
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kWeek_s = 604800.0;
 constexpr double kClockJumpDetect_s = 1e-7;  // receiver clock offsets change only by jumps (>= 1 ms in practice)
-
-std::string json_escape(const std::string& in) {
-  std::string out;
-  for (char ch : in) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
-      continue;
-    }
-    out += ch;
-  }
-  return out;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -603,7 +591,7 @@ std::string ReceiveFusion::summary_json() const {
   j += fmt::format("\"coupling\": \"{}\", \"filter\": \"{}\", \"align\": \"{}\", \"imu_file\": \"{}\", "
                    "\"imu_time_origin\": \"{}\", \"imu_preset\": \"{}\", \"started\": {}",
                    to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align,
-                   json_escape(m.settings.imu_file), m.origin_text(), json_escape(m.settings.config.imu_preset),
+                   io::json_escape(m.settings.imu_file), m.origin_text(), io::json_escape(m.settings.config.imu_preset),
                    m.integration.has_value());
   if (m.origin)
     j += fmt::format(", \"imu_time_origin_gps\": {{\"week\": {}, \"tow_s\": {:.9f}}}", m.origin->week, m.origin->tow_s);
@@ -612,12 +600,12 @@ std::string ReceiveFusion::summary_json() const {
                    m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
   if (m.is_tight()) j += fmt::format(", \"epochs_fewer_than_4_satellites\": {}", m.epochs_below_4);
   j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock_jumps, m.nav_rows);
-  if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", json_escape(m.not_started));
+  if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", io::json_escape(m.not_started));
   const auto& k = m.integration->counters();
   const auto& e = m.initial_attitude;
   j += fmt::format(", \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
                    "\"yaw_deg\": {:.6f}}}",
-                   json_escape(m.alignment_note), m.start_s, e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+                   io::json_escape(m.alignment_note), m.start_s, e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
   j += fmt::format(", \"start_s\": {}, \"end_s\": {}, \"imu_steps\": {}, \"updates_accepted\": {}, "
                    "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
                    m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,

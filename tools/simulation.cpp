@@ -24,6 +24,7 @@
 #include "signals/nominal_constellation.hpp"
 #include "signals/rinex_nav.hpp"
 #include "signals/sample_writer.hpp"
+#include "io/json_text.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -53,19 +54,6 @@ Eigen::Matrix3d ned_from_ecef(double lat_rad, double lon_rad) {
   Eigen::Matrix3d C;
   C << -sl * co, -sl * so, cl, -so, co, 0.0, -cl * co, -cl * so, -sl;
   return C;
-}
-
-std::string json_escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(c));
-      continue;
-    }
-    out += c;
-  }
-  return out;
 }
 
 }  // namespace
@@ -269,8 +257,8 @@ std::string inertial_summary(const Scenario& s, const InertialRun& run) {
   return fmt::format(
              "  \"trajectory\": \"{}\",\n  \"trajectory_duration_s\": {},\n  \"imu_rate_hz\": {},\n"
              "  \"imu_rows\": {},\n  \"imu_preset\": \"{}\",\n  \"imu_seed\": {},\n",
-             json_escape(s.trajectory_profile.empty() ? s.trajectory_file : s.trajectory_profile), run.duration_s,
-             s.imu_rate_hz, run.imu.imu_rows, json_escape(s.imu_preset), s.imu_seed) +
+             io::json_escape(s.trajectory_profile.empty() ? s.trajectory_file : s.trajectory_profile), run.duration_s,
+             s.imu_rate_hz, run.imu.imu_rows, io::json_escape(s.imu_preset), s.imu_seed) +
          turn_on_bias_json(run.imu.turn_on) +
          fmt::format("  \"lever_arms_body_m\": [{}],\n  \"distance_m\": {:.3f},\n  \"odometer\": {},\n", levers,
                      run.imu.distance_m, s.odometer);
@@ -297,7 +285,7 @@ SimulationResult run_inertial_only(const Scenario& s, const std::filesystem::pat
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const std::string summary =
       fmt::format("{{\n  \"command\": \"simulate\",\n  \"scenario\": \"{}\",\n  \"signal\": false,\n",
-                  json_escape(s.source.filename().string())) +
+                  io::json_escape(s.source.filename().string())) +
       inertial_summary(s, run) +
       fmt::format("  \"truth_rows\": {},\n  \"wall_s\": {:.3f}\n}}\n", result.truth_rows, result.wall_s);
   io::write_file_atomically(out_dir / "summary.json", summary);
@@ -425,11 +413,11 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
   std::string prns, files;
   for (const auto& v : result.satellites) prns += fmt::format("{}{}", prns.empty() ? "" : ", ", v.prn);
   for (const auto& f : result.sample_files)
-    files += fmt::format("{}\"{}\"", files.empty() ? "" : ", ", json_escape(f.filename().string()));
+    files += fmt::format("{}\"{}\"", files.empty() ? "" : ", ", io::json_escape(f.filename().string()));
   const std::string summary =
       fmt::format("{{\n  \"command\": \"simulate\",\n  \"scenario\": \"{}\",\n  \"navigation\": \"{}\",\n",
-                  json_escape(s.source.filename().string()),
-                  json_escape(std::filesystem::path(nav.name).filename().string())) +
+                  io::json_escape(s.source.filename().string()),
+                  io::json_escape(std::filesystem::path(nav.name).filename().string())) +
       (inertial ? inertial_summary(s, *inertial) : std::string()) +
       fmt::format(
           "  \"sample_rate_hz\": {},\n  \"if_hz\": {},\n  \"format\": \"{}\",\n  \"antennas\": {},\n"
