@@ -156,22 +156,15 @@ class Core final : public CoreBase {
     ins_.step(dth, dv, dt);
     nominal_.nav = ins_.state();
     if constexpr (N == 17) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
-    acc_dt_ += dt;
-    acc_dv_n_ += q0.slerp(0.5, nominal_.nav.q_nb) * dv;
-    w_ib_b_ = dth / dt;
-    if (acc_dt_ >= opt_.propagation_interval_s) propagate();
+    imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
+    if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
 
   void propagate() {
-    if (acc_dt_ <= 0.0) return;
-    InsLinearisation lin;
-    lin.nav = nominal_.nav;
-    lin.f_b = nominal_.nav.q_nb.conjugate() * (acc_dv_n_ / acc_dt_);
-    lin.w_ib_b = w_ib_b_;
-    model_.set_linearisation(lin);
-    filter_.predict(model_, acc_dt_);
-    acc_dt_ = 0.0;
-    acc_dv_n_.setZero();
+    if (imu_steps_.dt_s <= 0.0) return;
+    model_.set_linearisation(imu_steps_.linearisation(nominal_.nav));
+    filter_.predict(model_, imu_steps_.dt_s);
+    imu_steps_.clear();
   }
 
   template <class M>
@@ -213,7 +206,7 @@ class Core final : public CoreBase {
     if (const auto* f = std::get_if<PendingFix>(&p)) {
       if constexpr (N == 15) {
         if (f->fix.has_position || f->fix.has_velocity) {
-          if (update(LooseMeasurement<N>(nominal_, f->fix, opt_.lever_arm_b, w_ib_b_), 0))
+          if (update(LooseMeasurement<N>(nominal_, f->fix, opt_.lever_arm_b, imu_steps_.w_ib_b), 0))
             ++counters.fix_accepted;
           else
             ++counters.fix_rejected;
@@ -244,7 +237,7 @@ class Core final : public CoreBase {
           ++counters.height_rejected;
       }
       for (const auto& s : sats)
-        update(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, w_ib_b_, opt_.tight.use_range_rate), s.prn);
+        update(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b, opt_.tight.use_range_rate), s.prn);
       if (!few) {  // full geometry: hold this epoch's height for later epochs with fewer satellites
         held_height_ = nominal_.nav.height_m;
         held_sigma_m_ = std::sqrt(std::max(filter_.P()(ix::kPos + 2, ix::kPos + 2), 0.0));
@@ -279,9 +272,7 @@ class Core final : public CoreBase {
   Filter filter_;
   NominalState nominal_;
   std::multimap<double, Pending> pending_;
-  double acc_dt_ = 0.0;
-  Eigen::Vector3d acc_dv_n_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d w_ib_b_ = Eigen::Vector3d::Zero();
+  ImuStepAccumulator imu_steps_;
   bool attitude_since_fix_ = false;
   // Height aiding: IMU height at the last full-geometry epoch (at first: the initial state's), aids since then.
   double held_height_ = 0.0, held_sigma_m_ = 0.0, held_t_s_ = 0.0;

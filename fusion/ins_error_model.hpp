@@ -61,6 +61,32 @@ struct InsLinearisation {
   Eigen::Vector3d w_ib_b = Eigen::Vector3d::Zero();  // compensated body rate [rad/s]
 };
 
+// What the covariance propagation needs from the compensated IMU steps since the last predict: their length,
+// their velocity increment in NED (each step's dv rotated at its mid-attitude) and the latest body rate. The
+// INS runs at the IMU rate; the filter predicts over several steps at once with the mean specific force.
+struct ImuStepAccumulator {
+  double dt_s = 0.0;
+  Eigen::Vector3d dv_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d w_ib_b = Eigen::Vector3d::Zero();
+
+  // One step from attitude q0 to q1 with compensated increments dth, dv over dt > 0.
+  void add(const Eigen::Quaterniond& q0, const Eigen::Quaterniond& q1, const Eigen::Vector3d& dth,
+           const Eigen::Vector3d& dv, double dt) {
+    dt_s += dt;
+    dv_n += q0.slerp(0.5, q1) * dv;
+    w_ib_b = dth / dt;
+  }
+  // The linearisation point for predicting over the accumulated steps (dt_s > 0), ending at nav.
+  InsLinearisation linearisation(const ins::NavState& nav) const {
+    return {nav, nav.q_nb.conjugate() * (dv_n / dt_s), w_ib_b};
+  }
+  // After a predict: the body rate stays (measurement models use the latest one).
+  void clear() {
+    dt_s = 0.0;
+    dv_n.setZero();
+  }
+};
+
 template <int N>
 class InsErrorModel {
   static_assert(N == 15 || N == 17, "INS error model: 15 or 17 states");

@@ -149,9 +149,7 @@ class UltraTightCore final : public UltraTightCoreBase {
     ins_.step(dth, dv, dt);
     nominal_.nav = ins_.state();
     nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
-    acc_dt_ += dt;
-    acc_dv_n_ += q0.slerp(0.5, nominal_.nav.q_nb) * dv;
-    w_ib_b_ = dth / dt;
+    imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
     fill_output();
   }
 
@@ -205,7 +203,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       // The prediction with the nominal as it stands now (earlier satellites of this period have updated it).
       const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
       const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
-                                    antenna_velocity_n(nominal_.nav, w_ib_b_, opt_.lever_arm_b);
+                                    antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
       const double pr_now = predicted_pseudorange_m(*s, r_ant, nominal_.clock_bias_m);
       const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
       const double back = nominal_.nav.t_s - (r.t_start_s + 0.5 * T_);
@@ -219,14 +217,14 @@ class UltraTightCore final : public UltraTightCoreBase {
       is.tap_offset_chips = opt_.tap_offset_chips;
       bool ok = false;
       if (opt_.form == UltraTightForm::Iq) {
-        const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, w_ib_b_);
+        const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
         const Eigen::Matrix<double, 1, 17> h_range = rep.jacobian().row(0);
         const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
-        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, w_ib_b_, is, offset, c->taps, sigma_code));
+        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, c->taps, sigma_code));
       } else {
         const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
                                 frequency_discriminator_hz(c->taps, is) * kLambda_m);
-        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, w_ib_b_, offset, z,
+        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, z,
                                                    discriminator_noise(is)));
       }
       ch.coasting = !ok;
@@ -244,7 +242,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   void predict_satellites(std::vector<SatelliteObservable>& out) const {
     const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
     const Eigen::Vector3d v_ant =
-        ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) * antenna_velocity_n(nominal_.nav, w_ib_b_, opt_.lever_arm_b);
+        ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) * antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
     receiver::ObservationEpoch epoch;
     epoch.receive_time =
         signals::add_seconds(opt_.gps_time_origin, nominal_.nav.t_s + nominal_.clock_bias_m / kC);
@@ -276,15 +274,10 @@ class UltraTightCore final : public UltraTightCoreBase {
   }
 
   void propagate() {
-    if (acc_dt_ <= 0.0) return;
-    InsLinearisation lin;
-    lin.nav = nominal_.nav;
-    lin.f_b = nominal_.nav.q_nb.conjugate() * (acc_dv_n_ / acc_dt_);
-    lin.w_ib_b = w_ib_b_;
-    model_.set_linearisation(lin);
-    filter_.predict(model_, acc_dt_);
-    acc_dt_ = 0.0;
-    acc_dv_n_.setZero();
+    if (imu_steps_.dt_s <= 0.0) return;
+    model_.set_linearisation(imu_steps_.linearisation(nominal_.nav));
+    filter_.predict(model_, imu_steps_.dt_s);
+    imu_steps_.clear();
   }
 
   template <class M>
@@ -328,9 +321,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   std::vector<SatelliteObservable> sats_start_;
   std::map<int, ChannelState> channels_;
   double T_ = 0.020;
-  double acc_dt_ = 0.0;
-  Eigen::Vector3d acc_dv_n_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d w_ib_b_ = Eigen::Vector3d::Zero();
+  ImuStepAccumulator imu_steps_;
 };
 
 }  // namespace
