@@ -89,6 +89,11 @@ Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) 
                     block_size_ == whole_period * static_cast<std::size_t>(options_.coherent_ms);
   fft_size_ = fold ? whole_period : block_size_;
   lags_ = std::min(fft_size_, static_cast<std::size_t>(std::ceil(period)));
+  // Rotation (file comment of the header): R grid steps per FFT bin, when that is a whole number.
+  const double per_fft_bin = options_.fs_hz / static_cast<double>(fft_size_) / options_.step_hz();
+  const double whole = std::round(per_fft_bin);
+  rotation_ = whole >= 1.0 && std::abs(per_fft_bin - whole) < 1e-6 ? static_cast<std::size_t>(whole) : 0;
+  segment_ = static_cast<std::size_t>(std::max<long long>(1, std::llround(options_.fs_hz * 1e-4)));
   forward_ = FftwPlan(fft_size_, FftwPlan::Direction::forward);
   backward_ = FftwPlan(fft_size_, FftwPlan::Direction::backward);
   scratch_.push_back(std::make_unique<Scratch>(fft_size_, lags_));
@@ -96,7 +101,7 @@ Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) 
 }
 
 Acquisition::Scratch::Scratch(std::size_t fft_size, std::size_t lags)
-    : mixed(fft_size), product(fft_size), correlation(fft_size), spectrum(fft_size), row(lags) {}
+    : mixed(fft_size), product(fft_size), correlation(fft_size), spectrum(fft_size), grid(lags) {}
 
 template <class F>
 void Acquisition::spread(WorkerPool* pool, int n, F&& f) {
@@ -180,96 +185,166 @@ void Acquisition::doppler_spectrum(std::span<const std::complex<float>> samples,
   forward_.execute(s.mixed, out);
 }
 
-void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, const FftwBuffer* cached, int prn,
-                                double doppler_hz, Scratch& s) const {
+const FftwBuffer* Acquisition::signal_spectra(std::span<const std::complex<float>> samples,
+                                              const std::vector<double>& dopplers, WorkerPool* pool) {
+  const std::size_t bases = rotation_ > 0 ? std::min(rotation_, dopplers.size()) : dopplers.size();
+  const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
+  const std::size_t spectra = bases * k_blocks;
+  if (spectra * fft_size_ * sizeof(std::complex<float>) > memory_budget_bytes_) return nullptr;
+  while (spectrum_cache_.size() < spectra) spectrum_cache_.emplace_back(fft_size_);  // grows once, then reused
+  spread(pool, static_cast<int>(spectra), [&](int i, Scratch& s) {
+    const auto b = static_cast<std::size_t>(i) / k_blocks, k = static_cast<std::size_t>(i) % k_blocks;
+    doppler_spectrum(samples, static_cast<int>(k), dopplers[b], spectrum_cache_[b * k_blocks + k], s);
+  });
+  return spectrum_cache_.data();
+}
+
+void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, const FftwBuffer* spectra,
+                                std::size_t shift, int prn, double doppler_hz, float* acc, Scratch& s) const {
   const FftwBuffer& code = *code_spectra_[static_cast<std::size_t>(prn - 1)];  // made before the search
-  std::vector<float>& acc = s.row;
-  std::fill(acc.begin(), acc.end(), 0.0f);
+  std::fill(acc, acc + lags_, 0.0f);
   // Code-phase drift per block from the code Doppler (and from N not being a whole number of periods).
   const double period = kCodeLength * options_.fs_hz / code_rate_hz(doppler_hz);
   const auto n = static_cast<std::ptrdiff_t>(fft_size_);
   for (int k = 0; k < options_.noncoherent; ++k) {
-    const FftwBuffer* spectrum = cached ? cached + k : &s.spectrum;
-    if (!cached) doppler_spectrum(samples, k, doppler_hz, s.spectrum, s);
-    // X * C in real arithmetic: std::complex's operator* carries a NaN-recovery branch that stops vectorisation.
+    const FftwBuffer* spectrum = spectra ? spectra + k : &s.spectrum;
+    if (!spectra) doppler_spectrum(samples, k, doppler_hz, s.spectrum, s);
+    // P[i] = X[(i + shift) mod F] C[i] in real arithmetic (std::complex's operator* carries a NaN-recovery
+    // branch that stops vectorisation), in the two runs of the rotation.
     const float* x = reinterpret_cast<const float*>(spectrum->data());
     const float* c = reinterpret_cast<const float*>(code.data());
     float* p = reinterpret_cast<float*>(s.product.data());
-    for (std::size_t i = 0; i < fft_size_; ++i) {
-      const float xr = x[2 * i], xi = x[2 * i + 1], cr = c[2 * i], ci = c[2 * i + 1];
-      p[2 * i] = xr * cr - xi * ci;
-      p[2 * i + 1] = xr * ci + xi * cr;
-    }
+    auto multiply = [&](std::size_t from, std::size_t to, const float* xs) {
+      for (std::size_t i = from; i < to; ++i) {
+        const float xr = xs[2 * i], xi = xs[2 * i + 1], cr = c[2 * i], ci = c[2 * i + 1];
+        p[2 * i] = xr * cr - xi * ci;
+        p[2 * i + 1] = xr * ci + xi * cr;
+      }
+    };
+    multiply(0, fft_size_ - shift, x + 2 * shift);
+    multiply(fft_size_ - shift, fft_size_, x + 2 * shift - 2 * fft_size_);
     backward_.execute(s.product, s.correlation);
     const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
-    std::ptrdiff_t shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
-    if (shift < 0) shift += n;
-    // row[lag] += |corr[(lag + shift) mod n]|^2, in the two unwrapped runs.
+    std::ptrdiff_t lag_shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
+    if (lag_shift < 0) lag_shift += n;
+    // acc[lag] += |corr[(lag + lag_shift) mod n]|^2, in the two unwrapped runs.
     const auto* y = reinterpret_cast<const float*>(s.correlation.data());
-    const auto first_run = static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(lags_), n - shift));
-    const float* a = y + 2 * shift;
+    const auto first_run =
+        static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(lags_), n - lag_shift));
+    const float* a = y + 2 * lag_shift;
     for (std::size_t lag = 0; lag < first_run; ++lag) acc[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
     const float* b = y - 2 * static_cast<std::ptrdiff_t>(first_run);
     for (std::size_t lag = first_run; lag < lags_; ++lag) acc[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
   }
 }
 
-std::complex<double> Acquisition::correlate_time(std::span<const std::complex<float>> samples, int prn, int block,
-                                                 double doppler_hz, double lag_samples) const {
+void Acquisition::segment_sums(std::span<const std::complex<float>> samples, int prn, double doppler_hz,
+                               double lag_samples, Scratch& s) const {
   const auto& code = signals::ca_code(prn);
-  const std::size_t first = static_cast<std::size_t>(block) * block_size_;
+  const std::size_t per_block = (block_size_ + segment_ - 1) / segment_;
+  s.segment_re.resize(per_block * static_cast<std::size_t>(options_.noncoherent));  // no-ops after the first
+  s.segment_im.resize(s.segment_re.size());
   const double chips_per_sample = code_rate_hz(doppler_hz) / options_.fs_hz;
-  const std::complex<double> step = std::polar(1.0, -kTwoPi * doppler_hz / options_.fs_hz);
-  // The complex products written out in real arithmetic (the same operations as std::complex's, without its
-  // NaN-recovery branches, which cost more than the arithmetic).
+  const double cycles_per_sample = doppler_hz / options_.fs_hz;
+  const std::complex<double> step = std::polar(1.0, -kTwoPi * cycles_per_sample);
   const double step_re = step.real(), step_im = step.imag();
-  double nco_re = 1.0, nco_im = 0.0, sum_re = 0.0, sum_im = 0.0;
-  double phase = (static_cast<double>(first) - lag_samples) * chips_per_sample;
-  const auto* x = reinterpret_cast<const float*>(samples.data() + first);
-  for (std::size_t m = 0; m < block_size_; ++m) {
-    const double xr = x[2 * m], xi = x[2 * m + 1];
-    const double chip = chip_at(code, phase);
-    sum_re += (xr * nco_re - xi * nco_im) * chip;
-    sum_im += (xr * nco_im + xi * nco_re) * chip;
-    const double next_re = nco_re * step_re - nco_im * step_im;
-    nco_im = nco_re * step_im + nco_im * step_re;
-    nco_re = next_re;
-    phase += chips_per_sample;
+  for (int k = 0; k < options_.noncoherent; ++k) {
+    const std::size_t first = static_cast<std::size_t>(k) * block_size_;
+    double phase = (static_cast<double>(first) - lag_samples) * chips_per_sample;
+    phase -= kCodeLength * std::floor(phase / kCodeLength);
+    const auto* x = reinterpret_cast<const float*>(samples.data() + first);
+    for (std::size_t j = 0; j < per_block; ++j) {
+      const std::size_t from = j * segment_, to = std::min(block_size_, from + segment_);
+      // The carrier phase relative to the block's first sample, exact at each segment's start.
+      const double turns = cycles_per_sample * static_cast<double>(from);
+      const std::complex<double> anchor = std::polar(1.0, -kTwoPi * (turns - std::floor(turns)));
+      double nco_re = anchor.real(), nco_im = anchor.imag(), sum_re = 0.0, sum_im = 0.0;
+      for (std::size_t m = from; m < to; ++m) {
+        const double xr = x[2 * m], xi = x[2 * m + 1];
+        const auto chip_index = std::min(static_cast<std::size_t>(phase), static_cast<std::size_t>(kCodeLength - 1));
+        const double chip = code[chip_index];
+        sum_re += (xr * nco_re - xi * nco_im) * chip;
+        sum_im += (xr * nco_im + xi * nco_re) * chip;
+        const double next_re = nco_re * step_re - nco_im * step_im;
+        nco_im = nco_re * step_im + nco_im * step_re;
+        nco_re = next_re;
+        phase += chips_per_sample;
+        if (phase >= kCodeLength) phase -= kCodeLength;
+      }
+      s.segment_re[static_cast<std::size_t>(k) * per_block + j] = sum_re;
+      s.segment_im[static_cast<std::size_t>(k) * per_block + j] = sum_im;
+    }
   }
-  return {sum_re, sum_im};
 }
 
-double Acquisition::power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz,
-                             double lag_samples) const {
+double Acquisition::segment_power(const Scratch& s, double offset_hz) const {
+  const std::size_t per_block = (block_size_ + segment_ - 1) / segment_;
   double power = 0.0;
-  for (int k = 0; k < options_.noncoherent; ++k)
-    power += std::norm(correlate_time(samples, prn, k, doppler_hz, lag_samples));
+  for (int k = 0; k < options_.noncoherent; ++k) {
+    double re = 0.0, im = 0.0;
+    for (std::size_t j = 0; j < per_block; ++j) {
+      const std::size_t from = j * segment_, to = std::min(block_size_, from + segment_);
+      // The offset's phase at the segment's centre, relative to the block's first sample.
+      const double centre = 0.5 * static_cast<double>(from + to - 1);
+      const double angle = -kTwoPi * offset_hz * centre / options_.fs_hz;
+      const double c = std::cos(angle), sn = std::sin(angle);
+      const double a = s.segment_re[static_cast<std::size_t>(k) * per_block + j];
+      const double b = s.segment_im[static_cast<std::size_t>(k) * per_block + j];
+      re += a * c - b * sn;
+      im += a * sn + b * c;
+    }
+    power += re * re + im * im;
+  }
   return power;
 }
 
+double Acquisition::power_at(std::span<const std::complex<float>> samples, int prn, double doppler_hz,
+                             double lag_samples, Scratch& s) const {
+  segment_sums(samples, prn, doppler_hz, lag_samples, s);
+  return segment_power(s, 0.0);
+}
+
 AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> samples, int prn,
-                                           const std::vector<double>& dopplers, bool cached, Scratch& s) const {
-  std::vector<float>& acc = s.row;
+                                           const std::vector<double>& dopplers, const FftwBuffer* spectra, Scratch& s,
+                                           WorkerPool* pool) {
   std::vector<float>& grid = s.grid;
   std::vector<double>& row_noise = s.row_noise;
   const std::size_t bins = dopplers.size();
   if (grid.size() < bins * lags_) grid.resize(bins * lags_);
   row_noise.resize(bins);
+  // The rows: independent, each written by one job into its own part of the grid.
+  const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
+  auto fill = [&](int i, Scratch& t) {
+    const auto d = static_cast<std::size_t>(i);
+    const std::size_t base = rotation_ > 0 ? d % rotation_ : d, shift = rotation_ > 0 ? d / rotation_ : 0;
+    correlate_bin(samples, spectra ? spectra + base * k_blocks : nullptr, spectra ? shift : 0, prn, dopplers[d],
+                  &grid[d * lags_], t);
+  };
+  if (pool) {
+    spread(pool, static_cast<int>(bins), fill);
+  } else {
+    for (std::size_t d = 0; d < bins; ++d) fill(static_cast<int>(d), s);
+  }
+  // Index of a row's largest cell (the first of equals).
+  auto largest = [&](const float* row) {
+    float top = row[0];
+    for (std::size_t lag = 1; lag < lags_; ++lag) top = std::max(top, row[lag]);
+    return static_cast<std::size_t>(std::find(row, row + lags_, top) - row);
+  };
+
   // Candidate peak on rows normalised by their plain means (the signal raises its row's mean a little).
   double candidate = -1.0;
   std::size_t candidate_lag = 0;
   for (std::size_t d = 0; d < bins; ++d) {
-    correlate_bin(samples, cached ? &spectrum_cache_[d * static_cast<std::size_t>(options_.noncoherent)] : nullptr, prn,
-                  dopplers[d], s);
-    std::copy(acc.begin(), acc.end(), grid.begin() + static_cast<std::ptrdiff_t>(d * lags_));
+    const float* row = &grid[d * lags_];
     double sum = 0.0;
-    for (float v : acc) sum += v;
+    for (std::size_t lag = 0; lag < lags_; ++lag) sum += row[lag];
+    row_noise[d] = sum;
     const double mean = sum / static_cast<double>(lags_);
-    for (std::size_t lag = 0; lag < lags_; ++lag) {
-      if (acc[lag] > candidate * mean) {
-        candidate = acc[lag] / mean;
-        candidate_lag = lag;
-      }
+    const std::size_t top = largest(row);
+    if (row[top] > candidate * mean) {
+      candidate = row[top] / mean;
+      candidate_lag = top;
     }
   }
 
@@ -277,31 +352,23 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
   // candidate's code phase (+-1.5 chips; in every row, which also removes the signal's Doppler side
   // lobes). Per row because real front ends leave narrowband spurs that raise whole rows evenly: one
   // noise level for the whole grid would turn those rows into false alarms.
-  const auto guard = static_cast<std::ptrdiff_t>(std::ceil(1.5 * samples_per_chip_)) + 1;
+  const auto guard = std::min(static_cast<std::ptrdiff_t>(std::ceil(1.5 * samples_per_chip_)) + 1,
+                              (static_cast<std::ptrdiff_t>(lags_) - 2) / 2);
   const auto lags = static_cast<std::ptrdiff_t>(lags_);
-  auto excluded = [&](std::size_t lag) {
-    std::ptrdiff_t distance = std::abs(static_cast<std::ptrdiff_t>(lag) - static_cast<std::ptrdiff_t>(candidate_lag));
-    return std::min(distance, lags - distance) <= guard;
-  };
   double best = -1.0;
   int best_bin = 0;
   std::size_t best_lag = 0;
   for (std::size_t d = 0; d < bins; ++d) {
     const float* row = &grid[d * lags_];
-    double sum = 0.0;
-    std::size_t count = 0;
-    for (std::size_t lag = 0; lag < lags_; ++lag) {
-      if (excluded(lag)) continue;
-      sum += row[lag];
-      ++count;
-    }
-    row_noise[d] = sum / static_cast<double>(count);
-    for (std::size_t lag = 0; lag < lags_; ++lag) {
-      if (row[lag] > best * row_noise[d]) {
-        best = row[lag] / row_noise[d];
-        best_bin = static_cast<int>(d);
-        best_lag = lag;
-      }
+    double excluded = 0.0;
+    for (std::ptrdiff_t o = -guard; o <= guard; ++o)
+      excluded += row[((static_cast<std::ptrdiff_t>(candidate_lag) + o) % lags + lags) % lags];
+    row_noise[d] = (row_noise[d] - excluded) / static_cast<double>(lags - (2 * guard + 1));
+    const std::size_t top = largest(row);
+    if (row[top] > best * row_noise[d]) {
+      best = row[top] / row_noise[d];
+      best_bin = static_cast<int>(d);
+      best_lag = top;
     }
   }
   const double k = options_.noncoherent;
@@ -317,12 +384,14 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
   double lag = static_cast<double>(best_lag);
   double peak_power = best * k * noise_power;
   if (result.detected) {
-    // Fine Doppler: step/8 over +-1 coarse step at the peak lag, then a parabola through the best three.
+    // Fine Doppler: step/8 over +-1 coarse step at the peak lag, by rotating the partial sums made once at the
+    // coarse Doppler, then a parabola through the best three.
     const double fine = options_.step_hz() / 8.0;
     std::array<double, 17> powers{};
     std::size_t top = 0;
+    segment_sums(samples, prn, doppler, lag, s);
     for (std::size_t i = 0; i < powers.size(); ++i) {
-      powers[i] = power_at(samples, prn, doppler + (static_cast<double>(i) - 8.0) * fine, lag);
+      powers[i] = segment_power(s, (static_cast<double>(i) - 8.0) * fine);
       if (powers[i] > powers[top]) top = i;
     }
     double offset = static_cast<double>(top) - 8.0;
@@ -334,12 +403,12 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
 
     // Fine code phase: triangle fit through the signal amplitudes (noise power removed) at lag -1, 0, +1.
     auto amplitude = [&](double l) {
-      return std::sqrt(std::max(power_at(samples, prn, doppler, l) / k - noise_power, 0.0));
+      return std::sqrt(std::max(power_at(samples, prn, doppler, l, s) / k - noise_power, 0.0));
     };
     const double before = amplitude(lag - 1.0), centre = amplitude(lag), after = amplitude(lag + 1.0);
     const double drop = centre - std::min(before, after);
     if (drop > 0.0) lag += std::clamp((after - before) / (2.0 * drop), -0.5, 0.5);
-    peak_power = power_at(samples, prn, doppler, lag);
+    peak_power = power_at(samples, prn, doppler, lag, s);
   }
   const double snr = peak_power / (k * noise_power) - 1.0;  // coherent SNR = C/N0 T_coh
   result.cn0_dbhz = 10.0 * std::log10(std::max(snr, 1e-3) / options_.coherent_s());
@@ -367,30 +436,20 @@ AcquisitionResult Acquisition::search(std::span<const std::complex<float>> sampl
                                       std::optional<DopplerWindow> assist) {
   check(samples, prn);
   code_spectrum(prn);
-  return search_grid(samples, prn, doppler_grid(assist), false, *scratch_[0]);
+  const std::vector<double> dopplers = doppler_grid(assist);
+  return search_grid(samples, prn, dopplers, signal_spectra(samples, dopplers, nullptr), *scratch_[0], nullptr);
 }
 
 std::vector<AcquisitionResult> Acquisition::search_each(std::span<const std::complex<float>> samples,
                                                         std::span<const int> prns, WorkerPool* pool) {
   for (int prn : prns) code_spectrum(prn);  // made here, read-only below
   const std::vector<double> dopplers = doppler_grid(std::nullopt);
-  const std::size_t spectra = dopplers.size() * static_cast<std::size_t>(options_.noncoherent);
-  const bool cache = prns.size() > 1 && spectra * fft_size_ * sizeof(std::complex<float>) <= memory_budget_bytes_;
-  if (cache) {
-    // One forward FFT per (Doppler bin, block), shared by every PRN.
-    if (spectrum_cache_.size() != spectra) {
-      spectrum_cache_.clear();
-      for (std::size_t i = 0; i < spectra; ++i) spectrum_cache_.emplace_back(fft_size_);
-    }
-    const auto k_blocks = static_cast<std::size_t>(options_.noncoherent);
-    spread(pool, static_cast<int>(spectra), [&](int i, Scratch& s) {
-      const auto d = static_cast<std::size_t>(i) / k_blocks, k = static_cast<std::size_t>(i) % k_blocks;
-      doppler_spectrum(samples, static_cast<int>(k), dopplers[d], spectrum_cache_[d * k_blocks + k], s);
-    });
-  }
+  // The Doppler-shifted signal spectra (of the grid's rotation bases), shared by every PRN.
+  const FftwBuffer* spectra = signal_spectra(samples, dopplers, pool);
   std::vector<AcquisitionResult> results(prns.size());
   spread(pool, static_cast<int>(prns.size()), [&](int i, Scratch& s) {
-    results[static_cast<std::size_t>(i)] = search_grid(samples, prns[static_cast<std::size_t>(i)], dopplers, cache, s);
+    results[static_cast<std::size_t>(i)] =
+        search_grid(samples, prns[static_cast<std::size_t>(i)], dopplers, spectra, s, nullptr);
   });
   return results;
 }
@@ -439,9 +498,11 @@ std::vector<AcquisitionResult> Acquisition::search(std::span<const std::complex<
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return results[a].metric > results[b].metric; });
   cleaned_.assign(samples.begin(), samples.begin() + static_cast<std::ptrdiff_t>(samples_needed()));
+  const std::vector<double> dopplers = doppler_grid(std::nullopt);
   for (std::size_t n = 0; n < order.size(); ++n) {
     AcquisitionResult& r = results[order[n]];
-    if (n > 0) r = search_grid(cleaned_, r.prn, doppler_grid(std::nullopt), false, *scratch_[0]);
+    // One PRN at a time (each on the samples the stronger ones were removed from): its rows over the pool.
+    if (n > 0) r = search_grid(cleaned_, r.prn, dopplers, signal_spectra(cleaned_, dopplers, pool), *scratch_[0], pool);
     if (r.detected) cancel(cleaned_, r);
   }
   std::vector<int> rest;
