@@ -321,3 +321,50 @@ TEST(FalseAlarmRate, OversampledGridIsNotAbovePfa) {
   std::printf("  %d false alarms in %.0f searches (at most %.1f expected)\n", detections, n, mean);
   EXPECT_LT(detections, mean + 4.0 * sigma) << "expected at most " << mean;
 }
+
+// The receiver's search (4 ms x 5 at 2.6 MHz: a grid of 6 steps per FFT bin, so 6 signal spectra per block serve
+// all 61 Doppler bins by rotation; the cold start's pool): satellites spread over the whole Doppler range (bins of
+// every rotation class, far from their bases) are found at the simulated Doppler and code phase, and every
+// result is the same, bit for bit, with 1, 2 and 3 threads (the rows of the cancellation passes are spread
+// over the pool).
+TEST(Acquisition, RotatedSpectraFindTruthAndPoolDoesNotChangeResults) {
+  AcquisitionOptions o;
+  o.fs_hz = 2.6e6;
+  o.coherent_ms = 4;
+  o.noncoherent = 5;
+  auto samples = complex_noise(static_cast<std::size_t>(std::llround(o.fs_hz * 0.02)), 11);
+  const std::vector<CaSignal> present{{.prn = 5, .code_phase_chips = 100.3, .doppler_hz = -4871.0, .cn0_dbhz = 45.0},
+                                      {.prn = 10, .code_phase_chips = 511.8, .doppler_hz = -1234.0, .cn0_dbhz = 42.0},
+                                      {.prn = 13, .code_phase_chips = 3.6, .doppler_hz = 77.0, .cn0_dbhz = 45.0},
+                                      {.prn = 23, .code_phase_chips = 1001.1, .doppler_hz = 2950.0, .cn0_dbhz = 40.0},
+                                      {.prn = 24, .code_phase_chips = 640.5, .doppler_hz = 4420.0, .cn0_dbhz = 45.0}};
+  for (const auto& s : present) add_ca_signal(samples, o.fs_hz, s);
+  std::vector<int> prns(32);
+  std::iota(prns.begin(), prns.end(), 1);
+  std::vector<std::vector<AcquisitionResult>> runs;
+  for (int threads = 1; threads <= 3; ++threads) {
+    WorkerPool pool(threads);
+    Acquisition acq(o);
+    runs.push_back(acq.search(samples, prns, &pool));
+  }
+  for (const auto& r : runs[0]) {
+    auto it = std::find_if(present.begin(), present.end(), [&](const CaSignal& s) { return s.prn == r.prn; });
+    if (it == present.end()) continue;  // false alarms: the pfa tests
+    ASSERT_TRUE(r.detected) << "PRN " << r.prn;
+    std::printf("  PRN %2d  Doppler error %6.2f Hz  code error %6.3f chips  C/N0 %.1f dB-Hz (true %.1f)\n", r.prn,
+                r.doppler_hz - it->doppler_hz, chip_error(r.code_phase_chips, it->code_phase_chips), r.cn0_dbhz,
+                it->cn0_dbhz);
+    // Fine grid step 166.7 / 8 = 20.8 Hz with a parabola: within half a fine step, plus noise at 40 dB-Hz.
+    EXPECT_NEAR(r.doppler_hz, it->doppler_hz, 15.0) << "PRN " << r.prn;
+    // Triangle fit on 2.54 samples per chip: a small fraction of a chip.
+    EXPECT_NEAR(chip_error(r.code_phase_chips, it->code_phase_chips), 0.0, 0.1) << "PRN " << r.prn;
+    EXPECT_NEAR(r.cn0_dbhz, it->cn0_dbhz, 1.5) << "PRN " << r.prn;
+  }
+  for (std::size_t t = 1; t < runs.size(); ++t)
+    for (std::size_t i = 0; i < runs[0].size(); ++i) {
+      EXPECT_EQ(runs[t][i].detected, runs[0][i].detected) << t + 1 << " threads, PRN " << i + 1;
+      EXPECT_EQ(runs[t][i].doppler_hz, runs[0][i].doppler_hz) << t + 1 << " threads, PRN " << i + 1;
+      EXPECT_EQ(runs[t][i].code_phase_chips, runs[0][i].code_phase_chips) << t + 1 << " threads, PRN " << i + 1;
+      EXPECT_EQ(runs[t][i].metric, runs[0][i].metric) << t + 1 << " threads, PRN " << i + 1;
+    }
+}
