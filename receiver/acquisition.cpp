@@ -325,23 +325,35 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
   } else {
     for (std::size_t d = 0; d < bins; ++d) fill(static_cast<int>(d), s);
   }
-  // Index of a row's largest cell (the first of equals).
+  // Index of a row's largest cell (the first of equals): eight independent running maxima (a reduction the
+  // compiler vectorises; one running maximum is a dependency chain), then the first cell equal to it.
   auto largest = [&](const float* row) {
-    float top = row[0];
-    for (std::size_t lag = 1; lag < lags_; ++lag) top = std::max(top, row[lag]);
-    return static_cast<std::size_t>(std::find(row, row + lags_, top) - row);
+    std::array<float, 8> top;
+    top.fill(row[0]);
+    std::size_t lag = 0;
+    for (; lag + 8 <= lags_; lag += 8)
+      for (std::size_t j = 0; j < 8; ++j) top[j] = top[j] < row[lag + j] ? row[lag + j] : top[j];
+    for (; lag < lags_; ++lag) top[0] = top[0] < row[lag] ? row[lag] : top[0];
+    const float m = *std::max_element(top.begin(), top.end());
+    return static_cast<std::size_t>(std::find(row, row + lags_, m) - row);
   };
+  std::vector<std::size_t>& row_top = s.row_top;
+  row_top.resize(bins);
 
   // Candidate peak on rows normalised by their plain means (the signal raises its row's mean a little).
   double candidate = -1.0;
   std::size_t candidate_lag = 0;
   for (std::size_t d = 0; d < bins; ++d) {
     const float* row = &grid[d * lags_];
-    double sum = 0.0;
-    for (std::size_t lag = 0; lag < lags_; ++lag) sum += row[lag];
+    std::array<double, 4> partial{};  // four running sums: vectorised, and no longer one dependency chain
+    std::size_t lag = 0;
+    for (; lag + 4 <= lags_; lag += 4)
+      for (std::size_t j = 0; j < 4; ++j) partial[j] += row[lag + j];
+    for (; lag < lags_; ++lag) partial[0] += row[lag];
+    const double sum = (partial[0] + partial[1]) + (partial[2] + partial[3]);
     row_noise[d] = sum;
     const double mean = sum / static_cast<double>(lags_);
-    const std::size_t top = largest(row);
+    const std::size_t top = row_top[d] = largest(row);
     if (row[top] > candidate * mean) {
       candidate = row[top] / mean;
       candidate_lag = top;
@@ -364,7 +376,7 @@ AcquisitionResult Acquisition::search_grid(std::span<const std::complex<float>> 
     for (std::ptrdiff_t o = -guard; o <= guard; ++o)
       excluded += row[((static_cast<std::ptrdiff_t>(candidate_lag) + o) % lags + lags) % lags];
     row_noise[d] = (row_noise[d] - excluded) / static_cast<double>(lags - (2 * guard + 1));
-    const std::size_t top = largest(row);
+    const std::size_t top = row_top[d];  // the same cell: the row is divided by one number
     if (row[top] > best * row_noise[d]) {
       best = row[top] / row_noise[d];
       best_bin = static_cast<int>(d);

@@ -131,6 +131,7 @@ class Acquisition {
     FftwBuffer mixed, product, correlation, spectrum;
     std::vector<float> grid;                  // all rows [bin * lags + lag]
     std::vector<double> row_noise;            // row sums, then noise cell mean per Doppler row
+    std::vector<std::size_t> row_top;         // lag of each row's largest cell
     std::vector<double> segment_re, segment_im;  // 0.1 ms partial sums of one code phase [block * segments + j]
     std::array<float, 256> base_re{}, base_im{};  // carrier wipe-off phasors of one chunk
   };
