@@ -4,6 +4,7 @@
 #include <map>
 #include <numbers>
 #include <stdexcept>
+#include <type_traits>
 #include <variant>
 
 #include "signals/gps_constants.hpp"
@@ -57,10 +58,11 @@ void check_options(const IntegrationOptions& o) {
   if (!(o.attitude.max_abs_pitch_rad > 0.0 && o.attitude.max_abs_pitch_rad <= 0.5 * std::numbers::pi))
     throw std::invalid_argument("integration: attitude pitch limit must lie in (0, 90] deg");
   const HeightAidingOptions& h = o.height_aiding;
-  if (!(h.sigma0_m > 0.0) || !(h.growth_mps >= 0.0) || !std::isfinite(h.sigma0_m) || !std::isfinite(h.growth_mps) ||
-      !(h.min_interval_s >= 0.0) ||
-      (h.fixed_height_m && !std::isfinite(*h.fixed_height_m)))
-    throw std::invalid_argument("integration: height aiding needs a positive sigma, growth >= 0, a finite height");
+  if (!(h.sigma0_m > 0.0) || !std::isfinite(h.sigma0_m) || !(h.terrain_sigma_m > 0.0) ||
+      !std::isfinite(h.terrain_sigma_m) || !(h.terrain_correlation_s > 0.0) || !std::isfinite(h.terrain_correlation_s) ||
+      !(h.min_interval_s >= 0.0) || (h.fixed_height_m && !std::isfinite(*h.fixed_height_m)))
+    throw std::invalid_argument(
+        "integration: height aiding needs positive sigmas and correlation time, interval >= 0, a finite height");
 }
 
 }  // namespace
@@ -78,16 +80,35 @@ struct CoreBase {
 
 namespace {
 
+// 15: loose; 17: tight (clock bias, drift); 18: tight with height aiding (+ terrain height, height_aiding.hpp).
+template <int N>
+using ProcessModelFor = std::conditional_t<N == 18, TerrainAugmentedModel, InsErrorModel<N>>;
+
+// A measurement model written for 15 or 17 states, as the filter of N states takes it.
+template <int N, class M>
+auto for_filter(M m) {
+  if constexpr (N == 18)
+    return TerrainPadded<M>(std::move(m));
+  else
+    return m;
+}
+
 template <int N, class Filter>
 class Core final : public CoreBase {
+  static constexpr int kNav = N == 18 ? 17 : N;  // states of the INS/clock error model (no terrain)
+
  public:
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
-      : opt_(opt), ins_(initial, opt.strapdown), model_(opt.model), filter_(std::move(filter)) {
+      : opt_(opt), ins_(initial, opt.strapdown), model_(make_model(opt)), filter_(std::move(filter)) {
     nominal_.nav = ins_.state();
-    held_height_ = initial.height_m;
-    held_sigma_m_ = opt.sigma_pos_ned_m.z();
-    held_t_s_ = initial.t_s;
-    if constexpr (N == 17) {
+    if constexpr (N == 18) {
+      if (opt.height_aiding.fixed_height_m) {
+        terrain_ref_m_ = terrain_m_ = *opt.height_aiding.fixed_height_m;  // P0: sigma_t^2, uncorrelated
+      } else {
+        hold_terrain();
+      }
+    }
+    if constexpr (N >= 17) {
       nominal_.clock_bias_m = opt.initial_clock_bias_m;
       nominal_.clock_drift_mps = opt.initial_clock_drift_mps;
     }
@@ -146,7 +167,7 @@ class Core final : public CoreBase {
   }
 
   NominalState nominal() const override { return nominal_; }
-  Eigen::MatrixXd covariance() const override { return filter_.P(); }
+  Eigen::MatrixXd covariance() const override { return filter_.P().template topLeftCorner<kNav, kNav>(); }
 
  private:
   void ins_step(const Eigen::Vector3d& dth_raw, const Eigen::Vector3d& dv_raw, double dt) {
@@ -155,7 +176,9 @@ class Core final : public CoreBase {
     const Eigen::Quaterniond q0 = ins_.state().q_nb;
     ins_.step(dth, dv, dt);
     nominal_.nav = ins_.state();
-    if constexpr (N == 17) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
+    if constexpr (N >= 17) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
+    if constexpr (N == 18)  // the nominal terrain follows the Gauss-Markov mean back to the reference
+      terrain_m_ = terrain_ref_m_ + (terrain_m_ - terrain_ref_m_) * std::exp(-dt / opt_.height_aiding.terrain_correlation_s);
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
@@ -177,8 +200,9 @@ class Core final : public CoreBase {
       return false;
     }
     ++counters.accepted;
-    // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock), reset to zero.
-    nominal_ = corrected<N>(nominal_, filter_.x());
+    // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock, terrain), reset.
+    nominal_ = corrected<kNav>(nominal_, filter_.x().template head<kNav>());
+    if constexpr (N == 18) terrain_m_ -= filter_.x()(ix::kTerrain);
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<N>::Zero());
     return true;
@@ -192,7 +216,7 @@ class Core final : public CoreBase {
         ++counters.attitude_unusable;
         return;
       }
-      if (update(AttitudeMeasurement<N>(nominal_, a->attitude, opt_.attitude), -1)) {
+      if (update(for_filter<N>(AttitudeMeasurement<kNav>(nominal_, a->attitude, opt_.attitude)), -1)) {
         ++counters.attitude_accepted;
         attitude_since_fix_ = true;
       } else {
@@ -214,7 +238,7 @@ class Core final : public CoreBase {
       }
       return;
     }
-    if constexpr (N == 17) {
+    if constexpr (N >= 17) {
       const auto& e = std::get<PendingEpoch>(p);
       PrepareStats stats;
       const auto sats = prepare_satellites(e.epoch, e.ephemerides, e.iono,
@@ -224,25 +248,22 @@ class Core final : public CoreBase {
       const bool few = static_cast<int>(sats.size()) < ha.min_satellites;
       if (few) ++counters.epochs_few_satellites;
       // Height first: the satellites' rows are then linearised about the aided height.
-      if (few && ha.enabled && nominal_.nav.t_s - last_aid_t_s_ >= 0.99 * ha.min_interval_s) {
-        const double ref = ha.fixed_height_m ? *ha.fixed_height_m : held_height_;
-        const double held_sigma = ha.fixed_height_m ? 0.0 : held_sigma_m_;
-        const double dt = ha.fixed_height_m ? 0.0 : nominal_.nav.t_s - held_t_s_;
-        ++aids_since_held_;  // (0.99: epochs come on the receiver clock, slightly off 1 s in true time)
-        const double sigma = height_aiding_sigma_m(ha, held_sigma, dt) * std::sqrt(double(aids_since_held_));
-        last_aid_t_s_ = nominal_.nav.t_s;
-        if (update(HeightMeasurement<N>(nominal_, ref, sigma), -2))
-          ++counters.height_accepted;
-        else
-          ++counters.height_rejected;
+      // (0.99: epochs come on the receiver clock, slightly off 1 s in true time.)
+      if constexpr (N == 18) {
+        if (few && nominal_.nav.t_s - last_aid_t_s_ >= 0.99 * ha.min_interval_s) {
+          last_aid_t_s_ = nominal_.nav.t_s;
+          if (update(TerrainHeightMeasurement(nominal_, terrain_m_, ha.sigma0_m), -2))
+            ++counters.height_accepted;
+          else
+            ++counters.height_rejected;
+        }
       }
       for (const auto& s : sats)
-        update(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b, opt_.tight.use_range_rate), s.prn);
-      if (!few) {  // full geometry: hold this epoch's height for later epochs with fewer satellites
-        held_height_ = nominal_.nav.height_m;
-        held_sigma_m_ = std::sqrt(std::max(filter_.P()(ix::kPos + 2, ix::kPos + 2), 0.0));
-        held_t_s_ = nominal_.nav.t_s;
-        aids_since_held_ = 0;
+        update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
+                                                    opt_.tight.use_range_rate)),
+               s.prn);
+      if constexpr (N == 18) {  // full geometry: this epoch's height is the terrain reference from now on
+        if (!few && !ha.fixed_height_m) hold_terrain();
       }
     }
   }
@@ -258,7 +279,11 @@ class Core final : public CoreBase {
     o.gyro_bias_b = nominal_.gyro_bias_b;
     o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
     o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
-    if constexpr (N == 17) {
+    if constexpr (N == 18) {
+      o.terrain_height_m = terrain_m_;
+      o.sigma_terrain_height_m = sd(ix::kTerrain);
+    }
+    if constexpr (N >= 17) {
       o.clock_bias_m = nominal_.clock_bias_m;
       o.clock_drift_mps = nominal_.clock_drift_mps;
       o.sigma_clock_bias_m = sd(ix::kClockBias);
@@ -266,18 +291,37 @@ class Core final : public CoreBase {
     }
   }
 
+  static ProcessModelFor<N> make_model(const IntegrationOptions& o) {
+    if constexpr (N == 18)
+      return TerrainAugmentedModel(o.model, o.height_aiding);
+    else
+      return InsErrorModel<N>(o.model);
+  }
+
+  // The INS height becomes the terrain reference; the terrain error is the negative INS down error.
+  void hold_terrain() {
+    if constexpr (N == 18) {
+      StateMatrix<18> P = filter_.P();
+      hold_terrain_at_ins_height(P, opt_.height_aiding.sigma0_m);
+      filter_.set_P(P);
+      StateVector<18> x = filter_.x();
+      x(ix::kTerrain) = -x(ix::kPos + 2);
+      filter_.set_x(x);
+      terrain_ref_m_ = terrain_m_ = nominal_.nav.height_m;
+    }
+  }
+
   IntegrationOptions opt_;
   ins::Strapdown ins_;
-  InsErrorModel<N> model_;
+  ProcessModelFor<N> model_;
   Filter filter_;
   NominalState nominal_;
   std::multimap<double, Pending> pending_;
   ImuStepAccumulator imu_steps_;
   bool attitude_since_fix_ = false;
-  // Height aiding: IMU height at the last full-geometry epoch (at first: the initial state's), aids since then.
-  double held_height_ = 0.0, held_sigma_m_ = 0.0, held_t_s_ = 0.0;
+  // Height aiding (18 states): the terrain nominal and its Gauss-Markov mean (the held or configured height).
+  double terrain_m_ = 0.0, terrain_ref_m_ = 0.0;
   double last_aid_t_s_ = -1e300;
-  long long aids_since_held_ = 0;
 };
 
 template <int N>
@@ -286,8 +330,11 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
   mo.discretisation = o.discretisation;
   IntegrationOptions oo = o;
   oo.model = mo;
-  const InsErrorModel<N> model(mo);
-  const StateMatrix<N> P0 = model.initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  StateMatrix<N> P0;
+  if constexpr (N == 18)
+    P0 = TerrainAugmentedModel(mo, o.height_aiding).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  else
+    P0 = InsErrorModel<N>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   const StateVector<N> x0 = StateVector<N>::Zero();
   if (o.filter == FilterKind::Ekf)
     return std::make_unique<Core<N, Ekf<N>>>(initial, oo, Ekf<N>(x0, P0, EkfOptions{o.discretisation, o.gate}));
@@ -305,7 +352,12 @@ GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const Integ
     : impl_(std::make_unique<Impl>()) {
   check_options(options);
   impl_->options = options;
-  impl_->core = options.coupling == Coupling::Loose ? make_core<15>(initial, options) : make_core<17>(initial, options);
+  if (options.coupling == Coupling::Loose)
+    impl_->core = make_core<15>(initial, options);
+  else if (options.height_aiding.enabled)
+    impl_->core = make_core<18>(initial, options);
+  else
+    impl_->core = make_core<17>(initial, options);
 }
 
 GnssInsIntegration::~GnssInsIntegration() = default;

@@ -10,7 +10,8 @@
 // its own time: epochs with attitude, position/velocity, or both; without attitude the update falls back to
 // position/velocity only (counted: fixes_without_attitude). At equal times attitude goes first.
 // Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
-// Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides. EKF or UKF.
+// Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides; with height aiding 18 (+ the
+// terrain height). EKF or UKF.
 #pragma once
 
 #include <Eigen/Core>
@@ -53,7 +54,8 @@ struct IntegrationOptions {
   double propagation_interval_s = 0.05;
   ins::StrapdownOptions strapdown;
   TightOptions tight;
-  // Tight mode: height pseudo-measurement in epochs with fewer than 4 usable satellites (off by default).
+  // Tight mode: terrain-height state and height aids in epochs with fewer than 4 usable satellites (off by
+  // default).
   HeightAidingOptions height_aiding;
   AttitudeAidingOptions attitude;  // GPS attitude: array-to-IMU mounting, pitch limit
   // Tight mode: GPS time at t_s = 0 of the run's time line. A receive time T (receiver clock) is applied at
@@ -76,6 +78,7 @@ struct IntegrationOutput {
   Eigen::Vector3d sigma_gyro_bias_b = Eigen::Vector3d::Zero();
   double clock_bias_m = 0.0, clock_drift_mps = 0.0;  // tight mode (else 0)
   double sigma_clock_bias_m = 0.0, sigma_clock_drift_mps = 0.0;
+  double terrain_height_m = 0.0, sigma_terrain_height_m = 0.0;  // tight with height aiding (else 0)
 };
 
 struct IntegrationCounters {
@@ -133,7 +136,8 @@ class GnssInsIntegration {
   void add_imu(const ins::ImuIncrement& inc);
 
   const IntegrationOutput& output() const;
-  // Current nominal (nav + bias estimates + clock) and the error covariance (15 x 15 or 17 x 17).
+  // Current nominal (nav + bias estimates + clock) and the error covariance (15 x 15 or 17 x 17; with height
+  // aiding the terrain state is left out: output().sigma_terrain_height_m).
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;
   const IntegrationCounters& counters() const;

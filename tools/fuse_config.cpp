@@ -104,12 +104,8 @@ const std::map<std::string, Table>& sections() {
            c.height_aiding.enabled = m == "auto";
          }},
         {"sigma_m", [](const Value& v, C& c) { c.height_aiding.sigma0_m = v.positive(); }},
-        {"growth_mps",
-         [](const Value& v, C& c) {
-           c.height_aiding.growth_mps = v.number();
-           if (!(c.height_aiding.growth_mps >= 0.0))
-             throw io::InputError(v.file, "key '" + v.key + "' must not be negative", v.line());
-         }},
+        {"terrain_sigma_m", [](const Value& v, C& c) { c.height_aiding.terrain_sigma_m = v.positive(); }},
+        {"terrain_correlation_s", [](const Value& v, C& c) { c.height_aiding.terrain_correlation_s = v.positive(); }},
         {"height_m", [](const Value& v, C& c) { c.height_aiding.fixed_height_m = v.number(); }},
         {"interval_s",
          [](const Value& v, C& c) {

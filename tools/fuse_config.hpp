@@ -6,10 +6,11 @@
 //   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z]
 //   [clock]      (tight) oscillator = "tcxo"|"ocxo" (fusion/clock_model presets; default tcxo), h0, h_minus2
 //                (override the preset's Allan coefficients)
-//   [height_aiding] (tight) mode = "off"|"auto" (default off: aircraft; auto: land vehicles, a height pseudo-
-//                measurement in epochs with < 4 satellites), sigma_m = 2, growth_mps = 0.1, height_m (a fixed IMU
-//                ellipsoidal height instead of the one held from the last epoch with >= 4 satellites), interval_s = 1
-//                (at most one height update per interval)
+//   [height_aiding] (tight) mode = "off"|"auto" (default off: aircraft; auto: land vehicles, a terrain-height
+//                state and a height aid in epochs with < 4 satellites, fusion/height_aiding.hpp), sigma_m = 2
+//                (white part of each aid), terrain_sigma_m = 10 and terrain_correlation_s = 100 (Gauss-Markov
+//                terrain about the reference height), height_m (a fixed IMU ellipsoidal reference height instead of
+//                the one held from the last epoch with >= 4 satellites), interval_s = 1 (at most one aid per interval)
 //   [filter]     ukf_alpha = 1, ukf_beta = 2, ukf_kappa = 0, gate = true, gate_probability = 0.9999,
 //                propagation_interval_s = 0.05
 //   [output]     convergence_heading_sigma_deg = 1

@@ -74,6 +74,7 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
   out.epoch.receive_time = signals::add_seconds(origin, t_true_s + clock.bias_m / kC);
   for (const auto& eph : ephemerides) {
     // Pseudorange at true time t with receiver clock bias b; elevation returned through el.
+    double az = 0.0;
     auto pseudorange = [&](double t, double b, double& el) {
       const Eigen::Vector3d r_rx = truth.antenna(t, lever_arm_b).r_e;
       double tau = 0.075;
@@ -87,6 +88,7 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
       const Eigen::Vector3d r_sat = signals::rotate_to_receive_frame(sat.r_e_m, tau);
       const signals::LookAngles la = signals::look_angles(r_rx, r_sat);
       el = la.elevation_rad;
+      az = la.azimuth_rad;
       double lat, lon, h;
       geodetic(r_rx, lat, lon, h);
       double delay = troposphere ? signals::troposphere_delay_m(lat, h, std::max(el, 5.0 * kDeg)) : 0.0;
@@ -95,6 +97,7 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
     };
     double el = 0.0, el2 = 0.0;
     const double pr = pseudorange(t_true_s, clock.bias_m, el);
+    const double az0 = az;
     if (el < 10.0 * kDeg) continue;
     const double dt = 0.05;
     const double rate = (pseudorange(t_true_s + dt, clock.bias_m + clock.drift_mps * dt, el2) -
@@ -106,6 +109,8 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
     o.doppler_hz = -rate / signals::kL1Wavelength_m;
     o.cn0_dbhz = 30.0 + 20.0 * std::sin(el);  // for ordering (highest first); the tests weight uniformly
     out.epoch.observations.push_back(o);
+    out.los_ned.emplace_back(std::cos(el) * std::cos(az0), std::cos(el) * std::sin(az0),
+                             -std::sin(el));
   }
   return out;
 }
@@ -177,6 +182,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   const double imu_dt = 1.0 / cfg.imu_rate_hz;
   double next_gnss = cfg.gnss_offset_s;  // loose: true time; tight: receiver-clock time
   bool record_pending = false;
+  std::vector<Eigen::Vector3d> last_los;
+  std::vector<int> last_prns;
   std::size_t epochs = 0;
   auto in_outage = [&](double t) {
     return t > cfg.outage_start_s + 1e-6 && t < cfg.outage_start_s + cfg.outage_length_s - 1e-6;
@@ -225,9 +232,33 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
                                              constellation.klobuchar, origin, t_true, ck);
           auto& obs = se.epoch.observations;
           if (cfg.max_satellites > 0 && t_true >= cfg.reduce_after_s && static_cast<int>(obs.size()) > cfg.max_satellites) {
-            std::sort(obs.begin(), obs.end(), [](const auto& a, const auto& b) { return a.cn0_dbhz > b.cn0_dbhz; });
-            obs.resize(cfg.max_satellites);
+            std::vector<std::size_t> order(obs.size());
+            for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+            std::sort(order.begin(), order.end(),
+                      [&](std::size_t a, std::size_t b) { return obs[a].cn0_dbhz > obs[b].cn0_dbhz; });
+            std::vector<receiver::Observation> kept;
+            std::vector<Eigen::Vector3d> kept_los;
+            for (int i = 0; i < cfg.max_satellites; ++i) {
+              kept.push_back(obs[order[i]]);
+              kept_los.push_back(se.los_ned[order[i]]);
+            }
+            obs = kept;
+            se.los_ned = kept_los;
           }
+          if (!cfg.keep_prns.empty() && t_true >= cfg.reduce_after_s) {
+            std::vector<receiver::Observation> kept;
+            std::vector<Eigen::Vector3d> kept_los;
+            for (std::size_t i = 0; i < obs.size(); ++i) {
+              if (std::find(cfg.keep_prns.begin(), cfg.keep_prns.end(), obs[i].prn) == cfg.keep_prns.end()) continue;
+              kept.push_back(obs[i]);
+              kept_los.push_back(se.los_ned[i]);
+            }
+            obs = kept;
+            se.los_ned = kept_los;
+          }
+          last_los = se.los_ned;
+          last_prns.clear();
+          for (const auto& o : obs) last_prns.push_back(o.prn);
           for (auto& o : obs) {
             o.pseudorange_m += cfg.sigma_range_m * n01(rng);
             o.doppler_hz -= cfg.sigma_rate_mps * n01(rng) / signals::kL1Wavelength_m;
@@ -248,6 +279,7 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
           po.sigma_zenith_m = cfg.sigma_range_m;
           const receiver::PvtSolution pvt =
               receiver::solve_pvt(sm, se.epoch.receive_time, constellation.klobuchar, po);
+          if (pvt.valid && t_true >= cfg.reduce_after_s && (cfg.max_satellites > 0 || !cfg.keep_prns.empty())) ++res.pvt_fixes_reduced;
           if (pvt.valid) {
             const Eigen::Vector3d d_n =
                 ins::C_en(pvt.lat_rad, pvt.lon_rad).transpose() * (pvt.r_e_m - ant.r_e);
@@ -283,6 +315,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
       res.t_s.push_back(t_end);
       res.pos_err_m.push_back(e.segment<3>(0));
       res.sigma_pos_m.push_back(integ.output().sigma_pos_ned_m);
+      res.los_ned.push_back(last_los);
+      res.prns.push_back(last_prns);
       res.nees.push_back(e.dot(P.ldlt().solve(e)));
       const Eigen::VectorXd e9 = e.head(9);
       const Eigen::MatrixXd P9 = P.topLeftCorner(9, 9);

@@ -37,6 +37,7 @@ struct SimConfig {
   Eigen::Vector3d sigma0_att_rad{1e-3, 1e-3, 1e-2};
   // Tight: satellites kept (all above the mask when 0), from reduce_after_s on.
   int max_satellites = 0;
+  std::vector<int> keep_prns;  // from reduce_after_s on: only these satellites (instead of the highest)
   double reduce_after_s = 0.0;
   double sigma_range_m = 1.0;
   double sigma_rate_mps = 0.05;
@@ -56,6 +57,9 @@ struct RunResult {
   long long accepted = 0, rejected = 0;
   int state_size = 15;
   std::vector<Eigen::Vector3d> sigma_pos_m;  // filter's NED 1-sigma at the recorded times
+  std::vector<std::vector<Eigen::Vector3d>> los_ned;  // tight: unit vectors to the satellites used, per record
+  std::vector<std::vector<int>> prns;                 // ... and their PRNs
+  long long pvt_fixes_reduced = 0;           // tight: GNSS-only fixes from reduce_after_s on
   fusion::IntegrationCounters counters;
 };
 
@@ -75,6 +79,7 @@ struct TruthClock {
 };
 struct SimulatedEpoch {
   receiver::ObservationEpoch epoch;
+  std::vector<Eigen::Vector3d> los_ned;  // receiver -> satellite unit vectors (NED), one per observation
   double t_true_s = 0.0;  // GPS time of the epoch on the run's time line
 };
 SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::Vector3d& lever_arm_b,
