@@ -1,5 +1,6 @@
 #include "fusion/ultratight_integration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -29,10 +30,16 @@ class PeriodIqMeasurement {
  public:
   PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
                       const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
-                      double span_s, const IqTaps& measured, double prior_code_sigma_chips)
+                      double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var)
       : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), M_(period_mixing(span_s)),
         R_(iq_noise_covariance(s)),
         code_sigma_(prior_code_sigma_chips) {
+    // Frequency noise of the receiver clock within the period (common to every satellite; see finish_period)
+    // enters the taps through their frequency derivative.
+    if (rate_noise_var > 0.0) {
+      const Eigen::Matrix<double, 6, 1> g = iq_jacobian(errors(StateVector<17>::Zero()), s_).col(1) / kLambda_m;
+      R_ += rate_noise_var * g * g.transpose();
+    }
     z_.resize(6);
     for (int k = 0; k < 3; ++k) {
       z_(k) = measured.i[k];
@@ -85,11 +92,11 @@ class PeriodDiscriminatorMeasurement {
   PeriodDiscriminatorMeasurement(const NominalState& nominal, const SatelliteObservable& sat,
                                  const Eigen::Vector3d& lever_b, const Eigen::Vector3d& w_ib_b,
                                  const Eigen::Vector2d& offset, double span_s, const Eigen::Vector2d& measured,
-                                 const DiscriminatorNoise& noise)
+                                 const DiscriminatorNoise& noise, double rate_noise_var)
       : replica_(nominal, {sat}, lever_b, w_ib_b), offset_(offset), M_(period_mixing(span_s)), z_(measured),
         R_(Eigen::MatrixXd::Zero(2, 2)) {
     R_(0, 0) = noise.range_sigma_m * noise.range_sigma_m;
-    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps;
+    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps + rate_noise_var;
   }
   Eigen::VectorXd z() const { return z_; }
   Eigen::VectorXd h(const StateVector<17>& dx) const { return M_ * replica_.errors(dx) + offset_; }
@@ -192,17 +199,28 @@ class UltraTightCore final : public UltraTightCoreBase {
     propagate();
     std::vector<SatelliteObservable> now;
     predict_satellites(now);
+    auto lookup = [&](int prn, const ChannelCorrelation*& c, const SatelliteObservable*& s) {
+      c = nullptr;
+      s = nullptr;
+      for (const auto& x : corr)
+        if (x.prn == prn) c = &x;
+      for (const auto& x : now)
+        if (x.prn == prn) s = &x;
+      return c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
+             std::abs(c->integration_time_s - T_) < 1e-9;
+    };
+    int usable_count = 0;
+    for (const ReplicaCommand& r : replicas) {
+      const ChannelCorrelation* c;
+      const SatelliteObservable* s;
+      usable_count += lookup(r.prn, c, s) ? 1 : 0;
+    }
     for (ReplicaCommand& r : replicas) {
       ChannelState& ch = channels_[r.prn];
       ch.carrier_phase_cycles = r.carrier_phase_cycles + r.nco.carrier_frequency_hz * T_;  // keeps running
-      const ChannelCorrelation* c = nullptr;
-      for (const auto& x : corr)
-        if (x.prn == r.prn) c = &x;
-      const SatelliteObservable* s = nullptr;
-      for (const auto& x : now)
-        if (x.prn == r.prn) s = &x;
-      const bool usable = c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
-                          std::abs(c->integration_time_s - T_) < 1e-9;
+      const ChannelCorrelation* c;
+      const SatelliteObservable* s;
+      const bool usable = lookup(r.prn, c, s);
       if (!usable) {
         ch.coasting = true;
         ++counters.coasting;
@@ -223,6 +241,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       const double slope = s->range_rate_mps - r.range_rate_mps;
       const Eigen::Vector2d offset =
           period_replica_errors(r.pseudorange_m, r.range_rate_mps, pr_now, rr_now - slope, rr_now, span);
+      const double clock_rate_var = clock_rate_noise_var(span, usable_count);
       IqSettings is;
       is.cn0_dbhz = c->cn0_dbhz;
       is.integration_time_s = T_;
@@ -233,12 +252,13 @@ class UltraTightCore final : public UltraTightCoreBase {
         const MeasurementJacobian<17> J = rep.jacobian();
         const Eigen::Matrix<double, 1, 17> h_range = J.row(0) - 0.5 * span * J.row(1);
         const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
-        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code));
+        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code,
+                                         clock_rate_var));
       } else {
         const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
                                 frequency_discriminator_hz(c->taps, is) * kLambda_m);
         ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span, z,
-                                                   discriminator_noise(is)));
+                                                   discriminator_noise(is), clock_rate_var));
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
@@ -284,6 +304,19 @@ class UltraTightCore final : public UltraTightCoreBase {
       s.range_rate_mps = predicted_range_rate_mps(s, r_ant, v_ant, nominal_.clock_drift_mps);
       s.has_rate = true;
     }
+  }
+
+  // The receiver clock's frequency inside the period is not the drift state at its end: the white FM (phase
+  // random walk, PSD S_b) adds a mean phase whose rate equivalent has variance 4 S_b / (3 T), the random-walk
+  // FM (S_d) a difference between the T/3-weighted drift and the end drift of variance 8 S_d T / 15. That
+  // error is common to the n satellites of the period; updated one by one as independent, each gets n times
+  // the variance, so that their mean (the clock drift direction) carries the whole of it (conservative in
+  // the directions where it cancels between satellites: velocity).
+  double clock_rate_noise_var(double T, int satellites) const {
+    if (!(T > 0.0)) return 0.0;
+    const ClockNoiseModel& c = opt_.model.clock;
+    const double v = 4.0 * c.bias_psd_m2_per_s / (3.0 * T) + 8.0 * c.drift_psd_m2_per_s3 * T / 15.0;
+    return v * std::max(satellites, 1);
   }
 
   void propagate() {

@@ -43,9 +43,7 @@ IqTaps ideal_correlation(const std::vector<double>& code, const std::vector<doub
 }
 
 CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg) {
-  ins::TrajectorySpec spec = ins::profile_spec(cfg.profile == "fast_straight" || cfg.profile == "slow_circle" ? "circle" : cfg.profile, cfg.duration_s + 1.0, 37.0 * kDeg, 127.0 * kDeg, 100.0);
-  if (cfg.profile == "fast_straight") spec.segments[0].turn_rate_rps = 0.0;
-  if (cfg.profile == "slow_circle") spec.speed0_mps = 10.0;
+  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s + 1.0, 37.0 * kDeg, 127.0 * kDeg, 100.0);
   const ins::SimulatedRun run = ins::simulate(spec, cfg.imu_rate_hz);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(cfg.imu_preset);
