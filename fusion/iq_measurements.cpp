@@ -63,6 +63,15 @@ TrackingErrors tracking_errors(double range_error_m, double range_rate_error_mps
   return {range_error_m / kChip_m, range_rate_error_mps / kLambda_m};
 }
 
+Eigen::Vector2d period_replica_errors(double replica_range_start_m, double replica_rate_mps, double signal_range_end_m,
+                                      double signal_rate_start_mps, double signal_rate_end_mps, double L) {
+  const double slope = signal_rate_end_mps - signal_rate_start_mps;  // rate change over the period
+  // Signal range at u: end range minus the integral of the rate from u to L; its mean over [0, L].
+  const double signal_mean = signal_range_end_m - signal_rate_start_mps * L / 2.0 - slope * L / 3.0;
+  const double replica_mean = replica_range_start_m + replica_rate_mps * L / 2.0;
+  return {replica_mean - signal_mean, replica_rate_mps - (signal_rate_start_mps + slope / 3.0)};
+}
+
 IqTaps expected_iq(const TrackingErrors& e, const IqSettings& s) {
   check(s);
   const double A = iq_amplitude(s);

@@ -53,6 +53,15 @@ double triangle_slope(double x_chips);
 // code = e_rho / chip length, frequency = e_rhodot / L1 wavelength.
 TrackingErrors tracking_errors(double range_error_m, double range_rate_error_mps);
 
+// What the I&Q of one period see of a replica held at constant range rate against a signal whose range rate
+// varies linearly over the period [0, L] (from signal_rate_start to signal_rate_end, signal range signal_range_end
+// at L). The code taps average the range error over the period: (replica minus signal) mean range. The prompt's
+// phase is the mean of the carrier phase error, (1 / L) int_0^L (L - u) (rate error at u) du, i.e. the rate error
+// at u = L / 3 (not at mid-period): that is the rate error a linear phase must have to give the same taps.
+// Returns (range error m, rate error m/s), replica minus signal, for tracking_errors.
+Eigen::Vector2d period_replica_errors(double replica_range_start_m, double replica_rate_mps, double signal_range_end_m,
+                                      double signal_rate_start_mps, double signal_rate_end_mps, double period_s);
+
 // E[I], E[Q] of the early/prompt/late taps: with x = pi df T and phi the start phase,
 // I_k = A R(tau - o_k) sinc(x) cos(phi + x), Q_k = A R(tau - o_k) sinc(x) sin(phi + x), o = (+d, 0, -d) for E, P, L
 // (the early replica runs d chips ahead, so a leading signal, tau > 0, raises the early tap)

@@ -1,5 +1,6 @@
 #include "fusion/ultratight_integration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -14,16 +15,31 @@ constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kLambda_m = signals::kL1Wavelength_m;
 constexpr double kChip_m = kC / signals::kCaChipRate_hz;
 
-// One satellite's I&Q (6 rows) with the replica actually held over the period: the replica errors of the
-// nominal at the update time plus the known offset between that nominal's prediction and the replica used
-// (range at mid-period, rate), so h(dx) is the I&Q of the replica that really ran.
+// The replica errors of a hypothesis dx over the period that ended at the update time: the nominal's errors
+// at that time (range e0, rate e1) seen over the period (mean range: a rate error e1 held over the period
+// moves the mean range by -e1 span / 2) plus the known offset of the replica that ran from the nominal
+// (period_replica_errors), so h(dx) describes the replica that really ran.
+Eigen::Matrix2d period_mixing(double span_s) {
+  Eigen::Matrix2d M = Eigen::Matrix2d::Identity();
+  M(0, 1) = -0.5 * span_s;
+  return M;
+}
+
+// One satellite's I&Q (6 rows) over the period with the replica actually held.
 class PeriodIqMeasurement {
  public:
   PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
                       const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
-                      const IqTaps& measured, double prior_code_sigma_chips)
-      : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), R_(iq_noise_covariance(s)),
+                      double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var)
+      : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), M_(period_mixing(span_s)),
+        R_(iq_noise_covariance(s)),
         code_sigma_(prior_code_sigma_chips) {
+    // Frequency noise of the receiver clock within the period (common to every satellite; see finish_period)
+    // enters the taps through their frequency derivative.
+    if (rate_noise_var > 0.0) {
+      const Eigen::Matrix<double, 6, 1> g = iq_jacobian(errors(StateVector<17>::Zero()), s_).col(1) / kLambda_m;
+      R_ += rate_noise_var * g * g.transpose();
+    }
     z_.resize(6);
     for (int k = 0; k < 3; ++k) {
       z_(k) = measured.i[k];
@@ -52,18 +68,19 @@ class PeriodIqMeasurement {
       J(4, 0) *= w;
     }
     const Eigen::Matrix<double, 2, 2> D = Eigen::Vector2d(1.0 / kChip_m, 1.0 / kLambda_m).asDiagonal();
-    return J * D * replica_.jacobian();
+    return J * D * M_ * replica_.jacobian();
   }
   Eigen::MatrixXd R() const { return R_; }
 
  private:
   TrackingErrors errors(const StateVector<17>& dx) const {
-    const Eigen::VectorXd e = replica_.errors(dx);
-    return tracking_errors(e(0) + offset_(0), e(1) + offset_(1));
+    const Eigen::Vector2d e = M_ * replica_.errors(dx) + offset_;
+    return tracking_errors(e(0), e(1));
   }
   ReplicaErrors17 replica_;
   IqSettings s_;
   Eigen::Vector2d offset_;
+  Eigen::Matrix2d M_;
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
   double code_sigma_ = 0.0;
@@ -74,20 +91,22 @@ class PeriodDiscriminatorMeasurement {
  public:
   PeriodDiscriminatorMeasurement(const NominalState& nominal, const SatelliteObservable& sat,
                                  const Eigen::Vector3d& lever_b, const Eigen::Vector3d& w_ib_b,
-                                 const Eigen::Vector2d& offset, const Eigen::Vector2d& measured,
-                                 const DiscriminatorNoise& noise)
-      : replica_(nominal, {sat}, lever_b, w_ib_b), offset_(offset), z_(measured), R_(Eigen::MatrixXd::Zero(2, 2)) {
+                                 const Eigen::Vector2d& offset, double span_s, const Eigen::Vector2d& measured,
+                                 const DiscriminatorNoise& noise, double rate_noise_var)
+      : replica_(nominal, {sat}, lever_b, w_ib_b), offset_(offset), M_(period_mixing(span_s)), z_(measured),
+        R_(Eigen::MatrixXd::Zero(2, 2)) {
     R_(0, 0) = noise.range_sigma_m * noise.range_sigma_m;
-    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps;
+    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps + rate_noise_var;
   }
   Eigen::VectorXd z() const { return z_; }
-  Eigen::VectorXd h(const StateVector<17>& dx) const { return replica_.errors(dx) + offset_; }
-  MeasurementJacobian<17> H(const StateVector<17>&) const { return replica_.jacobian(); }
+  Eigen::VectorXd h(const StateVector<17>& dx) const { return M_ * replica_.errors(dx) + offset_; }
+  MeasurementJacobian<17> H(const StateVector<17>&) const { return M_ * replica_.jacobian(); }
   Eigen::MatrixXd R() const { return R_; }
 
  private:
   ReplicaErrors17 replica_;
-  Eigen::VectorXd offset_;
+  Eigen::Vector2d offset_;
+  Eigen::Matrix2d M_;
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
 };
@@ -180,37 +199,49 @@ class UltraTightCore final : public UltraTightCoreBase {
     propagate();
     std::vector<SatelliteObservable> now;
     predict_satellites(now);
+    auto lookup = [&](int prn, const ChannelCorrelation*& c, const SatelliteObservable*& s) {
+      c = nullptr;
+      s = nullptr;
+      for (const auto& x : corr)
+        if (x.prn == prn) c = &x;
+      for (const auto& x : now)
+        if (x.prn == prn) s = &x;
+      return c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
+             std::abs(c->integration_time_s - T_) < 1e-9;
+    };
+    int usable_count = 0;
+    for (const ReplicaCommand& r : replicas) {
+      const ChannelCorrelation* c;
+      const SatelliteObservable* s;
+      usable_count += lookup(r.prn, c, s) ? 1 : 0;
+    }
     for (ReplicaCommand& r : replicas) {
       ChannelState& ch = channels_[r.prn];
       ch.carrier_phase_cycles = r.carrier_phase_cycles + r.nco.carrier_frequency_hz * T_;  // keeps running
-      const ChannelCorrelation* c = nullptr;
-      for (const auto& x : corr)
-        if (x.prn == r.prn) c = &x;
-      const SatelliteObservable* s = nullptr;
-      for (const auto& x : now)
-        if (x.prn == r.prn) s = &x;
-      const bool usable = c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
-                          std::abs(c->integration_time_s - T_) < 1e-9;
+      const ChannelCorrelation* c;
+      const SatelliteObservable* s;
+      const bool usable = lookup(r.prn, c, s);
       if (!usable) {
         ch.coasting = true;
         ++counters.coasting;
         continue;
       }
-      // Offset of the replica that ran (its mid-period range, its constant rate) from this nominal's signal
-      // prediction over the period: range at mid-period and mean rate, the rate taken as varying linearly
-      // between the start prediction and this one (line-of-sight acceleration: up to ~0.2 Hz over 10 ms at
-      // 4 m/s^2, not negligible against the 0.45 Hz I&Q frequency noise at 45 dB-Hz).
-      // The prediction with the nominal as it stands now (earlier satellites of this period have updated it).
+      // Offset of the replica that ran (constant rate from its start range) from this nominal's signal over
+      // the period, as the correlations see it (period_replica_errors: mean range, rate error at a third of
+      // the period): the signal's rate varies linearly over the period with the slope of the nominal's own
+      // predictions (start and end, both before this period's updates; line-of-sight acceleration up to
+      // 4 m/s^2 on the circle, 0.46 Hz over 20 ms), anchored at the end on the nominal as it stands now
+      // (earlier satellites of this period have updated it; those corrections hold over the whole period).
       const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
       const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
                                     antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
       const double pr_now = predicted_pseudorange_m(*s, r_ant, nominal_.clock_bias_m);
       const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
-      const double back = nominal_.nav.t_s - (r.t_start_s + 0.5 * T_);
-      const double mean_rate = 0.5 * (r.range_rate_mps + rr_now);
-      const Eigen::Vector2d offset(r.pseudorange_m + r.range_rate_mps * 0.5 * T_ -
-                                       (pr_now - 0.5 * (mean_rate + rr_now) * back),
-                                   r.range_rate_mps - mean_rate);
+      const double span = nominal_.nav.t_s - r.t_start_s;
+      const double slope = s->range_rate_mps - r.range_rate_mps;
+      const Eigen::Vector2d offset =
+          period_replica_errors(r.pseudorange_m, r.range_rate_mps, pr_now, rr_now - slope, rr_now, span);
+      const double clock_rate_var = clock_rate_noise_var(span, usable_count);
       IqSettings is;
       is.cn0_dbhz = c->cn0_dbhz;
       is.integration_time_s = T_;
@@ -218,14 +249,16 @@ class UltraTightCore final : public UltraTightCoreBase {
       bool ok = false;
       if (opt_.form == UltraTightForm::Iq) {
         const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
-        const Eigen::Matrix<double, 1, 17> h_range = rep.jacobian().row(0);
+        const MeasurementJacobian<17> J = rep.jacobian();
+        const Eigen::Matrix<double, 1, 17> h_range = J.row(0) - 0.5 * span * J.row(1);
         const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
-        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, c->taps, sigma_code));
+        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code,
+                                         clock_rate_var));
       } else {
         const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
                                 frequency_discriminator_hz(c->taps, is) * kLambda_m);
-        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, z,
-                                                   discriminator_noise(is)));
+        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span, z,
+                                                   discriminator_noise(is), clock_rate_var));
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
@@ -271,6 +304,19 @@ class UltraTightCore final : public UltraTightCoreBase {
       s.range_rate_mps = predicted_range_rate_mps(s, r_ant, v_ant, nominal_.clock_drift_mps);
       s.has_rate = true;
     }
+  }
+
+  // The receiver clock's frequency inside the period is not the drift state at its end: the white FM (phase
+  // random walk, PSD S_b) adds a mean phase whose rate equivalent has variance 4 S_b / (3 T), the random-walk
+  // FM (S_d) a difference between the T/3-weighted drift and the end drift of variance 8 S_d T / 15. That
+  // error is common to the n satellites of the period; updated one by one as independent, each gets n times
+  // the variance, so that their mean (the clock drift direction) carries the whole of it (conservative in
+  // the directions where it cancels between satellites: velocity).
+  double clock_rate_noise_var(double T, int satellites) const {
+    if (!(T > 0.0)) return 0.0;
+    const ClockNoiseModel& c = opt_.model.clock;
+    const double v = 4.0 * c.bias_psd_m2_per_s / (3.0 * T) + 8.0 * c.drift_psd_m2_per_s3 * T / 15.0;
+    return v * std::max(satellites, 1);
   }
 
   void propagate() {

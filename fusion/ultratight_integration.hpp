@@ -7,7 +7,9 @@
 // C/N0 below the threshold) keep being predicted and are reported as coasting.
 // Time line: t_s of the IMU samples (GPS time minus gps_time_origin). Metres, m/s, chips, Hz, cycles.
 // Model assumption (iq_measurements.hpp): data bits known/wiped off, carrier NCO phase realigned at the start
-// of every period (the phase error inside a period is 2 pi df s).
+// of every period (the phase error inside a period is 2 pi df s). Over a period the taps see the mean range
+// error and the rate error at a third of the period (period_replica_errors), and the receiver clock's frequency
+// noise within the period (from options.model.clock) is part of R.
 #pragma once
 
 #include <Eigen/Core>

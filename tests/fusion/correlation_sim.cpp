@@ -98,6 +98,7 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
   opt.model.clock.bias_sigma_m = cfg.sigma0_clock_bias_m;
   opt.model.clock.drift_sigma_mps = cfg.sigma0_clock_drift_mps;
   opt.lever_arm_b = cfg.lever_arm_b;
+  opt.tight.troposphere = cfg.troposphere;
   opt.sigma_pos_ned_m = cfg.sigma0_pos_m;
   opt.sigma_vel_n_mps = cfg.sigma0_vel_mps;
   opt.sigma_att_rad = cfg.sigma0_att_rad;
@@ -142,9 +143,9 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
         const double t0 = replicas.empty() ? t1 - T : replicas.front().t_start_s;
         const double tm = 0.5 * (t0 + t1);
         const bool blocked = tm >= cfg.blockage_start_s && tm < cfg.blockage_start_s + cfg.blockage_length_s;
-        const SimulatedEpoch s0 = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t0, clock_at(t0));
-        const SimulatedEpoch sm = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, tm, clock_at(tm));
-        const SimulatedEpoch s1 = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t1, clock_at(t1));
+        const SimulatedEpoch s0 = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t0, clock_at(t0), cfg.troposphere);
+        const SimulatedEpoch sm = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, tm, clock_at(tm), cfg.troposphere);
+        const SimulatedEpoch s1 = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t1, clock_at(t1), cfg.troposphere);
         corr.clear();
         double max_code = 0.0, max_freq = 0.0;
         for (const ReplicaCommand& r : replicas) {

@@ -39,6 +39,7 @@ struct CorrelationSimConfig {
   // model (frequency error constant within T, equal to the drift state) does not represent.
   double clock_bias_psd_m2_per_s = 9e-6;
   double clock_drift_psd_m2_per_s3 = 0.0355;
+  bool troposphere = true;  // in the signal and in the filter's model alike
 };
 
 struct CorrelationRunResult {
