@@ -113,6 +113,7 @@ struct UltraTightCoreBase {
   virtual NominalState nominal() const = 0;
   virtual Eigen::MatrixXd covariance() const = 0;
   std::vector<ReplicaCommand> replicas;
+  std::vector<UltraTightSatelliteUpdate> last_updates;
   IntegrationOutput output;
   UltraTightCounters counters;
 };
@@ -133,6 +134,8 @@ class UltraTightCore final : public UltraTightCoreBase {
     nominal_.nav = ins_.state();
     nominal_.clock_bias_m = o.initial_clock_bias_m;
     nominal_.clock_drift_mps = o.initial_clock_drift_mps;
+    nominal_.accel_bias_b = o.initial_accel_bias_b;
+    nominal_.gyro_bias_b = o.initial_gyro_bias_b;
     InsLinearisation lin;
     lin.nav = nominal_.nav;
     lin.f_b = nominal_.nav.q_nb.conjugate() * Eigen::Vector3d(0.0, 0.0, -9.80665);
@@ -177,11 +180,13 @@ class UltraTightCore final : public UltraTightCoreBase {
 
   void finish_period(const std::vector<ChannelCorrelation>& corr) override {
     ++counters.periods;
+    last_updates.clear();
     propagate();
     std::vector<SatelliteObservable> now;
     predict_satellites(now);
-    for (ReplicaCommand& r : replicas) {
-      ChannelState& ch = channels_[r.prn];
+    for (ReplicaCommand& command : replicas) {
+      ChannelState& ch = channels_[command.prn];
+      ReplicaCommand r = command;
       ch.carrier_phase_cycles = r.carrier_phase_cycles + r.nco.carrier_frequency_hz * T_;  // keeps running
       const ChannelCorrelation* c = nullptr;
       for (const auto& x : corr)
@@ -191,6 +196,11 @@ class UltraTightCore final : public UltraTightCoreBase {
         if (x.prn == r.prn) s = &x;
       const bool usable = c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
                           std::abs(c->integration_time_s - T_) < 1e-9;
+      if (usable && c->has_replica) {  // the replica that ran instead of the command
+        r.t_start_s = c->replica_t_start_s;
+        r.pseudorange_m = c->replica_pseudorange_m;
+        r.range_rate_mps = c->replica_range_rate_mps;
+      }
       if (!usable) {
         ch.coasting = true;
         ++counters.coasting;
@@ -207,7 +217,11 @@ class UltraTightCore final : public UltraTightCoreBase {
       const double pr_now = predicted_pseudorange_m(*s, r_ant, nominal_.clock_bias_m);
       const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
       const double back = nominal_.nav.t_s - (r.t_start_s + 0.5 * T_);
-      const double mean_rate = 0.5 * (r.range_rate_mps + rr_now);
+      // The nominal's rate at the replica's mid-period, linear between the command's start prediction and now
+      // (= the mean of the two for the commanded replica; a replica that ran elsewhere in time is placed on it).
+      const double span = nominal_.nav.t_s - command.t_start_s;
+      const double mean_rate = span > 0.0 ? rr_now + (command.range_rate_mps - rr_now) * back / span
+                                          : 0.5 * (command.range_rate_mps + rr_now);
       const Eigen::Vector2d offset(r.pseudorange_m + r.range_rate_mps * 0.5 * T_ -
                                        (pr_now - 0.5 * (mean_rate + rr_now) * back),
                                    r.range_rate_mps - mean_rate);
@@ -229,6 +243,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
+      last_updates.push_back({r.prn, ok, last_result_.nis, last_result_.innovation});
     }
     fill_output();
   }
@@ -256,7 +271,7 @@ class UltraTightCore final : public UltraTightCoreBase {
     TightOptions t = opt_.tight;
     t.use_range_rate = true;
     for (int pass = 0; pass < 2; ++pass) {
-      out = prepare_satellites(epoch, eph_, signals::KlobucharParameters{}, r_ant, t);
+      out = prepare_satellites(epoch, eph_, opt_.iono, r_ant, t);
       epoch.observations.clear();
       for (const auto& s : out) {
         receiver::Observation ob;
@@ -284,6 +299,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   bool update(const M& m) {
     ++counters.updates;
     const UpdateResult r = filter_.update(m);
+    last_result_ = r;
     if (!r.accepted) {
       ++counters.rejected;
       return false;
@@ -322,6 +338,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   std::map<int, ChannelState> channels_;
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;
+  UpdateResult last_result_;
 };
 
 }  // namespace
@@ -366,6 +383,9 @@ const IntegrationOutput& UltraTightIntegration::output() const { return impl_->c
 NominalState UltraTightIntegration::nominal() const { return impl_->core->nominal(); }
 Eigen::MatrixXd UltraTightIntegration::covariance() const { return impl_->core->covariance(); }
 const UltraTightCounters& UltraTightIntegration::counters() const { return impl_->core->counters; }
+const std::vector<UltraTightSatelliteUpdate>& UltraTightIntegration::last_updates() const {
+  return impl_->core->last_updates;
+}
 const UltraTightOptions& UltraTightIntegration::options() const { return impl_->options; }
 
 }  // namespace ultratrack::fusion
