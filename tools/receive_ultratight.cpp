@@ -92,6 +92,8 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   o.sigma_att_rad = floor(out.sigma_att_rad, 1e-4);
   o.gate = c.gate;
   o.ukf = c.ukf;
+  // The PVT's mask: satellites below it stay scalar. (A 0 or 5 deg mask brought the two low satellites of the 10 g
+  // turn in and the position then diverged to 10 m RMS in the turn: docs/validation.md.)
   o.tight.elevation_mask_rad = options_.pvt.elevation_mask_rad;
   o.tight.ionosphere = options_.pvt.ionosphere;
   o.tight.troposphere = options_.pvt.troposphere;
