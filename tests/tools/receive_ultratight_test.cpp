@@ -5,7 +5,7 @@
 // over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
 // loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
 // signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
-// UKF + discriminators both. Bad option combinations give one InputError.
+// UKF + discriminators both; the same bytes with one thread and two. Bad option combinations give one InputError.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -215,6 +215,23 @@ void check_run(const std::string& filter, const std::string& form) {
 TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ekf", "iq");
+}
+
+// The loop runs on the engine's caller thread after the channels' parallel work: one thread gives the same bytes.
+TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  std::string text[2][2];
+  for (int threads : {1, 2}) {
+    const auto rx = sim().dir / ("rx_threads" + std::to_string(threads));
+    auto args = receive_args(rx);
+    args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", std::to_string(threads)});
+    test_support::run_command("receive", args);
+    text[threads - 1][0] = read_text(rx / "ultratight.csv");
+    text[threads - 1][1] = read_text(rx / "nav.csv");
+  }
+  EXPECT_GT(text[0][0].size(), 10000u);
+  EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
+  EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
 }
 
 TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
