@@ -14,6 +14,10 @@
 #   relock_s    seconds from the signal's return until every PRN locked before the tunnel is locked again
 #               (tunnel only; "never" when one does not re-lock before the end)
 #   refix_s     seconds from the signal's return to the first fix after it (tunnel only)
+#   nav_rms_3d_m  3-D position RMS of nav.csv (GNSS/INS couplings: the fused solution) against truth.csv from
+#               its first row + 1 s ("" without nav.csv)
+#   wall_s, cpu_s  the receive's wall time and CPU time (user + sys)
+# In --receive-args, {sim} stands for the simulation folder (e.g. "--imu {sim}/imu.csv --coupling ultra-tight").
 # Hot start: --nav is the scenario's RINEX (ephemerides known). Receiver settings are its defaults (scalar loops,
 # default bandwidths) plus --receive-args (e.g. "--coupling vector") and --config FILE for receive.
 #
@@ -49,7 +53,7 @@ fi
 mkdir -p "$out"; out=$(realpath "$out")
 results=$out/results.csv
 if [ "$report_only" = 1 ]; then rm -f "$results"; fi
-[ -f "$results" ] || echo "scenario,cn0_dbhz,sats,lost,never,losses,pos_rms_3d_m,fixes,last_fix_s,tracked_frac,fixes_gap,relock_s,refix_s" > "$results"
+[ -f "$results" ] || echo "scenario,cn0_dbhz,sats,lost,never,losses,pos_rms_3d_m,fixes,last_fix_s,tracked_frac,fixes_gap,relock_s,refix_s,nav_rms_3d_m,wall_s,cpu_s" > "$results"
 
 analyse() {  # sim rx scenario level: one results row
   local sim=$1 rx=$2 sc=$3 level=$4 rms
@@ -116,10 +120,32 @@ if os.path.exists(f"{rx}/summary.json"):
   per = json.load(open(f"{rx}/summary.json")).get("per_satellite", [])
   frac = sum(p["tracked_s"] for p in per if p["prn"] in sats) / (len(sats) * t_end) if sats else frac
   losses = sum(p["losses"] for p in per)
+nav_rms = ""
+if os.path.exists(f"{rx}/nav.csv"):
+  import bisect, math
+  def ecef(lat, lon, h):
+      a = 6378137.0; f = 1 / 298.257223563; e2 = f * (2 - f)
+      la, lo = math.radians(lat), math.radians(lon); n = a / math.sqrt(1 - e2 * math.sin(la) ** 2)
+      return ((n + h) * math.cos(la) * math.cos(lo), (n + h) * math.cos(la) * math.sin(lo), (n * (1 - e2) + h) * math.sin(la))
+  tt = [float(r["t_s"]) for r in truth]
+  pp = [(float(r["ecef_x_m"]), float(r["ecef_y_m"]), float(r["ecef_z_m"])) for r in truth]
+  s2, n, t_first = 0.0, 0, None
+  for r in csv.DictReader(open(f"{rx}/nav.csv")):
+      t = float(r["t_s"]); t_first = t if t_first is None else t_first
+      i = bisect.bisect_left(tt, t)
+      if t < t_first + 1.0 or i <= 0 or i >= len(tt): continue
+      w = (t - tt[i - 1]) / (tt[i] - tt[i - 1])
+      q = ecef(float(r["lat_deg"]), float(r["lon_deg"]), float(r["height_m"]))
+      s2 += sum((pp[i - 1][k] + w * (pp[i][k] - pp[i - 1][k]) - q[k]) ** 2 for k in range(3)); n += 1
+  nav_rms = f"{math.sqrt(s2 / n):.2f}" if n else "nan"
+timing = open(f"{rx}.time").read().split("\n") if os.path.exists(f"{rx}.time") else []
+timing = next((l.split() for l in reversed(timing) if len(l.split()) == 3), ["", "", ""])  # after "Command exited..."
+
 rl = "" if not gap else ("never" if (not relock or None in relock) else f"{max(relock):.2f}")
 print(f"{sc},{level},{len(sats)},{' '.join(lost) or '-'},{' '.join(never) or '-'},{losses},{rms},{fixes},{last_fix:.1f},{frac:.2f},"
     f"{fixes_gap if gap else ''},{rl},"
-    f"{'' if not gap else ('never' if refix is None else f'{refix:.1f}')}")
+    f"{'' if not gap else ('never' if refix is None else f'{refix:.1f}')},{nav_rms},{timing[0]},"
+    f"{'' if not timing[1] else f'{float(timing[1]) + float(timing[2]):.2f}'}")
 PY
 }
 
@@ -145,8 +171,9 @@ PY
     nice -n 5 "$ultratrack" simulate --scenario "$sim.toml" --out "$sim" --quiet > "$sim.log" 2>&1
     prns=$(tail -n +2 "$sim/satellites.csv" | cut -d, -f1 | paste -sd, -)
     # shellcheck disable=SC2086
-    nice -n 5 "$ultratrack" receive --input "$sim/antenna0.i8.bin" --format i8 --fs 2.6e6 --nav "$nav" \
-      --prn "$prns" --out "$rx" --quiet $receive_args > "$rx.log" 2>&1 || true
+    /usr/bin/time -f "%e %U %S" -o "$rx.time" nice -n 5 "$ultratrack" receive --input "$sim/antenna0.i8.bin" \
+      --format i8 --fs 2.6e6 --nav "$nav" --prn "$prns" --out "$rx" --quiet ${receive_args//\{sim\}/$sim} \
+      > "$rx.log" 2>&1 || true
     analyse "$sim" "$rx" "$sc" "$level" >> "$results"
     echo "dynamics_baseline: $(tail -1 "$results")" >&2
     [ "$keep" = 1 ] || rm -f "$sim/antenna0.i8.bin"

@@ -132,6 +132,7 @@ struct UltraTightCoreBase {
   virtual NominalState nominal() const = 0;
   virtual Eigen::MatrixXd covariance() const = 0;
   std::vector<ReplicaCommand> replicas;
+  std::vector<UltraTightSatelliteUpdate> last_updates;
   IntegrationOutput output;
   UltraTightCounters counters;
 };
@@ -152,6 +153,8 @@ class UltraTightCore final : public UltraTightCoreBase {
     nominal_.nav = ins_.state();
     nominal_.clock_bias_m = o.initial_clock_bias_m;
     nominal_.clock_drift_mps = o.initial_clock_drift_mps;
+    nominal_.accel_bias_b = o.initial_accel_bias_b;
+    nominal_.gyro_bias_b = o.initial_gyro_bias_b;
     InsLinearisation lin;
     lin.nav = nominal_.nav;
     lin.f_b = nominal_.nav.q_nb.conjugate() * Eigen::Vector3d(0.0, 0.0, -9.80665);
@@ -196,6 +199,7 @@ class UltraTightCore final : public UltraTightCoreBase {
 
   void finish_period(const std::vector<ChannelCorrelation>& corr) override {
     ++counters.periods;
+    last_updates.clear();
     propagate();
     std::vector<SatelliteObservable> now;
     predict_satellites(now);
@@ -215,12 +219,18 @@ class UltraTightCore final : public UltraTightCoreBase {
       const SatelliteObservable* s;
       usable_count += lookup(r.prn, c, s) ? 1 : 0;
     }
-    for (ReplicaCommand& r : replicas) {
-      ChannelState& ch = channels_[r.prn];
+    for (ReplicaCommand& command : replicas) {
+      ChannelState& ch = channels_[command.prn];
+      ReplicaCommand r = command;
       ch.carrier_phase_cycles = r.carrier_phase_cycles + r.nco.carrier_frequency_hz * T_;  // keeps running
       const ChannelCorrelation* c;
       const SatelliteObservable* s;
       const bool usable = lookup(r.prn, c, s);
+      if (usable && c->has_replica) {  // the replica that ran instead of the command
+        r.t_start_s = c->replica_t_start_s;
+        r.pseudorange_m = c->replica_pseudorange_m;
+        r.range_rate_mps = c->replica_range_rate_mps;
+      }
       if (!usable) {
         ch.coasting = true;
         ++counters.coasting;
@@ -237,11 +247,17 @@ class UltraTightCore final : public UltraTightCoreBase {
                                     antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
       const double pr_now = predicted_pseudorange_m(*s, r_ant, nominal_.clock_bias_m);
       const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
-      const double span = nominal_.nav.t_s - r.t_start_s;
-      const double slope = s->range_rate_mps - r.range_rate_mps;
-      const Eigen::Vector2d offset =
-          period_replica_errors(r.pseudorange_m, r.range_rate_mps, pr_now, rr_now - slope, rr_now, span);
-      const double clock_rate_var = clock_rate_noise_var(span, usable_count);
+      // The replica's period [t0, t0 + T] may end before this update (a receiver channel's epoch): the signal's
+      // rate is carried back along the slope of the command's two predictions.
+      const double back_end = nominal_.nav.t_s - (r.t_start_s + T_);
+      const double command_span = nominal_.nav.t_s - command.t_start_s;
+      const double rate_slope = command_span > 0.0 ? (s->range_rate_mps - command.range_rate_mps) / command_span : 0.0;
+      const double rate_end = rr_now - rate_slope * back_end;
+      const double range_end = pr_now - 0.5 * (rate_end + rr_now) * back_end;
+      const Eigen::Vector2d offset = period_replica_errors(r.pseudorange_m, r.range_rate_mps, range_end,
+                                                           rate_end - rate_slope * T_, rate_end, T_);
+      const double span = 2.0 * (nominal_.nav.t_s - r.t_start_s) - T_;  // the mean range sits span / 2 back
+      const double clock_rate_var = clock_rate_noise_var(T_, usable_count);
       IqSettings is;
       is.cn0_dbhz = c->cn0_dbhz;
       is.integration_time_s = T_;
@@ -262,6 +278,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
+      last_updates.push_back({r.prn, ok, last_result_.nis, last_result_.innovation});
     }
     fill_output();
   }
@@ -289,7 +306,7 @@ class UltraTightCore final : public UltraTightCoreBase {
     TightOptions t = opt_.tight;
     t.use_range_rate = true;
     for (int pass = 0; pass < 2; ++pass) {
-      out = prepare_satellites(epoch, eph_, signals::KlobucharParameters{}, r_ant, t);
+      out = prepare_satellites(epoch, eph_, opt_.iono, r_ant, t);
       epoch.observations.clear();
       for (const auto& s : out) {
         receiver::Observation ob;
@@ -330,6 +347,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   bool update(const M& m) {
     ++counters.updates;
     const UpdateResult r = filter_.update(m);
+    last_result_ = r;
     if (!r.accepted) {
       ++counters.rejected;
       return false;
@@ -368,6 +386,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   std::map<int, ChannelState> channels_;
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;
+  UpdateResult last_result_;
 };
 
 }  // namespace
@@ -412,6 +431,9 @@ const IntegrationOutput& UltraTightIntegration::output() const { return impl_->c
 NominalState UltraTightIntegration::nominal() const { return impl_->core->nominal(); }
 Eigen::MatrixXd UltraTightIntegration::covariance() const { return impl_->core->covariance(); }
 const UltraTightCounters& UltraTightIntegration::counters() const { return impl_->core->counters; }
+const std::vector<UltraTightSatelliteUpdate>& UltraTightIntegration::last_updates() const {
+  return impl_->core->last_updates;
+}
 const UltraTightOptions& UltraTightIntegration::options() const { return impl_->options; }
 
 }  // namespace ultratrack::fusion

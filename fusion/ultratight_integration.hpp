@@ -37,11 +37,16 @@ struct UltraTightOptions {
   UkfParameters ukf;
   Discretisation discretisation = Discretisation::SecondOrderSeries;
   ins::StrapdownOptions strapdown;
-  TightOptions tight;               // elevation mask, troposphere (ionosphere: no Klobuchar parameters given)
+  TightOptions tight;               // elevation mask, troposphere, ionosphere (with `iono`)
+  signals::KlobucharParameters iono;  // broadcast ionosphere (default: invalid, no ionospheric delay)
   double tap_offset_chips = 0.5;    // early/late offset d
   double coast_cn0_dbhz = 18.0;     // below: no update, the channel coasts on the INS
   signals::GpsTime gps_time_origin;
   double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;
+  // IMU biases already estimated (e.g. by the tight filter the receiver hands over from); the filter's bias
+  // states are errors of these.
+  Eigen::Vector3d initial_accel_bias_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d initial_gyro_bias_b = Eigen::Vector3d::Zero();
 };
 
 // The replica of one satellite for the period starting at t_start_s, held constant-rate over the period.
@@ -63,6 +68,20 @@ struct ChannelCorrelation {
   double cn0_dbhz = 0.0;           // the channel's C/N0 estimate
   double integration_time_s = 0.020;
   bool data_wiped = true;          // false: this period is not used (sign ambiguity)
+  // The replica that actually ran, when it was not the commanded one (a receiver channel whose carrier follows
+  // its own PLL, whose correlation epoch is not the driver's period): its start time (s), its code pseudorange
+  // at that start and its constant carrier range rate. has_replica false: the ReplicaCommand of this PRN.
+  bool has_replica = false;
+  double replica_t_start_s = 0.0, replica_pseudorange_m = 0.0, replica_range_rate_mps = 0.0;
+};
+
+// One satellite's update in the latest finish_period (for logs): the filter's innovation (Iq: I_E, I_P, I_L,
+// Q_E, Q_P, Q_L, unit-noise units; Discriminator: range m, range rate m/s) and its normalised square.
+struct UltraTightSatelliteUpdate {
+  int prn = 0;
+  bool accepted = false;
+  double nis = 0.0;
+  Eigen::VectorXd innovation;
 };
 
 struct UltraTightCounters {
@@ -94,6 +113,8 @@ class UltraTightIntegration {
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;  // 17 x 17
   const UltraTightCounters& counters() const;
+  // The updates of the latest finish_period (satellites with a usable measurement), in replica order.
+  const std::vector<UltraTightSatelliteUpdate>& last_updates() const;
   const UltraTightOptions& options() const;
 
  private:

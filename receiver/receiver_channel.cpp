@@ -106,6 +106,16 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
       pseudorange(in.measurement_sample, e.first_code_period, e.code_phase_start_chips + e.code_rate_chips_per_s * half / fs_hz_);
   constexpr double kChip_m = signals::kSpeedOfLight_mps / signals::kCaChipRate_hz;
   in.measured_pseudorange_m = in.replica_pseudorange_mid_m - e.code_error_chips * kChip_m;
+  in.measurement_first_sample = e.first_sample;
+  in.replica_carrier_frequency_hz = (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * fs_hz_ / e.num_samples;
+  if (e.noise_power > 0.0) {
+    const double scale = 1.0 / std::sqrt(0.5 * e.noise_power);  // noise tap: variance 2 sigma^2 (I and Q)
+    const std::array<std::complex<float>, 3> taps{e.early, e.prompt, e.late};
+    for (int k = 0; k < 3; ++k) {
+      in.iq_i[k] = taps[k].real() * scale;
+      in.iq_q[k] = taps[k].imag() * scale;
+    }
+  }
   const EpochSummary& p = previous_epoch_;
   if (p.valid && p.bit_synced && p.num_code_periods == e.num_code_periods &&
       p.first_sample + p.num_samples == e.first_sample) {
@@ -146,7 +156,9 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
   s.code_rate_chips_per_s = e.code_rate_chips_per_s;
   s.carrier_phase_start_cycles = e.carrier_phase_start_cycles;
   s.carrier_phase_end_cycles = e.carrier_phase_end_cycles;
+  s.early = e.master().early;
   s.prompt = e.master().prompt;
+  s.late = e.master().late;
   s.code_error_chips = report.code_error_chips;
   // A fade shows in one epoch's prompt long before the C/N0 estimate (0.2 s window) follows: vector tracking
   // takes no measurement from an epoch whose |P|^2 / mean |noise|^2 is below 1 + 10^(2.5) T (25 dB-Hz; noise
@@ -158,6 +170,7 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
   } else {
     noise_power_ += 0.05 * (n2 - noise_power_);
   }
+  s.noise_power = noise_power_;
   s.signal_present = std::norm(std::complex<double>(s.prompt)) > (1.0 + 316.0 * e.integration_time_s) * noise_power_;
   last_epoch_new_ = true;
 }

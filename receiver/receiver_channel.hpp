@@ -134,7 +134,8 @@ class ReceiverChannel {
     std::int64_t first_code_period = 0;
     double code_phase_start_chips = 0.0, code_rate_chips_per_s = 0.0;
     double carrier_phase_start_cycles = 0.0, carrier_phase_end_cycles = 0.0;
-    std::complex<float> prompt{};
+    std::complex<float> early{}, prompt{}, late{};
+    double noise_power = 0.0;  // noise_power_ after this epoch
     double code_error_chips = 0.0;
     bool signal_present = false;  // this epoch's prompt power well above the noise tap's (see after_epoch)
   };

@@ -5,6 +5,7 @@
 // carrier stays with the channel's Costas PLL). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -50,6 +51,12 @@ struct VectorChannelInput {
   double measured_doppler_hz = 0.0;
   std::int64_t doppler_sample = 0;
   double doppler_interval_s = 0.0;       // middle-to-middle time of the two epochs
+  // The same correlation epoch for a loop that updates from correlations (ultra-tight): its first sample, the
+  // replica carrier's mean frequency over it (Hz), and the early/prompt/late I and Q of the master antenna
+  // normalised to unit noise variance per I or Q (by the noise tap's running mean power), data bit not removed.
+  std::int64_t measurement_first_sample = 0;
+  double replica_carrier_frequency_hz = 0.0;
+  std::array<double, 3> iq_i{}, iq_q{};  // early, prompt, late
 };
 
 struct VectorEpochInput {

@@ -8,6 +8,8 @@
 // --coupling vector: one vector filter closes the channels' code loops (tools/receive_vector.hpp).
 // --imu F --coupling loose|tight: GNSS/INS integration on the way (tools/receive_fusion.hpp): nav.csv and a "fusion"
 // object in summary.json; exit 3 also when the integration never started, 0 with a fused solution but no PVT fix.
+// --imu F --coupling ultra-tight: tight pull-in, then the ultra-tight loop drives the channels
+// (tools/receive_ultratight.hpp): ultratight.csv and an "ultratight" object in summary.json.
 #include <fmt/core.h>
 #include <unistd.h>
 
@@ -29,6 +31,7 @@
 #include "format_options.hpp"
 #include "receive_config.hpp"
 #include "receive_fusion.hpp"
+#include "receive_ultratight.hpp"
 #include "receive_vector.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
@@ -180,6 +183,9 @@ void run_receive(const ReceiveArgs& args) {
   const ReceiveCoupling coupling = parse_receive_coupling(args.fusion.coupling);
   std::unique_ptr<ReceiveVector> vector;  // --coupling vector: the vector tracking filter closes the code loops
   if (coupling == ReceiveCoupling::Vector) (vector = std::make_unique<ReceiveVector>(options, args.out))->attach(engine);
+  std::unique_ptr<ReceiveUltraTight> ultratight;  // --coupling ultra-tight: the INS-predicted replica drives them
+  if (coupling == ReceiveCoupling::UltraTight)
+    (ultratight = std::make_unique<ReceiveUltraTight>(*fusion, options, args.out))->attach(engine);
 
   SigintGuard sigint;
   Progress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
@@ -222,6 +228,10 @@ void run_receive(const ReceiveArgs& args) {
     fusion->finish(engine.stats().first_sample + engine.stats().samples_processed);
     run.extra_json = fusion->summary_json();
   }
+  if (ultratight) {
+    ultratight->finish(engine.stats().first_sample + engine.stats().samples_processed);
+    run.extra_json += ",\n  " + ultratight->summary_json();
+  }
   if (vector) {
     vector->finish();
     run.extra_json = vector->summary_json();
@@ -244,6 +254,7 @@ void run_receive(const ReceiveArgs& args) {
   fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", tracked, used, stats.fixes,
              engine.decoded_ephemerides().size());
   if (fusion) fmt::print("{}\n", fusion->report());
+  if (ultratight) fmt::print("{}\n", ultratight->report());
   if (fusion && !fusion->started())
     throw CommandExit(3, fmt::format("{}: no fused solution ({}); outputs up to the end are in {}", args.input,
                                      fusion->not_started_reason(), args.out));

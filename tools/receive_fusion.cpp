@@ -67,7 +67,9 @@ ReceiveCoupling parse_receive_coupling(const std::string& text) {
   if (text == "vector") return ReceiveCoupling::Vector;
   if (text == "loose") return ReceiveCoupling::Loose;
   if (text == "tight") return ReceiveCoupling::Tight;
-  throw io::InputError("command line", "--coupling must be scalar, vector, loose or tight, got '" + text + "'");
+  if (text == "ultra-tight") return ReceiveCoupling::UltraTight;
+  throw io::InputError("command line",
+                       "--coupling must be scalar, vector, loose, tight or ultra-tight, got '" + text + "'");
 }
 
 std::string to_string(ReceiveCoupling coupling) {
@@ -76,6 +78,7 @@ std::string to_string(ReceiveCoupling coupling) {
     case ReceiveCoupling::Vector: return "vector";
     case ReceiveCoupling::Loose: return "loose";
     case ReceiveCoupling::Tight: return "tight";
+    case ReceiveCoupling::UltraTight: return "ultra-tight";
   }
   return "?";
 }
@@ -84,7 +87,8 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   cmd->add_option("--imu", a.imu, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps) for GNSS/INS integration (--coupling)");
   cmd->add_option("--coupling", a.coupling,
                   "scalar (default: per-channel loops), vector (one vector filter closes the code loops), or "
-                  "GNSS/INS integration with --imu: loose (PVT fixes) or tight (pseudoranges and rates)");
+                  "GNSS/INS integration with --imu: loose (PVT fixes), tight (pseudoranges and rates) or "
+                  "ultra-tight (the INS-predicted replica drives the channels, the filter updates from correlations)");
   cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
   cmd->add_option("--align", a.align, "with --coupling: static, motion (default) or config");
   cmd->add_option("--fusion-config", a.config,
@@ -92,6 +96,8 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   cmd->add_option("--imu-time-origin", a.time_origin,
                   "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
                   "the GPS time of week) or a GPS time of week in seconds");
+  cmd->add_option("--ut-measurement", a.ut_measurement,
+                  "with --coupling ultra-tight: iq (default: the E/P/L I&Q, seed 001 eqs. 11-17) or discriminator");
 }
 
 std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& a) {
@@ -100,8 +106,18 @@ std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArg
   if (s.coupling == ReceiveCoupling::Scalar || s.coupling == ReceiveCoupling::Vector) {
     if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
       throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
-                                           "--coupling loose or tight");
+                                           "--coupling loose, tight or ultra-tight");
+    if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
     return std::nullopt;
+  }
+  if (!a.ut_measurement.empty() && s.coupling != ReceiveCoupling::UltraTight)
+    throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
+  if (a.ut_measurement.empty() || a.ut_measurement == "iq") {
+    s.ut_form = fusion::UltraTightForm::Iq;
+  } else if (a.ut_measurement == "discriminator") {
+    s.ut_form = fusion::UltraTightForm::Discriminator;
+  } else {
+    throw io::InputError("command line", "--ut-measurement must be iq or discriminator, got '" + a.ut_measurement + "'");
   }
   if (a.imu.empty()) throw io::InputError("command line", "--coupling " + a.coupling + " needs --imu FILE");
   s.imu_file = a.imu;
@@ -206,7 +222,11 @@ struct ReceiveFusion::Impl {
     tight.sigma_rate_zenith_mps = ro.pvt.sigma_doppler_mps;
   }
 
-  bool is_tight() const { return settings.coupling == ReceiveCoupling::Tight; }
+  // Ultra-tight pulls in with the tight integration until the hand-over.
+  bool is_tight() const {
+    return settings.coupling == ReceiveCoupling::Tight || settings.coupling == ReceiveCoupling::UltraTight;
+  }
+  bool handed_over = false;
 
   const std::vector<signals::Ephemeris>& ephemerides() {
     if (engine && engine->decoded_ephemerides().size() != decoded_seen) {
@@ -459,6 +479,7 @@ struct ReceiveFusion::Impl {
   void process(const receiver::ObservationEpoch& raw, const receiver::PvtSolution* fix) {
     ++epochs_seen;
     if (fix) ++fixes_seen;
+    if (handed_over) return;
     const receiver::ObservationEpoch e = continuous(raw);
     std::optional<signals::GpsTime> g;
     if (fix) {
@@ -572,7 +593,7 @@ void ReceiveFusion::on_fix(const receiver::PvtSolution& fix, const receiver::Obs
 void ReceiveFusion::finish(std::int64_t end_sample) {
   Impl& m = *impl_;
   m.flush();
-  if (m.integration && m.have_epoch_time) {
+  if (m.integration && m.have_epoch_time && !m.handed_over) {
     const double t_end = m.last_epoch_t_s + static_cast<double>(end_sample - m.last_epoch_sample) / m.fs_hz;
     m.advance_imu(std::min(t_end, m.imu.back().t_s), true);
   }
@@ -581,6 +602,28 @@ void ReceiveFusion::finish(std::int64_t end_sample) {
 bool ReceiveFusion::started() const { return impl_->integration.has_value(); }
 std::string ReceiveFusion::not_started_reason() const { return impl_->not_started; }
 void ReceiveFusion::commit() { impl_->nav.commit(); }
+
+const fusion::GnssInsIntegration* ReceiveFusion::integration() const {
+  return impl_->integration ? &*impl_->integration : nullptr;
+}
+const std::vector<ins::ImuIncrement>& ReceiveFusion::imu() const { return impl_->imu; }
+const ReceiveFusionSettings& ReceiveFusion::settings() const { return impl_->settings; }
+std::optional<signals::GpsTime> ReceiveFusion::imu_time_origin() const { return impl_->origin; }
+std::optional<std::pair<std::int64_t, double>> ReceiveFusion::last_epoch_time() const {
+  if (!impl_->have_epoch_time) return std::nullopt;
+  return std::make_pair(impl_->last_epoch_sample, impl_->last_epoch_t_s);
+}
+void ReceiveFusion::hand_over() { impl_->handed_over = true; }
+bool ReceiveFusion::handed_over() const { return impl_->handed_over; }
+void ReceiveFusion::write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
+                              const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad) {
+  Impl& m = *impl_;
+  m.final_sigma = NavSigma{sigma_pos_ned_m, sigma_vel_n_mps, sigma_att_rad};
+  if (m.nav_rows > 0 && !(nav.t_s > m.last_row_t_s)) return;
+  m.last_row_t_s = nav.t_s;
+  m.nav.write(nav, m.final_sigma);
+  ++m.nav_rows;
+}
 
 std::string ReceiveFusion::summary_json() const {
   const Impl& m = *impl_;
@@ -598,6 +641,8 @@ std::string ReceiveFusion::summary_json() const {
   j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
                    "\"epochs_unused\": {}",
                    m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
+  if (m.settings.coupling == ReceiveCoupling::UltraTight)
+    j += fmt::format(", \"handed_over\": {}", m.handed_over);
   if (m.is_tight()) j += fmt::format(", \"epochs_fewer_than_4_satellites\": {}", m.epochs_below_4);
   j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock_jumps, m.nav_rows);
   if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", io::json_escape(m.not_started));

@@ -23,6 +23,7 @@
 #include "fuse_config.hpp"
 #include "fuse_run.hpp"
 #include "fusion/gnss_ins_integration.hpp"
+#include "fusion/ultratight_integration.hpp"
 #include "ins/nav_state.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "signals/ephemeris.hpp"
@@ -30,9 +31,10 @@
 namespace ultratrack::tools {
 
 // --coupling of `receive`: scalar (per-channel loops; "none" is accepted too), vector (tools/receive_vector.hpp),
-// loose or tight (GNSS/INS integration, this file). A new kind of coupling is one more value here and in
+// loose or tight (GNSS/INS integration, this file), ultra-tight (tools/receive_ultratight.hpp: the tight integration
+// of this file pulls in, then the ultra-tight loop takes the channels over). A new kind of coupling is one more value here and in
 // parse_receive_coupling / to_string.
-enum class ReceiveCoupling { Scalar, Vector, Loose, Tight };
+enum class ReceiveCoupling { Scalar, Vector, Loose, Tight, UltraTight };
 ReceiveCoupling parse_receive_coupling(const std::string& text);  // InputError for an unknown value
 std::string to_string(ReceiveCoupling coupling);
 
@@ -43,7 +45,7 @@ struct ImuTimeOrigin {
 
 // The command-line text of the fusion options (parsed by parse_receive_fusion).
 struct ReceiveFusionArgs {
-  std::string imu, coupling = "scalar", filter, align, config, time_origin;
+  std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement;
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 
@@ -54,6 +56,7 @@ struct ReceiveFusionSettings {
   FuseConfig config;  // `fuse`'s configuration keys (--fusion-config)
   std::string imu_file;
   ImuTimeOrigin time_origin;
+  fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;  // --ut-measurement iq|discriminator
 };
 
 // Checks and parses the options (InputError naming the option or the configuration file). Nothing for
@@ -90,6 +93,20 @@ class ReceiveFusion final : public receiver::ReceiverObserver {
   bool started() const;
   std::string not_started_reason() const;
   void commit();  // nav.csv
+
+  // For the ultra-tight loop (tools/receive_ultratight.hpp), which starts from this tight integration: the
+  // running integration (nullptr before the start), the IMU rows, the GPS time of IMU t_s = 0 (once known), the
+  // latest observation epoch's sample and IMU time. hand_over(): from now on this object only forwards to the
+  // receiver's outputs (no more updates, no INS steps); nav.csv rows then come from write_nav.
+  const fusion::GnssInsIntegration* integration() const;
+  const std::vector<ins::ImuIncrement>& imu() const;
+  const ReceiveFusionSettings& settings() const;
+  std::optional<signals::GpsTime> imu_time_origin() const;
+  std::optional<std::pair<std::int64_t, double>> last_epoch_time() const;
+  void hand_over();
+  bool handed_over() const;
+  void write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m, const Eigen::Vector3d& sigma_vel_n_mps,
+                 const Eigen::Vector3d& sigma_att_rad);
 
  private:
   struct Impl;

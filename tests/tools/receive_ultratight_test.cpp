@@ -1,0 +1,268 @@
+// `ultratrack receive --imu --coupling ultra-tight` end to end (issue 7), short for CI: `simulate` writes 18 s of a
+// car on a 100 m circle at 30 km/h (45 dB-Hz, 2 MHz, brdc0010.22n; IF samples, imu.csv (HG1700) and truth.csv
+// from one trajectory) with every signal absent from 14.0 to 15.0 s (a short tunnel). The receiver starts hot,
+// pulls in scalar, the tight integration aligns in motion, and ~2 s later the ultra-tight loop takes the channels
+// over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
+// loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
+// signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
+// UKF + discriminators both; the same bytes with one thread and two. Bad option combinations give one InputError.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fused_nav_csv.hpp"
+#include "ins/earth_model.hpp"
+#include "io/input_error.hpp"
+#include "run_command.hpp"
+#include "solution_compare.hpp"
+#include "support/test_data.hpp"
+
+namespace fs = std::filesystem;
+using namespace ultratrack;
+
+namespace {
+
+constexpr double kGapStart_s = 14.0, kGapEnd_s = 15.0;
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream s(line);
+  std::string f;
+  while (std::getline(s, f, ',')) out.push_back(f);
+  return out;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 3));
+}
+
+struct Sim {
+  fs::path dir, sim, nav;
+  bool ok = false;
+};
+
+Sim& sim() {
+  static Sim s = [] {
+    Sim r;
+    const auto shared = test::shared_data_dir();
+    if (!shared || !fs::exists(*shared / "brdc0010.22n")) return r;
+    const fs::path brdc = *shared / "brdc0010.22n";
+    r.dir = test::scratch_dir();
+    r.sim = r.dir / "sim";
+    r.nav = brdc;
+    std::ofstream(r.dir / "circle.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
+                                          "18.0,0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
+    std::ofstream(r.dir / "circle.toml")
+        << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 18.0\ncn0_dbhz = 45.0\nseed = 4\n"
+           "[time]\ngps_week = 2190\ntow_s = 518776.0\n[navigation]\nrinex = \""
+        << brdc.generic_string()
+        << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+           "[trajectory]\nfile = \"circle.csv\"\nspeed_mps = 8.333333333\nheading_deg = 0.0\nimu_rate_hz = 100.0\n"
+           "[imu]\npreset = \"hg1700ae\"\nseed = 7\n[atmosphere]\nionosphere = true\ntroposphere = true\n"
+           "[[blockage]]\nantenna = 0\nstart_s = "
+        << kGapStart_s << "\nduration_s = " << kGapEnd_s - kGapStart_s << "\n";
+    test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
+    std::ofstream(r.dir / "motion.toml") << "[alignment]\nmotion_window_s = 1.0\n";
+    r.ok = true;
+    return r;
+  }();
+  return s;
+}
+
+std::vector<std::string> receive_args(const fs::path& rx) {
+  const auto& s = sim();
+  return {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string(),
+          "--imu", (s.sim / "imu.csv").string(), "--align", "motion", "--fusion-config",
+          (s.dir / "motion.toml").string(), "--out", rx.string()};
+}
+
+// Position error of nav.csv against truth.csv (IMU = antenna: no lever arm) from t0 on: 3-D RMS, and the RMS of
+// the filter's own 3-D 1-sigma over the same rows.
+struct NavError {
+  int rows = 0;
+  double rms_m = 0.0, sigma_m = 0.0;
+};
+NavError nav_error(const fs::path& rx, double t0) {
+  const auto truth = tools::read_simulation_truth_csv(sim().sim / "truth.csv");
+  const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
+  NavError e;
+  double s2 = 0.0, g2 = 0.0;
+  for (const auto& r : nav) {
+    const double tow = 518776.0 + r.nav.t_s;
+    if (r.nav.t_s < t0) continue;
+    auto it = std::lower_bound(truth.begin(), truth.end(), tow,
+                               [](const tools::TruthPoint& p, double t) { return p.tow_s < t; });
+    if (it == truth.begin() || it == truth.end()) continue;
+    const double w = (tow - (it - 1)->tow_s) / (it->tow_s - (it - 1)->tow_s);
+    const Eigen::Vector3d p = (it - 1)->r_e_m + w * (it->r_e_m - (it - 1)->r_e_m);
+    s2 += (ins::ecef_from_geodetic(r.nav.lat_rad, r.nav.lon_rad, r.nav.height_m) - p).squaredNorm();
+    g2 += r.sigma.position_ned_m.squaredNorm();
+    ++e.rows;
+  }
+  if (e.rows) {
+    e.rms_m = std::sqrt(s2 / e.rows);
+    e.sigma_m = std::sqrt(g2 / e.rows);
+  }
+  return e;
+}
+
+// ultratight.csv: per PRN, (time, ultratight, coasting) rows.
+struct Row {
+  double t;
+  bool ultratight, coasting, updated, accepted;
+};
+std::map<int, std::vector<Row>> read_log(const fs::path& rx) {
+  std::ifstream in(rx / "ultratight.csv");
+  std::string line;
+  std::getline(in, line);
+  const auto header = split(line);
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const std::size_t t = col("time_s"), prn = col("prn"), ut = col("ultratight"), co = col("coasting"),
+                    acc = col("accepted"), upd = col("updated");
+  std::map<int, std::vector<Row>> out;
+  while (std::getline(in, line)) {
+    const auto f = split(line);
+    out[std::stoi(f[prn])].push_back({std::stod(f[t]), f[ut] == "1", f[co] == "1", f[upd] == "1", f[acc] == "1"});
+  }
+  return out;
+}
+
+void check_run(const std::string& filter, const std::string& form) {
+  const auto rx = sim().dir / ("rx_" + filter + "_" + form);
+  auto args = receive_args(rx);
+  args.insert(args.end(), {"--coupling", "ultra-tight", "--filter", filter, "--ut-measurement", form});
+  test_support::run_command("receive", args);
+  const std::string summary = read_text(rx / "summary.json");
+  ASSERT_NE(summary.find("\"ultratight\": {\"filter\": \"" + filter + "\", \"measurement\": \"" + form +
+                         "\", \"handed_over\": true"),
+            std::string::npos)
+      << summary;
+  const double handover_s = json_number(summary, "handover_t_s");
+  EXPECT_GT(handover_s, 9.0);
+  EXPECT_LT(handover_s, kGapStart_s - 1.0);
+  EXPECT_EQ(json_number(summary, "releases"), 0.0);
+
+  const auto log = read_log(rx);
+  // The channels commanded at the hand-over: at least 6 (the file's 10 satellites, 8 above 10 deg).
+  std::set<int> handed;
+  for (const auto& [prn, rows] : log)
+    if (!rows.empty() && rows.front().ultratight) handed.insert(prn);
+  EXPECT_GE(handed.size(), 6u);
+  EXPECT_GE(json_number(summary, "relocks"), static_cast<double>(handed.size()));
+  for (int prn : handed) {
+    const auto& rows = log.at(prn);
+    double relock_s = NAN;
+    int before = 0, before_ok = 0, after = 0, after_ok = 0;  // updates (measurements) and accepted ones
+    int outside_gap = 0;
+    for (const Row& r : rows) {
+      // Commanded by the loop throughout (kept in lock, or coasting on the prediction in the gap).
+      EXPECT_TRUE(r.ultratight) << "PRN " << prn << " at " << r.t;
+      if (r.updated && r.t < kGapStart_s) ++before, before_ok += r.accepted;
+      if (r.updated && r.t > kGapEnd_s + 1.5) ++after, after_ok += r.accepted;
+      // Coasting only inside the gap and until the re-lock (the C/N0 estimate needs ~0.2 s to see the fade).
+      if (r.coasting && (r.t < kGapStart_s || r.t > kGapEnd_s + 1.0)) ++outside_gap;
+      if (r.t >= kGapEnd_s && !r.coasting && std::isnan(relock_s)) relock_s = r.t - kGapEnd_s;
+    }
+    EXPECT_EQ(outside_gap, 0) << "PRN " << prn;
+    EXPECT_LE(relock_s, 1.0) << "PRN " << prn;  // issue 7: back in lock within 1 s, no acquisition
+    // Measurements pass the gate (p = 0.9999): before the gap nearly all (97-100 % seen); from 1.5 s after the
+    // return most (84-100 % seen: the I&Q form's NIS runs ~1.5 x its 6 degrees of freedom, and in the first
+    // second after a re-lock the PLL's residual phase makes the gate refuse a third of them: docs/validation.md).
+    EXPECT_GE(before_ok, 0.9 * before) << "PRN " << prn;
+    EXPECT_GE(after_ok, 0.75 * after) << "PRN " << prn;
+    EXPECT_GE(before, 100) << "PRN " << prn;
+  }
+  // No re-acquisition: each handed-over satellite acquired once (summary per_satellite).
+  for (int prn : handed) {
+    const auto at = summary.find("\"prn\": " + std::to_string(prn) + ",");
+    ASSERT_NE(at, std::string::npos);
+    EXPECT_EQ(json_number(summary.substr(at), "acquisitions"), 1.0) << "PRN " << prn;
+  }
+  // Position against truth after the hand-over, the gap included. Bound from the noise: the code noise of one
+  // 20 ms epoch at 45 dB-Hz is sqrt(d / (2 C/N0 T)) chip = 0.02 chip = 5.8 m per satellite; the filter averages it
+  // with the INS over ~1 s (50 epochs x 7 satellites, PDOP ~2: ~0.5 m), leaving the unmodelled residual
+  // atmosphere (broadcast Klobuchar and Saastamoinen against the simulated same models: < 0.5 m) and the INS drift
+  // in the 1 s gap (HG1700: centimetres). 2 m 3-D RMS (issue 3's fix tolerance), and at most 3 times the
+  // filter's own stated 1-sigma (consistency).
+  const NavError e = nav_error(rx, handover_s + 0.5);
+  std::printf("ultra-tight %s %s: hand-over %.2f s, %zu channels, nav 3-D RMS %.3f m (stated %.3f m) over %d rows\n",
+              filter.c_str(), form.c_str(), handover_s, handed.size(), e.rms_m, e.sigma_m, e.rows);
+  EXPECT_GE(e.rows, 500);
+  EXPECT_LT(e.rms_m, 2.0);
+  EXPECT_LT(e.rms_m, 3.0 * e.sigma_m);
+}
+
+}  // namespace
+
+TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ekf", "iq");
+}
+
+// The loop runs on the engine's caller thread after the channels' parallel work: one thread gives the same bytes.
+TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  std::string text[2][2];
+  for (int threads : {1, 2}) {
+    const auto rx = sim().dir / ("rx_threads" + std::to_string(threads));
+    auto args = receive_args(rx);
+    args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", std::to_string(threads)});
+    test_support::run_command("receive", args);
+    text[threads - 1][0] = read_text(rx / "ultratight.csv");
+    text[threads - 1][1] = read_text(rx / "nav.csv");
+  }
+  EXPECT_GT(text[0][0].size(), 10000u);
+  EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
+  EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
+}
+
+TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ukf", "discriminator");
+}
+
+TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto& s = sim();
+  const std::vector<std::string> base = {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs",
+                                         "2.0e6", "--nav", s.nav.string()};
+  auto expect_error = [&](const std::string& name, std::vector<std::string> extra, const std::string& words) {
+    auto args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    args.insert(args.end(), {"--out", (s.dir / ("bad_" + name)).string()});
+    try {
+      test_support::run_command("receive", args);
+      ADD_FAILURE() << name << ": no error";
+    } catch (const io::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << name << ": " << e.what();
+    }
+    EXPECT_FALSE(fs::exists(s.dir / ("bad_" + name) / "summary.json")) << name;
+  };
+  expect_error("no_imu", {"--coupling", "ultra-tight"}, "--coupling ultra-tight needs --imu");
+  expect_error("form_without_ut", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-measurement", "iq"},
+               "--ut-measurement needs --coupling ultra-tight");
+  expect_error("form_scalar", {"--ut-measurement", "iq"}, "--ut-measurement needs --coupling ultra-tight");
+  expect_error("bad_form", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement",
+                            "phase"},
+               "--ut-measurement must be iq or discriminator");
+  expect_error("bad_coupling", {"--coupling", "ultratight"}, "ultra-tight");
+  expect_error("missing_imu_file", {"--imu", (s.dir / "none.csv").string(), "--coupling", "ultra-tight"}, "not found");
+}

@@ -1,0 +1,348 @@
+#include "receive_ultratight.hpp"
+
+#include <fmt/core.h>
+#include <fmt/ostream.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fusion/clock_model.hpp"
+#include "fusion/ins_error_model.hpp"
+#include "fusion/loose_measurements.hpp"
+#include "fusion/tight_measurements.hpp"
+#include "ins/earth_model.hpp"
+#include "ins/imu_error_model.hpp"
+#include "io/input_error.hpp"
+#include "signals/ephemeris_selection.hpp"
+#include "signals/gps_constants.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+constexpr double kC = signals::kSpeedOfLight_mps;
+constexpr double kLambda_m = signals::kL1Wavelength_m;
+constexpr double kChip_m = kC / signals::kCaChipRate_hz;
+
+}  // namespace
+
+ReceiveUltraTight::ReceiveUltraTight(ReceiveFusion& fusion, const receiver::ReceiverOptions& options,
+                                     const std::filesystem::path& dir, ReceiveUltraTightOptions ut)
+    : fusion_(fusion), options_(options), ut_(ut), log_(dir / "ultratight.csv") {
+  log_.stream() << "sample,time_s,prn,synchronised,ultratight,coasting,coast_s,cn0_dbhz,measured_pseudorange_m,"
+                   "predicted_pseudorange_m,measured_doppler_hz,predicted_doppler_hz,replica_carrier_hz,"
+                   "replica_code_rate_chips_per_s,predicted_code_rate_chips_per_s,code_jump_chips,updated,accepted,"
+                   "nis,innovation_1,innovation_2,innovation_3,innovation_4,innovation_5,innovation_6\n";
+}
+
+void ReceiveUltraTight::attach(receiver::ReceiverEngine& engine) { engine.set_vector_loop(this, ut_.period_s); }
+
+// IMU time of a receiver sample: the receive time on the clock continuous since the hand-over, less the
+// driver's clock bias (carried to that time by its drift).
+double ReceiveUltraTight::imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const {
+  const signals::GpsTime rx = signals::add_seconds(
+      epoch.receive_time,
+      (epoch.clock_corrections_s - corrections_at_start_s_) + static_cast<double>(sample - epoch.sample) / epoch.fs_hz);
+  const double t_rx = signals::seconds_between(rx, origin_);
+  const auto& o = driver_->output();
+  const double bias_m = o.clock_bias_m + o.clock_drift_mps * (t_rx - t_ins_);
+  return t_rx - bias_m / kC;
+}
+
+void ReceiveUltraTight::emit_nav() {
+  const auto& o = driver_->output();
+  fusion_.write_nav(o.nav, o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+}
+
+// IMU rows are split where a vector epoch falls inside one (constant rates over a row); a nav row at each row end.
+void ReceiveUltraTight::feed_imu_to(double t) {
+  const auto& imu = fusion_.imu();
+  while (t_ins_ < t - 1e-9) {
+    while (next_imu_ < imu.size() && imu[next_imu_].t_s <= t_ins_ + 1e-9) ++next_imu_;
+    if (next_imu_ == 0 || next_imu_ >= imu.size())
+      throw io::InputError(fusion_.settings().imu_file,
+                           fmt::format("does not cover the signal: the ultra-tight loop needs IMU time {:.3f} s, the "
+                                       "rows span {:.3f}-{:.3f} s",
+                                       t, imu.front().t_s, imu.back().t_s));
+    const ins::ImuIncrement& a = imu[next_imu_ - 1];
+    const ins::ImuIncrement& b = imu[next_imu_];
+    const double end = std::min(b.t_s, t);
+    const double share = (end - t_ins_) / (b.t_s - a.t_s);
+    driver_->add_imu({end, b.dtheta_b * share, b.dv_b * share});
+    t_ins_ = end;
+    if (end >= b.t_s - 1e-9) emit_nav();
+  }
+}
+
+void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_k) {
+  const fusion::IntegrationOutput& out = fusion_.integration()->output();
+  const ReceiveFusionSettings& s = fusion_.settings();
+  const FuseConfig& c = s.config;
+  fusion::UltraTightOptions o;
+  o.filter = s.filter;
+  o.form = s.ut_form;
+  o.model = fusion::error_model_from_preset(ins::imu_preset(c.imu_preset));
+  // The tight filter's clock sigmas (its bias is re-expressed below, exactly, from the time line) with margin.
+  o.model.clock.bias_sigma_m = 3.0 * out.sigma_clock_bias_m + 1.0;
+  o.model.clock.drift_sigma_mps = 3.0 * out.sigma_clock_drift_mps + 0.1;
+  o.model.clock = fusion::clock_noise_from_allan(c.clock_allan, o.model.clock);
+  o.lever_arm_b = c.lever_arm_b;
+  const auto floor = [](const Eigen::Vector3d& v, double m) { return Eigen::Vector3d(v.cwiseMax(m)); };
+  o.sigma_pos_ned_m = floor(out.sigma_pos_ned_m, 0.1);
+  o.sigma_vel_n_mps = floor(out.sigma_vel_n_mps, 0.01);
+  o.sigma_att_rad = floor(out.sigma_att_rad, 1e-4);
+  o.gate = c.gate;
+  o.ukf = c.ukf;
+  // The PVT's mask: satellites below it stay scalar. (A 0 or 5 deg mask brought the two low satellites of the 10 g
+  // turn in and the position then diverged to 10 m RMS in the turn: docs/validation.md.)
+  o.tight.elevation_mask_rad = options_.pvt.elevation_mask_rad;
+  o.tight.ionosphere = options_.pvt.ionosphere;
+  o.tight.troposphere = options_.pvt.troposphere;
+  if (epoch.iono) o.iono = *epoch.iono;
+  o.tap_offset_chips = options_.tracking.early_late_offset_chips;
+  o.gps_time_origin = origin_;
+  o.initial_accel_bias_b = out.accel_bias_b;
+  o.initial_gyro_bias_b = out.gyro_bias_b;
+  // The bias that makes this epoch's receive time (on the clock as it reads now) the tight filter's GPS time of it:
+  // pseudoranges c (t_rx - t_tx) then equal range + bias, as the driver predicts them.
+  corrections_at_start_s_ = epoch.clock_corrections_s;
+  o.initial_clock_drift_mps = out.clock_drift_mps;
+  o.initial_clock_bias_m =
+      kC * (signals::seconds_between(epoch.receive_time, origin_) - t_k) - out.clock_drift_mps * (t_k - out.nav.t_s);
+  // One ephemeris per PRN (the driver predicts every ephemeris it holds: a day's RINEX has ~12 per PRN), chosen
+  // for this time; 2-4 h fit intervals cover any run `receive` makes of a recording.
+  std::vector<signals::Ephemeris> eph;
+  for (int prn = 1; prn <= 32; ++prn)
+    if (auto e = signals::select_ephemeris(*epoch.ephemerides, prn, epoch.receive_time)) eph.push_back(*e);
+  ephemerides_ = eph;
+  driver_.emplace(out.nav, std::move(eph), o);
+  t_ins_ = out.nav.t_s;
+  next_imu_ = 0;
+  handover_t_s_ = t_k;
+  handover_sample_ = epoch.sample;
+  fusion_.hand_over();
+}
+
+std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const receiver::VectorEpochInput& epoch,
+                                                                        double t_k) {
+  std::vector<fusion::ChannelCorrelation> out;
+  const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
+  for (const auto& in : epoch.channels) {
+    if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
+    if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
+    if (in.iq_i == std::array<double, 3>{} && in.iq_q == std::array<double, 3>{}) continue;  // no noise estimate
+    ++measurements_;
+    fusion::ChannelCorrelation c;
+    c.prn = in.prn;
+    // The I&Q model's amplitude A = sqrt(2 C/N0 T) must be the one of these normalised taps: C/N0 by the moments
+    // of the same taps (E[I_P^2 + Q_P^2] = A^2 + 2), averaged over ~10 epochs (0.2 s, as the channel's estimator).
+    ChannelState& st = channels_[in.prn];
+    const double p2 = in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1];
+    st.prompt_power = std::isfinite(st.prompt_power) ? st.prompt_power + 0.1 * (p2 - st.prompt_power) : p2;
+    const double a2 = st.prompt_power - 2.0;
+    c.cn0_dbhz = a2 > 0.0 ? 10.0 * std::log10(a2 / (2.0 * ut_.period_s)) : -100.0;
+    c.integration_time_s = ut_.period_s;
+    // Data wipe-off by the prompt's sign: the Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms:
+    // Q(sqrt(2 C/N0 T)) = Q(6.3), none in practice).
+    const double sign = in.iq_i[1] >= 0.0 ? 1.0 : -1.0;
+    for (int k = 0; k < 3; ++k) {
+      c.taps.i[k] = sign * in.iq_i[k];
+      c.taps.q[k] = sign * in.iq_q[k];
+    }
+    c.data_wiped = std::abs(in.iq_i[1]) > std::abs(in.iq_q[1]);  // else the sign is a guess: no update
+    if (!c.data_wiped) ++not_wiped_;
+    // The replica that ran over this epoch: code pseudorange (continuous clock) and the PLL's carrier rate.
+    const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
+    c.has_replica = true;
+    c.replica_range_rate_mps = -kLambda_m * in.replica_carrier_frequency_hz;
+    c.replica_t_start_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz;
+    c.replica_pseudorange_m = in.replica_pseudorange_mid_m + shift_m - c.replica_range_rate_mps * half_s;
+    out.push_back(c);
+  }
+  return out;
+}
+
+// The change of each satellite's predicted Doppler over the period just ended caused by the INS propagation alone
+// (the nominal at its end, before this epoch's update, against the period's replicas). The channels' PLLs get
+// only this as aiding: the filter's corrections would reach them as frequency steps, and the PLL's residual
+// phase, which the I&Q / discriminator measurement reads as a frequency error, would then be fed back into it
+// (a loop inside the loop: it diverged within a second in the 500 km/h circle).
+std::map<int, double> ReceiveUltraTight::propagated_doppler_change() {
+  std::map<int, double> out;
+  const fusion::NominalState n = driver_->nominal();
+  const auto& o = driver_->options();
+  const Eigen::Vector3d r_ant = fusion::antenna_position_e(n.nav, o.lever_arm_b);
+  const Eigen::Vector3d v_ant =
+      ins::C_en(n.nav.lat_rad, n.nav.lon_rad) * fusion::antenna_velocity_n(n.nav, Eigen::Vector3d::Zero(), o.lever_arm_b);
+  receiver::ObservationEpoch e;
+  e.receive_time = signals::add_seconds(origin_, n.nav.t_s + n.clock_bias_m / kC);
+  for (const auto& [prn, r] : period_replicas_) {
+    receiver::Observation ob;
+    ob.prn = prn;
+    ob.pseudorange_m = r.pseudorange_m + r.range_rate_mps * (n.nav.t_s - r.t_start_s);
+    ob.doppler_hz = 0.0;
+    e.observations.push_back(ob);
+  }
+  fusion::TightOptions t = o.tight;
+  t.use_range_rate = true;
+  for (const auto& sat : fusion::prepare_satellites(e, ephemerides_, o.iono, r_ant, t)) {
+    const double doppler = -fusion::predicted_range_rate_mps(sat, r_ant, v_ant, n.clock_drift_mps) / kLambda_m;
+    out[sat.prn] = doppler - period_replicas_[sat.prn].nco.carrier_frequency_hz;
+  }
+  return out;
+}
+
+void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double t_k,
+                                std::span<receiver::VectorChannelCommand> commands,
+                                const std::map<int, double>& aid_change) {
+  const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
+  std::map<int, const fusion::UltraTightSatelliteUpdate*> updates;
+  for (const auto& u : driver_->last_updates()) updates[u.prn] = &u;
+  std::map<int, fusion::ReplicaCommand> previous;
+  previous.swap(period_replicas_);
+  for (const auto& r : driver_->replicas()) period_replicas_[r.prn] = r;
+  int commanded = 0;
+  for (std::size_t i = 0; i < epoch.channels.size(); ++i) {
+    const receiver::VectorChannelInput& in = epoch.channels[i];
+    ChannelState& st = channels_[in.prn];
+    const auto rep = period_replicas_.find(in.prn);
+    double jump = NAN, predicted_m = NAN, measured_m = NAN, predicted_doppler = NAN;
+    if (in.has_measurement) {
+      measured_m = in.measured_pseudorange_m + shift_m;
+      if (const auto p = previous.find(in.prn); p != previous.end()) {
+        const double t_mid = t_k - static_cast<double>(epoch.sample - in.measurement_sample) / epoch.fs_hz;
+        predicted_m = p->second.pseudorange_m + p->second.range_rate_mps * (t_mid - p->second.t_start_s);
+      }
+    }
+    bool vector = false;
+    if (in.synchronised && rep != period_replicas_.end()) {
+      const fusion::ReplicaCommand& r = rep->second;
+      predicted_doppler = r.nco.carrier_frequency_hz;
+      const double dt = static_cast<double>(in.next_epoch_sample - epoch.sample) / epoch.fs_hz;
+      // Both on the receiver clock as it reads now: the replica left at its code rate vs the prediction.
+      const double replica_m =
+          in.replica_pseudorange_m + kC * (1.0 - in.code_rate_chips_per_s / signals::kCaChipRate_hz) * dt;
+      const double prediction_m = r.pseudorange_m + r.range_rate_mps * dt - shift_m;
+      jump = (replica_m - prediction_m) / kChip_m;  // replica too far away: advance it
+      st.coast_s = in.coasting ? st.coast_s + ut_.period_s : 0.0;
+      vector = std::abs(jump) <= ut_.max_jump_chips && st.coast_s <= ut_.max_coast_s;
+      if (vector) {
+        commands[i].vector = true;
+        commands[i].code_rate_chips_per_s = r.nco.code_rate_chips_per_s;
+        commands[i].code_phase_jump_chips = jump;
+        const auto change = aid_change.find(in.prn);
+        if (!st.commanded || !std::isfinite(st.aid_hz) || change == aid_change.end())
+          st.aid_hz = r.nco.carrier_frequency_hz;  // joins (the channel only uses changes of it)
+        else
+          st.aid_hz += change->second;
+        commands[i].carrier_frequency_hz = st.aid_hz;
+        ++commanded;
+        ++channel_epochs_;
+        if (in.coasting) ++coasting_channel_epochs_;
+      }
+    }
+    if (st.commanded && !vector) ++releases_;
+    st.ever = st.ever || vector;
+    st.commanded = vector;
+    const auto u = updates.find(in.prn);
+    const fusion::UltraTightSatelliteUpdate* up = u == updates.end() ? nullptr : u->second;
+    auto& s = log_.stream();
+    fmt::print(s, "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
+               epoch.sample, static_cast<double>(epoch.sample) / epoch.fs_hz, in.prn, in.synchronised, vector,
+               in.coasting, st.coast_s, in.cn0_dbhz, measured_m, predicted_m,
+               in.has_doppler ? in.measured_doppler_hz : NAN, predicted_doppler,
+               in.has_measurement ? in.replica_carrier_frequency_hz : NAN, in.code_rate_chips_per_s,
+               vector ? commands[i].code_rate_chips_per_s : NAN, jump, up != nullptr, up && up->accepted,
+               up ? up->nis : NAN);
+    for (int k = 0; k < 6; ++k)
+      fmt::print(s, ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
+    s << '\n';
+  }
+  if (commanded > 0) ++vector_epochs_;
+}
+
+void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
+                               std::span<receiver::VectorChannelCommand> commands) {
+  if (!driver_) {
+    if (fusion_.handed_over() || !fusion_.integration() || !epoch.ephemerides) return;
+    const auto origin = fusion_.imu_time_origin();
+    const auto last = fusion_.last_epoch_time();
+    if (!origin || !last) return;
+    origin_ = *origin;
+    const double t_k = last->second + static_cast<double>(epoch.sample - last->first) / epoch.fs_hz;
+    const double t_ins = fusion_.integration()->output().nav.t_s;
+    if (!first_integration_t_s_) first_integration_t_s_ = t_k;
+    // The INS must not be ahead of this epoch (it steps whole IMU rows up to the observation epoch).
+    if (t_k - *first_integration_t_s_ < ut_.handover_after_s || t_ins > t_k - 1e-6) return;
+    start(epoch, t_k);
+    feed_imu_to(t_k);
+    driver_->start_period(ut_.period_s);
+    period_open_ = true;
+    command(epoch, t_k, commands, {});
+    return;
+  }
+  const double t_k = imu_time(epoch, epoch.sample);
+  // The last vector epochs of a file whose IMU rows end with the signal (as `simulate` writes them) may lie a
+  // few ms past the last row: the loop stops there (the channels finish scalar); further out is an InputError.
+  if (t_k > fusion_.imu().back().t_s + 1e-9 && t_k <= fusion_.imu().back().t_s + 0.1) return;
+  feed_imu_to(t_k);
+  const std::map<int, double> aid_change = propagated_doppler_change();
+  if (period_open_) driver_->finish_period(correlations(epoch, t_k));
+  driver_->start_period(ut_.period_s);
+  period_open_ = true;
+  for (const auto& in : epoch.channels) {
+    ChannelState& st = channels_[in.prn];
+    if (st.was_coasting && !in.coasting && in.vector_mode) ++relocks_;
+    st.was_coasting = in.coasting;
+  }
+  last_sample_ = epoch.sample;
+  last_t_s_ = t_k;
+  command(epoch, t_k, commands, aid_change);
+}
+
+void ReceiveUltraTight::finish(std::int64_t end_sample) {
+  if (driver_ && last_sample_) {
+    const double t_end = last_t_s_ + static_cast<double>(end_sample - *last_sample_) / options_.fs_hz;
+    feed_imu_to(std::min(t_end, fusion_.imu().back().t_s));
+  }
+  log_.commit();
+}
+
+std::string ReceiveUltraTight::summary_json() const {
+  const ReceiveFusionSettings& s = fusion_.settings();
+  std::string j = fmt::format(
+      "\"ultratight\": {{\"filter\": \"{}\", \"measurement\": \"{}\", \"handed_over\": {}",
+      s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf",
+      s.ut_form == fusion::UltraTightForm::Iq ? "iq" : "discriminator", driver_.has_value());
+  if (!driver_) return j + "}";
+  long long channels = 0;
+  for (const auto& [prn, st] : channels_) channels += st.ever;
+  const auto& k = driver_->counters();
+  const auto& o = driver_->output();
+  j += fmt::format(", \"handover_t_s\": {:.3f}, \"handover_sample\": {}, \"end_t_s\": {:.3f}, \"channels_handed_over\": {}, "
+                   "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
+                   "\"releases\": {}, \"measurements\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
+                   "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}",
+                   handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_,
+                   coasting_channel_epochs_, relocks_, releases_, measurements_, not_wiped_, k.periods, k.updates,
+                   k.accepted, k.rejected, k.coasting);
+  j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
+                   "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
+                   o.sigma_pos_ned_m.x(), o.sigma_pos_ned_m.y(), o.sigma_pos_ned_m.z(), o.sigma_clock_bias_m,
+                   o.sigma_clock_drift_mps);
+  return j;
+}
+
+std::string ReceiveUltraTight::report() const {
+  if (!driver_) return "receive: ultra-tight: never handed over (the tight integration did not start or ran too briefly)";
+  const auto& k = driver_->counters();
+  long long channels = 0;
+  for (const auto& [prn, st] : channels_) channels += st.ever;
+  return fmt::format("receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
+                     "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}",
+                     fusion_.settings().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
+                     fusion_.settings().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
+                     handover_t_s_, channels, channel_epochs_, coasting_channel_epochs_, relocks_, releases_,
+                     k.accepted, k.rejected);
+}
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,93 @@
+// `ultratrack receive --imu F --coupling ultra-tight --filter ekf|ukf [--ut-measurement iq|discriminator]`: the
+// closed-loop ultra-tight driver (fusion/ultratight_integration.hpp) attached to the receiver engine through the
+// vector-loop seam (receiver/vector_loop.hpp). Channels acquire and pull in as scalar while the tight integration
+// of tools/receive_fusion.hpp aligns and runs; then the driver starts from the tight filter's state and, every
+// 20 ms, (1) runs the INS to the vector epoch, (2) updates from each synchronised channel's latest correlation
+// epoch (E/P/L I&Q normalised to unit noise, data bit removed by the prompt's sign, the replica that actually ran
+// given explicitly), (3) predicts every satellite's replica and commands each channel's code (rate and phase jump)
+// and carrier aiding (predicted Doppler; the channel's Costas PLL stays closed, so carrier phase stays continuous).
+// A channel that loses lock coasts on the prediction and re-locks without acquisition. Logs: ultratight.csv
+// (per vector epoch and channel, keyed like tracking.csv by sample/time/prn) and nav.csv rows after the hand-over.
+// Time: the driver's t_s is IMU time (GPS time minus the IMU time origin); its clock bias is against the receiver
+// clock with the engine's clock jumps since the hand-over taken out. Units: s, m, m/s, Hz, chips.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+
+#include "fusion/ultratight_integration.hpp"
+#include "io/atomic_file.hpp"
+#include "receive_fusion.hpp"
+#include "receiver/receiver_engine.hpp"
+#include "receiver/vector_loop.hpp"
+
+namespace ultratrack::tools {
+
+struct ReceiveUltraTightOptions {
+  double period_s = 0.020;          // vector epoch = the driver's period = the channels' 20 ms coherent epochs
+  double handover_after_s = 2.0;    // the tight integration runs this long (IMU time) before the hand-over
+  double max_jump_chips = 0.5;      // a channel joins / stays only while prediction and replica agree this well
+  double max_coast_s = 30.0;        // a coasting channel is released (scalar, then lost) after this
+};
+
+class ReceiveUltraTight final : public receiver::VectorLoop {
+ public:
+  // fusion: the tight pull-in (settings().coupling UltraTight); opens DIR/ultratight.csv (committed by finish).
+  ReceiveUltraTight(ReceiveFusion& fusion, const receiver::ReceiverOptions& options, const std::filesystem::path& dir,
+                    ReceiveUltraTightOptions ut = {});
+  void attach(receiver::ReceiverEngine& engine);
+  void update(const receiver::VectorEpochInput& epoch, std::span<receiver::VectorChannelCommand> commands) override;
+  // Runs the INS to end_sample (the receiver's next unprocessed sample) and commits the log.
+  void finish(std::int64_t end_sample);
+
+  bool handed_over() const { return driver_.has_value(); }
+  const fusion::UltraTightIntegration* driver() const { return driver_ ? &*driver_ : nullptr; }
+  std::string summary_json() const;  // the "ultratight" member of summary.json
+  std::string report() const;        // one line for stdout
+
+ private:
+  struct ChannelState {
+    bool commanded = false;  // in vector mode under this loop (as of the last command)
+    double coast_s = 0.0;
+    bool ever = false;
+    bool was_coasting = false;
+    double prompt_power = NAN;
+    double aid_hz = NAN;  // the carrier aiding sent (changes by the INS propagation only)  // running mean of I_P^2 + Q_P^2 (normalised taps): A^2 + 2
+  };
+  void start(const receiver::VectorEpochInput& epoch, double t_k);
+  double imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const;
+  void feed_imu_to(double t);
+  void emit_nav();
+  std::vector<fusion::ChannelCorrelation> correlations(const receiver::VectorEpochInput& epoch, double t_k);
+  std::map<int, double> propagated_doppler_change();
+  void command(const receiver::VectorEpochInput& epoch, double t_k, std::span<receiver::VectorChannelCommand> out,
+               const std::map<int, double>& aid_change);
+
+  ReceiveFusion& fusion_;
+  receiver::ReceiverOptions options_;
+  ReceiveUltraTightOptions ut_;
+  io::AtomicFile log_;
+  std::optional<fusion::UltraTightIntegration> driver_;
+  std::vector<signals::Ephemeris> ephemerides_;  // the driver's (one per PRN)
+  signals::GpsTime origin_;
+  double corrections_at_start_s_ = 0.0;  // the engine's clock corrections at the hand-over
+  double t_ins_ = 0.0;                   // the driver's INS time (IMU rows split at vector epochs)
+  std::size_t next_imu_ = 0;
+  bool period_open_ = false;
+  std::map<int, fusion::ReplicaCommand> period_replicas_;  // the open period's replicas by PRN
+  std::map<int, ChannelState> channels_;
+  std::optional<double> first_integration_t_s_;
+  std::optional<std::int64_t> last_sample_;
+  double last_t_s_ = 0.0;
+  // Counts.
+  double handover_t_s_ = 0.0;
+  std::int64_t handover_sample_ = 0;
+  long long vector_epochs_ = 0, channel_epochs_ = 0, coasting_channel_epochs_ = 0, releases_ = 0, relocks_ = 0;
+  long long measurements_ = 0, not_wiped_ = 0;
+};
+
+}  // namespace ultratrack::tools
