@@ -26,7 +26,10 @@ constexpr double kSmoothing_s = 0.1;
 constexpr double kBitPeriod_s = 0.02;
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr int kCoherentEpochChoices[] = {1, 2, 5, 10, 20};
-constexpr double kCn0Slow_s = 1.0;  // C/N0 low-pass for the choice of N and the long-coherent loss test
+constexpr double kCn0Slow_s = 1.0;
+// The PLI's time constant in long updates (its spread from one update at SNR c T = 10, 20 dB-Hz at 100 ms, is
+// ~0.6; over 10 updates ~0.2); the loss test then waits at least as long.
+constexpr double kPliUpdates = 10.0;  // C/N0 low-pass for the choice of N and the long-coherent loss test
 
 int epochs_in(double window_s, double t_s) { return std::max(1, static_cast<int>(std::lround(window_s / t_s))); }
 
@@ -272,7 +275,7 @@ int ScalarTracking::known_bits_wanted() const {
 void ScalarTracking::set_loop_epochs(int epochs) {
   const int pli_epochs = std::max(epochs, target_epochs_);
   const double tau = pli_epochs == 1 ? opt_.pli_time_constant_s
-                                     : std::max(opt_.pli_time_constant_s, 3.0 * pli_epochs * kBitPeriod_s);
+                                     : std::max(opt_.pli_time_constant_s, kPliUpdates * pli_epochs * kBitPeriod_s);
   if (epochs == loop_epochs_ && tau == pli_tau_s_) return;
   if (epochs != loop_epochs_) {
     carrier_.set_bandwidths(epochs == 1 ? opt_.pll_bw_coherent_hz : long_coherent_pll_bw_hz(opt_, epochs), 0.0);
@@ -501,7 +504,7 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
   const bool low_cn0 = slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(n));
   const bool low_pli = r.pli < opt_.pli_loss_threshold;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
-  if (loss_time_s_ >= opt_.loss_of_lock_time_s) {
+  if (loss_time_s_ >= std::max(opt_.loss_of_lock_time_s, pli_tau_s_)) {
     loss_time_s_ = 0.0;
     target_epochs_ = 1;
     set_loop_epochs(1);

@@ -87,23 +87,25 @@ struct ScalarTrackingOptions {
   // Long coherent integration with data wipe-off (issue 7). After bit sync, while the navigation bits ahead are
   // known (receiver/nav_bit_predictor.hpp), N consecutive 20 ms epochs are summed with each bit's sign removed
   // (the channel's epochs stay 20 ms: one correlator, summed epochs) and the loops run once per N x 20 ms with
-  // T = N x 20 ms: PLL and DLL noise bandwidths min(their 20 ms value, coherent_max_bn_t / T) (the loop filters'
-  // gains follow T; Bn T is kept where the digital loop stays within ~20 % of its design), the PLI on the long
-  // sums (noise power N x the 20 ms one, time constant max(pli_time_constant_s, 3 T)), and the C/N0 loss test at
-  // cn0_loss_threshold_dbhz - 10 log10 N (the same pre-detection SNR as a 20 ms epoch at the threshold) on the
-  // C/N0 estimates low-passed (in dB) over 1 s. Where bits are unknown the channel stays on 20 ms (bits and C/N0 are always from
-  // 20 ms epochs: non-coherent across them).
+  // T = N x 20 ms: PLL and DLL noise bandwidths min(their 20 ms value, coherent_max_bn_t / T) (the loop
+  // filters' gains follow T; at Bn T = 0.2 the digital loop is ~55 % wider than its design), the PLI on the long
+  // sums (noise power N x the 20 ms one, time constant max(pli_time_constant_s, 10 T); the loss test waits as
+  // long), and the C/N0 loss test at cn0_loss_threshold_dbhz - 10 log10 N (the pre-detection SNR of a 20 ms
+  // epoch at the threshold) on the C/N0 estimates low-passed (in dB) over 1 s. Where bits are unknown the
+  // channel stays on 20 ms (bits and C/N0 always come from 20 ms epochs: non-coherent across them).
   // N per channel from the measured C/N0 (adaptive_coherent): the shortest N in {1, 2, 5, 10, 20} (N x 20 <=
   // max_coherent_ms) whose thermal Costas PLL jitter sqrt(Bn / c (1 + 1 / (2 T c))) (c = C/N0 in Hz, Bn at that
   // T) is at most coherent_jitter_deg, else the longest; a shorter N only once it also holds coherent_hysteresis_db
-  // lower. With the defaults (5 Hz at 20 ms, Bn T <= 0.1, 4 deg): 20 ms above 30.2 dB-Hz, 40 ms from 30.2 to
-  // 27.2, 100 ms below 27.2 (200 ms below 23.2 and 400 ms below 17.2 when max_coherent_ms allows), and back up
-  // 2 dB higher. adaptive_coherent = false: always max_coherent_ms while bits are known.
+  // lower. With the defaults (5 Hz at 20 ms, Bn T <= 0.2, 4 deg): 20 ms above 30.21 dB-Hz, 40 ms (still 5 Hz)
+  // down to 30.16, 100 ms (2 Hz) below; with max_coherent_ms 200 or 400, 200 ms (1 Hz) below 26.18 and 400 ms
+  // (0.5 Hz) below 23.17; back to a shorter time 2 dB above its threshold. A 1 Hz 3rd-order loop at 100 ms (Bn T
+  // = 0.1) tracked a 0.5 Hz/s Doppler ramp with ~30 deg slow swings (its rate state's noise from the 5 Hz loop):
+  // hence 0.2. adaptive_coherent = false: always max_coherent_ms while bits are known.
   int max_coherent_ms = 100;           // 20 (off), 40, 100, 200 or 400
   bool adaptive_coherent = true;
   double coherent_jitter_deg = 4.0;    // (0, 30]
   double coherent_hysteresis_db = 2.0; // [0, 10]
-  double coherent_max_bn_t = 0.1;      // (0, 0.25]
+  double coherent_max_bn_t = 0.2;      // (0, 0.25]
 };
 
 // Thermal phase jitter of a Costas PLL, radians: sqrt(Bn / c (1 + 1 / (2 T c))), c = 10^(cn0_dbhz / 10).
