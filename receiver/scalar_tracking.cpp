@@ -29,7 +29,10 @@ constexpr int kCoherentEpochChoices[] = {1, 2, 5, 10, 20};
 constexpr double kCn0Slow_s = 1.0;
 // The PLI's time constant in long updates (its spread from one update at SNR c T = 10, 20 dB-Hz at 100 ms, is
 // ~0.6; over 10 updates ~0.2); the loss test then waits at least as long.
-constexpr double kPliUpdates = 10.0;  // C/N0 low-pass for the choice of N and the long-coherent loss test
+constexpr double kPliUpdates = 10.0;
+// Longest stretch of unknown bits bridged on 20 ms with the long updates' loss test: a subframe 4 and 5 pair
+// whose pages are unknown (9.6 s).
+constexpr double kBridge_s = 10.0;  // C/N0 low-pass for the choice of N and the long-coherent loss test
 
 int epochs_in(double window_s, double t_s) { return std::max(1, static_cast<int>(std::lround(window_s / t_s))); }
 
@@ -393,9 +396,10 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   if (bits_) r.bit = bits_->add(e);
 
   // Loss of lock: low C/N0 at any time, or (once phase lock was achieved) a low PLI, held for the loss time.
-  // (While weak enough for long coherent integration, 20 ms updates bridging unknown bits judge the C/N0 as the
-  // long updates do.)
-  const bool weak_bridge = long_enabled() && state_ == TrackingState::kBitSynced && target_epochs_ > 1;
+  // (While weak enough for long coherent integration, 20 ms updates bridging unknown bits between long updates
+  // judge the C/N0 as the long updates do; with no long update for kBridge_s, the plain 20 ms test holds.)
+  const bool weak_bridge = long_enabled() && state_ == TrackingState::kBitSynced && target_epochs_ > 1 &&
+                           have_long_update_ && time_s_ - last_long_update_s_ < kBridge_s;
   const bool low_cn0 = weak_bridge ? slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(target_epochs_))
                                    : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
   const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold;
@@ -490,6 +494,8 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
     return r;
   }
   block_count_ = 0;
+  have_long_update_ = true;
+  last_long_update_s_ = time_s_;
   const int n = block_epochs_;
   const double t = block_time_s_;
   set_loop_epochs(n);

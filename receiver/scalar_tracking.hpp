@@ -241,6 +241,8 @@ class ScalarTracking final {
   double pli_tau_s_ = 0.0;  // PLI time constant set by set_loop_epochs (0: the option's)
   double cn0_slow_dbhz_ = 0.0;  // C/N0 estimates low-passed over 1 s
   bool have_slow_cn0_ = false;
+  bool have_long_update_ = false;
+  double last_long_update_s_ = 0.0;
   int block_epochs_ = 0, block_count_ = 0;
   std::int64_t block_next_period_ = 0;
   double block_time_s_ = 0.0;
