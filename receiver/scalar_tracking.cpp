@@ -26,13 +26,13 @@ constexpr double kSmoothing_s = 0.1;
 constexpr double kBitPeriod_s = 0.02;
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr int kCoherentEpochChoices[] = {1, 2, 5, 10, 20};
-constexpr double kCn0Slow_s = 1.0;
+constexpr double kCn0Slow_s = 1.0;  // C/N0 low-pass for the long-coherent loss test
 // The PLI's time constant in long updates (its spread from one update at SNR c T = 10, 20 dB-Hz at 100 ms, is
 // ~0.6; over 10 updates ~0.2); the loss test then waits at least as long.
 constexpr double kPliUpdates = 10.0;
 // Longest stretch of unknown bits bridged on 20 ms with the long updates' loss test: a subframe 4 and 5 pair
 // whose pages are unknown (9.6 s).
-constexpr double kBridge_s = 10.0;  // C/N0 low-pass for the choice of N and the long-coherent loss test
+constexpr double kBridge_s = 10.0;
 
 int epochs_in(double window_s, double t_s) { return std::max(1, static_cast<int>(std::lround(window_s / t_s))); }
 
@@ -276,7 +276,7 @@ int ScalarTracking::known_bits_wanted() const {
 // scale changes with the length) with a time constant of at least 3 updates, and keeps that of the chosen length
 // while 20 ms updates bridge unknown bits.
 void ScalarTracking::set_loop_epochs(int epochs) {
-  const int pli_epochs = std::max(epochs, target_epochs_);
+  const int pli_epochs = epochs > 1 || bridging() ? std::max(epochs, target_epochs_) : 1;
   const double tau = pli_epochs == 1 ? opt_.pli_time_constant_s
                                      : std::max(opt_.pli_time_constant_s, kPliUpdates * pli_epochs * kBitPeriod_s);
   if (epochs == loop_epochs_ && tau == pli_tau_s_) return;
@@ -398,8 +398,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   // Loss of lock: low C/N0 at any time, or (once phase lock was achieved) a low PLI, held for the loss time.
   // (While weak enough for long coherent integration, 20 ms updates bridging unknown bits between long updates
   // judge the C/N0 as the long updates do; with no long update for kBridge_s, the plain 20 ms test holds.)
-  const bool weak_bridge = long_enabled() && state_ == TrackingState::kBitSynced && target_epochs_ > 1 &&
-                           have_long_update_ && time_s_ - last_long_update_s_ < kBridge_s;
+  const bool weak_bridge = bridging();
   const bool low_cn0 = weak_bridge ? slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(target_epochs_))
                                    : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
   const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold;
@@ -462,6 +461,11 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
                                    dll_rate_correction_chips_per_s(r.code_error_chips, dll_bw);
   r.command = command_;
   return r;
+}
+
+bool ScalarTracking::bridging() const {
+  return long_enabled() && state_ == TrackingState::kBitSynced && target_epochs_ > 1 && have_long_update_ &&
+         time_s_ - last_long_update_s_ < kBridge_s;
 }
 
 bool ScalarTracking::slow_cn0_below(double threshold_dbhz) const {
@@ -545,6 +549,9 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
     carrier_.reset(command_.carrier_frequency_hz, 0.0);
     carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
     pli_.reset();
+    pli_.set_time_constant(opt_.pli_time_constant_s);
+    pli_tau_s_ = opt_.pli_time_constant_s;
+    loop_epochs_ = 1;
     relock_fll_ = {};
     relock_s_ = 0.0;
   } else if (!strong && relocking_) {

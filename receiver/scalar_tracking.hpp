@@ -197,6 +197,7 @@ class ScalarTracking final {
   TrackingReport long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign);
   void set_loop_epochs(int epochs);
   bool slow_cn0_below(double threshold_dbhz) const;
+  bool bridging() const;
   bool long_enabled() const { return opt_.max_coherent_ms > 20 && opt_.coherent_ms == 20; }
 
   static constexpr int kMaxSearchEpochs = 500;
