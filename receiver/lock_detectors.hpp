@@ -18,6 +18,8 @@ class PhaseLockIndicator final {
   double update(std::complex<float> prompt, double noise_power, double t_s);
   double value() const { return value_; }
   void reset() { narrow_ = wide_ = 0.0; value_ = 0.0; started_ = false; }
+  // A new low-pass time constant (e.g. for longer epochs); the state is kept.
+  void set_time_constant(double time_constant_s) { tau_s_ = time_constant_s; }
 
  private:
   double tau_s_;

@@ -29,6 +29,7 @@ void NavigationDataChannel::add_bit(float soft, std::int64_t first_code_period) 
   if (decoder_.last_update().ephemeris) new_ephemeris_ = true;
   polarity_ = out->result.subframe.inverted ? -1 : 1;
   const auto start = decoder_.last_subframe_start();
+  if (start) predictor_.add_subframe(out->result.subframe, *start);
   if (start) tag_ = TransmitTimeTag{code_periods_[static_cast<std::size_t>(out->first_bit_index % kHistory)], *start};
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "receiver/nav_bit_predictor.hpp"
 #include "signals/gps_time.hpp"
 #include "signals/lnav_decoder.hpp"
 #include "signals/lnav_frame_sync.hpp"
@@ -41,11 +42,14 @@ class NavigationDataChannel {
   const signals::LnavDecoder& decoder() const { return decoder_; }
   // True once after each subframe that completed a new ephemeris (cleared by the call).
   bool take_new_ephemeris();
+  // The bits ahead, from the decoded subframes (and a supplied source, if given one).
+  NavBitPredictor& bit_predictor() { return predictor_; }
 
  private:
   static constexpr int kHistory = 302;  // a subframe and the two bits before it
   signals::LnavFrameSync frame_sync_;
   signals::LnavDecoder decoder_;
+  NavBitPredictor predictor_;
   std::array<std::int64_t, kHistory> code_periods_{};  // code period of each recent bit, by bit index
   std::optional<TransmitTimeTag> tag_;
   int polarity_ = 1;

@@ -188,7 +188,30 @@ TrackingRecord ReceiverChannel::record(const CorrelationEpoch& e, const Tracking
   r.pli = report.pli;
   r.phase_locked = report.phase_locked;
   r.frame_synced = nav_.synchronised();
+  r.coherent_ms = report.loop_integration_ms;
   return r;
+}
+
+// The signs of the bits from epoch e's on (20 ms epochs on bit edges), while the predictor knows them: transmit
+// time from the frame's time tag, sign = polarity x (+1 for bit 0). Not while a vector loop drives the replica.
+KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
+  KnownBits k;
+  if (wanted <= 0 || vector_.vector || e.num_code_periods != 20 || !nav_.synchronised()) return k;
+  const TransmitTimeTag& tag = *nav_.time_tag();
+  NavBitPredictor& predictor = nav_.bit_predictor();
+  if (supplied_ && !supplied_tried_) {
+    supplied_tried_ = true;  // selected once, near the channel's start (as the simulator selects at its start)
+    const signals::GpsTime start = signals::add_seconds(tag.transmit_time, -1e-3 * static_cast<double>(tag.code_period));
+    predictor.supply_navigation(prn(), supplied_->ephemerides, supplied_->klobuchar, supplied_->utc, start);
+  }
+  for (int i = 0; i < wanted; ++i) {
+    const std::int64_t p = e.first_code_period + 20 * static_cast<std::int64_t>(i);
+    const auto bit = predictor.bit_at(signals::add_seconds(tag.transmit_time, 1e-3 * static_cast<double>(p - tag.code_period)));
+    if (!bit) break;
+    if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity();
+    ++k.ahead;
+  }
+  return k;
 }
 
 std::optional<ChannelMeasurement> ReceiverChannel::measure() {

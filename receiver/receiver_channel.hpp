@@ -8,7 +8,9 @@
 #include <cmath>
 #include <complex>
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <vector>
 
 #include "receiver/acquisition.hpp"
 #include "receiver/antenna_phase_tracker.hpp"
@@ -40,6 +42,15 @@ struct TrackingRecord {
   double pli = 0.0;
   bool phase_locked = false;
   bool frame_synced = false;
+  int coherent_ms = 1;            // the loops' integration time (N x 20 ms with data wipe-off)
+};
+
+// Broadcast navigation supplied to the receiver (a nav file): the source of known bits for data wipe-off
+// (NavBitPredictor::supply_navigation), shared read-only by the channels.
+struct SuppliedNavigation {
+  std::vector<signals::Ephemeris> ephemerides;
+  signals::KlobucharParameters klobuchar;
+  signals::UtcParameters utc;
 };
 
 // What a synchronised channel measures at the sample it has reached.
@@ -73,7 +84,7 @@ class ReceiverChannel {
       offset += r.consumed;
       if (r.epoch_ready) {
         const CorrelationEpoch& e = channel_.epoch();
-        const TrackingReport report = loop_.update(e);
+        const TrackingReport report = loop_.update(e, known_bits(e, loop_.known_bits_wanted()));
         last_scalar_ = report.command;
         // vector mode only while bit-synced or coasting on the vector loop's prediction
         if (report.state != TrackingState::kBitSynced && report.state != TrackingState::kCoasting) {
@@ -102,6 +113,8 @@ class ReceiverChannel {
            nav_.synchronised();
   }
   bool coasting() const { return loop_.coasting(); }
+  // Known bits for data wipe-off from this source too (from the first time tag on); nullptr: decoded ones only.
+  void supply_navigation(std::shared_ptr<const SuppliedNavigation> navigation) { supplied_ = std::move(navigation); }
   // The measurement at next_sample(); nothing unless synchronised() and the time tag's week is known.
   // Marks the track as reported.
   std::optional<ChannelMeasurement> measure();
@@ -123,6 +136,7 @@ class ReceiverChannel {
   void after_epoch(const CorrelationEpoch& e, const TrackingReport& report);
   TrackingRecord record(const CorrelationEpoch& e, const TrackingReport& report) const;
   NcoCommand merged_command();
+  KnownBits known_bits(const CorrelationEpoch& e, int wanted);
 
   // What vector tracking needs of a completed epoch.
   struct EpochSummary {
@@ -158,6 +172,8 @@ class ReceiverChannel {
   bool reported_ = false;
   double tracked_s_ = 0.0;
   std::optional<AntennaPhaseTracker> antenna_phases_;
+  std::shared_ptr<const SuppliedNavigation> supplied_;
+  bool supplied_tried_ = false;
 };
 
 }  // namespace ultratrack::receiver

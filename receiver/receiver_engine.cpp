@@ -65,6 +65,7 @@ void ReceiverEngine::add_navigation(const std::vector<signals::Ephemeris>& ephem
   ephemerides_.insert(ephemerides_.end(), ephemerides.begin(), ephemerides.end());
   if (iono.valid) iono_ = iono;
   if (utc.valid) utc_ = utc;
+  supplied_navigation_ = std::make_shared<const SuppliedNavigation>(SuppliedNavigation{ephemerides_, iono, utc});
 }
 
 int ReceiverEngine::channels_in_use() const {
@@ -241,6 +242,7 @@ void ReceiverEngine::finish_acquisition(std::int64_t start_sample) {
     *free = std::make_unique<ReceiverChannel>(r->prn, start, options_.fs_hz, options_.tracking, options_.reference_week,
                                               options_.reference_week_is_signal_week, record_periods_,
                                               options_.num_antennas);
+    (*free)->supply_navigation(supplied_navigation_);
     ++stats_.satellites[static_cast<std::size_t>(r->prn)].acquisitions;
   }
 }

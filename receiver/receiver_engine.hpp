@@ -176,6 +176,7 @@ class ReceiverEngine {
   std::vector<signals::Ephemeris> decoded_;
   std::array<std::optional<signals::Almanac>, 33> almanacs_{};
   signals::KlobucharParameters iono_;
+  std::shared_ptr<const SuppliedNavigation> supplied_navigation_;  // the nav file's sets: known bits (issue 7)
   signals::UtcParameters utc_;
   std::optional<PvtSolution> last_fix_;
   CarrierSmoothing smoothing_;

@@ -36,14 +36,14 @@ ReceiverOutputs::ReceiverOutputs(const std::filesystem::path& dir, double fs_hz,
       obs_(dir_ / "observations.rnx", obs_header(observation_interval_s)),
       tracking_(dir_ / "tracking.csv") {
   tracking_.stream() << "prn,sample,time_s,prompt_i,prompt_q,integration_ms,cn0_dbhz,doppler_hz,code_phase_chips,"
-                        "state,pli,phase_locked,frame_synced\n";
+                        "state,pli,phase_locked,frame_synced,coherent_ms\n";
 }
 
 void ReceiverOutputs::on_tracking(const TrackingRecord& r) {
-  fmt::print(tracking_.stream(), "{},{},{:.6f},{:.1f},{:.1f},{},{:.2f},{:.3f},{:.4f},{},{:.3f},{},{}\n", r.prn,
+  fmt::print(tracking_.stream(), "{},{},{:.6f},{:.1f},{:.1f},{},{:.2f},{:.3f},{:.4f},{},{:.3f},{},{},{}\n", r.prn,
              r.sample_index, static_cast<double>(r.sample_index) / fs_hz_, r.prompt.real(), r.prompt.imag(),
              r.integration_ms, r.cn0_dbhz, r.doppler_hz, r.code_phase_chips, to_string(r.state), r.pli,
-             r.phase_locked ? 1 : 0, r.frame_synced ? 1 : 0);
+             r.phase_locked ? 1 : 0, r.frame_synced ? 1 : 0, r.coherent_ms);
 }
 
 void ReceiverOutputs::on_observations(const ObservationEpoch& epoch) { obs_.write(epoch); }

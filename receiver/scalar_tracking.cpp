@@ -23,6 +23,16 @@ struct Checker {
 };
 
 constexpr double kSmoothing_s = 0.1;
+constexpr double kBitPeriod_s = 0.02;
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+constexpr int kCoherentEpochChoices[] = {1, 2, 5, 10, 20};
+constexpr double kCn0Slow_s = 1.0;  // C/N0 low-pass for the long-coherent loss test
+// The PLI's time constant in long updates (its spread from one update at SNR c T = 10, 20 dB-Hz at 100 ms, is
+// ~0.6; over 10 updates ~0.2); the loss test then waits at least as long.
+constexpr double kPliUpdates = 10.0;
+// Longest stretch of unknown bits bridged on 20 ms with the long updates' loss test: a subframe 4 and 5 pair
+// whose pages are unknown (9.6 s).
+constexpr double kBridge_s = 10.0;
 
 int epochs_in(double window_s, double t_s) { return std::max(1, static_cast<int>(std::lround(window_s / t_s))); }
 
@@ -83,7 +93,42 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.pli_loss_threshold >= -1 && o.pli_loss_threshold < o.pli_lock_threshold, "pli_loss_threshold",
           o.pli_loss_threshold, "[-1, pli_lock_threshold)");
   c.check(o.loss_of_lock_time_s >= 0.02 && o.loss_of_lock_time_s <= 10, "loss_of_lock_time_s", o.loss_of_lock_time_s, "[0.02, 10] s");
+  c.check(o.max_coherent_ms == 20 || o.max_coherent_ms == 40 || o.max_coherent_ms == 100 || o.max_coherent_ms == 200 ||
+              o.max_coherent_ms == 400,
+          "max_coherent_ms", o.max_coherent_ms, "{20, 40, 100, 200, 400} ms");
+  c.check(o.coherent_jitter_deg > 0 && o.coherent_jitter_deg <= 30, "coherent_jitter_deg", o.coherent_jitter_deg, "(0, 30] deg");
+  c.check(o.coherent_hysteresis_db >= 0 && o.coherent_hysteresis_db <= 10, "coherent_hysteresis_db",
+          o.coherent_hysteresis_db, "[0, 10] dB");
+  c.check(o.coherent_max_bn_t > 0 && o.coherent_max_bn_t <= 0.25, "coherent_max_bn_t", o.coherent_max_bn_t, "(0, 0.25]");
   return c.error;
+}
+
+double pll_thermal_jitter_rad(double bn_hz, double t_s, double cn0_dbhz) {
+  const double c = std::pow(10.0, cn0_dbhz / 10.0);
+  return std::sqrt(bn_hz / c * (1.0 + 1.0 / (2.0 * t_s * c)));
+}
+
+double long_coherent_pll_bw_hz(const ScalarTrackingOptions& o, int epochs) {
+  return std::min(o.pll_bw_coherent_hz, o.coherent_max_bn_t / (epochs * kBitPeriod_s));
+}
+
+int choose_coherent_epochs(const ScalarTrackingOptions& o, double cn0_dbhz, int current) {
+  const int max_epochs = std::max(1, o.max_coherent_ms / 20);
+  const auto shortest = [&](double cn0) {
+    int chosen = 1;
+    for (const int n : kCoherentEpochChoices) {
+      if (n > max_epochs) break;
+      chosen = n;
+      if (pll_thermal_jitter_rad(long_coherent_pll_bw_hz(o, n), n * kBitPeriod_s, cn0) <= o.coherent_jitter_deg * kDegToRad)
+        break;
+    }
+    return chosen;
+  };
+  if (!o.adaptive_coherent) return max_epochs;
+  const int longer = shortest(cn0_dbhz);
+  if (longer > current) return longer;  // weaker: longer at once
+  const int shorter = shortest(cn0_dbhz - o.coherent_hysteresis_db);
+  return shorter < current ? shorter : current;
 }
 
 ChannelConfig channel_config(const ScalarTrackingOptions& o, int prn, double sample_rate_hz, int num_antennas) {
@@ -222,11 +267,40 @@ void ScalarTracking::allow_coasting(bool allowed) {
   }
 }
 
-TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
+int ScalarTracking::known_bits_wanted() const {
+  if (!long_enabled() || state_ != TrackingState::kBitSynced) return 0;
+  return target_epochs_ > 1 || block_count_ > 0 ? std::max(target_epochs_, block_epochs_) : 0;
+}
+
+// The loops' settings for updates every `epochs` x 20 ms (1: the plain 20 ms loop); the PLI restarts (its sums'
+// scale changes with the length) with a time constant of at least 3 updates, and keeps that of the chosen length
+// while 20 ms updates bridge unknown bits.
+void ScalarTracking::set_loop_epochs(int epochs) {
+  const int pli_epochs = epochs > 1 || bridging() ? std::max(epochs, target_epochs_) : 1;
+  const double tau = pli_epochs == 1 ? opt_.pli_time_constant_s
+                                     : std::max(opt_.pli_time_constant_s, kPliUpdates * pli_epochs * kBitPeriod_s);
+  if (epochs == loop_epochs_ && tau == pli_tau_s_) return;
+  if (epochs != loop_epochs_) {
+    carrier_.set_bandwidths(epochs == 1 ? opt_.pll_bw_coherent_hz : long_coherent_pll_bw_hz(opt_, epochs), 0.0);
+    pli_.reset();
+  }
+  loop_epochs_ = epochs;
+  pli_tau_s_ = tau;
+  pli_.set_time_constant(tau);
+}
+
+TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known) {
   TrackingReport r;
   const double t = e.integration_time_s;
   const CorrelatorTaps& taps = e.master();
   time_s_ += t;
+  r.loop_integration_ms = e.num_code_periods;
+  // Long coherent integration: a block of target_epochs_ epochs starts only where that many bits are known; a
+  // gap or an unknown bit inside a block drops its partial sum (the command given stays in force).
+  const bool long_ready = long_enabled() && state_ == TrackingState::kBitSynced && e.num_code_periods == 20;
+  if (block_count_ > 0 && (!long_ready || known.sign == 0 || e.first_code_period != block_next_period_)) block_count_ = 0;
+  const bool long_path = long_ready && known.sign != 0 &&
+                         (block_count_ > 0 || (target_epochs_ > 1 && known.ahead >= target_epochs_));
 
   // Lock detectors. Their statistics depend on the epoch length: restart them when it changes.
   if (e.num_code_periods != cn0_epoch_periods_) {
@@ -243,8 +317,18 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
       noise_power_ += std::min(1.0, t / opt_.cn0_window_s) * (n2 - noise_power_);
     }
   }
-  r.pli = pli_.update(taps.prompt, noise_power_, t);
-  if (auto c = cn0_.add(taps.prompt, taps.noise, t)) cn0_dbhz_ = *c;
+  r.pli = long_path ? pli_.value() : pli_.update(taps.prompt, noise_power_, t);
+  if (auto c = cn0_.add(taps.prompt, taps.noise, t)) {
+    cn0_dbhz_ = *c;
+    if (long_enabled()) {
+      // The choice follows each estimate (the hysteresis absorbs its ~1 dB spread; a fade must reach the longer
+      // integration before the 20 ms loop fails); the loss test in long mode reads the slow one (in dB: it
+      // follows a loss of signal, whose estimates read 0 dB-Hz, within about a second).
+      cn0_slow_dbhz_ = have_slow_cn0_ ? cn0_slow_dbhz_ + std::min(1.0, opt_.cn0_window_s / kCn0Slow_s) * (*c - cn0_slow_dbhz_) : *c;
+      have_slow_cn0_ = true;
+      if (state_ == TrackingState::kBitSynced) target_epochs_ = choose_coherent_epochs(opt_, *c, target_epochs_);
+    }
+  }
   r.cn0_dbhz = cn0_dbhz_;
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
 
@@ -264,6 +348,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   previous_prompt_ = taps.prompt;
   previous_t_s_ = t;
   r.code_error_chips = dll_nelp_chips(taps.early, taps.late, opt_.early_late_offset_chips);
+  if (long_path) return long_coherent_epoch(e, r, known.sign);
 
   if (state_ == TrackingState::kLost) {
     r.state = state_;
@@ -311,7 +396,11 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   if (bits_) r.bit = bits_->add(e);
 
   // Loss of lock: low C/N0 at any time, or (once phase lock was achieved) a low PLI, held for the loss time.
-  const bool low_cn0 = cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
+  // (While weak enough for long coherent integration, 20 ms updates bridging unknown bits between long updates
+  // judge the C/N0 as the long updates do; with no long update for kBridge_s, the plain 20 ms test holds.)
+  const bool weak_bridge = bridging();
+  const bool low_cn0 = weak_bridge ? slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(target_epochs_))
+                                   : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
   const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
   if (loss_time_s_ >= opt_.loss_of_lock_time_s) {
@@ -334,6 +423,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   const bool fll_only = pullin && !search_stage && time_s_ <= narrow_end_s_;
   const bool fine_stage = pullin && !search_stage && !fll_only && time_s_ <= pll_start_s_;
   const bool coherent = state_ == TrackingState::kBitSynced;
+  if (coherent && long_enabled()) set_loop_epochs(1);
   // After phase lock on 1 ms epochs: the narrower PLL while the signal is weak.
   if (state_ == TrackingState::kPhaseLocked && e.num_code_periods == 1 && cn0_dbhz_) {
     const double bw = *cn0_dbhz_ < opt_.weak_cn0_dbhz ? std::min(opt_.pll_bw_weak_hz, opt_.pll_bw_hz) : opt_.pll_bw_hz;
@@ -373,6 +463,79 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e) {
   return r;
 }
 
+bool ScalarTracking::bridging() const {
+  return long_enabled() && state_ == TrackingState::kBitSynced && target_epochs_ > 1 && have_long_update_ &&
+         time_s_ - last_long_update_s_ < kBridge_s;
+}
+
+bool ScalarTracking::slow_cn0_below(double threshold_dbhz) const {
+  return have_slow_cn0_ && cn0_slow_dbhz_ < threshold_dbhz;
+}
+
+// One 20 ms epoch of long coherent integration: its taps, sign-corrected, go into the block; at the block's end
+// the loops, the PLI and the loss test run once on the block's sums with T = its length.
+TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign) {
+  const CorrelatorTaps& taps = e.master();
+  if (block_count_ == 0) {
+    block_epochs_ = target_epochs_;
+    block_early_ = block_prompt_ = block_late_ = {};
+    block_time_s_ = 0.0;
+  }
+  const double s = sign;
+  block_early_ += s * std::complex<double>(taps.early);
+  block_prompt_ += s * std::complex<double>(taps.prompt);
+  block_late_ += s * std::complex<double>(taps.late);
+  block_time_s_ += e.integration_time_s;
+  block_next_period_ = e.first_code_period + e.num_code_periods;
+  ++block_count_;
+  if (bits_) r.bit = bits_->add(e);
+  r.state = state_;
+  r.loop_integration_ms = block_epochs_ * 20;
+  if (block_count_ < block_epochs_) {
+    r.pli = pli_.value();
+    r.phase_locked = r.pli >= opt_.pli_lock_threshold;
+    r.command = command_;
+    return r;
+  }
+  block_count_ = 0;
+  have_long_update_ = true;
+  last_long_update_s_ = time_s_;
+  const int n = block_epochs_;
+  const double t = block_time_s_;
+  set_loop_epochs(n);
+  const std::complex<float> prompt(block_prompt_);
+  // The sum of n 20 ms epochs holds n times their noise power.
+  r.pli = pli_.update(prompt, n * noise_power_, t);
+  r.phase_locked = r.pli >= opt_.pli_lock_threshold;
+  r.phase_error_cycles = costas_atan_cycles(prompt);
+  r.frequency_error_hz = 0.0;
+  r.code_error_chips = dll_nelp_chips(std::complex<float>(block_early_), std::complex<float>(block_late_),
+                                      opt_.early_late_offset_chips);
+  const bool low_cn0 = slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(n));
+  const bool low_pli = r.pli < opt_.pli_loss_threshold;
+  loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
+  if (loss_time_s_ >= std::max(opt_.loss_of_lock_time_s, pli_tau_s_)) {
+    loss_time_s_ = 0.0;
+    target_epochs_ = 1;
+    set_loop_epochs(1);
+    if (coasting_allowed_) {
+      state_ = TrackingState::kCoasting;
+      return coast_epoch(e, r, false);
+    }
+    state_ = TrackingState::kLost;
+    r.state = state_;
+    r.command = command_;
+    return r;
+  }
+  const double f = carrier_.update(r.phase_error_cycles, 0.0, t);
+  const double dll_bw = std::min(opt_.dll_bw_coherent_hz, opt_.coherent_max_bn_t / t);
+  command_.carrier_frequency_hz = f;
+  command_.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 + f / signals::kL1Frequency_hz) +
+                                   dll_rate_correction_chips_per_s(r.code_error_chips, dll_bw);
+  r.command = command_;
+  return r;
+}
+
 // Coasting: the carrier holds the aided (predicted) frequency and the code the nominal rate at that frequency (the
 // vector loop's commands replace it) while the signal is gone; once the C/N0 estimate is back above the loss
 // threshold plus relock_margin_dbhz, an FLL-assisted Costas PLL starts from that frequency, and a PLI held for
@@ -386,6 +549,9 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
     carrier_.reset(command_.carrier_frequency_hz, 0.0);
     carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
     pli_.reset();
+    pli_.set_time_constant(opt_.pli_time_constant_s);
+    pli_tau_s_ = opt_.pli_time_constant_s;
+    loop_epochs_ = 1;
     relock_fll_ = {};
     relock_s_ = 0.0;
   } else if (!strong && relocking_) {

@@ -84,6 +84,43 @@ struct ScalarTrackingOptions {
   double relock_fll_bw_hz = 6.0;
   double relock_fll_time_s = 0.2;
   double relock_assist_bw_hz = 2.0;
+  // Long coherent integration with data wipe-off (issue 7). After bit sync, while the navigation bits ahead are
+  // known (receiver/nav_bit_predictor.hpp), N consecutive 20 ms epochs are summed with each bit's sign removed
+  // (the channel's epochs stay 20 ms: one correlator, summed epochs) and the loops run once per N x 20 ms with
+  // T = N x 20 ms: PLL and DLL noise bandwidths min(their 20 ms value, coherent_max_bn_t / T) (the loop
+  // filters' gains follow T; at Bn T = 0.2 the digital loop is ~55 % wider than its design), the PLI on the long
+  // sums (noise power N x the 20 ms one, time constant max(pli_time_constant_s, 10 T); the loss test waits as
+  // long), and the C/N0 loss test at cn0_loss_threshold_dbhz - 10 log10 N (the pre-detection SNR of a 20 ms
+  // epoch at the threshold) on the C/N0 estimates low-passed (in dB) over 1 s. Where bits are unknown the
+  // channel stays on 20 ms (bits and C/N0 always come from 20 ms epochs: non-coherent across them).
+  // N per channel from the measured C/N0 (adaptive_coherent): the shortest N in {1, 2, 5, 10, 20} (N x 20 <=
+  // max_coherent_ms) whose thermal Costas PLL jitter sqrt(Bn / c (1 + 1 / (2 T c))) (c = C/N0 in Hz, Bn at that
+  // T) is at most coherent_jitter_deg, else the longest; a shorter N only once it also holds coherent_hysteresis_db
+  // lower. With the defaults (5 Hz at 20 ms, Bn T <= 0.2, 4 deg): 20 ms above 30.21 dB-Hz, 40 ms (still 5 Hz)
+  // down to 30.16, 100 ms (2 Hz) below; with max_coherent_ms 200 or 400, 200 ms (1 Hz) below 26.18 and 400 ms
+  // (0.5 Hz) below 23.17; back to a shorter time 2 dB above its threshold. A 1 Hz 3rd-order loop at 100 ms (Bn T
+  // = 0.1) tracked a 0.5 Hz/s Doppler ramp with ~30 deg slow swings (its rate state's noise from the 5 Hz loop):
+  // hence 0.2. adaptive_coherent = false: always max_coherent_ms while bits are known.
+  int max_coherent_ms = 100;           // 20 (off), 40, 100, 200 or 400
+  bool adaptive_coherent = true;
+  double coherent_jitter_deg = 4.0;    // (0, 30]
+  double coherent_hysteresis_db = 2.0; // [0, 10]
+  double coherent_max_bn_t = 0.2;      // (0, 0.25]
+};
+
+// Thermal phase jitter of a Costas PLL, radians: sqrt(Bn / c (1 + 1 / (2 T c))), c = 10^(cn0_dbhz / 10).
+double pll_thermal_jitter_rad(double bn_hz, double t_s, double cn0_dbhz);
+// The PLL noise bandwidth long coherent integration uses at T = epochs x 20 ms (see ScalarTrackingOptions).
+double long_coherent_pll_bw_hz(const ScalarTrackingOptions& options, int epochs);
+// The number of 20 ms epochs (1, 2, 5, 10, 20) to integrate coherently at cn0_dbhz, with hysteresis around the
+// current number (see ScalarTrackingOptions).
+int choose_coherent_epochs(const ScalarTrackingOptions& options, double cn0_dbhz, int current_epochs);
+
+// Navigation bits known ahead of a 20 ms epoch (data wipe-off): the received sign (+1/-1, polarity applied) of
+// the bit the epoch holds, and how many consecutive bits from it on are known (0: none, sign 0).
+struct KnownBits {
+  int sign = 0;
+  int ahead = 0;
 };
 
 // Empty when the options are valid, else a message naming the first bad field, its value and its range.
@@ -118,6 +155,9 @@ struct TrackingReport {
   double frequency_error_hz = 0.0;
   double code_error_chips = 0.0;
   std::optional<NavBit> bit;         // a completed 20 ms navigation bit
+  // The integration time of the loops' latest update, ms: the epoch's length, or N x 20 ms with data wipe-off
+  // (the loops then update once per N epochs and the other epochs give the previous command).
+  int loop_integration_ms = 1;
 };
 
 class ScalarTracking final {
@@ -126,7 +166,11 @@ class ScalarTracking final {
   // the channel started with (from acquisition).
   ScalarTracking(const ScalarTrackingOptions& options, const NcoCommand& initial);
 
-  TrackingReport update(const CorrelationEpoch& epoch);
+  TrackingReport update(const CorrelationEpoch& epoch, KnownBits known = {});
+  // How many bits ahead long coherent integration wants to know before the next update (0: none wanted; the
+  // caller then need not look them up).
+  int known_bits_wanted() const;
+  int coherent_epochs() const { return target_epochs_; }
   TrackingState state() const { return state_; }
   // External carrier aiding (vector tracking): shifts the carrier loop's frequency integrator, and the command it
   // gives next, by delta_hz (the predicted change of the Doppler since the previous aid), so that the PLL only
@@ -150,6 +194,11 @@ class ScalarTracking final {
   double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
   double search_frequency_offset_hz() const;
   TrackingReport coast_epoch(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
+  TrackingReport long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign);
+  void set_loop_epochs(int epochs);
+  bool slow_cn0_below(double threshold_dbhz) const;
+  bool bridging() const;
+  bool long_enabled() const { return opt_.max_coherent_ms > 20 && opt_.coherent_ms == 20; }
 
   static constexpr int kMaxSearchEpochs = 500;
 
@@ -187,6 +236,18 @@ class ScalarTracking final {
   double smoothed_frequency_hz_ = 0.0;  // NCO frequency and rate low-passed while phase-locked at 1 ms
   bool smoothing_started_ = false;
   double previous_t_s_ = 0.0;
+  // long coherent integration
+  int target_epochs_ = 1;   // chosen from the C/N0
+  int loop_epochs_ = 1;     // of the loops' settings in effect
+  double pli_tau_s_ = 0.0;  // PLI time constant set by set_loop_epochs (0: the option's)
+  double cn0_slow_dbhz_ = 0.0;  // C/N0 estimates low-passed over 1 s
+  bool have_slow_cn0_ = false;
+  bool have_long_update_ = false;
+  double last_long_update_s_ = 0.0;
+  int block_epochs_ = 0, block_count_ = 0;
+  std::int64_t block_next_period_ = 0;
+  double block_time_s_ = 0.0;
+  std::complex<double> block_early_{}, block_prompt_{}, block_late_{};
 };
 
 // Runs a channel under a scalar closure over one block: feeds samples, updates the loop at every epoch, passes
