@@ -24,14 +24,33 @@
 #   benchmarks/tracking_threshold.sh [--levels "24 26 28 30 32"] [--files 4] [--duration 60] [--fs 2.6e6]
 #       [--seed0 100] [--out DIR] [--ultratrack build/tools/ultratrack] [--receive-args "..."]
 #       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep] [--coupling scalar|vector]
+#       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--scenario FILE]
 # Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3 (the report). CPU: about 15 s per file at
 # 2.6 MHz on one core. Files are deleted after their receive unless --keep.
+#
+# Issue 7's protocol (--strong-s T0 > 0): every file is T0 + DURATION s long, all satellites at --strong-cn0
+# (45 dB-Hz) for the first T0 s, so that acquisition, bit and frame sync and a vector hand-over complete, then a
+# [[cn0_step]] (sample-exact) to the level under test for DURATION s. A satellite-run is then
+#   kept          locked (phase-locked or bit-synced) at the step (a locked record within 0.2 s before T0), and
+#                 every record of the PRN from there on locked, with no gap, up to within 0.2 s of the end;
+#   lost          locked at the step, then a non-locked record (coasting counts as not locked), a gap, or an
+#                 early end;
+#   not locked at the step (left out of the fractions, like not acquired: pull-in is not what is measured).
+# --couplings runs every file through `receive --coupling X` for each X (the same files for every coupling);
+# loose, tight and ultra-tight get --imu DIR/imu.csv --filter ekf (needs --scenario with [trajectory]); a
+# coupling that `receive` rejects is skipped with a message. Per coupling: the per-level table, the 90 %
+# threshold with its 68 % range, and the 3-D position RMS of solution.csv against truth.csv over the weak part
+# (fixes at and after T0, `ultratrack compare`): positions.csv, one row per file and coupling.
+# --scenario FILE: the trajectory (and IMU) of an inertial scenario (e.g. scenarios/ultratight_circle.toml; its
+# trajectory must last T0 + DURATION s) instead of the static receiver; [signal] duration_s, cn0_dbhz and seed
+# are rewritten, relative paths made absolute.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
 levels="24 26 28 30 32"; files=4; duration=60; fs=2.6e6; seed0=100; out=/tmp/ultratrack_threshold
 ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$root/../shared/data/brdc0010.22n
 lock_deadline_s=5; extra_config=""; report_only=0
+strong_s=0; strong_cn0=45; couplings=""; scenario=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --levels) levels=$2; shift 2 ;;
@@ -46,9 +65,13 @@ while [ $# -gt 0 ]; do
     --nav) nav=$2; shift 2 ;;
     --lock-deadline) lock_deadline_s=$2; shift 2 ;;
     --config-extra) extra_config=$(realpath "$2"); shift 2 ;;
+    --strong-s) strong_s=$2; shift 2 ;;
+    --strong-cn0) strong_cn0=$2; shift 2 ;;
+    --couplings) couplings=$2; shift 2 ;;
+    --scenario) scenario=$(realpath "$2"); shift 2 ;;
     --keep) keep=1; shift ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
-    -h|--help) sed -n '2,30p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,49p' "$0"; exit 0 ;;
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -74,21 +97,53 @@ TOML
 [ -z "$extra_config" ] || cat "$extra_config" >> "$acq_config"
 
 runs=$out/runs.csv
-if [ "$report_only" = 1 ]; then levels=""; else echo "cn0_dbhz,file,prn,outcome,first_lock_s,lock_end_s" > "$runs"; fi
+positions=$out/positions.csv
+file_s=$(python3 -c "print($strong_s + $duration)")
+# The coupling list: "" (one pass, the classic mode: receive_args alone) or the named couplings.
+[ -n "$couplings" ] || couplings="-"
+if [ "$report_only" = 1 ]; then levels=""; else
+  echo "cn0_dbhz,file,prn,outcome,first_lock_s,lock_end_s,coupling" > "$runs"
+  echo "cn0_dbhz,file,coupling,fixes,rms_3d_m" > "$positions"
+fi
+skipped=" "
 for level in $levels; do
   for ((k = 0; k < files; ++k)); do
     seed=$((seed0 + k))
     tow=$((518400 + 90 * k))  # different nav-bit content and geometry per file, inside the ephemerides' fit
     name=cn0_${level}_file_${k}
-    sim=$out/$name.sim; rx=$out/$name.rx
-    rm -rf "$sim" "$rx"
+    sim=$out/$name.sim
+    rm -rf "$sim"
     mkdir -p "$sim"
-    cat > "$sim.toml" <<TOML
+    file_cn0=$level
+    [ "$strong_s" = 0 ] || file_cn0=$strong_cn0
+    if [ -n "$scenario" ]; then
+      python3 - "$scenario" "$file_s" "$file_cn0" "$seed" > "$sim.toml" <<'PY'
+import os, re, sys
+path, duration, cn0, seed = sys.argv[1:5]
+folder = os.path.dirname(path)
+section, out = "", []
+for line in open(path):
+    m = re.match(r"\s*\[+([a-z_0-9]+)\]+", line)
+    if m:
+        section = m.group(1)
+    key = re.match(r"\s*([a-z_0-9]+)\s*=", line)
+    if section == "signal" and key and key.group(1) in ("duration_s", "cn0_dbhz", "seed"):
+        continue
+    p = re.match(r'(\s*[a-z_0-9]+\s*=\s*)"([^"]+)"(.*)', line)
+    if p and not os.path.isabs(p.group(2)) and os.path.exists(os.path.join(folder, p.group(2))):
+        line = f'{p.group(1)}"{os.path.join(folder, p.group(2))}"{p.group(3)}\n'
+    out.append(line)
+    if m and section == "signal":
+        out.append(f"duration_s = {duration}\ncn0_dbhz = {cn0}\nseed = {seed}\n")
+print("".join(out))
+PY
+    else
+      cat > "$sim.toml" <<TOML
 [signal]
 sample_rate_hz = $fs
 format = "i8"
-duration_s = $duration
-cn0_dbhz = $level
+duration_s = $file_s
+cn0_dbhz = $file_cn0
 seed = $seed
 [time]
 gps_week = 2190
@@ -103,16 +158,47 @@ llh_deg_m = [35.274016, 137.013759, 100.0]
 ionosphere = true
 troposphere = false
 TOML
+    fi
+    [ "$strong_s" = 0 ] || printf '\n[[cn0_step]]\nstart_s = %s\ncn0_dbhz = %s\n' "$strong_s" "$level" >> "$sim.toml"
     nice -n 5 "$ultratrack" simulate --scenario "$sim.toml" --out "$sim" --quiet > /dev/null
+    sim_fs=$(python3 -c "import json; print(json.load(open('$sim/summary.json'))['sample_rate_hz'])")
     prns=$(tail -n +2 "$sim/satellites.csv" | cut -d, -f1 | paste -sd, -)
     config_args=(--config "$acq_config")
-    # shellcheck disable=SC2086
-    nice -n 5 "$ultratrack" receive --input "$sim/antenna0.i8.bin" --format i8 --fs "$fs" --nav "$nav" \
-      --prn "$prns" --out "$rx" --quiet "${config_args[@]}" $receive_args > "$rx.log" 2>&1 || true
-    python3 - "$sim/satellites.csv" "$rx/tracking.csv" "$duration" "$lock_deadline_s" "$level" "$name" >> "$runs" <<'PY'
+    # Issue 7's protocol compares positions with the truth: the receiver's troposphere model as simulated.
+    if [ "$strong_s" != 0 ] && grep -A3 '^\[atmosphere\]' "$sim/scenario.toml" | grep -q 'troposphere = false'; then
+      config_args+=(--troposphere off)
+    fi
+    for coupling in $couplings; do
+      case "$skipped" in *" $coupling "*) continue ;; esac
+      coupling_args=()
+      label=""
+      if [ "$coupling" != "-" ]; then
+        label=$coupling
+        coupling_args=(--coupling "$coupling")
+        case "$coupling" in
+          loose|tight|ultra-tight)
+            if [ ! -f "$sim/imu.csv" ]; then
+              echo "tracking_threshold: coupling $coupling needs an IMU (--scenario with [trajectory]): skipped" >&2
+              skipped="$skipped$coupling "; continue
+            fi
+            coupling_args+=(--imu "$sim/imu.csv" --filter ekf) ;;
+        esac
+      fi
+      rx=$out/$name${label:+.$label}.rx
+      rm -rf "$rx"
+      rc=0
+      # shellcheck disable=SC2086
+      nice -n 5 "$ultratrack" receive --input "$sim/antenna0.i8.bin" --format i8 --fs "$sim_fs" --nav "$nav" \
+        --prn "$prns" --out "$rx" --quiet "${config_args[@]}" $receive_args "${coupling_args[@]}" > "$rx.log" 2>&1 || rc=$?
+      if [ "$rc" != 0 ] && [ ! -f "$rx/tracking.csv" ] && grep -q -- "--coupling\|coupling" "$rx.log"; then
+        echo "tracking_threshold: receive rejects --coupling $coupling ($(tail -n 1 "$rx.log")): skipped" >&2
+        skipped="$skipped$coupling "; continue
+      fi
+      python3 - "$sim/satellites.csv" "$rx/tracking.csv" "$file_s" "$lock_deadline_s" "$level" "$name" "$strong_s" \
+        "$label" >> "$runs" <<'PY'
 import csv, sys
-sats_file, tracking_file, duration, deadline, level, name = sys.argv[1:7]
-duration, deadline = float(duration), float(deadline)
+sats_file, tracking_file, duration, deadline, level, name, strong_s, coupling = sys.argv[1:9]
+duration, deadline, strong_s = float(duration), float(deadline), float(strong_s)
 prns = [int(r["prn"]) for r in csv.DictReader(open(sats_file))]
 rows = {}
 try:
@@ -124,7 +210,23 @@ locked_states = ("phase-locked", "bit-synced")
 for prn in prns:
     recs = rows.get(prn, [])
     outcome, first, end = "not_acquired", "", ""
-    if recs:
+    if recs and strong_s > 0:
+        # Issue 7: locked at the step, then locked through the weak part.
+        outcome = "not_locked_at_step"
+        before = [i for i, (t, s) in enumerate(recs) if strong_s - 0.2 <= t <= strong_s]
+        if before and recs[before[-1]][1] in locked_states:
+            i0 = before[-1]
+            first = f"{recs[i0][0]:.3f}"
+            outcome, end_t, previous = "kept", recs[-1][0], recs[i0][0]
+            for t, s in recs[i0:]:
+                if s not in locked_states or t - previous > 0.2:
+                    outcome, end_t = "lost", previous
+                    break
+                previous = t
+            if outcome == "kept" and end_t < duration - 0.2:
+                outcome = "lost"
+            end = f"{end_t:.3f}"
+    elif recs:
         outcome = "never_locked"
         lock = next((i for i, (t, s) in enumerate(recs) if s in locked_states), None)
         if lock is not None and recs[lock][0] <= deadline:
@@ -139,17 +241,43 @@ for prn in prns:
             if outcome == "kept" and end_t < duration - 0.2:
                 outcome = "lost"
             end = f"{end_t:.3f}"
-    print(f"{level},{name},{prn},{outcome},{first},{end}")
+    print(f"{level},{name},{prn},{outcome},{first},{end},{coupling}")
 PY
-    echo "tracking_threshold: $name: $(grep -c ",$name," "$runs") runs, $(grep ",$name," "$runs" | grep -c ',kept,') kept" >&2
+      # 3-D position RMS over the weak part: fixes at and after T0 (receiver time since the first sample).
+      fixes=0; rms=""
+      if [ -f "$rx/solution.csv" ]; then
+        python3 - "$rx/solution.csv" "$sim/truth.csv" "$strong_s" > "$rx/solution_weak.csv" <<'PY'
+import csv, sys
+sol, truth, t0 = sys.argv[1], sys.argv[2], float(sys.argv[3])
+tow0 = float(next(csv.DictReader(open(truth)))["tow_s"])
+lines = open(sol).read().splitlines()
+header = lines[0].split(",")
+col = header.index("tow_s")
+print(lines[0])
+for line in lines[1:]:
+    d = float(line.split(",")[col]) - tow0
+    d -= 604800 * round(d / 604800)
+    if d >= t0 - 1e-3:
+        print(line)
+PY
+        fixes=$(($(wc -l < "$rx/solution_weak.csv") - 1))
+        if [ "$fixes" -gt 0 ]; then
+          rms=$("$ultratrack" compare --solution "$rx/solution_weak.csv" --truth "$sim/truth.csv" --json 2>/dev/null |
+                python3 -c "import json, sys; print(f\"{json.load(sys.stdin)['rms_3d_m']:.3f}\")" 2>/dev/null || true)
+        fi
+      fi
+      echo "$level,$name,$label,$fixes,$rms" >> "$positions"
+      echo "tracking_threshold: $name${label:+ $label}: $(grep ",$name,.*,$label\$" "$runs" | grep -c .) runs," \
+        "$(grep ",$name,.*,$label\$" "$runs" | grep -c ',kept,') kept, weak-part fixes $fixes, 3-D RMS ${rms:--} m" >&2
+    done
     [ "$keep" = 1 ] || rm -f "$sim/antenna0.i8.bin"
   done
 done
 
-python3 - "$runs" <<'PY'
-import csv, math, sys
-runs = list(csv.DictReader(open(sys.argv[1])))
-levels = sorted({float(r["cn0_dbhz"]) for r in runs})
+python3 - "$runs" "$out/positions.csv" <<'PY'
+import csv, math, os, sys
+all_runs = list(csv.DictReader(open(sys.argv[1])))
+positions = list(csv.DictReader(open(sys.argv[2]))) if os.path.exists(sys.argv[2]) else []
 def wilson(k, n, z=1.0):
     if n == 0:
         return (0.0, 1.0)
@@ -158,21 +286,6 @@ def wilson(k, n, z=1.0):
     c = (p + z * z / (2 * n)) / d
     h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
     return (max(0.0, c - h), min(1.0, c + h))
-table, table_locked = [], []
-print("cn0_dbhz  runs  kept  lost  never_locked  not_acquired  fraction_kept  wilson68        kept_of_locked  wilson68")
-for L in levels:
-    rs = [r for r in runs if float(r["cn0_dbhz"]) == L]
-    count = {o: sum(r["outcome"] == o for r in rs) for o in ("kept", "lost", "never_locked", "not_acquired")}
-    n = count["kept"] + count["lost"] + count["never_locked"]
-    f = count["kept"] / n if n else float("nan")
-    lo, hi = wilson(count["kept"], n)
-    table.append((L, f, lo, hi))
-    m = count["kept"] + count["lost"]
-    g = count["kept"] / m if m else 0.0
-    glo, ghi = wilson(count["kept"], m)
-    table_locked.append((L, g, glo, ghi))
-    print(f"{L:8.1f}  {len(rs):4d}  {count['kept']:4d}  {count['lost']:4d}  {count['never_locked']:12d}  "
-          f"{count['not_acquired']:12d}  {f:13.3f}  [{lo:.3f}, {hi:.3f}]  {g:14.3f}  [{glo:.3f}, {ghi:.3f}]")
 def crossing(values):
     # lowest C/N0 above which the curve stays >= 0.9, interpolated between the bracketing levels
     pts = [(L, v) for L, v in values]
@@ -184,7 +297,37 @@ def crossing(values):
         return f"<= {pts[0][0]:.1f}"
     (L0, v0), (L1, v1) = pts[i - 1], pts[i]
     return f"{L0 + (0.9 - v0) * (L1 - L0) / (v1 - v0):.2f}"
-for label, t in (("of acquired satellites (pull-in included)", table), ("of locked satellites (lock kept)", table_locked)):
-    print(f"90 % threshold, {label}: {crossing([(L, f) for L, f, _, _ in t])} dB-Hz; from the 68 % intervals: "
-          f"{crossing([(L, hi) for L, _, _, hi in t])} .. {crossing([(L, lo) for L, _, lo, _ in t])}")
+step_mode = any(r["outcome"] == "not_locked_at_step" for r in all_runs) or any(r.get("coupling") for r in all_runs)
+for coupling in sorted({r.get("coupling") or "" for r in all_runs}):
+    runs = [r for r in all_runs if (r.get("coupling") or "") == coupling]
+    if coupling:
+        print(f"== coupling {coupling}")
+    levels = sorted({float(r["cn0_dbhz"]) for r in runs})
+    table, table_locked = [], []
+    print("cn0_dbhz  runs  kept  lost  never_locked  not_acquired  fraction_kept  wilson68        kept_of_locked  wilson68"
+          + ("        not_locked_at_step  weak_fixes  rms_3d_m(per file)" if step_mode else ""))
+    for L in levels:
+        rs = [r for r in runs if float(r["cn0_dbhz"]) == L]
+        count = {o: sum(r["outcome"] == o for r in rs) for o in ("kept", "lost", "never_locked", "not_acquired", "not_locked_at_step")}
+        n = count["kept"] + count["lost"] + count["never_locked"]
+        f = count["kept"] / n if n else float("nan")
+        lo, hi = wilson(count["kept"], n)
+        table.append((L, f, lo, hi))
+        m = count["kept"] + count["lost"]
+        g = count["kept"] / m if m else 0.0
+        glo, ghi = wilson(count["kept"], m)
+        table_locked.append((L, g, glo, ghi))
+        line = (f"{L:8.1f}  {len(rs):4d}  {count['kept']:4d}  {count['lost']:4d}  {count['never_locked']:12d}  "
+                f"{count['not_acquired']:12d}  {f:13.3f}  [{lo:.3f}, {hi:.3f}]  {g:14.3f}  [{glo:.3f}, {ghi:.3f}]")
+        if step_mode:
+            ps = [p for p in positions if float(p["cn0_dbhz"]) == L and (p.get("coupling") or "") == coupling]
+            fixes = sum(int(p["fixes"]) for p in ps)
+            rms = " ".join(p["rms_3d_m"] or "-" for p in ps)
+            line += f"  {count['not_locked_at_step']:18d}  {fixes:10d}  {rms}"
+        print(line)
+    for label, t in (("of acquired satellites (pull-in included)", table), ("of locked satellites (lock kept)", table_locked)):
+        if step_mode and label.startswith("of acquired"):
+            continue  # in the step protocol both fractions are kept / (kept + lost)
+        print(f"90 % threshold, {label}: {crossing([(L, f) for L, f, _, _ in t])} dB-Hz; from the 68 % intervals: "
+              f"{crossing([(L, hi) for L, _, _, hi in t])} .. {crossing([(L, lo) for L, _, lo, _ in t])}")
 PY

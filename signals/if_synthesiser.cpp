@@ -60,8 +60,14 @@ struct IfSynthesiser::Impl {
     bool active = false;
     std::array<float, kCaCodeLength_chips> chip_amplitude{};  // +-gain*A per chip
   };
+  struct Level {  // a C/N0 step of one track
+    std::int64_t first_sample = 0;
+    double cn0_dbhz = 0.0;
+    float scale = 1.0f;  // amplitude against the satellite's base amplitude
+  };
   struct Track {  // one satellite on one antenna
     Node n0, n1;
+    std::vector<Level> levels;  // in sample order
     double travel_guess_s = 0.075;
     double d_guess_s = 0.0;
     std::unique_ptr<LnavTransmitter> lnav;
@@ -77,6 +83,7 @@ struct IfSynthesiser::Impl {
   std::vector<Sat> sats;
   std::vector<Track> tracks;  // antenna-major: tracks[a * sats.size() + k]
   std::vector<synth::GaussianNoise> noise;
+  std::vector<std::int64_t> step_samples;  // every C/N0 step's first sample, sorted, unique
   std::int64_t block_samples = 1;
   std::int64_t visibility_blocks = 1000;
   std::int64_t current_block = -1;
@@ -198,6 +205,16 @@ struct IfSynthesiser::Impl {
     return cycles;
   }
 
+  // The C/N0 step in force on a track at a sample (nullptr: the satellite's base level).
+  static const Level* level_at(const Track& tr, std::int64_t sample) {
+    const Level* in_force = nullptr;
+    for (const Level& l : tr.levels) {
+      if (l.first_sample > sample) break;
+      in_force = &l;
+    }
+    return in_force;
+  }
+
   // Whether satellite prn's signal is absent at antenna a at receiver time tau (blockage or a slip's fade).
   bool absent(int prn, int antenna, double tau) const {
     for (const BlockageEvent& b : opt.blockages)
@@ -237,8 +254,11 @@ struct IfSynthesiser::Impl {
   }
 
   // Adds satellite k's signal on antenna a for samples [first, first + count) of the current block.
+  // The caller splits segments at the C/N0 steps, so one amplitude scale holds for the whole segment.
   void add_satellite(std::size_t k, int a, std::int64_t first, std::complex<float>* out, std::size_t count) {
     Track& tr = tracks[static_cast<std::size_t>(a) * sats.size() + k];
+    const Level* level = level_at(tr, first);
+    const float scale = level ? level->scale : 1.0f;
     const double n_in_block = static_cast<double>(first - tr.n0.sample);
     const double code_rate = (tr.n1.code_chips - tr.n0.code_chips) / static_cast<double>(block_samples);
     const double carrier_rate = (tr.n1.carrier_cycles - tr.n0.carrier_cycles) / static_cast<double>(block_samples);
@@ -257,7 +277,7 @@ struct IfSynthesiser::Impl {
         const double t_sv = mid_chips / kCaChipRate_hz - frac20_s;
         data = static_cast<float>(tr.lnav->data_symbol_at(add_seconds(opt.start, t_sv)));
       }
-      synth::add_code_carrier(out + done, seg, sats[k].chip_amplitude.data(), data,
+      synth::add_code_carrier(out + done, seg, sats[k].chip_amplitude.data(), data * scale,
                               floor_mod(code, kCaCodeLength_chips), code_rate, carrier, carrier_rate, opt.real_output);
       done += seg;
       code += static_cast<double>(seg) * code_rate;
@@ -296,7 +316,21 @@ std::string validate(const SynthesiserOptions& o) {
   for (const auto& b : o.blockages)
     if (b.antenna < 0 || !(b.start_s >= 0.0) || !(b.duration_s > 0.0))
       return "blockage: antenna >= 0, start_s >= 0 and duration_s > 0 are needed";
+  for (const auto& c : o.cn0_steps) {
+    if (c.antenna < 0 || !(c.start_s >= 0.0 && c.start_s <= 86400.0))
+      return "C/N0 step: antenna >= 0 and start_s within 0..86400 s are needed";
+    if (!(c.cn0_dbhz >= 0.0 && c.cn0_dbhz <= 80.0)) return "C/N0 step: cn0_dbhz must be within 0..80 dB-Hz";
+    for (int prn : c.prns)
+      if (prn < kMinPrn || prn > kMaxPrn) return "C/N0 step: PRN must be 1..32";
+  }
   return {};
+}
+
+std::int64_t cn0_step_first_sample(const Cn0StepEvent& step, double sample_rate_hz) {
+  // A start on a sample (to rounding) is that sample; otherwise the next one.
+  const double x = step.start_s * sample_rate_hz;
+  const double nearest = std::round(x);
+  return static_cast<std::int64_t>(std::abs(x - nearest) < 1e-6 ? nearest : std::ceil(x));
 }
 
 IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> ephemerides,
@@ -312,6 +346,8 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
     if (e.antenna >= antennas) throw std::invalid_argument("cycle slip on antenna " + std::to_string(e.antenna) + ": no such antenna");
   for (const auto& b : options_.blockages)
     if (b.antenna >= antennas) throw std::invalid_argument("blockage of antenna " + std::to_string(b.antenna) + ": no such antenna");
+  for (const auto& c : options_.cn0_steps)
+    if (c.antenna >= antennas) throw std::invalid_argument("C/N0 step on antenna " + std::to_string(c.antenna) + ": no such antenna");
   impl_ = std::make_unique<Impl>(options_, *motion_);
   Impl& m = *impl_;
   m.block_samples = std::max<std::int64_t>(1, std::llround(options_.sample_rate_hz * kNodeInterval_s));
@@ -347,11 +383,33 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
         tr.lnav = std::make_unique<LnavTransmitter>(m.sats[k].eph, options_.klobuchar, options_.utc, ephemerides);
     }
   }
-  // Automatic gain from the expected power of noise plus the satellites in view at the start.
+  // C/N0 steps: per track, in sample order (a later entry wins a tie, as it comes later in the list).
+  for (const auto& c : options_.cn0_steps) {
+    const std::int64_t first = cn0_step_first_sample(c, options_.sample_rate_hz);
+    m.step_samples.push_back(first);
+    for (std::size_t k = 0; k < m.sats.size(); ++k) {
+      if (!c.prns.empty() && std::find(c.prns.begin(), c.prns.end(), m.sats[k].eph.prn) == c.prns.end()) continue;
+      auto& levels = m.tracks[static_cast<std::size_t>(c.antenna) * m.sats.size() + k].levels;
+      const auto scale = static_cast<float>(std::pow(10.0, (c.cn0_dbhz - m.sats[k].cn0_dbhz) / 20.0));
+      const auto at = std::upper_bound(levels.begin(), levels.end(), first,
+                                       [](std::int64_t s, const Impl::Level& l) { return s < l.first_sample; });
+      levels.insert(at, {first, c.cn0_dbhz, scale});
+    }
+  }
+  std::sort(m.step_samples.begin(), m.step_samples.end());
+  m.step_samples.erase(std::unique(m.step_samples.begin(), m.step_samples.end()), m.step_samples.end());
+  // Automatic gain from the expected power of noise plus the satellites in view at the start, each at its
+  // strongest level over the run (steps included) on any antenna.
   m.update_visibility(0);
   double power = 1.0;
-  for (const auto& sat : m.sats)
-    if (sat.active) power += 0.5 * sat.amplitude * sat.amplitude;
+  for (std::size_t k = 0; k < m.sats.size(); ++k) {
+    if (!m.sats[k].active) continue;
+    double scale = 1.0;
+    for (int a = 0; a < n_ant; ++a)
+      for (const auto& l : m.tracks[static_cast<std::size_t>(a) * m.sats.size() + k].levels)
+        scale = std::max(scale, std::pow(10.0, (l.cn0_dbhz - m.sats[k].cn0_dbhz) / 20.0));
+    power += 0.5 * std::pow(scale * m.sats[k].amplitude, 2);
+  }
   gain_ = options_.output_rms / std::sqrt(power);
   for (auto& sat : m.sats) {
     const auto& chips = ca_code(sat.eph.prn);
@@ -375,7 +433,10 @@ void IfSynthesiser::generate(std::span<const std::span<std::complex<float>>> out
   while (done < count) {
     const std::int64_t block = next_sample_ / m.block_samples;
     if (block != m.current_block) m.enter_block(block);
-    const std::int64_t block_end = (block + 1) * m.block_samples;
+    std::int64_t block_end = (block + 1) * m.block_samples;
+    // A C/N0 step inside the block ends the segment there (sample-exact steps).
+    const auto step = std::upper_bound(m.step_samples.begin(), m.step_samples.end(), next_sample_);
+    if (step != m.step_samples.end()) block_end = std::min(block_end, *step);
     const std::size_t seg = static_cast<std::size_t>(
         std::min<std::int64_t>(block_end - next_sample_, static_cast<std::int64_t>(count - done)));
     for (std::size_t a = 0; a < out.size(); ++a) {
@@ -413,7 +474,7 @@ std::vector<SatelliteView> IfSynthesiser::visible_satellites(std::int64_t sample
     v.prn = sat.eph.prn;
     v.elevation_rad = s.timing.elevation_rad;
     v.azimuth_rad = s.timing.azimuth_rad;
-    v.cn0_dbhz = sat.cn0_dbhz;
+    v.cn0_dbhz = cn0_dbhz(sat.eph.prn, 0, sample);
     v.doppler_hz = (sp.carrier_cycles - sm.carrier_cycles) / (2.0 * kDopplerHalfStep_s) - options_.if_hz;
     v.code_phase_chips = s.timing.code_phase_chips;
     views.push_back(v);
@@ -435,6 +496,17 @@ ReceiverClockState IfSynthesiser::receiver_clock(std::int64_t sample) { return i
 double IfSynthesiser::receive_time_s(std::int64_t sample) {
   const double tau = impl_->tau_of(sample);
   return tau - (impl_->clock.at(tau).bias_s - options_.clock.bias_s);
+}
+
+double IfSynthesiser::cn0_dbhz(int prn, int antenna, std::int64_t sample) const {
+  const Impl& m = *impl_;
+  for (std::size_t k = 0; k < m.sats.size(); ++k) {
+    if (m.sats[k].eph.prn != prn) continue;
+    if (antenna < 0 || antenna >= antenna_count()) throw std::out_of_range("no antenna " + std::to_string(antenna));
+    const Impl::Level* l = Impl::level_at(m.tracks[static_cast<std::size_t>(antenna) * m.sats.size() + k], sample);
+    return l ? l->cn0_dbhz : m.sats[k].cn0_dbhz;
+  }
+  throw std::out_of_range("no transmitted satellite with PRN " + std::to_string(prn));
 }
 
 double IfSynthesiser::amplitude(int prn) const {

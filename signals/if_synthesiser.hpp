@@ -70,6 +70,18 @@ struct BlockageEvent {
   double duration_s = 0.0;
 };
 
+// From the first sample at or after start_s (receiver time since sample 0: sample ceil(start_s fs)) on, the
+// listed satellites (every satellite when `prns` is empty) arrive at antenna `antenna` with C/N0 cn0_dbhz,
+// until a later step changes it (a weak-signal test: strong for acquisition and sync, then weak). Sample-exact,
+// not resolved to the 1 ms blocks. The noise is not changed, nor the run's gain (set for each satellite's
+// strongest level, so that a step up does not clip).
+struct Cn0StepEvent {
+  int antenna = 0;
+  double start_s = 0.0;
+  double cn0_dbhz = 45.0;
+  std::vector<int> prns;  // empty: all
+};
+
 struct SynthesiserOptions {
   double sample_rate_hz = 4e6;      // > 0
   double if_hz = 0.0;               // output centre offset; |if_hz| < fs/2 (real output: 0 < if_hz < fs/2)
@@ -93,7 +105,11 @@ struct SynthesiserOptions {
   double phase_noise_correlation_s = 0.1;              // > 0
   std::vector<CycleSlipEvent> cycle_slips;
   std::vector<BlockageEvent> blockages;
+  std::vector<Cn0StepEvent> cn0_steps;
 };
+
+// The first sample of a C/N0 step: the first sample at or after start_s (sample-exact).
+std::int64_t cn0_step_first_sample(const Cn0StepEvent& step, double sample_rate_hz);
 
 // Empty when the options are usable; otherwise what is wrong (the caller names the file).
 std::string validate(const SynthesiserOptions& options);
@@ -102,7 +118,7 @@ std::string validate(const SynthesiserOptions& options);
 struct SatelliteView {
   int prn = 0;
   double elevation_rad = 0.0, azimuth_rad = 0.0;
-  double cn0_dbhz = 0.0;
+  double cn0_dbhz = 0.0;           // at that sample (C/N0 steps applied)
   double doppler_hz = 0.0;        // d(carrier phase)/d(receiver time), IF removed; includes the rx clock drift
   double code_phase_chips = 0.0;  // chip of the code received at that sample, [0, 1023)
 };
@@ -151,7 +167,9 @@ class IfSynthesiser {
 
   double gain() const { return gain_; }         // output units per unit noise sigma
   double noise_sigma() const { return gain_; }  // per output component, output units
-  double amplitude(int prn) const;              // signal amplitude in output units
+  double amplitude(int prn) const;              // signal amplitude in output units, at the scenario's C/N0
+  // C/N0 of a satellite at one antenna and sample, the C/N0 steps applied; std::out_of_range for an unknown PRN.
+  double cn0_dbhz(int prn, int antenna, std::int64_t sample) const;
 
  private:
   struct Impl;

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -140,6 +141,44 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
         s.lever_arms_body_m.push_back(l);
       }
       antennas_given = true;
+      continue;
+    }
+    if (section == "cn0_step") {
+      const auto* arr = section_node.as_array();
+      if (!arr || arr->empty() || !arr->is_array_of_tables()) r.fail(section_node, section, "expected [[cn0_step]] tables");
+      for (const auto& e : *arr) {
+        signals::Cn0StepEvent ev;
+        bool start_given = false, cn0_given = false;
+        for (auto&& [k, n] : *e.as_table()) {
+          const std::string key(k.str());
+          if (key == "antenna") {
+            const auto antenna = r.integer(n, "cn0_step.antenna");
+            check_range(r, n, "cn0_step.antenna", antenna >= 0 && antenna < 4, "must be 0..3");
+            ev.antenna = static_cast<int>(antenna);
+          } else if (key == "start_s") {
+            ev.start_s = r.number(n, "cn0_step.start_s");
+            check_range(r, n, "cn0_step.start_s", ev.start_s >= 0 && ev.start_s <= 86400, "must be within 0..86400 s");
+            start_given = true;
+          } else if (key == "cn0_dbhz") {
+            ev.cn0_dbhz = r.number(n, "cn0_step.cn0_dbhz");
+            check_range(r, n, "cn0_step.cn0_dbhz", ev.cn0_dbhz >= 0 && ev.cn0_dbhz <= 80, "must be within 0..80 dB-Hz");
+            cn0_given = true;
+          } else if (key == "prns") {
+            const auto* list = n.as_array();
+            if (!list || list->empty()) r.fail(n, "cn0_step.prns", "expected a list of PRNs, e.g. [3, 7] (leave out for all)");
+            for (const auto& p : *list) {
+              const auto prn = r.integer(p, "cn0_step.prns");
+              check_range(r, p, "cn0_step.prns", prn >= 1 && prn <= 32, "PRN must be 1..32");
+              ev.prns.push_back(static_cast<int>(prn));
+            }
+          } else {
+            r.fail(n, "cn0_step." + key, "unknown key in [[cn0_step]] (antenna, start_s, cn0_dbhz, prns)");
+          }
+        }
+        if (!start_given) r.fail(e, "cn0_step.start_s", "missing in a [[cn0_step]] table");
+        if (!cn0_given) r.fail(e, "cn0_step.cn0_dbhz", "missing in a [[cn0_step]] table");
+        s.cn0_steps.push_back(ev);
+      }
       continue;
     }
     if (section == "cycle_slip" || section == "blockage") {
@@ -403,7 +442,7 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
       } else {
         r.fail(section_node, section,
                "unknown section (signal, time, navigation, receiver, atmosphere, output, trajectory, imu, "
-               "[[antenna]], [[cycle_slip]], [[blockage]])");
+               "[[antenna]], [[cycle_slip]], [[blockage]], [[cn0_step]])");
       }
     }
   }
@@ -438,6 +477,10 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
   for (const auto& b : s.blockages)
     if (static_cast<std::size_t>(b.antenna) >= n_antennas)
       fail_file(fmt::format("key blockage.antenna: antenna {} does not exist ({} antennas)", b.antenna, n_antennas));
+  if (!s.cn0_steps.empty() && !s.signal) fail_file("[[cn0_step]] needs a [signal] section");
+  for (const auto& c : s.cn0_steps)
+    if (static_cast<std::size_t>(c.antenna) >= n_antennas)
+      fail_file(fmt::format("key cn0_step.antenna: antenna {} does not exist ({} antennas)", c.antenna, n_antennas));
   // Cross-key checks that need the whole scenario.
   const bool real = !signals::is_complex(s.format);
   if (real && !(s.if_hz > 0))
@@ -559,6 +602,11 @@ std::string to_toml(const Scenario& s) {
   for (const auto& b : s.blockages)
     out += fmt::format("\n[[blockage]]\nantenna = {}\nstart_s = {}\nduration_s = {}\n", b.antenna, toml_float(b.start_s),
                        toml_float(b.duration_s));
+  for (const auto& c : s.cn0_steps) {
+    out += fmt::format("\n[[cn0_step]]\nantenna = {}\nstart_s = {}\ncn0_dbhz = {}\n", c.antenna, toml_float(c.start_s),
+                       toml_float(c.cn0_dbhz));
+    if (!c.prns.empty()) out += fmt::format("prns = [{}]\n", fmt::join(c.prns, ", "));
+  }
   return out;
 }
 

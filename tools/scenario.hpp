@@ -38,6 +38,9 @@
 //                 first sample; the signal fades for fade_s, then comes back stepped by `cycles`)
 //   [[blockage]]  antenna = 2  start_s = 40.0  duration_s = 5.0   (every satellite absent at that antenna)
 //                 Both need [signal]; `simulate` writes them to antenna_events.csv (the detection truth).
+//   [[cn0_step]]  antenna = 0  start_s = 15.0  cn0_dbhz = 25.0  prns = [3, 7]   (antenna and prns optional: 0
+//                 and every satellite; from the first sample at or after start_s the satellites arrive at that
+//                 C/N0, sample-exact, until a later step; needs [signal]; `simulate` writes cn0_steps.csv)
 // With [trajectory], [receiver] takes neither trajectory nor antenna_offsets_enu_m, and [signal] is optional:
 // without it only the IMU and truth files are written. [[antenna]] and attitude_deg need [trajectory].
 #pragma once
@@ -125,6 +128,7 @@ struct Scenario {
   std::vector<signals::AntennaImpairment> antenna_impairments;
   std::vector<signals::CycleSlipEvent> cycle_slips;
   std::vector<signals::BlockageEvent> blockages;
+  std::vector<signals::Cn0StepEvent> cn0_steps;  // [[cn0_step]]
 
   bool trajectory_enabled() const { return !trajectory_profile.empty() || !trajectory_file.empty(); }
 };

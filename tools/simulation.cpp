@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <GeographicLib/Geocentric.hpp>
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -193,6 +194,7 @@ signals::SynthesiserOptions synthesiser_options(const Scenario& s, const Navigat
   o.antenna_impairments = s.antenna_impairments;
   o.cycle_slips = s.cycle_slips;
   o.blockages = s.blockages;
+  o.cn0_steps = s.cn0_steps;
   if (const auto err = signals::validate(o); !err.empty()) throw InputError(s.source.string(), err);
   return o;
 }
@@ -407,6 +409,21 @@ SimulationResult run_simulation(const Scenario& s, const std::filesystem::path& 
     for (const auto& b : s.blockages)
       events += fmt::format("blockage,{},0,{},{},0\n", b.antenna, b.start_s, b.start_s + b.duration_s);
     io::write_file_atomically(out_dir / "antenna_events.csv", events);
+  }
+  if (!s.cn0_steps.empty()) {
+    // One row per step and transmitted satellite it applies to, in the scenario's order: the first sample with
+    // the new level (sample-exact) and its receiver time.
+    std::string steps = "antenna,prn,start_s,first_sample,first_sample_s,cn0_dbhz\n";
+    for (const auto& c : s.cn0_steps) {
+      const std::int64_t first = signals::cn0_step_first_sample(c, s.sample_rate_hz);
+      for (const auto& eph : nav.ephemerides) {
+        if (eph.health != 0 && !s.include_unhealthy) continue;
+        if (!c.prns.empty() && std::find(c.prns.begin(), c.prns.end(), eph.prn) == c.prns.end()) continue;
+        steps += fmt::format("{},{},{},{},{:.9f},{}\n", c.antenna, eph.prn, c.start_s, first,
+                             static_cast<double>(first) / s.sample_rate_hz, c.cn0_dbhz);
+      }
+    }
+    io::write_file_atomically(out_dir / "cn0_steps.csv", steps);
   }
 
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -17,6 +17,8 @@
 // velocity of every antenna at the truth rows. DIR/odometer.csv when [trajectory] odometer = true.
 // antenna_events.csv (scenarios with [[cycle_slip]] or [[blockage]]): kind,antenna,prn,start_s,end_s,cycles, the
 // injected events (prn 0 = all satellites; end_s = when the signal is back), for detection tests.
+// cn0_steps.csv (scenarios with [[cn0_step]]): antenna,prn,start_s,first_sample,first_sample_s,cn0_dbhz, one row
+// per step and transmitted satellite it applies to (below the mask too), in the scenario's order.
 // Without [signal] there is no receiver: truth.csv's t_s is the GPS time since the start, its clock columns
 // the deterministic clock model (bias + drift t), and no sample, satellite or antenna file is written.
 #pragma once

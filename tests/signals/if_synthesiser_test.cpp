@@ -532,3 +532,112 @@ TEST(IfSynthesiser, RejectsImpairmentsOfMissingAntennas) {
 
 }  // namespace
 }  // namespace ultratrack::signals
+
+// C/N0 steps (issue 7's tracking threshold: strong for acquisition and sync, then weak).
+namespace ultratrack::signals {
+namespace {
+
+// One satellite at 48 dB-Hz, stepped to 41 dB-Hz at 0.25 s and back up to 45 dB-Hz (that PRN listed) at 0.5 s:
+// the independent brute-force acquisition's C/N0 (1 ms prompt power against the off-peak noise floor, 200 ms)
+// on each 250 ms window reads the level of that window. Its statistical error: the mean of 200 1 ms prompt
+// powers scatters by sqrt(2 / SNR + 1 / SNR^2) / sqrt(200) relative (SNR = C/N0 x 1 ms: 2.9 % at 41 dB-Hz, 1.3 %
+// at 48), the noise floor from 8 x 200 off-peak values by 1 / sqrt(1600) = 2.5 %: 0.12-0.17 dB (1 sigma) on the
+// ratio; 0.6 dB is 3.5-5 sigma. (This seed reads 44.56 dB-Hz in window 2 of an unstepped 45 dB-Hz file too.)
+TEST(IfSynthesiser, Cn0StepsChangeTheMeasuredCn0WithinNoise) {
+  auto eph = walker_constellation(kStart);
+  IfSynthesiser probe(base_options(2.048e6), eph, static_receiver());
+  const int prn = probe.visible_satellites(0)[1].prn;
+  auto o = base_options(2.048e6);
+  o.default_cn0_dbhz = 48.0;
+  o.cn0_steps = {{0, 0.25, 41.0, {}}, {0, 0.5, 45.0, {prn}}};
+  IfSynthesiser synth(o, {eph[prn - 1]}, static_receiver());
+  EXPECT_EQ(synth.visible_satellites(0).front().cn0_dbhz, 48.0);
+  EXPECT_EQ(synth.visible_satellites(512000).front().cn0_dbhz, 41.0);
+  EXPECT_EQ(synth.cn0_dbhz(prn, 0, 1024000 - 1), 41.0);
+  EXPECT_EQ(synth.cn0_dbhz(prn, 0, 1024000), 45.0);
+  const auto x = via_file(synthesise(synth, 2048 * 750), SampleFormat::i8);
+  const double expected[] = {48.0, 41.0, 45.0};
+  for (int w = 0; w < 3; ++w) {
+    const std::vector<std::complex<float>> window(x.begin() + w * 512000, x.begin() + (w + 1) * 512000);
+    const auto r = BruteForceAcquisition(window, o.sample_rate_hz).acquire(prn, 200);
+    ASSERT_TRUE(r.found) << w;
+    EXPECT_NEAR(r.cn0_dbhz, expected[w], 0.6) << "window " << w;
+    std::printf("C/N0 step: window %d measured %.2f dB-Hz for %.1f\n", w, r.cn0_dbhz, expected[w]);
+  }
+  // The noise floor is the same before and after the step (the gain is one for the run): the variance of the
+  // samples, signal included, differs only by the signal's share, (C/N0) / fs = 3e-2 at 48 dB-Hz.
+  const std::vector<std::complex<float>> before(x.begin(), x.begin() + 512000), after(x.begin() + 512000, x.begin() + 1024000);
+  const double c48 = std::pow(10.0, 4.8) / o.sample_rate_hz, c41 = std::pow(10.0, 4.1) / o.sample_rate_hz;
+  const double ratio = (variance(before, false) + variance(before, true)) / (variance(after, false) + variance(after, true));
+  // Sample variance of 512000 complex samples: relative sigma 1 / sqrt(512000) = 0.0014 per window; 4 sigma on the ratio.
+  EXPECT_NEAR(ratio, (1.0 + c48) / (1.0 + c41), 4 * std::sqrt(2.0 / 512000));
+}
+
+// Noise and data off, two antennas at one point and two satellites: the step acts on antenna 1 and on the listed
+// PRN only, from exactly the first sample at or after start_s (inside a 1 ms block and inside a generate() call),
+// and the envelope of the stepped satellite (constant for a BPSK code times a unit carrier) changes by exactly
+// 10^(dB/20) there: a1 - a0 = (10^(-6/20) - 1) x that satellite's signal.
+TEST(IfSynthesiser, Cn0StepIsSampleExactOnItsAntennaAndSatellitesOnly) {
+  auto eph = walker_constellation(kStart);
+  IfSynthesiser probe(base_options(1.0e6), eph, static_receiver());
+  const auto views = probe.visible_satellites(0);
+  const int stepped = views[0].prn, other = views[1].prn;
+  auto o = base_options(1.0e6);
+  o.noise = false;
+  o.default_cn0_dbhz = 45.0;
+  o.cn0_steps = {{1, 0.0123456, 39.0, {stepped}}};
+  const std::int64_t first = cn0_step_first_sample(o.cn0_steps[0], o.sample_rate_hz);
+  ASSERT_EQ(first, 12346);  // 12345.6 samples: the next whole sample
+  const Eigen::Vector3d r0 = ecef_from_llh(35.274016, 137.013759, 100.0);
+  IfSynthesiser synth(o, {eph[stepped - 1], eph[other - 1]}, std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r0, r0}));
+  const std::size_t n = 30000;
+  std::vector<std::complex<float>> a0(n), a1(n);
+  for (std::size_t done = 0; done < n;) {  // calls of 777 samples: the step falls inside one
+    const std::size_t c = std::min<std::size_t>(777, n - done);
+    std::vector<std::span<std::complex<float>>> spans{std::span(a0.data() + done, c), std::span(a1.data() + done, c)};
+    synth.generate(spans);
+    done += c;
+  }
+  // Envelope of one satellite at 45 dB-Hz: gain x sqrt(2 C/N0 / fs) (documented amplitude).
+  const double envelope = synth.gain() * std::sqrt(2.0 * std::pow(10.0, 4.5) / o.sample_rate_hz);
+  const double drop = (1.0 - std::pow(10.0, -6.0 / 20.0)) * envelope;
+  EXPECT_NEAR(synth.amplitude(stepped), envelope, 1e-9 * envelope);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = std::abs(std::complex<double>(a1[i]) - std::complex<double>(a0[i]));
+    if (static_cast<std::int64_t>(i) < first) {
+      ASSERT_LT(d, 1e-6 * envelope) << "sample " << i << " before the step";
+    } else {
+      ASSERT_NEAR(d, drop, 1e-4 * envelope) << "sample " << i << " after the step";  // float samples, 4096-entry table
+    }
+  }
+  EXPECT_EQ(synth.cn0_dbhz(stepped, 1, first), 39.0);
+  EXPECT_EQ(synth.cn0_dbhz(stepped, 1, first - 1), 45.0);
+  EXPECT_EQ(synth.cn0_dbhz(stepped, 0, first), 45.0);
+  EXPECT_EQ(synth.cn0_dbhz(other, 1, first), 45.0);
+}
+
+// A step up: the gain is set for each satellite's strongest level, so the output RMS stays at or below
+// output_rms over the run (no extra clipping), and a step to a level does what that level as a start does.
+TEST(IfSynthesiser, Cn0StepUpSetsTheGainForTheStrongestLevel) {
+  auto eph = walker_constellation(kStart);
+  auto o = base_options(2.0e6);
+  o.default_cn0_dbhz = 40.0;
+  o.cn0_steps = {{0, 0.001, 65.0, {}}};
+  IfSynthesiser stepped(o, eph, static_receiver());
+  auto strong = base_options(2.0e6);
+  strong.default_cn0_dbhz = 65.0;
+  IfSynthesiser reference(strong, eph, static_receiver());
+  EXPECT_NEAR(stepped.gain(), reference.gain(), 1e-12 * reference.gain());
+  const auto x = synthesise(stepped, 200000);
+  const std::vector<std::complex<float>> after(x.begin() + 2000, x.end());
+  EXPECT_NEAR((variance(after, false) + variance(after, true)) / 2 / (o.output_rms * o.output_rms), 1.0, 0.01);
+  o.cn0_steps = {{0, 0.0, 81.0, {}}};
+  EXPECT_FALSE(validate(o).empty());
+  o.cn0_steps = {{0, 0.0, 30.0, {33}}};
+  EXPECT_FALSE(validate(o).empty());
+  o.cn0_steps = {{1, 0.0, 30.0, {}}};
+  EXPECT_THROW(IfSynthesiser(o, eph, static_receiver()), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace ultratrack::signals

@@ -198,3 +198,82 @@ TEST(Simulate, TrajectoryFileDrivesTheReceiver) {
 
 }  // namespace
 }  // namespace ultratrack::tools
+
+namespace ultratrack::tools {
+namespace {
+
+// [[cn0_step]]: parsed, echoed, checked, and written to cn0_steps.csv with the sample-exact first sample
+// (ceil(start_s fs): 0.0123456 s at 1 MHz is sample 12346); satellites.csv gives the level at sample 0.
+TEST(Simulate, Cn0StepsParseEchoAndAreRecorded) {
+  const std::string base = R"(
+[signal]
+sample_rate_hz = 1.0e6
+format = "i8"
+duration_s = 0.02
+cn0_dbhz = 45.0
+[receiver]
+llh_deg_m = [35.274016, 137.013759, 100.0]
+)";
+  const std::string steps = R"(
+[[cn0_step]]
+start_s = 0.0
+cn0_dbhz = 50.0
+[[cn0_step]]
+antenna = 0
+start_s = 0.0123456
+cn0_dbhz = 25.5
+prns = [3, 40]
+)";
+  const auto error_of = [](const std::string& text) -> std::string {
+    try {
+      parse_scenario(text, "/data/s.toml");
+    } catch (const signals::InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_NE(error_of(base + steps).find("cn0_step.prns"), std::string::npos);  // PRN 40
+  EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\n").find("cn0_step.cn0_dbhz"), std::string::npos);
+  EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\ncn0_dbhz = 90.0\n").find("cn0_step.cn0_dbhz"), std::string::npos);
+  EXPECT_NE(error_of(base + "[[cn0_step]]\nantenna = 1\nstart_s = 1.0\ncn0_dbhz = 30.0\n").find("antenna 1 does not exist"),
+            std::string::npos);
+  EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\ncn0_dbhz = 30.0\nduration_s = 2\n").find("cn0_step.duration_s"),
+            std::string::npos);
+
+  const std::string good_steps = R"(
+[[cn0_step]]
+start_s = 0.0
+cn0_dbhz = 50.0
+[[cn0_step]]
+antenna = 0
+start_s = 0.0123456
+cn0_dbhz = 25.5
+prns = [3, 5]
+)";
+  Scenario s = parse_scenario(base + good_steps, "/data/s.toml");
+  ASSERT_EQ(s.cn0_steps.size(), 2u);
+  EXPECT_TRUE(s.cn0_steps[0].prns.empty());
+  EXPECT_EQ(s.cn0_steps[1].prns, (std::vector<int>{3, 5}));
+  EXPECT_EQ(s.cn0_steps[1].cn0_dbhz, 25.5);
+  const Scenario back = parse_scenario(to_toml(s), "/data/s.toml");
+  ASSERT_EQ(back.cn0_steps.size(), 2u);
+  EXPECT_EQ(back.cn0_steps[1].start_s, 0.0123456);
+  EXPECT_EQ(back.cn0_steps[1].prns, (std::vector<int>{3, 5}));
+
+  s.source.clear();
+  const auto dir = test::scratch_dir() / "cn0_steps";
+  const SimulationResult r = run_simulation(s, dir);
+  ASSERT_FALSE(r.satellites.empty());
+  for (const auto& v : r.satellites) EXPECT_EQ(v.cn0_dbhz, 50.0) << v.prn;  // the step at 0 s is in force at sample 0
+  const auto lines = read_lines(dir / "cn0_steps.csv");
+  ASSERT_GE(lines.size(), 4u);
+  EXPECT_EQ(lines[0], "antenna,prn,start_s,first_sample,first_sample_s,cn0_dbhz");
+  EXPECT_EQ(lines[lines.size() - 2], "0,3,0.0123456,12346,0.012346000,25.5");
+  EXPECT_EQ(lines.back(), "0,5,0.0123456,12346,0.012346000,25.5");
+  // The all-satellite step: one row per transmitted PRN (the nominal constellation, all healthy).
+  EXPECT_EQ(lines.size() - 3u, load_navigation(s).ephemerides.size());
+  EXPECT_EQ(lines[1].rfind("0,1,0,0,0.000000000,50", 0), 0u) << lines[1];
+}
+
+}  // namespace
+}  // namespace ultratrack::tools
