@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 #include "ins/earth_model.hpp"
@@ -296,9 +297,13 @@ class UltraTightCore final : public UltraTightCoreBase {
     receiver::ObservationEpoch epoch;
     epoch.receive_time =
         signals::add_seconds(opt_.gps_time_origin, nominal_.nav.t_s + nominal_.clock_bias_m / kC);
-    for (const auto& e : eph_) {
+    // One observation per PRN: ephemerides may hold several sets of a satellite (a day's RINEX: ~12), and
+    // prepare_satellites picks the set valid at the transmit time.
+    std::set<int> prns;
+    for (const auto& e : eph_) prns.insert(e.prn);
+    for (const int prn : prns) {
       receiver::Observation ob;
-      ob.prn = e.prn;
+      ob.prn = prn;
       ob.pseudorange_m = 0.075 * kC + nominal_.clock_bias_m;
       ob.doppler_hz = 0.0;
       epoch.observations.push_back(ob);

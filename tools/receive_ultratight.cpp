@@ -108,8 +108,8 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   o.initial_clock_drift_mps = out.clock_drift_mps;
   o.initial_clock_bias_m =
       kC * (signals::seconds_between(epoch.receive_time, origin_) - t_k) - out.clock_drift_mps * (t_k - out.nav.t_s);
-  // One ephemeris per PRN (the driver predicts every ephemeris it holds: a day's RINEX has ~12 per PRN), chosen
-  // for this time; 2-4 h fit intervals cover any run `receive` makes of a recording.
+  // One ephemeris per PRN, chosen for this time (the driver would pick it among a day's ~12 sets every period);
+  // 2-4 h fit intervals cover any run `receive` makes of a recording.
   std::vector<signals::Ephemeris> eph;
   for (int prn = 1; prn <= 32; ++prn)
     if (auto e = signals::select_ephemeris(*epoch.ephemerides, prn, epoch.receive_time)) eph.push_back(*e);

@@ -11,6 +11,8 @@
 #include "correlation_sim.hpp"
 #include "fusion/chi_square.hpp"
 #include "fusion/iq_measurements.hpp"
+#include "fusion/ultratight_integration.hpp"
+#include "signals/nominal_constellation.hpp"
 
 namespace ultratrack::fusion {
 namespace {
@@ -47,6 +49,33 @@ void expect_closed_loop(const CorrelationRunResult& r, const char* what) {
   std::printf("%s: sats %d, code max %.4f chip, freq max %.3f Hz, pos err %.3f m (sigma %.3f m), cpu %.3f s\n", what,
               r.satellites, max_from(r.max_code_err_chips, r.t_s, 0.2), max_from(r.max_freq_err_hz, r.t_s, 0.2),
               r.pos_err_m.back().norm(), r.sigma_pos_m.back().norm(), r.cpu_s);
+}
+
+// A navigation file holds several sets per satellite (a day's RINEX: ~12). The driver must predict each
+// satellite once, from the set valid at the time: the replicas equal those from the valid sets alone.
+TEST(UltraTight, SeveralEphemerisSetsPerSatellitePredictOneReplicaEach) {
+  const signals::GpsTime origin{2300, 200000.0};  // nominal toe 201600 s: |t - toe| = 1600 s
+  const std::vector<signals::Ephemeris> valid = signals::nominal_constellation(origin).ephemerides;
+  std::vector<signals::Ephemeris> day = valid;
+  for (const double shift_s : {-7200.0, 7200.0})  // toe 194400 s (inside its fit interval, farther) and 208800 s
+    for (const auto& e : signals::nominal_constellation(signals::add_seconds(origin, shift_s)).ephemerides)
+      day.push_back(e);
+  ins::NavState nav;
+  nav.lat_rad = 35.27 * M_PI / 180.0;
+  nav.lon_rad = 137.01 * M_PI / 180.0;
+  nav.height_m = 100.0;
+  UltraTightOptions opt;
+  opt.gps_time_origin = origin;
+  UltraTightIntegration from_valid(nav, valid, opt), from_day(nav, day, opt);
+  const std::vector<ReplicaCommand> a = from_valid.start_period(0.020);
+  const std::vector<ReplicaCommand> b = from_day.start_period(0.020);
+  ASSERT_GE(a.size(), 4u);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].prn, b[i].prn);
+    EXPECT_EQ(a[i].pseudorange_m, b[i].pseudorange_m);
+    EXPECT_EQ(a[i].range_rate_mps, b[i].range_rate_mps);
+  }
 }
 
 TEST(UltraTight, ClosedLoopCircle45dBHzEkfAndUkf) {
