@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "receiver/scalar_tracking.hpp"
-#include "test_signal.hpp"
+#include "channel_feed.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -60,46 +60,33 @@ Outcome run(const ScalarTrackingOptions& opt_in, bool known, double weak_dbhz, d
   int polarity = 0;  // the Costas loop's half-cycle: resolved by the first bit-synced prompt (45 dB-Hz)
   Outcome out;
   const std::int64_t block = 125000;
-  for (std::int64_t first = 0; first < static_cast<std::int64_t>(duration_s * kFs) && !out.lost; first += block) {
-    const auto x = test::generate({strong, weak}, sig, first, block);
-    SampleBlockView v;
-    v.first_sample = first;
-    v.num_samples = static_cast<int>(block);
-    v.antenna[0] = x.data();
-    int offset = 0;
-    while (offset < v.num_samples) {
-      const auto fr = channel.feed(v, offset);
-      offset += fr.consumed;
-      if (!fr.epoch_ready) continue;
-      const CorrelationEpoch& e = channel.epoch();
-      const double t = e.first_sample / kFs;
-      KnownBits k;
-      const int wanted = loop.known_bits_wanted();
-      if (known && polarity != 0 && wanted > 0 && e.num_code_periods == 20) {
-        k.sign = polarity * true_bit(t + 0.01);
-        k.ahead = wanted;
-      }
-      const TrackingReport r = loop.update(e, k);
-      if (r.state == TrackingState::kBitSynced && polarity == 0 && t < fade_s - 0.1)
-        polarity = (e.master().prompt.real() >= 0.0f ? 1 : -1) * true_bit(t + 0.01);
-      channel.command(r.command);
-      if (r.set_coherent) channel.set_coherent_periods(r.coherent_periods, r.aligned_period);
-      out.max_loop_ms = std::max(out.max_loop_ms, r.loop_integration_ms);
-      if (r.state == TrackingState::kLost) {
-        out.lost = true;
-        out.lost_at_s = t;
-        break;
-      }
-      if (t > 6.0 && r.state == TrackingState::kBitSynced) {
-        const double mid_s = (e.first_sample + 0.5 * e.num_samples) / kFs;
-        double d = test::true_carrier_phase_cycles(strong, mid_s) - 0.5 * (e.carrier_phase_start_cycles + e.carrier_phase_end_cycles);
-        d -= 0.5 * std::round(d / 0.5);
-        out.phase_error_cycles.push_back(d);
-        // the epoch starts where the replica crosses a period start: the truth's phase there is the code error
-        out.code_error_chips.push_back(std::remainder(test::true_code_phase_chips(strong, t) - e.code_phase_start_chips, 1023.0));
-      }
+  test::feed_generated(channel, {strong, weak}, sig, static_cast<std::int64_t>(duration_s * kFs), block,
+                       [&](const CorrelationEpoch& e) {
+    const double t = e.first_sample / kFs;
+    KnownBits k;
+    const int wanted = loop.known_bits_wanted();
+    if (known && polarity != 0 && wanted > 0 && e.num_code_periods == 20) {
+      k.sign = polarity * true_bit(t + 0.01);
+      k.ahead = wanted;
     }
-  }
+    const TrackingReport r = loop.update(e, k);
+    if (r.state == TrackingState::kBitSynced && polarity == 0 && t < fade_s - 0.1)
+      polarity = (e.master().prompt.real() >= 0.0f ? 1 : -1) * true_bit(t + 0.01);
+    channel.command(r.command);
+    if (r.set_coherent) channel.set_coherent_periods(r.coherent_periods, r.aligned_period);
+    out.max_loop_ms = std::max(out.max_loop_ms, r.loop_integration_ms);
+    if (r.state == TrackingState::kLost) {
+      out.lost = true;
+      out.lost_at_s = t;
+      return false;
+    }
+    if (t > 6.0 && r.state == TrackingState::kBitSynced) {
+      out.phase_error_cycles.push_back(test::costas_phase_error_cycles(strong, e, kFs));
+      // the epoch starts where the replica crosses a period start: the truth's phase there is the code error
+      out.code_error_chips.push_back(std::remainder(test::true_code_phase_chips(strong, t) - e.code_phase_start_chips, 1023.0));
+    }
+    return true;
+  });
   return out;
 }
 

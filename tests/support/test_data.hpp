@@ -1,8 +1,10 @@
-// Test helpers: where the optional shared recordings are, and a scratch folder per test.
+// Test helpers: where the optional shared recordings are, a scratch folder per test, and reading outputs back.
 #pragma once
 
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace ultratrack::test {
 
@@ -13,6 +15,11 @@ std::filesystem::path scenarios_dir();
 // A fresh empty folder under the system temp dir, unique to the calling test; called outside a test (in
 // SetUpTestSuite) unique to the suite and this process, and removed when the process exits.
 std::filesystem::path scratch_dir();
+
+// A whole text file as one string (empty when it cannot be read).
+std::string read_text_file(const std::filesystem::path& file);
+// The comma-separated fields of one CSV line, as written (no quoting).
+std::vector<std::string> split_csv_line(const std::string& line);
 
 }  // namespace ultratrack::test
 

@@ -107,13 +107,6 @@ Eigen::Vector3d nav_at(const std::vector<tools::FusedNavRow>& nav, double t_s) {
   return pos(*(it - 1)) + w * (pos(*it) - pos(*(it - 1)));
 }
 
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 double json_number(const std::string& json, const std::string& key) {
   const auto at = json.find("\"" + key + "\":");
   return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 3));
@@ -182,7 +175,7 @@ TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
                            motion_config().string()});
   test_support::run_command("receive", args);
   const Rms r = compare(rx);
-  const std::string summary = read_text(rx / "summary.json");
+  const std::string summary = test::read_text_file(rx / "summary.json");
   std::printf("loose EKF: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m, running-mean bound %.3f m\n", r.epochs,
               r.fused_m, r.gnss_m, r.running_mean_bound_m);
   EXPECT_NE(summary.find("\"fusion\": {\"coupling\": \"loose\""), std::string::npos);
@@ -203,7 +196,7 @@ TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
                              motion_config().string()});
     test_support::run_command("receive", args);
     const Rms r = compare(rx);
-    const std::string summary = read_text(rx / "summary.json");
+    const std::string summary = test::read_text_file(rx / "summary.json");
     std::printf("tight %s: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", filter.c_str(), r.epochs, r.fused_m,
                 r.gnss_m);
     EXPECT_NE(summary.find("\"filter\": \"" + filter + "\""), std::string::npos);
@@ -231,7 +224,7 @@ TEST(ReceiveFusion, TightCouplingCarriesItsClockThroughAReceiverClockJump) {
   args.insert(args.end(), {"--coupling", "tight", "--align", "config", "--fusion-config", config.string(), "--config",
                            rx_config.string()});
   test_support::run_command("receive", args);
-  const std::string summary = read_text(rx / "summary.json");
+  const std::string summary = test::read_text_file(rx / "summary.json");
   EXPECT_EQ(json_number(summary, "clock_jumps"), 1.0);
   EXPECT_EQ(json_number(summary, "clock_jumps_removed"), 1.0);
   EXPECT_EQ(json_number(summary, "epochs_before_start"), 0.0);  // the filter ran before and after the jump
@@ -259,9 +252,9 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
                            std::to_string(s.prns_by_elevation[0]) + "," + std::to_string(s.prns_by_elevation[1]) + "," +
                                std::to_string(s.prns_by_elevation[2])});
   test_support::run_command("receive", args);
-  const std::string summary = read_text(rx / "summary.json");
+  const std::string summary = test::read_text_file(rx / "summary.json");
   EXPECT_EQ(json_number(summary, "fixes"), 0.0);
-  const std::string solution = read_text(rx / "solution.csv");
+  const std::string solution = test::read_text_file(rx / "solution.csv");
   EXPECT_EQ(std::count(solution.begin(), solution.end(), '\n'), 1) << "solution.csv: header only";
   EXPECT_GE(json_number(summary, "epochs_fewer_than_4_satellites"), 50.0);
   const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");

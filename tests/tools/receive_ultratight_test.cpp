@@ -32,21 +32,6 @@ namespace {
 
 constexpr double kGapStart_s = 14.0, kGapEnd_s = 15.0;
 
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string f;
-  while (std::getline(s, f, ',')) out.push_back(f);
-  return out;
-}
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 double json_number(const std::string& json, const std::string& key) {
   const auto at = json.find("\"" + key + "\":");
   return at == std::string::npos ? -1.0 : std::stod(json.substr(at + key.size() + 3));
@@ -131,7 +116,7 @@ std::map<int, std::vector<Row>> read_log(const fs::path& rx) {
   std::ifstream in(rx / "ultratight.csv");
   std::string line;
   std::getline(in, line);
-  const auto header = split(line);
+  const auto header = test::split_csv_line(line);
   const auto col = [&](const std::string& name) {
     return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
   };
@@ -139,7 +124,7 @@ std::map<int, std::vector<Row>> read_log(const fs::path& rx) {
                     acc = col("accepted"), upd = col("updated");
   std::map<int, std::vector<Row>> out;
   while (std::getline(in, line)) {
-    const auto f = split(line);
+    const auto f = test::split_csv_line(line);
     out[std::stoi(f[prn])].push_back({std::stod(f[t]), f[ut] == "1", f[co] == "1", f[upd] == "1", f[acc] == "1"});
   }
   return out;
@@ -150,7 +135,7 @@ void check_run(const std::string& filter, const std::string& form) {
   auto args = receive_args(rx);
   args.insert(args.end(), {"--coupling", "ultra-tight", "--filter", filter, "--ut-measurement", form});
   test_support::run_command("receive", args);
-  const std::string summary = read_text(rx / "summary.json");
+  const std::string summary = test::read_text_file(rx / "summary.json");
   ASSERT_NE(summary.find("\"ultratight\": {\"filter\": \"" + filter + "\", \"measurement\": \"" + form +
                          "\", \"handed_over\": true"),
             std::string::npos)
@@ -226,8 +211,8 @@ TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
     auto args = receive_args(rx);
     args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", std::to_string(threads)});
     test_support::run_command("receive", args);
-    text[threads - 1][0] = read_text(rx / "ultratight.csv");
-    text[threads - 1][1] = read_text(rx / "nav.csv");
+    text[threads - 1][0] = test::read_text_file(rx / "ultratight.csv");
+    text[threads - 1][1] = test::read_text_file(rx / "nav.csv");
   }
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";

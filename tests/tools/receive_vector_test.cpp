@@ -27,21 +27,6 @@ void run(const std::string& command, std::vector<std::string> args) {
   ultratrack::test_support::run_command(command, std::move(args));
 }
 
-std::string slurp(const fs::path& file) {
-  std::ifstream in(file);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream s(line);
-  std::string f;
-  while (std::getline(s, f, ',')) out.push_back(f);
-  return out;
-}
-
 // A RINEX 2 nav file without one PRN's records (8 lines each, the PRN in columns 1-2 of the first).
 void drop_prn(const fs::path& in_path, const fs::path& out_path, int prn) {
   std::ifstream in(in_path);
@@ -98,10 +83,10 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
                   one_thread.string()});
   fs::remove(sim / "antenna0.i8.bin");
   for (const char* file : {"vector.csv", "vector_state.csv", "solution.csv", "tracking.csv"})
-    EXPECT_EQ(slurp(vector / file), slurp(one_thread / file)) << file << " differs between 1 thread and the default";
+    EXPECT_EQ(ultratrack::test::read_text_file(vector / file), ultratrack::test::read_text_file(one_thread / file)) << file << " differs between 1 thread and the default";
 
-  EXPECT_NE(slurp(vector / "summary.json").find("\"coupling\": \"vector\""), std::string::npos);
-  EXPECT_NE(slurp(scalar / "summary.json").find("\"coupling\": \"scalar\""), std::string::npos);
+  EXPECT_NE(ultratrack::test::read_text_file(vector / "summary.json").find("\"coupling\": \"vector\""), std::string::npos);
+  EXPECT_NE(ultratrack::test::read_text_file(scalar / "summary.json").find("\"coupling\": \"scalar\""), std::string::npos);
 
   // Every satellite of the file acquired once and never lost, in both runs.
   std::vector<int> prns;
@@ -114,7 +99,7 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
   ASSERT_GE(prns.size(), 8u);
   ASSERT_NE(std::find(prns.begin(), prns.end(), kNoEphemeris), prns.end());
   for (const auto& out : {scalar, vector}) {
-    const std::string summary = slurp(out / "summary.json");
+    const std::string summary = ultratrack::test::read_text_file(out / "summary.json");
     for (int prn : prns) {
       const auto at = summary.find("{\"prn\": " + std::to_string(prn) + ",");
       ASSERT_NE(at, std::string::npos) << out << " PRN " << prn << " not acquired";
@@ -131,7 +116,7 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
     std::string line;
     std::getline(in, line);
     while (std::getline(in, line)) {
-      const auto f = split(line);
+      const auto f = ultratrack::test::split_csv_line(line);
       const double t = std::stod(f[1]);
       const int prn = std::stoi(f[2]);
       const bool v = f[3] == "1";
@@ -166,14 +151,14 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
   std::string line;
   std::getline(truth_in, line);
   std::getline(truth_in, line);
-  const auto t0 = split(line);
+  const auto t0 = ultratrack::test::split_csv_line(line);
   const double tx = std::stod(t0[3]), ty = std::stod(t0[4]), tz = std::stod(t0[5]);
   std::ifstream state(vector / "vector_state.csv");
   std::getline(state, line);
   double sum2 = 0.0;
   int n = 0;
   while (std::getline(state, line)) {
-    const auto f = split(line);
+    const auto f = ultratrack::test::split_csv_line(line);
     if (std::stod(f[1]) < 13.5) continue;
     const double dx = std::stod(f[4]) - tx, dy = std::stod(f[5]) - ty, dz = std::stod(f[6]) - tz;
     sum2 += dx * dx + dy * dy + dz * dz;
@@ -211,7 +196,7 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
   fs::remove(sim / "antenna0.i8.bin");
 
   const auto losses = [](const fs::path& out) {
-    const std::string summary = slurp(out / "summary.json");
+    const std::string summary = ultratrack::test::read_text_file(out / "summary.json");
     int total = 0, satellites = 0;
     for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1)) {
       total += std::stoi(summary.substr(at + 10));
@@ -259,7 +244,7 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
   run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
                   brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
   fs::remove(sim / "antenna0.i8.bin");
-  const std::string summary = slurp(vector / "summary.json");
+  const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
   int satellites = 0;
   for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1)) {
     EXPECT_EQ(std::stoi(summary.substr(at + 10)), 0) << summary.substr(at - 200, 220);
@@ -302,7 +287,7 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
                   brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
   fs::remove(sim / "antenna0.i8.bin");
 
-  const std::string summary = slurp(vector / "summary.json");
+  const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
   int satellites = 0;
   bool faded_present = false;
   for (auto at = summary.find("\"acquisitions\": "); at != std::string::npos;
@@ -328,7 +313,7 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
     std::getline(in, line);
     std::map<int, bool> in_window;
     while (std::getline(in, line)) {
-      const auto f = split(line);
+      const auto f = ultratrack::test::split_csv_line(line);
       const int prn = std::stoi(f[0]);
       const double t = std::stod(f[2]);
       const bool coasting = f[9] == "coasting";
