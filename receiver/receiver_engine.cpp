@@ -263,7 +263,14 @@ void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples,
   for (int a = 1; a < options_.num_antennas; ++a)
     view_.antenna[static_cast<std::size_t>(a)] = antenna_block_[static_cast<std::size_t>(a)] + (first_sample - antenna_block_first_);
   view_.i16_gain = i16_gain_;
-  if (i16_gain_ > 0.0f) convert_part_to_i16(view_.num_samples);
+  if (i16_gain_ > 0.0f) {
+    if (given_i16_.re && given_i16_gain_ == i16_gain_) {
+      const std::int64_t offset = first_sample - given_i16_first_;
+      view_.antenna_i16[0] = {given_i16_.re + offset, given_i16_.im + offset};
+    } else {
+      convert_part_to_i16(view_.num_samples);
+    }
+  }
   // Channels are independent given the block: each job touches only its own channel and record buffer.
   auto job = [this](int slot) { feed_channel(slot); };
   pool_.parallel_for(static_cast<int>(channels_.size()), job);
@@ -330,6 +337,25 @@ void ReceiverEngine::release_lost_channels() {
 void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
   if (options_.num_antennas != 1) throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
   process_master(samples, first_sample);
+}
+
+void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::int64_t first_sample, PlanarI16 i16,
+                             float i16_gain) {
+  if (options_.num_antennas != 1) throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
+  // The gain may be fixed inside this call (the cold start): only a copy made at that gain is used, so the
+  // channels see the same int16 values whoever converted them.
+  if (i16_gain > 0.0f && i16.re && i16.im) {
+    given_i16_ = i16;
+    given_i16_first_ = first_sample;
+    given_i16_gain_ = i16_gain;
+  }
+  try {
+    process_master(samples, first_sample);
+  } catch (...) {
+    given_i16_ = {};
+    throw;
+  }
+  given_i16_ = {};
 }
 
 void ReceiverEngine::process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample) {

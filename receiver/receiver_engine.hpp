@@ -88,6 +88,10 @@ class ReceiverEngine {
   // Processes samples[0..n) whose first sample has receiver index first_sample. Blocks should be contiguous;
   // a gap is bridged by the channels (dead reckoning) and restarts a pending acquisition snapshot.
   void process(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+  // The same with the block also given as planar int16 times i16_gain (receiver/sample_prefetcher.hpp converts
+  // it off this thread): used instead of the engine's own conversion when i16_gain equals i16_gain() (the same
+  // values: the same conversion), ignored otherwise. One antenna only.
+  void process(std::span<const std::complex<float>> samples, std::int64_t first_sample, PlanarI16 i16, float i16_gain);
   // num_antennas > 1: one span per antenna, all the same size and on the same sample indices; antenna 0 (the
   // master) is the one acquired on. Throws std::invalid_argument when the spans do not match the options.
   void process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample);
@@ -103,6 +107,8 @@ class ReceiverEngine {
   int channels_in_use() const;
   int channels_synchronised() const;
   int threads() const { return pool_.threads(); }
+  // The integer correlator's gain from sample scale to int16: 0 until the cold start's snapshot fixes it.
+  float i16_gain() const { return i16_gain_; }
   // Ephemerides decoded from the signal (each new set once), and the broadcast Klobuchar/UTC parameters.
   const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return decoded_; }
   const signals::KlobucharParameters& klobuchar() const { return iono_; }
@@ -194,6 +200,9 @@ class ReceiverEngine {
   // the part being fed (I then Q per antenna; grown once to the largest part).
   float i16_gain_ = 0.0f;
   std::vector<std::int16_t> i16_block_;
+  PlanarI16 given_i16_{};            // the current block's int16 copy from the caller, if usable
+  std::int64_t given_i16_first_ = 0;
+  float given_i16_gain_ = 0.0f;
   void convert_part_to_i16(int n);
   AntennaPhaseEpoch antenna_epoch_;
   // Vector tracking (set_vector_loop).
