@@ -148,7 +148,7 @@ class ReceiverEngine {
   void feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample);
   void feed_channel(int slot);
   void collect_navigation(ReceiverChannel& channel);
-  void release_lost_channels();
+  void release_lost_channels(std::int64_t sample);
   void observation_epoch(std::int64_t sample);
   void solve(const ObservationEpoch& epoch);
   void vector_epoch(std::int64_t sample);
@@ -162,7 +162,10 @@ class ReceiverEngine {
   WorkerPool pool_;
   AcquisitionTask search_;
   std::size_t blind_cursor_ = 0;  // round robin over prns_ for blind re-acquisitions
+  std::size_t unknown_cursor_ = 0;  // the same for PRNs with no orbit known at the low duty cycle (blind_revisit_s)
   std::vector<int> prns_;
+  std::array<std::int64_t, 33> lost_at_{};  // sample at which a PRN's channel was last released (lost lock)
+  std::array<bool, 33> ever_lost_{};
   std::size_t hidden_cursor_ = 0;        // round robin over prns_ for checks of PRNs predicted below the horizon
   std::int64_t next_hidden_check_ = 0;   // sample from which the next such check may run
 

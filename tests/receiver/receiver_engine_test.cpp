@@ -261,3 +261,48 @@ TEST(ReceiverEngine, ResultsAreIdenticalForAnyNumberOfThreads) {
     }
   }
 }
+
+// Low duty cycle of blind re-acquisition (ReceiverOptions::blind_revisit_s): with 4 satellites in channels, the
+// PRNs nothing is known about are searched only as many per snapshot as keep each within blind_revisit_s, and a
+// satellite that appears later is still found within the documented bound: blind_revisit_s + 2 (interval +
+// latency) + 0.2 s from its appearance to its channel's first record (records every 20 code periods: + 21 ms).
+TEST(ReceiverEngine, LowDutyBlindSearchStillFindsALateSatelliteWithinTheBound) {
+  test::TestSatellite late = satellite(21, -1500.0, 77.7);
+  late.start_s = 2.0;
+  const std::vector<test::TestSatellite> sats = {satellite(4, 2100.0, 300.3), satellite(9, -2900.0, 45.6),
+                                                 satellite(13, -700.0, 900.9), satellite(17, 3300.0, 610.1), late};
+  struct Log : ReceiverObserver {
+    std::vector<std::pair<std::int64_t, std::vector<AcquisitionResult>>> acquisitions;
+    std::optional<std::int64_t> first21;
+    void on_tracking(const TrackingRecord& r) override {
+      if (r.prn == 21 && !first21) first21 = r.sample_index;
+    }
+    void on_acquisition(std::int64_t first, const std::vector<AcquisitionResult>& results) override {
+      acquisitions.emplace_back(first, results);
+    }
+  };
+  const double revisit_s = 4.0, interval_s = 1.0, latency_s = 0.5;
+  const std::int64_t total = static_cast<std::int64_t>(9.5 * kFs);
+  const auto signal = test::generate(sats, test::TestSignal{kFs, true, 23}, 0, total);
+  ReceiverOptions options;
+  options.fs_hz = kFs;
+  options.prns = {2, 4, 6, 9, 11, 13, 17, 21, 25, 30};  // 6 missing after the cold start, none with an orbit
+  options.reacquisition_interval_s = interval_s;
+  options.reacquisition_latency_s = latency_s;
+  options.blind_revisit_s = revisit_s;
+  options.threads = 2;
+  Log log;
+  ReceiverEngine engine(options, log);
+  for (std::int64_t first = 0; first < total; first += 130000)
+    engine.process(std::span(signal.data() + first, static_cast<std::size_t>(std::min<std::int64_t>(130000, total - first))),
+                   first);
+  ASSERT_GE(log.acquisitions.size(), 5u);
+  EXPECT_EQ(log.acquisitions.front().second.size(), 10u);  // the cold start: every PRN
+  // 6 missing, snapshots every 20 ms + 0.5 s + 1 s: ceil(6 * 1.52 / 4) = 3 per snapshot (blind_prns_per_snapshot
+  // would allow 8), 2 once PRN 21 has a channel (ceil(5 * 1.52 / 4)).
+  for (std::size_t i = 1; i < log.acquisitions.size(); ++i) EXPECT_LE(log.acquisitions[i].second.size(), 3u) << i;
+  ASSERT_TRUE(log.first21.has_value()) << "the late satellite was never found";
+  const double bound_s = 2.0 + revisit_s + 2.0 * (interval_s + latency_s) + 0.2 + 0.021;
+  EXPECT_LE(static_cast<double>(*log.first21) / kFs, bound_s);
+  EXPECT_EQ(engine.channels_in_use(), 5);
+}
