@@ -33,13 +33,24 @@ void SamplePrefetcher::set_i16_gain(float gain) {
 
 void SamplePrefetcher::fill(Slot& slot) {
   const auto want = static_cast<std::size_t>(std::min<std::int64_t>(static_cast<std::int64_t>(block_size_), left_));
-  slot.where = want > 0 ? source_.read(std::span(slot.samples.data(), want)) : SampleBlock{source_.next_sample(), 0};
-  left_ -= static_cast<std::int64_t>(slot.where.count);
+  slot.where = SampleBlock{source_.next_sample(), 0};
   slot.i16_gain = i16_gain_.load();
-  if (slot.i16_gain > 0.0f && slot.where.count > 0) {
-    const int n = static_cast<int>(slot.where.count);
-    convert_to_planar_i16(slot.samples.data(), n, slot.i16_gain, slot.i16.data(), slot.i16.data() + n);
+  // In pieces of 16k samples (128 kB of floats), each converted while it is still in cache; the source's
+  // output does not depend on how its reads are split (phase-continuous IF removal).
+  constexpr std::size_t kPiece = 16384;
+  std::int16_t* re = slot.i16.data();
+  std::int16_t* im = re + want;  // planar: all I, then all Q, of the samples this block holds
+  while (slot.where.count < want) {
+    const std::size_t at = slot.where.count;
+    const SampleBlock got = source_.read(std::span(slot.samples.data() + at, std::min(kPiece, want - at)));
+    if (got.count == 0) break;
+    if (slot.i16_gain > 0.0f)
+      convert_to_planar_i16(slot.samples.data() + at, static_cast<int>(got.count), slot.i16_gain, re + at, im + at);
+    slot.where.count += got.count;
   }
+  if (slot.where.count < want && slot.where.count > 0 && slot.i16_gain > 0.0f)  // the file ended early: close up Q
+    std::copy(im, im + slot.where.count, re + slot.where.count);
+  left_ -= static_cast<std::int64_t>(slot.where.count);
 }
 
 void SamplePrefetcher::reader_loop() {
