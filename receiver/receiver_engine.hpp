@@ -2,8 +2,9 @@
 // size), it acquires satellites on a snapshot of the first samples (assisted by ephemeris and the last fix once
 // they exist; satellites predicted below the horizon by an ephemeris or a decoded almanac are searched only
 // rarely; those with no orbit known at a low duty cycle once 4 are in channels: ReceiverOptions::blind_revisit_s),
-// allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh snapshots, forms observables at common receive epochs (every observation_interval_s, in samples), and solves
-// PVT from them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
+// allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh snapshots,
+// forms observables at common receive epochs (every observation_interval_s, in samples), and solves PVT from
+// them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
 // Threads (receiver/worker_pool.hpp): the channels of each block run in parallel, each sample read once and
 // shared; a re-acquisition searches in the background and its satellites join at a fixed later sample. Every
 // observer call is made on the caller's thread in a fixed order, so the results are the same for any number
