@@ -38,6 +38,13 @@ concept ProcessModel = requires(const M& m, const StateVector<N>& x, double dt) 
 //          sigma points, the EKF at the estimate);
 //   H(x):  the Jacobian dh/dx at x (k x N; used by the EKF only, tested against numerical differentiation);
 //   R():   the measurement noise covariance (k x k).
+// A process model that is linear, f(x, dt) = transition(dt) x: the UKF then propagates P = Phi P Phi' + Qd
+// directly, which is what its sigma points give for a linear f (to rounding), at a fraction of the cost.
+template <class M, int N>
+concept LinearProcessModel = ProcessModel<M, N> && requires(const M& m, double dt) {
+  { m.transition(dt) } -> std::convertible_to<StateMatrix<N>>;
+};
+
 template <class M, int N>
 concept MeasurementModel = requires(const M& m, const StateVector<N>& x) {
   { m.z() } -> std::convertible_to<Eigen::VectorXd>;

@@ -5,6 +5,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <array>
+#include <cstddef>
 #include <limits>
 
 #include "fusion/chi_square.hpp"
@@ -15,9 +17,28 @@ namespace ultratrack::fusion {
 // Fills r.threshold and r.nis from r.innovation and S (symmetric, k x k, k = r.dof) and leaves S's Cholesky
 // factor in `llt`. True when the update may go ahead: S positive definite, the innovation finite and inside
 // the gate. r.nis is infinity when S or the innovation is unusable.
+// The gate's chi-square quantile, remembered per thread for the latest probability of each small dof (a filter
+// updating every 20 ms asks for the same few values; the quantile's series costs more than the update's algebra).
+inline double gate_threshold(double probability, int dof) {
+  constexpr int kMemo = 32;
+  thread_local std::array<double, kMemo> memo_p = [] {
+    std::array<double, kMemo> a;
+    a.fill(std::numeric_limits<double>::quiet_NaN());  // matches no probability
+    return a;
+  }();
+  thread_local std::array<double, kMemo> memo_q{};
+  if (dof <= 0 || dof >= kMemo) return chi_square_quantile(probability, dof);
+  const auto i = static_cast<std::size_t>(dof);
+  if (memo_p[i] != probability) {
+    memo_q[i] = chi_square_quantile(probability, dof);
+    memo_p[i] = probability;
+  }
+  return memo_q[i];
+}
+
 inline bool passes_innovation_gate(const GateOptions& gate, const Eigen::MatrixXd& S, UpdateResult& r,
                                    Eigen::LLT<Eigen::MatrixXd>& llt) {
-  r.threshold = gate.enabled ? chi_square_quantile(gate.probability, r.dof) : std::numeric_limits<double>::infinity();
+  r.threshold = gate.enabled ? gate_threshold(gate.probability, r.dof) : std::numeric_limits<double>::infinity();
   llt.compute(S);
   if (llt.info() != Eigen::Success || !r.innovation.allFinite()) {
     r.nis = std::numeric_limits<double>::infinity();

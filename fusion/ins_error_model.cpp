@@ -135,12 +135,17 @@ void InsErrorModel<N>::set_linearisation(const InsLinearisation& lin) {
 }
 
 template <int N>
-StateVector<N> InsErrorModel<N>::f(const StateVector<N>& x, double dt) const {
+const StateMatrix<N>& InsErrorModel<N>::transition(double dt) const {
   if (dt != cached_dt_) {
     cached_phi_ = discretise<N>(F_, StateMatrix<N>::Zero(), dt, opt_.discretisation).Phi;
     cached_dt_ = dt;
   }
-  return cached_phi_ * x;
+  return cached_phi_;
+}
+
+template <int N>
+StateVector<N> InsErrorModel<N>::f(const StateVector<N>& x, double dt) const {
+  return transition(dt) * x;
 }
 
 template <int N>

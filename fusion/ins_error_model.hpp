@@ -103,6 +103,8 @@ class InsErrorModel {
 
   // ProcessModel interface.
   StateVector<N> f(const StateVector<N>& x, double dt) const;
+  // Phi(dt) of f (LinearProcessModel: the UKF propagates its covariance with it directly).
+  const StateMatrix<N>& transition(double dt) const;
   StateMatrix<N> F(const StateVector<N>& /*x*/) const { return F_; }
   Eigen::Matrix<double, N, kNoiseSize> G(const StateVector<N>& /*x*/) const;
   Eigen::Matrix<double, kNoiseSize, kNoiseSize> Qc() const;

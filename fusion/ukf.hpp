@@ -66,7 +66,9 @@ class Ukf {
   Ukf(const Vector& x0, const Matrix& P0, UkfOptions options = {})
       : x_(x0), P_(P0), opt_(options), w_(sigma_weights<N>(options.sigma)) {}
 
-  // Sigma points through f, weighted mean and covariance plus Qd. dt >= 0.
+  // Sigma points through f, weighted mean and covariance plus Qd. dt >= 0. A LinearProcessModel skips the
+  // sigma points: with f(x) = Phi x they give mean Phi x and covariance Phi (sum_i Wc_i (X_i - x)(X_i - x)') Phi'
+  // = Phi L L' Phi' = Phi P Phi' (the weights of the 2N symmetric points sum to 1 / (N + lambda)), exactly.
   template <class M>
     requires ProcessModel<M, N>
   void predict(const M& model, double dt) {
@@ -74,6 +76,14 @@ class Ukf {
     const Eigen::Matrix<double, N, M::kNoiseSize> G = model.G(x_);
     const Matrix Qs = G * model.Qc() * G.transpose();
     const DiscreteProcess<N> d = discretise<N>(F, Qs, dt, opt_.discretisation);
+    if constexpr (LinearProcessModel<M, N>) {
+      const Matrix Phi = model.transition(dt);
+      x_ = Phi * x_;
+      P_ = Phi * P_ * Phi.transpose() + d.Qd;
+      keep_psd();
+      ++counters_.predictions;
+      return;
+    }
     Sigmas X = sigma_points();
     for (int i = 0; i < 2 * N + 1; ++i) X.col(i) = model.f(Vector(X.col(i)), dt);
     Vector mean = w_.mean0 * X.col(0);
@@ -105,11 +115,11 @@ class Ukf {
     for (int i = 1; i < 2 * N + 1; ++i) zbar += w_.other * Z.col(i);
     Eigen::MatrixXd S = R;
     Eigen::Matrix<double, N, Eigen::Dynamic> Pxz = Eigen::Matrix<double, N, Eigen::Dynamic>::Zero(N, k);
+    Z.colwise() -= zbar;  // the deviations, in place (no temporary per sigma point)
     for (int i = 0; i < 2 * N + 1; ++i) {
       const double wc = i == 0 ? w_.cov0 : w_.other;
-      const Eigen::VectorXd dz = Z.col(i) - zbar;
-      S += wc * dz * dz.transpose();
-      Pxz += wc * (X.col(i) - x_) * dz.transpose();
+      S.noalias() += (wc * Z.col(i)) * Z.col(i).transpose();
+      Pxz.noalias() += (wc * (X.col(i) - x_)) * Z.col(i).transpose();
     }
     S = 0.5 * (S + S.transpose());
     r.innovation = z - zbar;

@@ -180,7 +180,15 @@ class UltraTightCore final : public UltraTightCoreBase {
     if (!(T >= 1e-3 - 1e-12 && T <= 0.020 + 1e-12))
       throw std::invalid_argument("ultra-tight: integration time must lie in [1, 20] ms");
     T_ = T;
-    predict_satellites(sats_start_);
+    // Right after finish_period (same instant): its satellites, re-ranged from the updated nominal. The updates
+    // move the nominal by mm to m, the transmit time by 1e-11 to 1e-8 s: satellite states differ from a new
+    // prediction by 4 km/s x that (< 0.1 mm), and the two-pass iteration is half the driver's cost per period.
+    if (now_valid_ && now_t_s_ == nominal_.nav.t_s) {
+      sats_start_ = now_;
+      predict_ranges(sats_start_);
+    } else {
+      predict_satellites(sats_start_);
+    }
     replicas.clear();
     for (const SatelliteObservable& s : sats_start_) {
       ChannelState& ch = channels_[s.prn];
@@ -202,8 +210,10 @@ class UltraTightCore final : public UltraTightCoreBase {
     ++counters.periods;
     last_updates.clear();
     propagate();
-    std::vector<SatelliteObservable> now;
-    predict_satellites(now);
+    predict_satellites(now_);
+    now_valid_ = true;
+    now_t_s_ = nominal_.nav.t_s;
+    const std::vector<SatelliteObservable>& now = now_;
     auto lookup = [&](int prn, const ChannelCorrelation*& c, const SatelliteObservable*& s) {
       c = nullptr;
       s = nullptr;
@@ -292,8 +302,6 @@ class UltraTightCore final : public UltraTightCoreBase {
   // the transmit-time iteration through prepare_satellites, the pseudorange and rate then being predictions.
   void predict_satellites(std::vector<SatelliteObservable>& out) const {
     const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
-    const Eigen::Vector3d v_ant =
-        ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) * antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
     receiver::ObservationEpoch epoch;
     epoch.receive_time =
         signals::add_seconds(opt_.gps_time_origin, nominal_.nav.t_s + nominal_.clock_bias_m / kC);
@@ -321,7 +329,15 @@ class UltraTightCore final : public UltraTightCoreBase {
         epoch.observations.push_back(ob);
       }
     }
-    for (auto& s : out) {
+    predict_ranges(out);
+  }
+
+  // Pseudorange and rate of each satellite from the current nominal (antenna position/velocity, clock).
+  void predict_ranges(std::vector<SatelliteObservable>& sats) const {
+    const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
+    const Eigen::Vector3d v_ant =
+        ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) * antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
+    for (auto& s : sats) {
       s.pseudorange_m = predicted_pseudorange_m(s, r_ant, nominal_.clock_bias_m);
       s.range_rate_mps = predicted_range_rate_mps(s, r_ant, v_ant, nominal_.clock_drift_mps);
       s.has_rate = true;
@@ -388,6 +404,9 @@ class UltraTightCore final : public UltraTightCoreBase {
   Filter filter_;
   NominalState nominal_;
   std::vector<SatelliteObservable> sats_start_;
+  std::vector<SatelliteObservable> now_;  // finish_period's satellites at now_t_s_ (before its updates)
+  bool now_valid_ = false;
+  double now_t_s_ = 0.0;
   std::map<int, ChannelState> channels_;
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;

@@ -9,6 +9,7 @@
 #include "fusion/chi_square.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/ekf.hpp"
+#include "fusion/ins_error_model.hpp"
 #include "fusion/ukf.hpp"
 
 namespace ultratrack::fusion {
@@ -138,6 +139,67 @@ TEST(Ukf, EqualsLinearKalmanFilterOnLinearGaussianModel) {
     EXPECT_LT((ukf.P() - P).cwiseAbs().maxCoeff(), 1e-9) << "step " << k;
     EXPECT_LT((ekf.x() - x).cwiseAbs().maxCoeff(), 1e-9) << "step " << k;
     EXPECT_LT((ekf.P() - P).cwiseAbs().maxCoeff(), 1e-9) << "step " << k;
+  }
+}
+
+// The INS error model is linear (f = Phi x): the UKF propagates it as Phi P Phi' + Qd without sigma points. The
+// same model with its transition hidden goes through the 35 sigma points; both must agree to rounding, with a
+// full, strongly scaled covariance (clock bias 1e4 m beside attitude 1e-3 rad) and a nonzero mean.
+struct SigmaPointsOnly {
+  static constexpr int kNoiseSize = InsErrorModel<17>::kNoiseSize;
+  const InsErrorModel<17>* m;
+  StateVector<17> f(const StateVector<17>& x, double dt) const { return m->f(x, dt); }
+  StateMatrix<17> F(const StateVector<17>& x) const { return m->F(x); }
+  Eigen::Matrix<double, 17, kNoiseSize> G(const StateVector<17>& x) const { return m->G(x); }
+  Eigen::Matrix<double, kNoiseSize, kNoiseSize> Qc() const { return m->Qc(); }
+};
+static_assert(LinearProcessModel<InsErrorModel<17>, 17>);
+static_assert(ProcessModel<SigmaPointsOnly, 17> && !LinearProcessModel<SigmaPointsOnly, 17>);
+
+TEST(Ukf, LinearModelShortcutEqualsSigmaPointPropagation) {
+  InsErrorModelOptions o;
+  o.accel.bias_sigma = 1e-2;
+  o.accel.white_noise_psd = 1e-6;
+  o.gyro.bias_sigma = 1e-5;
+  o.gyro.white_noise_psd = 1e-9;
+  InsErrorModel<17> model(o);
+  InsLinearisation lin;
+  lin.nav.lat_rad = 0.62;
+  lin.nav.lon_rad = 2.39;
+  lin.nav.height_m = 1000.0;
+  lin.nav.v_n = Eigen::Vector3d(120.0, -70.0, 1.0);
+  lin.nav.q_nb = Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.1, 0.2, 1.0).normalized()));
+  lin.f_b = Eigen::Vector3d(3.0, 9.0, -9.6);  // turning: a large horizontal specific force
+  lin.w_ib_b = Eigen::Vector3d(0.01, -0.02, 0.3);
+  model.set_linearisation(lin);
+  const SigmaPointsOnly sigma_only{&model};
+  StateVector<17> scale;
+  scale << 3, 3, 5, 0.1, 0.1, 0.2, 1e-3, 1e-3, 5e-3, 1e-2, 1e-2, 1e-2, 1e-5, 1e-5, 1e-5, 1e4, 100;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n01;
+  StateMatrix<17> A;
+  for (int i = 0; i < 17; ++i)
+    for (int j = 0; j < 17; ++j) A(i, j) = n01(rng);
+  const StateMatrix<17> C = (A * A.transpose() / 17.0 + 0.1 * StateMatrix<17>::Identity());  // correlated, SPD
+  const StateMatrix<17> P0 = scale.asDiagonal() * C * scale.asDiagonal();
+  StateVector<17> x0;
+  for (int i = 0; i < 17; ++i) x0(i) = 0.5 * scale(i) * n01(rng);
+  for (Discretisation d : {Discretisation::SecondOrderSeries, Discretisation::VanLoan}) {
+    UkfOptions uo;
+    uo.discretisation = d;
+    Ukf<17> direct(x0, P0, uo), sigma(x0, P0, uo);
+    for (int k = 0; k < 25; ++k) {
+      const double dt = k % 2 ? 0.02 : 0.013;
+      direct.predict(model, dt);
+      sigma.predict(sigma_only, dt);
+    }
+    // Relative to each element's own scale: rounding of 35 weighted outer products is ~1e-14 of it.
+    const StateVector<17> sd = sigma.P().diagonal().cwiseSqrt();
+    const StateMatrix<17> rel = (direct.P() - sigma.P()).cwiseQuotient(sd * sd.transpose());
+    EXPECT_LT(rel.cwiseAbs().maxCoeff(), 1e-11);
+    EXPECT_LT((direct.x() - sigma.x()).cwiseQuotient(sd).cwiseAbs().maxCoeff(), 1e-11);
+    EXPECT_GT((direct.P() - P0).cwiseQuotient(sd * sd.transpose()).cwiseAbs().maxCoeff(), 1e-3);  // it moved
+    EXPECT_EQ(direct.counters().predictions, 25);
   }
 }
 
