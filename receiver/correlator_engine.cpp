@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 
@@ -356,23 +357,28 @@ void correlate_i16_portable(const std::int8_t* table, const std::int16_t* /*tabl
   }
 }
 
-// Per chunk: for each tap, the first tap with the same 22-bit fraction (its chip indices serve this tap too).
-ULTRATRACK_ALWAYS_INLINE void tap_leaders(const std::uint32_t* frac, int num_taps, int* leader) {
-  for (int t = 0; t < num_taps; ++t) {
-    leader[t] = t;
-    for (int u = 0; u < t; ++u)
-      if (frac[u] == frac[t]) {
-        leader[t] = u;
-        break;
-      }
-  }
-}
-
 // Chip indices of a group of L samples without a multiply or a shift per lane: with S l = h_l 2^22 + g_l
 // (g_l < 2^22) fixed per call, the index of lane l relative to the group's first chip, for the group's 22-bit
 // fraction q, is floor((q + S l) / 2^22) = h_l + [q + g_l >= 2^22] = h_l + [q >= 2^22 - g_l]: one compare
 // against a per-call threshold per lane (exactly the portable copy's index, as q + g_l < 2^23).
 constexpr std::uint32_t kFracMask = (1u << kFracBits) - 1;
+
+// Which taps reuse another tap's chip indices, fixed per engine (taps whole chips apart, e.g. early/late at
+// +-0.5 and prompt/noise): 3 bits per tap, the index of the tap whose indices it reuses (itself if none).
+// A compile-time pattern, so that the shared indices stay in registers (a pattern read at run time made the
+// compiler keep them in memory and cost more than it saved).
+constexpr int share_leader(std::uint32_t share, int t) { return static_cast<int>((share >> (3 * t)) & 7u); }
+constexpr std::uint32_t share_code(std::initializer_list<int> leaders) {
+  std::uint32_t code = 0;
+  int t = 0;
+  for (const int l : leaders) code |= static_cast<std::uint32_t>(l) << (3 * t++);
+  return code;
+}
+constexpr std::uint32_t no_sharing(int taps) {
+  std::uint32_t code = 0;
+  for (int t = 0; t < taps; ++t) code |= static_cast<std::uint32_t>(t) << (3 * t);
+  return code;
+}
 
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
 // The AVX2 copy: 16 samples per step. Per group of taps sharing a fraction: the 16 relative chip indices
@@ -380,7 +386,69 @@ constexpr std::uint32_t kFracMask = (1u << kFracBits) - 1;
 // threshold lanes are laid out so that the packs give natural sample order); per tap: one 16-byte load of
 // chips, one byte shuffle, a widening to int16, then two pmaddwd (in-phase, quadrature) into int32 lanes. The
 // last n % 16 samples of a chunk go through the same step from a zero-padded copy (zero samples add nothing).
-template <int kTaps>
+struct LaneIndexAvx2 {  // per call: thresholds 2^22 - 1 - g_l in pack order, whole parts h_l as bytes
+  __m256i below_lo, below_hi;
+  __m128i whole;
+};
+
+template <int kTaps, std::uint32_t kShare>
+__attribute__((target("avx2,fma"), always_inline)) inline void avx2_chunk(const std::int16_t* xr_p, const std::int16_t* xi_p, int n,
+                                                                         const CorrelatorEngine::Rotation& rot,
+                                                                         const std::int8_t* const* base, const std::uint32_t* frac,
+                                                                         std::uint32_t step, const LaneIndexAvx2& lanes,
+                                                                         std::int64_t* re, std::int64_t* im) {
+  __m256i acc_re[kTaps], acc_im[kTaps];
+  for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm256_setzero_si256();
+  for (int i = 0; i < n; i += 16) {
+    __m256i xr, xi;
+    if (i + 16 <= n) {
+      xr = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xr_p + i));
+      xi = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xi_p + i));
+    } else {
+      alignas(32) std::int16_t pr[16] = {}, pi[16] = {};
+      std::memcpy(pr, xr_p + i, sizeof(std::int16_t) * static_cast<std::size_t>(n - i));
+      std::memcpy(pi, xi_p + i, sizeof(std::int16_t) * static_cast<std::size_t>(n - i));
+      xr = _mm256_load_si256(reinterpret_cast<const __m256i*>(pr));
+      xi = _mm256_load_si256(reinterpret_cast<const __m256i*>(pi));
+    }
+    const __m256i rr = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.re + i));
+    const __m256i ri = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.im + i));
+    const __m256i wr = _mm256_adds_epi16(_mm256_mulhrs_epi16(xr, rr), _mm256_mulhrs_epi16(xi, ri));
+    const __m256i wi = _mm256_subs_epi16(_mm256_mulhrs_epi16(xi, rr), _mm256_mulhrs_epi16(xr, ri));
+    __m128i rel[kTaps];
+    std::uint32_t first[kTaps];
+#pragma GCC unroll 8
+    for (int t = 0; t < kTaps; ++t) {
+      const int lead = share_leader(kShare, t);
+      if (lead == t) {
+        const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
+        first[t] = p >> kFracBits;
+        const __m256i q = _mm256_set1_epi32(static_cast<int>(p & kFracMask));
+        const __m256i carry = _mm256_packs_epi32(_mm256_cmpgt_epi32(q, lanes.below_lo), _mm256_cmpgt_epi32(q, lanes.below_hi));
+        rel[t] = _mm_sub_epi8(lanes.whole, _mm_packs_epi16(_mm256_castsi256_si128(carry), _mm256_extracti128_si256(carry, 1)));
+      } else {
+        rel[t] = rel[lead];
+        first[t] = first[lead];
+      }
+      const __m128i window = _mm_loadu_si128(reinterpret_cast<const __m128i*>(base[t] + first[t]));
+      const __m256i chips = _mm256_cvtepi8_epi16(_mm_shuffle_epi8(window, rel[t]));
+      acc_re[t] = _mm256_add_epi32(acc_re[t], _mm256_madd_epi16(wr, chips));
+      acc_im[t] = _mm256_add_epi32(acc_im[t], _mm256_madd_epi16(wi, chips));
+    }
+  }
+  for (int t = 0; t < kTaps; ++t) {
+    alignas(32) std::int32_t lr[8], li[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(lr), acc_re[t]);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(li), acc_im[t]);
+    re[t] = im[t] = 0;
+    for (int l = 0; l < 8; ++l) {
+      re[t] += lr[l];
+      im[t] += li[l];
+    }
+  }
+}
+
+template <int kTaps, std::uint32_t kShare>
 __attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* table, const std::int16_t* table16,
                                                            const double* offsets, int num_taps,
                                                            std::span<const PlanarI16> antennas, int num_samples,
@@ -400,80 +468,34 @@ __attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* t
     below[slot] = static_cast<std::int32_t>(kFracMask - (a & kFracMask));
     lane_whole[l] = static_cast<std::int8_t>(a >> kFracBits);
   }
-  const __m256i below_lo = _mm256_load_si256(reinterpret_cast<const __m256i*>(below));
-  const __m256i below_hi = _mm256_load_si256(reinterpret_cast<const __m256i*>(below + 8));
-  const __m128i whole_lanes = _mm_load_si128(reinterpret_cast<const __m128i*>(lane_whole));
+  const LaneIndexAvx2 lanes{_mm256_load_si256(reinterpret_cast<const __m256i*>(below)),
+                            _mm256_load_si256(reinterpret_cast<const __m256i*>(below + 8)),
+                            _mm_load_si128(reinterpret_cast<const __m128i*>(lane_whole))};
   for (int start = 0; start < num_samples; start += kChunkI16) {
     const int n = num_samples - start < kChunkI16 ? num_samples - start : kChunkI16;
     int whole[kMaxTaps];
     std::uint32_t frac[kMaxTaps];
     chunk_taps(rep, offsets, kTaps, start, whole, frac);
-    int leader[kMaxTaps];
-    tap_leaders(frac, kTaps, leader);
+    const std::int8_t* base[kTaps];
+    bool shared = true;  // the engine's pattern holds in this chunk (equal fractions: exact, as in the portable copy)
+    for (int t = 0; t < kTaps; ++t) {
+      base[t] = table + whole[t];
+      shared = shared && frac[share_leader(kShare, t)] == frac[t];
+    }
     const std::uint32_t phase0 = chunk_phase(rep, rot.step_q32, start, n);
     for (std::size_t a = 0; a < antennas.size(); ++a) {
-      const std::int16_t* xr_p = antennas[a].re + start;
-      const std::int16_t* xi_p = antennas[a].im + start;
-      __m256i acc_re[kTaps], acc_im[kTaps];
-      for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm256_setzero_si256();
-      for (int i = 0; i < n; i += 16) {
-        __m256i xr, xi;
-        if (i + 16 <= n) {
-          xr = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xr_p + i));
-          xi = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xi_p + i));
-        } else {
-          alignas(32) std::int16_t pr[16] = {}, pi[16] = {};
-          std::memcpy(pr, xr_p + i, sizeof(std::int16_t) * static_cast<std::size_t>(n - i));
-          std::memcpy(pi, xi_p + i, sizeof(std::int16_t) * static_cast<std::size_t>(n - i));
-          xr = _mm256_load_si256(reinterpret_cast<const __m256i*>(pr));
-          xi = _mm256_load_si256(reinterpret_cast<const __m256i*>(pi));
-        }
-        const __m256i rr = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.re + i));
-        const __m256i ri = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.im + i));
-        const __m256i wr = _mm256_adds_epi16(_mm256_mulhrs_epi16(xr, rr), _mm256_mulhrs_epi16(xi, ri));
-        const __m256i wi = _mm256_subs_epi16(_mm256_mulhrs_epi16(xi, rr), _mm256_mulhrs_epi16(xr, ri));
-        __m128i rel[kTaps];
-        int first[kTaps];
-        for (int t = 0; t < kTaps; ++t) {
-          if (leader[t] != t) {
-            rel[t] = rel[leader[t]];
-            first[t] = first[leader[t]];
-          } else {
-            const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
-            first[t] = static_cast<int>(p >> kFracBits);
-            const __m256i q = _mm256_set1_epi32(static_cast<int>(p & kFracMask));
-            const __m256i carry = _mm256_packs_epi32(_mm256_cmpgt_epi32(q, below_lo), _mm256_cmpgt_epi32(q, below_hi));
-            rel[t] = _mm_sub_epi8(whole_lanes, _mm_packs_epi16(_mm256_castsi256_si128(carry), _mm256_extracti128_si256(carry, 1)));
-          }
-          const __m128i window = _mm_loadu_si128(reinterpret_cast<const __m128i*>(table + whole[t] + first[t]));
-          const __m256i chips = _mm256_cvtepi8_epi16(_mm_shuffle_epi8(window, rel[t]));
-          acc_re[t] = _mm256_add_epi32(acc_re[t], _mm256_madd_epi16(wr, chips));
-          acc_im[t] = _mm256_add_epi32(acc_im[t], _mm256_madd_epi16(wi, chips));
-        }
-      }
-      std::int64_t re[kMaxTaps] = {}, im[kMaxTaps] = {};
-      for (int t = 0; t < kTaps; ++t) {
-        alignas(32) std::int32_t lr[8], li[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(lr), acc_re[t]);
-        _mm256_store_si256(reinterpret_cast<__m256i*>(li), acc_im[t]);
-        for (int l = 0; l < 8; ++l) {
-          re[t] += lr[l];
-          im[t] += li[l];
-        }
-      }
+      std::int64_t re[kMaxTaps], im[kMaxTaps];
+      if (kShare == no_sharing(kTaps) || !shared)
+        avx2_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+      else
+        avx2_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
       finish_chunk(re, im, kTaps, phase0, scale, sums[a]);
     }
   }
 }
 
-// The AVX-512 copy (BW, VL, VNNI): 32 samples per step. Chips as int16: per group of taps sharing a fraction,
-// the 32 relative indices (0..31) from two compares into a mask and one masked add; per tap one 64-byte load of
-// chips and one word permute (vpermw), then two vpdpwssd (multiply pairs and accumulate into int32, the
-// pmaddwd + add of the AVX2 copy in one instruction: same products, exact). The chunk's last n % 32 samples
-// run through the same step with masked (zeroing) sample loads. Lane sums per chunk stay below
-// 32 steps * 2 * 32768 = 2^21 (one chunk is 1024 samples), so the int32 reductions are exact.
-// Sum of the 16 int32 lanes (exact: see the bound above). Zero-masked extracts: GCC 12's plain ones (and
-// _mm512_reduce_add_epi32, _mm512_castsi512_si256) warn about an undefined register.
+// Sum of the 16 int32 lanes. Zero-masked extracts: GCC 12's plain ones (and _mm512_reduce_add_epi32,
+// _mm512_castsi512_si256) warn about an undefined register.
 __attribute__((target("avx2,avx512f"), always_inline)) inline std::int32_t lane_sum(__m512i v) {
   const __m256i h = _mm256_add_epi32(_mm512_maskz_extracti64x4_epi64(0xFF, v, 0), _mm512_maskz_extracti64x4_epi64(0xFF, v, 1));
   __m128i x = _mm_add_epi32(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
@@ -482,7 +504,58 @@ __attribute__((target("avx2,avx512f"), always_inline)) inline std::int32_t lane_
   return _mm_cvtsi128_si32(x);
 }
 
-template <int kTaps>
+// The AVX-512 copy (BW, VL, VNNI): 32 samples per step. Chips as int16: per group of taps sharing a fraction,
+// the 32 relative indices (0..31) from two compares into a mask and one masked add; per tap one 64-byte load of
+// chips and one word permute (vpermw), then two vpdpwssd (multiply pairs and accumulate into int32, the
+// pmaddwd + add of the AVX2 copy in one instruction: same products, exact). The chunk's last n % 32 samples
+// run through the same step with masked (zeroing) sample loads. Lane sums per chunk stay below
+// 32 steps * 2 * 32768 = 2^21 (one chunk is 1024 samples), so the int32 reductions are exact.
+struct LaneIndex {  // per call: lane l's threshold 2^22 - g_l and whole part h_l (see the comment above kFracMask)
+  __m512i threshold_lo, threshold_hi, whole;
+};
+
+template <int kTaps, std::uint32_t kShare>
+__attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"), always_inline)) inline void avx512_chunk(
+    const std::int16_t* xr_p, const std::int16_t* xi_p, int n, const CorrelatorEngine::Rotation& rot,
+    const std::int16_t* const* base, const std::uint32_t* frac, std::uint32_t step, const LaneIndex& lanes,
+    std::int64_t* re, std::int64_t* im) {
+  const __m512i one = _mm512_set1_epi16(1);
+  __m512i acc_re[kTaps], acc_im[kTaps];
+  for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm512_setzero_si512();
+  for (int i = 0; i < n; i += 32) {
+    const __mmask32 valid = n - i >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1u << (n - i)) - 1u);
+    const __m512i xr = _mm512_maskz_loadu_epi16(valid, xr_p + i);
+    const __m512i xi = _mm512_maskz_loadu_epi16(valid, xi_p + i);
+    const __m512i rr = _mm512_load_si512(rot.re + i), ri = _mm512_load_si512(rot.im + i);
+    const __m512i wr = _mm512_adds_epi16(_mm512_mulhrs_epi16(xr, rr), _mm512_mulhrs_epi16(xi, ri));
+    const __m512i wi = _mm512_subs_epi16(_mm512_mulhrs_epi16(xi, rr), _mm512_mulhrs_epi16(xr, ri));
+    __m512i rel[kTaps];
+    std::uint32_t first[kTaps];
+#pragma GCC unroll 8
+    for (int t = 0; t < kTaps; ++t) {
+      const int lead = share_leader(kShare, t);
+      if (lead == t) {
+        const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
+        first[t] = p >> kFracBits;
+        const __m512i q = _mm512_set1_epi32(static_cast<int>(p & kFracMask));
+        const __mmask32 carry = _mm512_kunpackw(_mm512_cmpge_epu32_mask(q, lanes.threshold_hi), _mm512_cmpge_epu32_mask(q, lanes.threshold_lo));
+        rel[t] = _mm512_mask_add_epi16(lanes.whole, carry, lanes.whole, one);
+      } else {
+        rel[t] = rel[lead];
+        first[t] = first[lead];
+      }
+      const __m512i chips = _mm512_permutexvar_epi16(rel[t], _mm512_loadu_si512(base[t] + first[t]));
+      acc_re[t] = _mm512_dpwssd_epi32(acc_re[t], wr, chips);
+      acc_im[t] = _mm512_dpwssd_epi32(acc_im[t], wi, chips);
+    }
+  }
+  for (int t = 0; t < kTaps; ++t) {
+    re[t] = lane_sum(acc_re[t]);
+    im[t] = lane_sum(acc_im[t]);
+  }
+}
+
+template <int kTaps, std::uint32_t kShare>
 __attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"))) void correlate_i16_avx512(
     const std::int8_t* table, const std::int16_t* table16, const double* offsets, int num_taps,
     std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& rep,
@@ -492,63 +565,70 @@ __attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"))) void co
     return;
   }
   const std::uint32_t step = step_q24(rep);
-  alignas(64) std::uint32_t threshold[32];  // 2^22 - g_l
+  alignas(64) std::uint32_t threshold[32];
   alignas(64) std::int16_t lane_whole[32];
   for (int l = 0; l < 32; ++l) {
     const std::uint32_t a = step * static_cast<std::uint32_t>(l);
     threshold[l] = (1u << kFracBits) - (a & kFracMask);
     lane_whole[l] = static_cast<std::int16_t>(a >> kFracBits);
   }
-  const __m512i threshold_lo = _mm512_load_si512(threshold), threshold_hi = _mm512_load_si512(threshold + 16);
-  const __m512i whole_lanes = _mm512_load_si512(lane_whole);
-  const __m512i one = _mm512_set1_epi16(1);
+  const LaneIndex lanes{_mm512_load_si512(threshold), _mm512_load_si512(threshold + 16), _mm512_load_si512(lane_whole)};
   for (int start = 0; start < num_samples; start += kChunkI16) {
     const int n = num_samples - start < kChunkI16 ? num_samples - start : kChunkI16;
     int whole[kMaxTaps];
     std::uint32_t frac[kMaxTaps];
     chunk_taps(rep, offsets, kTaps, start, whole, frac);
-    int leader[kMaxTaps];
-    tap_leaders(frac, kTaps, leader);
+    const std::int16_t* base[kTaps];
+    bool shared = true;  // the engine's pattern holds in this chunk (equal fractions: exact, as in the portable copy)
+    for (int t = 0; t < kTaps; ++t) {
+      base[t] = table16 + whole[t];
+      shared = shared && frac[share_leader(kShare, t)] == frac[t];
+    }
     const std::uint32_t phase0 = chunk_phase(rep, rot.step_q32, start, n);
     for (std::size_t a = 0; a < antennas.size(); ++a) {
-      const std::int16_t* xr_p = antennas[a].re + start;
-      const std::int16_t* xi_p = antennas[a].im + start;
-      __m512i acc_re[kTaps], acc_im[kTaps];
-      for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm512_setzero_si512();
-      for (int i = 0; i < n; i += 32) {
-        const __mmask32 valid = n - i >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1u << (n - i)) - 1u);
-        const __m512i xr = _mm512_maskz_loadu_epi16(valid, xr_p + i);
-        const __m512i xi = _mm512_maskz_loadu_epi16(valid, xi_p + i);
-        const __m512i rr = _mm512_load_si512(rot.re + i), ri = _mm512_load_si512(rot.im + i);
-        const __m512i wr = _mm512_adds_epi16(_mm512_mulhrs_epi16(xr, rr), _mm512_mulhrs_epi16(xi, ri));
-        const __m512i wi = _mm512_subs_epi16(_mm512_mulhrs_epi16(xi, rr), _mm512_mulhrs_epi16(xr, ri));
-        __m512i rel[kTaps];
-        int first[kTaps];
-        for (int t = 0; t < kTaps; ++t) {
-          if (leader[t] != t) {
-            rel[t] = rel[leader[t]];
-            first[t] = first[leader[t]];
-          } else {
-            const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
-            first[t] = static_cast<int>(p >> kFracBits);
-            const __m512i q = _mm512_set1_epi32(static_cast<int>(p & kFracMask));
-            const __mmask32 carry = _mm512_kunpackw(_mm512_cmpge_epu32_mask(q, threshold_hi), _mm512_cmpge_epu32_mask(q, threshold_lo));
-            rel[t] = _mm512_mask_add_epi16(whole_lanes, carry, whole_lanes, one);
-          }
-          const __m512i chips = _mm512_permutexvar_epi16(rel[t], _mm512_loadu_si512(table16 + whole[t] + first[t]));
-          acc_re[t] = _mm512_dpwssd_epi32(acc_re[t], wr, chips);
-          acc_im[t] = _mm512_dpwssd_epi32(acc_im[t], wi, chips);
-        }
-      }
       std::int64_t re[kMaxTaps], im[kMaxTaps];
-      for (int t = 0; t < kTaps; ++t) {
-        re[t] = lane_sum(acc_re[t]);
-        im[t] = lane_sum(acc_im[t]);
-      }
+      if (kShare == no_sharing(kTaps) || !shared)
+        avx512_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+      else
+        avx512_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
       finish_chunk(re, im, kTaps, phase0, scale, sums[a]);
     }
   }
 }
+
+// A vector kernel for an engine's tap count and sharing pattern: the receiver's (early/prompt/late/noise;
+// prompt/noise for further antennas; early/prompt/late) and the benchmarks' are compiled with sharing; any
+// other pattern runs without it.
+struct Avx2Kernels {
+  template <int kTaps, std::uint32_t kShare>
+  static constexpr CorrelatorEngine::KernelI16 get() { return &correlate_i16_avx2<kTaps, kShare>; }
+};
+struct Avx512Kernels {
+  template <int kTaps, std::uint32_t kShare>
+  static constexpr CorrelatorEngine::KernelI16 get() { return &correlate_i16_avx512<kTaps, kShare>; }
+};
+
+template <int kTaps, class Kernels>
+CorrelatorEngine::KernelI16 select_shared(std::uint32_t share) {
+  constexpr std::uint32_t kPatterns[] = {share_code({0, 0}),          share_code({0, 1, 0}),
+                                         share_code({0, 1, 1}),       share_code({0, 1, 0, 1}),
+                                         share_code({0, 1, 1, 0, 0}), share_code({0, 1, 0, 1, 0})};
+#define ULTRATRACK_SHARE_CASE(k) \
+  if (share == kPatterns[k]) return Kernels::template get<kTaps, kPatterns[k]>();
+  if constexpr (kTaps == 2) ULTRATRACK_SHARE_CASE(0)
+  if constexpr (kTaps == 3) {
+    ULTRATRACK_SHARE_CASE(1)
+    ULTRATRACK_SHARE_CASE(2)
+  }
+  if constexpr (kTaps == 4) ULTRATRACK_SHARE_CASE(3)
+  if constexpr (kTaps == 5) {
+    ULTRATRACK_SHARE_CASE(4)
+    ULTRATRACK_SHARE_CASE(5)
+  }
+#undef ULTRATRACK_SHARE_CASE
+  return Kernels::template get<kTaps, no_sharing(kTaps)>();
+}
+
 __attribute__((target("avx2,fma"))) void convert_planar_avx2(const std::complex<float>* in, int n, float gain, std::int16_t* re,
                                                             std::int16_t* im) {
   const float* x = reinterpret_cast<const float*>(in);
@@ -645,10 +725,10 @@ CorrelatorEngine::Kernel select_kernel([[maybe_unused]] CorrelatorIsa isa) {
 }
 
 template <int kTaps>
-CorrelatorEngine::KernelI16 select_kernel_i16([[maybe_unused]] CorrelatorIsa isa) {
+CorrelatorEngine::KernelI16 select_kernel_i16([[maybe_unused]] CorrelatorIsa isa, [[maybe_unused]] std::uint32_t share) {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-  if (isa == CorrelatorIsa::kAvx512) return &correlate_i16_avx512<kTaps>;
-  if (isa == CorrelatorIsa::kAvx2) return &correlate_i16_avx2<kTaps>;
+  if (isa == CorrelatorIsa::kAvx512) return select_shared<kTaps, Avx512Kernels>(share);
+  if (isa == CorrelatorIsa::kAvx2) return select_shared<kTaps, Avx2Kernels>(share);
 #endif
   return &correlate_i16_portable;
 }
@@ -676,13 +756,20 @@ CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_
   table_i16_.resize(table_.size() + 64);  // the AVX-512 copy reads 32-word windows past the last chip used
   for (int i = 0; i < static_cast<int>(table_i16_.size()); ++i) table_i16_[i] = static_cast<std::int16_t>(chips[i % kCodeLength]);
   const CorrelatorIsa level = resolve_isa(isa);
+  std::uint32_t share = 0;  // per tap: the first tap a whole number of chips from it (the AVX-512 copy's pattern)
+  for (int t = 0; t < num_taps_; ++t) {
+    int lead = t;
+    for (int u = 0; u < t && lead == t; ++u)
+      if (const double d = offsets_[t] - offsets_[u]; d == std::floor(d)) lead = u;
+    share |= static_cast<std::uint32_t>(lead) << (3 * t);
+  }
   switch (num_taps_) {
-    case 1: kernel_ = select_kernel<1>(level); kernel_i16_ = select_kernel_i16<1>(level); break;
-    case 2: kernel_ = select_kernel<2>(level); kernel_i16_ = select_kernel_i16<2>(level); break;
-    case 3: kernel_ = select_kernel<3>(level); kernel_i16_ = select_kernel_i16<3>(level); break;
-    case 4: kernel_ = select_kernel<4>(level); kernel_i16_ = select_kernel_i16<4>(level); break;
-    case 5: kernel_ = select_kernel<5>(level); kernel_i16_ = select_kernel_i16<5>(level); break;
-    default: kernel_ = select_kernel<6>(level); kernel_i16_ = select_kernel_i16<6>(level); break;
+    case 1: kernel_ = select_kernel<1>(level); kernel_i16_ = select_kernel_i16<1>(level, share); break;
+    case 2: kernel_ = select_kernel<2>(level); kernel_i16_ = select_kernel_i16<2>(level, share); break;
+    case 3: kernel_ = select_kernel<3>(level); kernel_i16_ = select_kernel_i16<3>(level, share); break;
+    case 4: kernel_ = select_kernel<4>(level); kernel_i16_ = select_kernel_i16<4>(level, share); break;
+    case 5: kernel_ = select_kernel<5>(level); kernel_i16_ = select_kernel_i16<5>(level, share); break;
+    default: kernel_ = select_kernel<6>(level); kernel_i16_ = select_kernel_i16<6>(level, share); break;
   }
 }
 

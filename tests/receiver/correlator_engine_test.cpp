@@ -393,9 +393,12 @@ TEST(CorrelatorEngine, IntegerKernelEveryCopyIsBitIdenticalToPortable) {
   std::mt19937 rng(23);
   std::normal_distribution<float> noise(0.0f, 20.0f);
   std::uniform_real_distribution<double> u(0.0, 1.0);
+  // Tap sets whose taps are whole chips apart share chip indices in the vector copies (compiled patterns:
+  // E/P/L, P/E/L, E/P/L/noise, prompt/noise, five taps either order); the rest do not share.
   const std::vector<std::vector<double>> layouts = {
-      {0.0}, {0.5, 0.0, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0},
-      {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}};
+      {0.0}, {0.5, 0.0, -0.5}, {0.0, 0.5, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)},
+      {0.0, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0}, {0.0, 0.5, -0.5, 1.0, -1.0},
+      {0.1, 0.0, -0.9}, {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}};
   const int lengths[] = {1, 7, 31, 32, 33, 100, 1023, 1024, 1025, 1300, 2049, 3001};
   const double steps[] = {1.023e6 / 16e6, 1.023e6 / 4e6, 1.023e6 / 2.6e6, 0.99, 1.2};
   int compared = 0;
@@ -445,7 +448,7 @@ TEST(CorrelatorEngine, IntegerKernelEveryCopyIsBitIdenticalToPortable) {
       }
     }
   }
-  EXPECT_EQ(compared, static_cast<int>(copies.size()) * 60 * 4 * (1 + 3 + 4 + 5 + 6));  // 60 x 1 + 60 x 3 antennas
+  EXPECT_EQ(compared, static_cast<int>(copies.size()) * 60 * 4 * (1 + 3 + 3 + 4 + 2 + 5 + 5 + 3 + 6));  // 60 x 1 + 60 x 3 antennas
 }
 
 // A level the CPU lacks is refused, never silently replaced; kAuto resolves to an available level.
