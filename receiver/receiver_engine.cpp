@@ -161,22 +161,26 @@ void ReceiverEngine::start_acquisition(std::int64_t end_sample) {
     where = Eigen::Vector3d((*options_.approximate_r_e_m)[0], (*options_.approximate_r_e_m)[1],
                             (*options_.approximate_r_e_m)[2]);
   const bool can_predict = where && clock_;
-  std::vector<int> blind, hidden;
+  std::vector<int> blind, hidden, unknown;  // unknown: blind for want of an orbit (or of position and time)
   for (int prn : missing_prns()) {
     if (!can_predict) {
       blind.push_back(prn);
+      unknown.push_back(prn);
       continue;
     }
     bool below = false;
-    const auto window = assistance(prn, clock_->time_at(snapshot_first_), *where, &below);
+    const signals::GpsTime t = clock_->time_at(snapshot_first_);
+    const auto window = assistance(prn, t, *where, &below);
     if (below) {
       hidden.push_back(prn);
       continue;
     }
-    if (window)
+    if (window) {
       search_.assisted.emplace_back(prn, *window);
-    else
+    } else {
       blind.push_back(prn);
+      if (!orbit_of(prn, t)) unknown.push_back(prn);
+    }
   }
   const bool cold = channels_in_use() == 0;
   if (cold && options_.integer_correlator && i16_gain_ == 0.0f) {
@@ -188,17 +192,43 @@ void ReceiverEngine::start_acquisition(std::int64_t end_sample) {
     const double rms = std::sqrt(power / (2.0 * static_cast<double>(snapshot_.size())));
     if (rms > 0.0 && std::isfinite(rms)) i16_gain_ = static_cast<float>(2048.0 / rms);
   }
-  const auto limit = static_cast<std::size_t>(options_.blind_prns_per_snapshot);
-  if (cold || limit == 0 || blind.size() <= limit) {
-    search_.blind = blind;
-  } else {
-    // Round robin over the PRN list: the next `limit` missing PRNs from the cursor on.
-    for (std::size_t k = 0; k < prns_.size() && search_.blind.size() < limit; ++k) {
-      const std::size_t i = (blind_cursor_ + k) % prns_.size();
-      if (std::find(blind.begin(), blind.end(), prns_[i]) == blind.end()) continue;
-      search_.blind.push_back(prns_[i]);
-      blind_cursor_ = (i + 1) % prns_.size();
+  // Round robin over the PRN list: the next `limit` PRNs of `from` after the cursor.
+  auto round_robin = [this](const std::vector<int>& from, std::size_t limit, std::size_t& cursor) {
+    if (limit == 0 || from.size() <= limit) {
+      search_.blind.insert(search_.blind.end(), from.begin(), from.end());
+      return;
     }
+    for (std::size_t k = 0, taken = 0; k < prns_.size() && taken < limit; ++k) {
+      const std::size_t i = (cursor + k) % prns_.size();
+      if (std::find(from.begin(), from.end(), prns_[i]) == from.end()) continue;
+      search_.blind.push_back(prns_[i]);
+      ++taken;
+      cursor = (i + 1) % prns_.size();
+    }
+  };
+  const auto limit = static_cast<std::size_t>(options_.blind_prns_per_snapshot);
+  if (cold) {
+    search_.blind = blind;
+  } else if (options_.blind_revisit_s > 0.0 && !unknown.empty() && (last_fix_ || channels_in_use() >= 4)) {
+    // Low duty cycle for the PRNs nothing is known about: a satellite that rises or re-appears. Those lost
+    // lately (a blockage) every time; the others round robin, as many as keep each within blind_revisit_s.
+    const std::int64_t window = std::llround(options_.blind_revisit_s * options_.fs_hz);
+    std::vector<int> recent, rest;
+    for (int prn : unknown) {
+      const auto p = static_cast<std::size_t>(prn);
+      (ever_lost_[p] && lost_at_[p] > snapshot_first_ - window ? recent : rest).push_back(prn);
+    }
+    std::erase_if(blind, [&](int prn) { return std::find(unknown.begin(), unknown.end(), prn) != unknown.end(); });
+    round_robin(blind, limit, blind_cursor_);  // predicted above the horizon: as before
+    search_.blind.insert(search_.blind.end(), recent.begin(), recent.end());
+    // Snapshot to snapshot: the snapshot, the latency, then the interval (from the apply sample on).
+    const double period_s = static_cast<double>(snapshot_.size()) / options_.fs_hz + options_.reacquisition_latency_s +
+                            options_.reacquisition_interval_s;
+    const auto need = static_cast<std::size_t>(
+        std::max(1.0, std::ceil(static_cast<double>(rest.size()) * period_s / options_.blind_revisit_s)));
+    round_robin(rest, limit == 0 ? need : std::min(limit, need), unknown_cursor_);
+  } else {
+    round_robin(blind, limit, blind_cursor_);
   }
   // Now and then one PRN predicted below the horizon, in case the prediction (or the almanac) is wrong.
   if (!hidden.empty() && snapshot_first_ >= next_hidden_check_) {
@@ -263,7 +293,14 @@ void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples,
   for (int a = 1; a < options_.num_antennas; ++a)
     view_.antenna[static_cast<std::size_t>(a)] = antenna_block_[static_cast<std::size_t>(a)] + (first_sample - antenna_block_first_);
   view_.i16_gain = i16_gain_;
-  if (i16_gain_ > 0.0f) convert_part_to_i16(view_.num_samples);
+  if (i16_gain_ > 0.0f) {
+    if (given_i16_.re && given_i16_gain_ == i16_gain_) {
+      const std::int64_t offset = first_sample - given_i16_first_;
+      view_.antenna_i16[0] = {given_i16_.re + offset, given_i16_.im + offset};
+    } else {
+      convert_part_to_i16(view_.num_samples);
+    }
+  }
   // Channels are independent given the block: each job touches only its own channel and record buffer.
   auto job = [this](int slot) { feed_channel(slot); };
   pool_.parallel_for(static_cast<int>(channels_.size()), job);
@@ -317,12 +354,14 @@ void ReceiverEngine::collect_navigation(ReceiverChannel& channel) {
     ephemerides_.push_back(eph);
 }
 
-void ReceiverEngine::release_lost_channels() {
+void ReceiverEngine::release_lost_channels(std::int64_t sample) {
   for (auto& channel : channels_) {
     if (!channel || !channel->lost()) continue;
     auto& stats = stats_.satellites[static_cast<std::size_t>(channel->prn())];
     ++stats.losses;
     stats.tracked_s += channel->tracked_time_s();
+    lost_at_[static_cast<std::size_t>(channel->prn())] = sample;
+    ever_lost_[static_cast<std::size_t>(channel->prn())] = true;
     channel.reset();
   }
 }
@@ -330,6 +369,25 @@ void ReceiverEngine::release_lost_channels() {
 void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::int64_t first_sample) {
   if (options_.num_antennas != 1) throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
   process_master(samples, first_sample);
+}
+
+void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::int64_t first_sample, PlanarI16 i16,
+                             float i16_gain) {
+  if (options_.num_antennas != 1) throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
+  // The gain may be fixed inside this call (the cold start): only a copy made at that gain is used, so the
+  // channels see the same int16 values whoever converted them.
+  if (i16_gain > 0.0f && i16.re && i16.im) {
+    given_i16_ = i16;
+    given_i16_first_ = first_sample;
+    given_i16_gain_ = i16_gain;
+  }
+  try {
+    process_master(samples, first_sample);
+  } catch (...) {
+    given_i16_ = {};
+    throw;
+  }
+  given_i16_ = {};
 }
 
 void ReceiverEngine::process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample) {
@@ -379,7 +437,7 @@ void ReceiverEngine::process_master(std::span<const std::complex<float>> samples
       observation_epoch(s);
       next_observation_ += observation_step_;
     }
-    release_lost_channels();
+    release_lost_channels(s);
     if (!snapshot_active_ && !search_.pending && s >= next_reacquisition_ &&
         channels_in_use() < options_.channels && !missing_prns().empty())
       begin_snapshot(s);

@@ -1,9 +1,10 @@
 // The scalar receiver as a processing object: fed with contiguous blocks of complex baseband samples (any
 // size), it acquires satellites on a snapshot of the first samples (assisted by ephemeris and the last fix once
 // they exist; satellites predicted below the horizon by an ephemeris or a decoded almanac are searched only
-// rarely), allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh
-// snapshots, forms observables at common receive epochs (every observation_interval_s, in samples), and solves
-// PVT from them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
+// rarely; those with no orbit known at a low duty cycle once 4 are in channels: ReceiverOptions::blind_revisit_s),
+// allocates them to tracking channels (ReceiverChannel), re-acquires missing satellites on fresh snapshots,
+// forms observables at common receive epochs (every observation_interval_s, in samples), and solves PVT from
+// them with the decoded (or supplied) ephemerides. Results go to a ReceiverObserver as they happen.
 // Threads (receiver/worker_pool.hpp): the channels of each block run in parallel, each sample read once and
 // shared; a re-acquisition searches in the background and its satellites join at a fixed later sample. Every
 // observer call is made on the caller's thread in a fixed order, so the results are the same for any number
@@ -88,6 +89,10 @@ class ReceiverEngine {
   // Processes samples[0..n) whose first sample has receiver index first_sample. Blocks should be contiguous;
   // a gap is bridged by the channels (dead reckoning) and restarts a pending acquisition snapshot.
   void process(std::span<const std::complex<float>> samples, std::int64_t first_sample);
+  // The same with the block also given as planar int16 times i16_gain (receiver/sample_prefetcher.hpp converts
+  // it off this thread): used instead of the engine's own conversion when i16_gain equals i16_gain() (the same
+  // values: the same conversion), ignored otherwise. One antenna only.
+  void process(std::span<const std::complex<float>> samples, std::int64_t first_sample, PlanarI16 i16, float i16_gain);
   // num_antennas > 1: one span per antenna, all the same size and on the same sample indices; antenna 0 (the
   // master) is the one acquired on. Throws std::invalid_argument when the spans do not match the options.
   void process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample);
@@ -103,6 +108,8 @@ class ReceiverEngine {
   int channels_in_use() const;
   int channels_synchronised() const;
   int threads() const { return pool_.threads(); }
+  // The integer correlator's gain from sample scale to int16: 0 until the cold start's snapshot fixes it.
+  float i16_gain() const { return i16_gain_; }
   // Ephemerides decoded from the signal (each new set once), and the broadcast Klobuchar/UTC parameters.
   const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return decoded_; }
   const signals::KlobucharParameters& klobuchar() const { return iono_; }
@@ -142,7 +149,7 @@ class ReceiverEngine {
   void feed_channels(std::span<const std::complex<float>> samples, std::int64_t first_sample);
   void feed_channel(int slot);
   void collect_navigation(ReceiverChannel& channel);
-  void release_lost_channels();
+  void release_lost_channels(std::int64_t sample);
   void observation_epoch(std::int64_t sample);
   void solve(const ObservationEpoch& epoch);
   void vector_epoch(std::int64_t sample);
@@ -156,7 +163,10 @@ class ReceiverEngine {
   WorkerPool pool_;
   AcquisitionTask search_;
   std::size_t blind_cursor_ = 0;  // round robin over prns_ for blind re-acquisitions
+  std::size_t unknown_cursor_ = 0;  // the same for PRNs with no orbit known at the low duty cycle (blind_revisit_s)
   std::vector<int> prns_;
+  std::array<std::int64_t, 33> lost_at_{};  // sample at which a PRN's channel was last released (lost lock)
+  std::array<bool, 33> ever_lost_{};
   std::size_t hidden_cursor_ = 0;        // round robin over prns_ for checks of PRNs predicted below the horizon
   std::int64_t next_hidden_check_ = 0;   // sample from which the next such check may run
 
@@ -194,6 +204,9 @@ class ReceiverEngine {
   // the part being fed (I then Q per antenna; grown once to the largest part).
   float i16_gain_ = 0.0f;
   std::vector<std::int16_t> i16_block_;
+  PlanarI16 given_i16_{};            // the current block's int16 copy from the caller, if usable
+  std::int64_t given_i16_first_ = 0;
+  float given_i16_gain_ = 0.0f;
   void convert_part_to_i16(int n);
   AntennaPhaseEpoch antenna_epoch_;
   // Vector tracking (set_vector_loop).

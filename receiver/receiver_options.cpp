@@ -22,6 +22,8 @@ std::string ReceiverOptions::validate() const {
     return fmt::format("re-acquisition latency {} s outside [0, 10]", reacquisition_latency_s);
   if (blind_prns_per_snapshot < 0 || blind_prns_per_snapshot > 32)
     return fmt::format("blind PRNs per snapshot {} outside 0..32", blind_prns_per_snapshot);
+  if (!(blind_revisit_s >= 0.0 && blind_revisit_s <= 3600.0))
+    return fmt::format("blind revisit time {} s outside [0, 3600]", blind_revisit_s);
   if (!(hidden_prn_check_interval_s >= 1.0 && hidden_prn_check_interval_s <= 3600.0))
     return fmt::format("hidden PRN check interval {} s outside [1, 3600]", hidden_prn_check_interval_s);
   if (threads < 0 || threads > 256) return fmt::format("threads = {}: must be within 0..256", threads);

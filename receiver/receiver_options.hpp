@@ -32,6 +32,13 @@ struct ReceiverOptions {
   // snapshot, round robin (each search keeps its full sensitivity; a PRN comes round every few snapshots).
   // 0: all of them every time. The cold start always searches every PRN.
   int blind_prns_per_snapshot = 8;
+  // Low duty cycle once the receiver can fix (a fix, or >= 4 channels in use): absent satellites are then ones
+  // that rise or re-appear, so a blind re-acquisition takes only as many missing PRNs as keep each searched
+  // once per blind_revisit_s (round robin, at most blind_prns_per_snapshot), and PRNs whose channel lost lock
+  // within the last blind_revisit_s every time. Worst case from a satellite's appearance (at a C/N0 the search
+  // detects) to its channel: blind_revisit_s + 2 (reacquisition_interval_s + reacquisition_latency_s) + 0.2 s
+  // (docs/performance.md). 0: off (blind_prns_per_snapshot every time). [0, 3600] s.
+  double blind_revisit_s = 60.0;
   // Satellites predicted below assisted_elevation_min_deg (from an ephemeris or a decoded almanac, at the last
   // fix or at approximate_r_e_m before one) are not searched blindly; one of them, round robin, is checked
   // this often in case the prediction is wrong. [1, 3600] s.

@@ -35,6 +35,7 @@
 #include "receive_vector.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
+#include "receiver/sample_prefetcher.hpp"
 #include "receiver/sample_source.hpp"
 #include "signals/gps_time.hpp"
 #include "signals/input_error.hpp"
@@ -190,15 +191,14 @@ void run_receive(const ReceiveArgs& args) {
   SigintGuard sigint;
   Progress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
   const auto block_size = static_cast<std::size_t>(std::max<std::int64_t>(1, std::llround(0.05 * options.fs_hz)));
-  std::vector<std::complex<float>> block(block_size);
   const auto wall_start = std::chrono::steady_clock::now();
-  std::int64_t done = 0;
-  while (done < to_process && !g_interrupted) {
-    const auto want = static_cast<std::size_t>(std::min<std::int64_t>(block_size, to_process - done));
-    const receiver::SampleBlock got = source.read(std::span(block.data(), want));
-    if (got.count == 0) break;
-    engine.process(std::span<const std::complex<float>>(block.data(), got.count), got.first_sample);
-    done += static_cast<std::int64_t>(got.count);
+  // With more than one thread the next block is read (and converted to int16) while this one is processed.
+  receiver::SamplePrefetcher reader(source, block_size, to_process, engine.threads() > 1);
+  while (!g_interrupted) {
+    const receiver::PrefetchedBlock got = reader.next();
+    if (got.where.count == 0) break;
+    engine.process(got.samples, got.where.first_sample, {got.re, got.im}, got.i16_gain);
+    reader.set_i16_gain(engine.i16_gain());
     progress.update(engine);
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -49,6 +49,7 @@ const std::map<std::string, Table>& sections() {
         {"reacquisition_interval_s", [](const Setter& v, O& o) { o.reacquisition_interval_s = v.number(); }},
         {"reacquisition_latency_s", [](const Setter& v, O& o) { o.reacquisition_latency_s = v.number(); }},
         {"blind_prns_per_snapshot", [](const Setter& v, O& o) { o.blind_prns_per_snapshot = v.integer(); }},
+        {"blind_revisit_s", [](const Setter& v, O& o) { o.blind_revisit_s = v.number(); }},
         {"hidden_prn_check_interval_s", [](const Setter& v, O& o) { o.hidden_prn_check_interval_s = v.number(); }},
         {"threads", [](const Setter& v, O& o) { o.threads = v.integer(); }},
         {"assisted_doppler_half_width_hz", [](const Setter& v, O& o) { o.assisted_doppler_half_width_hz = v.number(); }},

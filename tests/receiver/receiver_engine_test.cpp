@@ -12,6 +12,7 @@
 #include <random>
 
 #include "receiver/acquisition.hpp"
+#include "receiver/correlator_engine.hpp"
 #include "receiver/receiver_channel.hpp"
 #include "test_signal.hpp"
 
@@ -191,20 +192,35 @@ TEST(ReceiverEngine, ResultsAreIdenticalForAnyNumberOfThreads) {
   };
   const std::int64_t total = static_cast<std::int64_t>(4.0 * kFs);
   const auto signal = test::generate(sats, test::TestSignal{kFs, true, 17}, 0, total);
-  std::vector<Log> logs(3);
-  for (int threads = 1; threads <= 3; ++threads) {
+  // Run 4: two threads with every block also handed over as planar int16 (what SamplePrefetcher does), converted
+  // at the engine's gain once it is fixed: the channels must see exactly what the engine's own conversion gives.
+  std::vector<Log> logs(4);
+  std::vector<std::int16_t> i16(2 * 77777);
+  for (int run = 1; run <= 4; ++run) {
+    const int threads = run <= 3 ? run : 2;
     ReceiverOptions options;
     options.fs_hz = kFs;
     options.prns = {4, 9, 13, 21, 30};
     options.reacquisition_interval_s = 1.0;
     options.reacquisition_latency_s = 0.5;
     options.threads = threads;
-    Log& log = logs[static_cast<std::size_t>(threads - 1)];
+    Log& log = logs[static_cast<std::size_t>(run - 1)];
     ReceiverEngine engine(options, log);
     EXPECT_EQ(engine.threads(), threads);
+    int given = 0;
     for (std::int64_t first = 0, block = 50001; first < total; first += block, block = block == 50001 ? 77777 : 50001) {
       const auto n = std::min<std::int64_t>(block, total - first);
-      engine.process(std::span(signal.data() + first, static_cast<std::size_t>(n)), first);
+      const auto part = std::span(signal.data() + first, static_cast<std::size_t>(n));
+      if (run == 4 && engine.i16_gain() > 0.0f) {
+        convert_to_planar_i16(part.data(), static_cast<int>(n), engine.i16_gain(), i16.data(), i16.data() + n);
+        engine.process(part, first, PlanarI16{i16.data(), i16.data() + n}, engine.i16_gain());
+        ++given;
+      } else {
+        engine.process(part, first);
+      }
+    }
+    if (run == 4) {
+      EXPECT_GE(given, 150);  // all but the blocks before the cold start's gain
     }
     EXPECT_EQ(engine.channels_in_use(), 3) << threads;
   }
@@ -225,13 +241,13 @@ TEST(ReceiverEngine, ResultsAreIdenticalForAnyNumberOfThreads) {
   EXPECT_LE(first21->sample_index, join + 21 * 2600);
   for (std::size_t t = 1; t < logs.size(); ++t) {
     const Log& other = logs[t];
-    ASSERT_EQ(other.records.size(), one.records.size()) << t + 1 << " threads";
+    ASSERT_EQ(other.records.size(), one.records.size()) << "run " << t + 1;
     for (std::size_t i = 0; i < one.records.size(); ++i) {
       const TrackingRecord &a = one.records[i], &b = other.records[i];
       ASSERT_TRUE(a.prn == b.prn && a.sample_index == b.sample_index && a.prompt == b.prompt &&
                   a.doppler_hz == b.doppler_hz && a.code_phase_chips == b.code_phase_chips && a.state == b.state &&
                   (a.cn0_dbhz == b.cn0_dbhz || (std::isnan(a.cn0_dbhz) && std::isnan(b.cn0_dbhz))))
-          << "record " << i << " differs with " << t + 1 << " threads";
+          << "record " << i << " differs in run " << t + 1;
     }
     ASSERT_EQ(other.acquisitions.size(), one.acquisitions.size());
     for (std::size_t i = 0; i < one.acquisitions.size(); ++i) {
@@ -244,4 +260,49 @@ TEST(ReceiverEngine, ResultsAreIdenticalForAnyNumberOfThreads) {
       }
     }
   }
+}
+
+// Low duty cycle of blind re-acquisition (ReceiverOptions::blind_revisit_s): with 4 satellites in channels, the
+// PRNs nothing is known about are searched only as many per snapshot as keep each within blind_revisit_s, and a
+// satellite that appears later is still found within the documented bound: blind_revisit_s + 2 (interval +
+// latency) + 0.2 s from its appearance to its channel's first record (records every 20 code periods: + 21 ms).
+TEST(ReceiverEngine, LowDutyBlindSearchStillFindsALateSatelliteWithinTheBound) {
+  test::TestSatellite late = satellite(21, -1500.0, 77.7);
+  late.start_s = 2.0;
+  const std::vector<test::TestSatellite> sats = {satellite(4, 2100.0, 300.3), satellite(9, -2900.0, 45.6),
+                                                 satellite(13, -700.0, 900.9), satellite(17, 3300.0, 610.1), late};
+  struct Log : ReceiverObserver {
+    std::vector<std::pair<std::int64_t, std::vector<AcquisitionResult>>> acquisitions;
+    std::optional<std::int64_t> first21;
+    void on_tracking(const TrackingRecord& r) override {
+      if (r.prn == 21 && !first21) first21 = r.sample_index;
+    }
+    void on_acquisition(std::int64_t first, const std::vector<AcquisitionResult>& results) override {
+      acquisitions.emplace_back(first, results);
+    }
+  };
+  const double revisit_s = 4.0, interval_s = 1.0, latency_s = 0.5;
+  const std::int64_t total = static_cast<std::int64_t>(9.5 * kFs);
+  const auto signal = test::generate(sats, test::TestSignal{kFs, true, 23}, 0, total);
+  ReceiverOptions options;
+  options.fs_hz = kFs;
+  options.prns = {2, 4, 6, 9, 11, 13, 17, 21, 25, 30};  // 6 missing after the cold start, none with an orbit
+  options.reacquisition_interval_s = interval_s;
+  options.reacquisition_latency_s = latency_s;
+  options.blind_revisit_s = revisit_s;
+  options.threads = 2;
+  Log log;
+  ReceiverEngine engine(options, log);
+  for (std::int64_t first = 0; first < total; first += 130000)
+    engine.process(std::span(signal.data() + first, static_cast<std::size_t>(std::min<std::int64_t>(130000, total - first))),
+                   first);
+  ASSERT_GE(log.acquisitions.size(), 5u);
+  EXPECT_EQ(log.acquisitions.front().second.size(), 10u);  // the cold start: every PRN
+  // 6 missing, snapshots every 20 ms + 0.5 s + 1 s: ceil(6 * 1.52 / 4) = 3 per snapshot (blind_prns_per_snapshot
+  // would allow 8), 2 once PRN 21 has a channel (ceil(5 * 1.52 / 4)).
+  for (std::size_t i = 1; i < log.acquisitions.size(); ++i) EXPECT_LE(log.acquisitions[i].second.size(), 3u) << i;
+  ASSERT_TRUE(log.first21.has_value()) << "the late satellite was never found";
+  const double bound_s = 2.0 + revisit_s + 2.0 * (interval_s + latency_s) + 0.2 + 0.021;
+  EXPECT_LE(static_cast<double>(*log.first21) / kFs, bound_s);
+  EXPECT_EQ(engine.channels_in_use(), 5);
 }
