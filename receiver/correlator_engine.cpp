@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 
@@ -335,9 +337,9 @@ ULTRATRACK_ALWAYS_INLINE void mac_sample(std::int32_t xr, std::int32_t xi, std::
 
 std::uint32_t step_q24(const ReplicaSegment& rep) { return static_cast<std::uint32_t>(std::lround(rep.code_step_chips * kQ24)); }
 
-void correlate_i16_portable(const std::int8_t* table, const double* offsets, int num_taps, std::span<const PlanarI16> antennas,
-                            int num_samples, const ReplicaSegment& rep, const CorrelatorEngine::Rotation& rot, double scale,
-                            std::span<TapSums> sums) {
+void correlate_i16_portable(const std::int8_t* table, const std::int16_t* /*table16*/, const double* offsets, int num_taps,
+                            std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& rep,
+                            const CorrelatorEngine::Rotation& rot, double scale, std::span<TapSums> sums) {
   const std::uint32_t step = step_q24(rep);
   for (int start = 0; start < num_samples; start += kChunkI16) {
     const int n = num_samples - start < kChunkI16 ? num_samples - start : kChunkI16;
@@ -355,85 +357,276 @@ void correlate_i16_portable(const std::int8_t* table, const double* offsets, int
   }
 }
 
+// Chip indices of a group of L samples without a multiply or a shift per lane: with S l = h_l 2^22 + g_l
+// (g_l < 2^22) fixed per call, the index of lane l relative to the group's first chip, for the group's 22-bit
+// fraction q, is floor((q + S l) / 2^22) = h_l + [q + g_l >= 2^22] = h_l + [q >= 2^22 - g_l]: one compare
+// against a per-call threshold per lane (exactly the portable copy's index, as q + g_l < 2^23).
+constexpr std::uint32_t kFracMask = (1u << kFracBits) - 1;
+
+// Which taps reuse another tap's chip indices, fixed per engine (taps whole chips apart, e.g. early/late at
+// +-0.5 and prompt/noise): 3 bits per tap, the index of the tap whose indices it reuses (itself if none).
+// A compile-time pattern, so that the shared indices stay in registers (a pattern read at run time made the
+// compiler keep them in memory and cost more than it saved).
+constexpr int share_leader(std::uint32_t share, int t) { return static_cast<int>((share >> (3 * t)) & 7u); }
+constexpr std::uint32_t share_code(std::initializer_list<int> leaders) {
+  std::uint32_t code = 0;
+  int t = 0;
+  for (const int l : leaders) code |= static_cast<std::uint32_t>(l) << (3 * t++);
+  return code;
+}
+constexpr std::uint32_t no_sharing(int taps) {
+  std::uint32_t code = 0;
+  for (int t = 0; t < taps; ++t) code |= static_cast<std::uint32_t>(t) << (3 * t);
+  return code;
+}
+
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
 // The AVX2 copy: 16 samples per step. Per group of taps sharing a fraction: the 16 relative chip indices
-// (0..15, since step <= 0.99) as bytes; per tap: one 16-byte load of chips, one byte shuffle, a widening to
-// int16, then two pmaddwd (in-phase, quadrature) into int32 lanes.
-template <int kTaps>
-__attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* table, const double* offsets, int num_taps,
+// (0..15, since step <= 0.99) as bytes, from two compares against per-call thresholds and two packs (the
+// threshold lanes are laid out so that the packs give natural sample order); per tap: one 16-byte load of
+// chips, one byte shuffle, a widening to int16, then two pmaddwd (in-phase, quadrature) into int32 lanes. The
+// last n % 16 samples of a chunk go through the same step from a zero-padded copy (zero samples add nothing).
+struct LaneIndexAvx2 {  // per call: thresholds 2^22 - 1 - g_l in pack order, whole parts h_l as bytes
+  __m256i below_lo, below_hi;
+  __m128i whole;
+};
+
+template <int kTaps, std::uint32_t kShare>
+__attribute__((target("avx2,fma"), always_inline)) inline void avx2_chunk(const std::int16_t* xr_p, const std::int16_t* xi_p, int n,
+                                                                         const CorrelatorEngine::Rotation& rot,
+                                                                         const std::int8_t* const* base, const std::uint32_t* frac,
+                                                                         std::uint32_t step, const LaneIndexAvx2& lanes,
+                                                                         std::int64_t* re, std::int64_t* im) {
+  __m256i acc_re[kTaps], acc_im[kTaps];
+  for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm256_setzero_si256();
+  for (int i = 0; i < n; i += 16) {
+    __m256i xr, xi;
+    if (i + 16 <= n) {
+      xr = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xr_p + i));
+      xi = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xi_p + i));
+    } else {
+      alignas(32) std::int16_t pr[16] = {}, pi[16] = {};
+      std::memcpy(pr, xr_p + i, sizeof(std::int16_t) * static_cast<std::size_t>(n - i));
+      std::memcpy(pi, xi_p + i, sizeof(std::int16_t) * static_cast<std::size_t>(n - i));
+      xr = _mm256_load_si256(reinterpret_cast<const __m256i*>(pr));
+      xi = _mm256_load_si256(reinterpret_cast<const __m256i*>(pi));
+    }
+    const __m256i rr = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.re + i));
+    const __m256i ri = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.im + i));
+    const __m256i wr = _mm256_adds_epi16(_mm256_mulhrs_epi16(xr, rr), _mm256_mulhrs_epi16(xi, ri));
+    const __m256i wi = _mm256_subs_epi16(_mm256_mulhrs_epi16(xi, rr), _mm256_mulhrs_epi16(xr, ri));
+    __m128i rel[kTaps];
+    std::uint32_t first[kTaps];
+#pragma GCC unroll 8
+    for (int t = 0; t < kTaps; ++t) {
+      const int lead = share_leader(kShare, t);
+      if (lead == t) {
+        const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
+        first[t] = p >> kFracBits;
+        const __m256i q = _mm256_set1_epi32(static_cast<int>(p & kFracMask));
+        const __m256i carry = _mm256_packs_epi32(_mm256_cmpgt_epi32(q, lanes.below_lo), _mm256_cmpgt_epi32(q, lanes.below_hi));
+        rel[t] = _mm_sub_epi8(lanes.whole, _mm_packs_epi16(_mm256_castsi256_si128(carry), _mm256_extracti128_si256(carry, 1)));
+      } else {
+        rel[t] = rel[lead];
+        first[t] = first[lead];
+      }
+      const __m128i window = _mm_loadu_si128(reinterpret_cast<const __m128i*>(base[t] + first[t]));
+      const __m256i chips = _mm256_cvtepi8_epi16(_mm_shuffle_epi8(window, rel[t]));
+      acc_re[t] = _mm256_add_epi32(acc_re[t], _mm256_madd_epi16(wr, chips));
+      acc_im[t] = _mm256_add_epi32(acc_im[t], _mm256_madd_epi16(wi, chips));
+    }
+  }
+  for (int t = 0; t < kTaps; ++t) {
+    alignas(32) std::int32_t lr[8], li[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(lr), acc_re[t]);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(li), acc_im[t]);
+    re[t] = im[t] = 0;
+    for (int l = 0; l < 8; ++l) {
+      re[t] += lr[l];
+      im[t] += li[l];
+    }
+  }
+}
+
+template <int kTaps, std::uint32_t kShare>
+__attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* table, const std::int16_t* table16,
+                                                           const double* offsets, int num_taps,
                                                            std::span<const PlanarI16> antennas, int num_samples,
                                                            const ReplicaSegment& rep, const CorrelatorEngine::Rotation& rot,
                                                            double scale, std::span<TapSums> sums) {
   if (!(rep.code_step_chips <= 0.99)) {  // 16 samples could span more than 16 chips
-    correlate_i16_portable(table, offsets, num_taps, antennas, num_samples, rep, rot, scale, sums);
+    correlate_i16_portable(table, table16, offsets, num_taps, antennas, num_samples, rep, rot, scale, sums);
     return;
   }
   const std::uint32_t step = step_q24(rep);
-  const __m256i lanes_lo = _mm256_mullo_epi32(_mm256_set1_epi32(static_cast<int>(step)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-  const __m256i lanes_hi = _mm256_add_epi32(lanes_lo, _mm256_set1_epi32(static_cast<int>(8 * step)));
+  // Compare lanes: the first vector holds samples 0-3 and 8-11, the second 4-7 and 12-15 (pack order).
+  alignas(32) std::int32_t below[16];  // 2^22 - 1 - g_l: q > below <=> q >= 2^22 - g_l (signed compare, < 2^23)
+  alignas(16) std::int8_t lane_whole[16];
+  for (int l = 0; l < 16; ++l) {
+    const std::uint32_t a = step * static_cast<std::uint32_t>(l);
+    const int slot = (l & 4) ? 8 + (l & 3) + ((l & 8) ? 4 : 0) : (l & 3) + ((l & 8) ? 4 : 0);
+    below[slot] = static_cast<std::int32_t>(kFracMask - (a & kFracMask));
+    lane_whole[l] = static_cast<std::int8_t>(a >> kFracBits);
+  }
+  const LaneIndexAvx2 lanes{_mm256_load_si256(reinterpret_cast<const __m256i*>(below)),
+                            _mm256_load_si256(reinterpret_cast<const __m256i*>(below + 8)),
+                            _mm_load_si128(reinterpret_cast<const __m128i*>(lane_whole))};
   for (int start = 0; start < num_samples; start += kChunkI16) {
     const int n = num_samples - start < kChunkI16 ? num_samples - start : kChunkI16;
-    const int n_vec = n - n % 16;
     int whole[kMaxTaps];
     std::uint32_t frac[kMaxTaps];
     chunk_taps(rep, offsets, kTaps, start, whole, frac);
-    int leader[kTaps];  // the first tap with the same fraction: its chip indices serve this tap too
+    const std::int8_t* base[kTaps];
+    bool shared = true;  // the engine's pattern holds in this chunk (equal fractions: exact, as in the portable copy)
     for (int t = 0; t < kTaps; ++t) {
-      leader[t] = t;
-      for (int u = 0; u < t; ++u)
-        if (frac[u] == frac[t]) {
-          leader[t] = u;
-          break;
-        }
+      base[t] = table + whole[t];
+      shared = shared && frac[share_leader(kShare, t)] == frac[t];
     }
     const std::uint32_t phase0 = chunk_phase(rep, rot.step_q32, start, n);
     for (std::size_t a = 0; a < antennas.size(); ++a) {
-      const std::int16_t* xr_p = antennas[a].re + start;
-      const std::int16_t* xi_p = antennas[a].im + start;
-      __m256i acc_re[kTaps], acc_im[kTaps];
-      for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm256_setzero_si256();
-      for (int i = 0; i < n_vec; i += 16) {
-        const __m256i xr = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xr_p + i));
-        const __m256i xi = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(xi_p + i));
-        const __m256i rr = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.re + i));
-        const __m256i ri = _mm256_load_si256(reinterpret_cast<const __m256i*>(rot.im + i));
-        const __m256i wr = _mm256_adds_epi16(_mm256_mulhrs_epi16(xr, rr), _mm256_mulhrs_epi16(xi, ri));
-        const __m256i wi = _mm256_subs_epi16(_mm256_mulhrs_epi16(xi, rr), _mm256_mulhrs_epi16(xr, ri));
-        __m128i rel[kTaps];
-        int first[kTaps];
-        for (int t = 0; t < kTaps; ++t) {
-          if (leader[t] != t) {
-            rel[t] = rel[leader[t]];
-            first[t] = first[leader[t]];
-          } else {
-            const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
-            first[t] = static_cast<int>(p >> kFracBits);
-            const __m256i q = _mm256_set1_epi32(static_cast<int>(p & ((1u << kFracBits) - 1)));
-            const __m256i lo = _mm256_srli_epi32(_mm256_add_epi32(q, lanes_lo), kFracBits);
-            const __m256i hi = _mm256_srli_epi32(_mm256_add_epi32(q, lanes_hi), kFracBits);
-            const __m256i w16 = _mm256_permute4x64_epi64(_mm256_packus_epi32(lo, hi), 0xD8);  // natural order
-            rel[t] = _mm_packus_epi16(_mm256_castsi256_si128(w16), _mm256_extracti128_si256(w16, 1));
-          }
-          const __m128i window = _mm_loadu_si128(reinterpret_cast<const __m128i*>(table + whole[t] + first[t]));
-          const __m256i chips = _mm256_cvtepi8_epi16(_mm_shuffle_epi8(window, rel[t]));
-          acc_re[t] = _mm256_add_epi32(acc_re[t], _mm256_madd_epi16(wr, chips));
-          acc_im[t] = _mm256_add_epi32(acc_im[t], _mm256_madd_epi16(wi, chips));
-        }
-      }
-      std::int64_t re[kMaxTaps] = {}, im[kMaxTaps] = {};
-      for (int t = 0; t < kTaps; ++t) {
-        alignas(32) std::int32_t lr[8], li[8];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(lr), acc_re[t]);
-        _mm256_store_si256(reinterpret_cast<__m256i*>(li), acc_im[t]);
-        for (int l = 0; l < 8; ++l) {
-          re[t] += lr[l];
-          im[t] += li[l];
-        }
-      }
-      for (int i = n_vec; i < n; ++i) mac_sample(xr_p[i], xi_p[i], rot.re[i], rot.im[i], table, whole, frac, step, i, kTaps, re, im);
+      std::int64_t re[kMaxTaps], im[kMaxTaps];
+      if (kShare == no_sharing(kTaps) || !shared)
+        avx2_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+      else
+        avx2_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
       finish_chunk(re, im, kTaps, phase0, scale, sums[a]);
     }
   }
+}
+
+// Sum of the 16 int32 lanes. Zero-masked extracts: GCC 12's plain ones (and _mm512_reduce_add_epi32,
+// _mm512_castsi512_si256) warn about an undefined register.
+__attribute__((target("avx2,avx512f"), always_inline)) inline std::int32_t lane_sum(__m512i v) {
+  const __m256i h = _mm256_add_epi32(_mm512_maskz_extracti64x4_epi64(0xFF, v, 0), _mm512_maskz_extracti64x4_epi64(0xFF, v, 1));
+  __m128i x = _mm_add_epi32(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
+  x = _mm_add_epi32(x, _mm_shuffle_epi32(x, 0x4E));
+  x = _mm_add_epi32(x, _mm_shuffle_epi32(x, 0xB1));
+  return _mm_cvtsi128_si32(x);
+}
+
+// The AVX-512 copy (BW, VL, VNNI): 32 samples per step. Chips as int16: per group of taps sharing a fraction,
+// the 32 relative indices (0..31) from two compares into a mask and one masked add; per tap one 64-byte load of
+// chips and one word permute (vpermw), then two vpdpwssd (multiply pairs and accumulate into int32, the
+// pmaddwd + add of the AVX2 copy in one instruction: same products, exact). The chunk's last n % 32 samples
+// run through the same step with masked (zeroing) sample loads. Lane sums per chunk stay below
+// 32 steps * 2 * 32768 = 2^21 (one chunk is 1024 samples), so the int32 reductions are exact.
+struct LaneIndex {  // per call: lane l's threshold 2^22 - g_l and whole part h_l (see the comment above kFracMask)
+  __m512i threshold_lo, threshold_hi, whole;
+};
+
+template <int kTaps, std::uint32_t kShare>
+__attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"), always_inline)) inline void avx512_chunk(
+    const std::int16_t* xr_p, const std::int16_t* xi_p, int n, const CorrelatorEngine::Rotation& rot,
+    const std::int16_t* const* base, const std::uint32_t* frac, std::uint32_t step, const LaneIndex& lanes,
+    std::int64_t* re, std::int64_t* im) {
+  const __m512i one = _mm512_set1_epi16(1);
+  __m512i acc_re[kTaps], acc_im[kTaps];
+  for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm512_setzero_si512();
+  for (int i = 0; i < n; i += 32) {
+    const __mmask32 valid = n - i >= 32 ? ~__mmask32{0} : static_cast<__mmask32>((1u << (n - i)) - 1u);
+    const __m512i xr = _mm512_maskz_loadu_epi16(valid, xr_p + i);
+    const __m512i xi = _mm512_maskz_loadu_epi16(valid, xi_p + i);
+    const __m512i rr = _mm512_load_si512(rot.re + i), ri = _mm512_load_si512(rot.im + i);
+    const __m512i wr = _mm512_adds_epi16(_mm512_mulhrs_epi16(xr, rr), _mm512_mulhrs_epi16(xi, ri));
+    const __m512i wi = _mm512_subs_epi16(_mm512_mulhrs_epi16(xi, rr), _mm512_mulhrs_epi16(xr, ri));
+    __m512i rel[kTaps];
+    std::uint32_t first[kTaps];
+#pragma GCC unroll 8
+    for (int t = 0; t < kTaps; ++t) {
+      const int lead = share_leader(kShare, t);
+      if (lead == t) {
+        const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
+        first[t] = p >> kFracBits;
+        const __m512i q = _mm512_set1_epi32(static_cast<int>(p & kFracMask));
+        const __mmask32 carry = _mm512_kunpackw(_mm512_cmpge_epu32_mask(q, lanes.threshold_hi), _mm512_cmpge_epu32_mask(q, lanes.threshold_lo));
+        rel[t] = _mm512_mask_add_epi16(lanes.whole, carry, lanes.whole, one);
+      } else {
+        rel[t] = rel[lead];
+        first[t] = first[lead];
+      }
+      const __m512i chips = _mm512_permutexvar_epi16(rel[t], _mm512_loadu_si512(base[t] + first[t]));
+      acc_re[t] = _mm512_dpwssd_epi32(acc_re[t], wr, chips);
+      acc_im[t] = _mm512_dpwssd_epi32(acc_im[t], wi, chips);
+    }
+  }
+  for (int t = 0; t < kTaps; ++t) {
+    re[t] = lane_sum(acc_re[t]);
+    im[t] = lane_sum(acc_im[t]);
+  }
+}
+
+template <int kTaps, std::uint32_t kShare>
+__attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"))) void correlate_i16_avx512(
+    const std::int8_t* table, const std::int16_t* table16, const double* offsets, int num_taps,
+    std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& rep,
+    const CorrelatorEngine::Rotation& rot, double scale, std::span<TapSums> sums) {
+  if (!(rep.code_step_chips <= 0.99)) {  // 32 samples could span more than 32 chips
+    correlate_i16_portable(table, table16, offsets, num_taps, antennas, num_samples, rep, rot, scale, sums);
+    return;
+  }
+  const std::uint32_t step = step_q24(rep);
+  alignas(64) std::uint32_t threshold[32];
+  alignas(64) std::int16_t lane_whole[32];
+  for (int l = 0; l < 32; ++l) {
+    const std::uint32_t a = step * static_cast<std::uint32_t>(l);
+    threshold[l] = (1u << kFracBits) - (a & kFracMask);
+    lane_whole[l] = static_cast<std::int16_t>(a >> kFracBits);
+  }
+  const LaneIndex lanes{_mm512_load_si512(threshold), _mm512_load_si512(threshold + 16), _mm512_load_si512(lane_whole)};
+  for (int start = 0; start < num_samples; start += kChunkI16) {
+    const int n = num_samples - start < kChunkI16 ? num_samples - start : kChunkI16;
+    int whole[kMaxTaps];
+    std::uint32_t frac[kMaxTaps];
+    chunk_taps(rep, offsets, kTaps, start, whole, frac);
+    const std::int16_t* base[kTaps];
+    bool shared = true;  // the engine's pattern holds in this chunk (equal fractions: exact, as in the portable copy)
+    for (int t = 0; t < kTaps; ++t) {
+      base[t] = table16 + whole[t];
+      shared = shared && frac[share_leader(kShare, t)] == frac[t];
+    }
+    const std::uint32_t phase0 = chunk_phase(rep, rot.step_q32, start, n);
+    for (std::size_t a = 0; a < antennas.size(); ++a) {
+      std::int64_t re[kMaxTaps], im[kMaxTaps];
+      if (kShare == no_sharing(kTaps) || !shared)
+        avx512_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+      else
+        avx512_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+      finish_chunk(re, im, kTaps, phase0, scale, sums[a]);
+    }
+  }
+}
+
+// A vector kernel for an engine's tap count and sharing pattern: the receiver's (early/prompt/late/noise;
+// prompt/noise for further antennas; early/prompt/late) and the benchmarks' are compiled with sharing; any
+// other pattern runs without it.
+struct Avx2Kernels {
+  template <int kTaps, std::uint32_t kShare>
+  static constexpr CorrelatorEngine::KernelI16 get() { return &correlate_i16_avx2<kTaps, kShare>; }
+};
+struct Avx512Kernels {
+  template <int kTaps, std::uint32_t kShare>
+  static constexpr CorrelatorEngine::KernelI16 get() { return &correlate_i16_avx512<kTaps, kShare>; }
+};
+
+template <int kTaps, class Kernels>
+CorrelatorEngine::KernelI16 select_shared(std::uint32_t share) {
+  constexpr std::uint32_t kPatterns[] = {share_code({0, 0}),          share_code({0, 1, 0}),
+                                         share_code({0, 1, 1}),       share_code({0, 1, 0, 1}),
+                                         share_code({0, 1, 1, 0, 0}), share_code({0, 1, 0, 1, 0})};
+#define ULTRATRACK_SHARE_CASE(k) \
+  if (share == kPatterns[k]) return Kernels::template get<kTaps, kPatterns[k]>();
+  if constexpr (kTaps == 2) ULTRATRACK_SHARE_CASE(0)
+  if constexpr (kTaps == 3) {
+    ULTRATRACK_SHARE_CASE(1)
+    ULTRATRACK_SHARE_CASE(2)
+  }
+  if constexpr (kTaps == 4) ULTRATRACK_SHARE_CASE(3)
+  if constexpr (kTaps == 5) {
+    ULTRATRACK_SHARE_CASE(4)
+    ULTRATRACK_SHARE_CASE(5)
+  }
+#undef ULTRATRACK_SHARE_CASE
+  return Kernels::template get<kTaps, no_sharing(kTaps)>();
 }
 
 __attribute__((target("avx2,fma"))) void convert_planar_avx2(const std::complex<float>* in, int n, float gain, std::int16_t* re,
@@ -467,7 +660,7 @@ __attribute__((target("avx2,fma"))) void convert_planar_avx2(const std::complex<
 #endif
 
 // The instruction set is chosen once per process from the running CPU (the build targets baseline x86-64);
-// ULTRATRACK_CORRELATOR_ISA=baseline forces the portable copy (tests and benchmarks of both).
+// ULTRATRACK_CORRELATOR_ISA (baseline, avx2, avx512) caps the choice (tests and benchmarks of every copy).
 bool cpu_has_avx2() {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
   static const bool has = [] {
@@ -480,36 +673,62 @@ bool cpu_has_avx2() {
 #endif
 }
 
-bool use_avx2(CorrelatorIsa isa) {
+bool cpu_has_avx512() {
+#ifdef ULTRATRACK_HAVE_AVX2_KERNEL
+  static const bool has = [] {
+    __builtin_cpu_init();
+    return cpu_has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+           __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512vnni");
+  }();
+  return has;
+#else
+  return false;
+#endif
+}
+
+bool isa_available(CorrelatorIsa isa) {
   switch (isa) {
-    case CorrelatorIsa::kBaseline:
-      return false;
     case CorrelatorIsa::kAvx2:
-      if (!cpu_has_avx2()) throw std::invalid_argument("CorrelatorEngine: AVX2+FMA kernel not available here");
+      return cpu_has_avx2();
+    case CorrelatorIsa::kAvx512:
+      return cpu_has_avx512();
+    default:
       return true;
-    case CorrelatorIsa::kAuto:
-      break;
   }
-  static const bool chosen = [] {
+}
+
+CorrelatorIsa auto_isa() {
+  static const CorrelatorIsa chosen = [] {
     const char* forced = std::getenv("ULTRATRACK_CORRELATOR_ISA");
-    if (forced != nullptr && std::string(forced) == "baseline") return false;
-    return cpu_has_avx2();
+    const std::string cap = forced != nullptr ? forced : "";
+    if (cap == "baseline") return CorrelatorIsa::kBaseline;
+    if (cpu_has_avx512() && cap != "avx2") return CorrelatorIsa::kAvx512;
+    return cpu_has_avx2() ? CorrelatorIsa::kAvx2 : CorrelatorIsa::kBaseline;
   }();
   return chosen;
 }
 
+CorrelatorIsa resolve_isa(CorrelatorIsa isa) {
+  if (isa == CorrelatorIsa::kAuto) return auto_isa();
+  if (!isa_available(isa))
+    throw std::invalid_argument(isa == CorrelatorIsa::kAvx2 ? "CorrelatorEngine: AVX2+FMA kernel not available here"
+                                                            : "CorrelatorEngine: AVX-512 BW/VL/VNNI kernel not available here");
+  return isa;
+}
+
 template <int kTaps>
-CorrelatorEngine::Kernel select_kernel([[maybe_unused]] bool avx2) {
+CorrelatorEngine::Kernel select_kernel([[maybe_unused]] CorrelatorIsa isa) {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-  if (avx2) return &correlate_avx2<kTaps>;
+  if (isa != CorrelatorIsa::kBaseline) return &correlate_avx2<kTaps>;  // no AVX-512 float copy
 #endif
   return &correlate_baseline<kTaps>;
 }
 
 template <int kTaps>
-CorrelatorEngine::KernelI16 select_kernel_i16([[maybe_unused]] bool avx2) {
+CorrelatorEngine::KernelI16 select_kernel_i16([[maybe_unused]] CorrelatorIsa isa, [[maybe_unused]] std::uint32_t share) {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-  if (avx2) return &correlate_i16_avx2<kTaps>;
+  if (isa == CorrelatorIsa::kAvx512) return select_shared<kTaps, Avx512Kernels>(share);
+  if (isa == CorrelatorIsa::kAvx2) return select_shared<kTaps, Avx2Kernels>(share);
 #endif
   return &correlate_i16_portable;
 }
@@ -517,6 +736,8 @@ CorrelatorEngine::KernelI16 select_kernel_i16([[maybe_unused]] bool avx2) {
 }  // namespace
 
 bool correlator_avx2_available() { return cpu_has_avx2(); }
+bool correlator_isa_available(CorrelatorIsa isa) { return isa_available(isa); }
+CorrelatorIsa correlator_auto_isa() { return auto_isa(); }
 
 CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_chips, CorrelatorIsa isa)
     : prn_(prn), num_taps_(static_cast<int>(tap_offsets_chips.size())) {
@@ -532,14 +753,23 @@ CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_
   for (int i = 0; i < static_cast<int>(table_.size()); ++i) table_[i] = static_cast<float>(chips[i % kCodeLength]);
   table_i8_.resize(table_.size() + 32);  // the AVX2 integer copy reads 16-byte windows past the last chip used
   for (int i = 0; i < static_cast<int>(table_i8_.size()); ++i) table_i8_[i] = static_cast<std::int8_t>(chips[i % kCodeLength]);
-  const bool avx2 = use_avx2(isa);
+  table_i16_.resize(table_.size() + 64);  // the AVX-512 copy reads 32-word windows past the last chip used
+  for (int i = 0; i < static_cast<int>(table_i16_.size()); ++i) table_i16_[i] = static_cast<std::int16_t>(chips[i % kCodeLength]);
+  const CorrelatorIsa level = resolve_isa(isa);
+  std::uint32_t share = 0;  // per tap: the first tap a whole number of chips from it (the AVX-512 copy's pattern)
+  for (int t = 0; t < num_taps_; ++t) {
+    int lead = t;
+    for (int u = 0; u < t && lead == t; ++u)
+      if (const double d = offsets_[t] - offsets_[u]; d == std::floor(d)) lead = u;
+    share |= static_cast<std::uint32_t>(lead) << (3 * t);
+  }
   switch (num_taps_) {
-    case 1: kernel_ = select_kernel<1>(avx2); kernel_i16_ = select_kernel_i16<1>(avx2); break;
-    case 2: kernel_ = select_kernel<2>(avx2); kernel_i16_ = select_kernel_i16<2>(avx2); break;
-    case 3: kernel_ = select_kernel<3>(avx2); kernel_i16_ = select_kernel_i16<3>(avx2); break;
-    case 4: kernel_ = select_kernel<4>(avx2); kernel_i16_ = select_kernel_i16<4>(avx2); break;
-    case 5: kernel_ = select_kernel<5>(avx2); kernel_i16_ = select_kernel_i16<5>(avx2); break;
-    default: kernel_ = select_kernel<6>(avx2); kernel_i16_ = select_kernel_i16<6>(avx2); break;
+    case 1: kernel_ = select_kernel<1>(level); kernel_i16_ = select_kernel_i16<1>(level, share); break;
+    case 2: kernel_ = select_kernel<2>(level); kernel_i16_ = select_kernel_i16<2>(level, share); break;
+    case 3: kernel_ = select_kernel<3>(level); kernel_i16_ = select_kernel_i16<3>(level, share); break;
+    case 4: kernel_ = select_kernel<4>(level); kernel_i16_ = select_kernel_i16<4>(level, share); break;
+    case 5: kernel_ = select_kernel<5>(level); kernel_i16_ = select_kernel_i16<5>(level, share); break;
+    default: kernel_ = select_kernel<6>(level); kernel_i16_ = select_kernel_i16<6>(level, share); break;
   }
 }
 
@@ -547,12 +777,12 @@ void CorrelatorEngine::correlate_i16(std::span<const PlanarI16> antennas, int nu
                                      double scale, std::span<TapSums> sums) const {
   const std::uint32_t step = table_step(replica.carrier_step_q32);
   if (!rotation_.valid || rotation_.step_q32 != step) build_rotation(step, rotation_);
-  kernel_i16_(table_i8_.data(), offsets_.data(), num_taps_, antennas, num_samples, replica, rotation_, scale, sums);
+  kernel_i16_(table_i8_.data(), table_i16_.data(), offsets_.data(), num_taps_, antennas, num_samples, replica, rotation_, scale, sums);
 }
 
 void convert_to_planar_i16(const std::complex<float>* in, int n, float gain, std::int16_t* re, std::int16_t* im) {
 #ifdef ULTRATRACK_HAVE_AVX2_KERNEL
-  if (use_avx2(CorrelatorIsa::kAuto)) {
+  if (auto_isa() != CorrelatorIsa::kBaseline) {
     convert_planar_avx2(in, n, gain, re, im);
     return;
   }

@@ -8,6 +8,7 @@
 // An integer copy (correlate_i16) takes planar int16 samples: int16 carrier wipe-off against a Q15 rotation
 // table, +-1 chips from one index computation per group of taps a whole number of chips apart, pmaddwd-style
 // multiply-adds into int32, and the chunk's exact carrier phase applied to the sums afterwards (see the .cpp).
+// It has three copies (portable, AVX2, AVX-512 BW+VL+VNNI: 32 samples per instruction), bit-identical.
 #pragma once
 
 #include <array>
@@ -22,11 +23,16 @@ namespace ultratrack::receiver {
 
 inline constexpr int kMaxTaps = 6;
 
-// Which copy of the kernel an engine runs: the one picked from the CPU (kAuto; ULTRATRACK_CORRELATOR_ISA=baseline
-// forces the portable copy), or one named (tests comparing both in one process; kAvx2 throws
-// std::invalid_argument where the CPU or the build lacks it: see correlator_avx2_available()).
-enum class CorrelatorIsa { kAuto, kBaseline, kAvx2 };
+// Which copy of the kernel an engine runs: the best one the CPU has (kAuto), or one named (tests comparing
+// copies in one process; a level the CPU or the build lacks throws std::invalid_argument: see
+// correlator_isa_available()). kAvx512 is the integer kernel's AVX-512 BW+VL+VNNI copy (the float kernel has
+// no AVX-512 copy and runs its AVX2 one there). The environment variable ULTRATRACK_CORRELATOR_ISA = baseline,
+// avx2 or avx512 caps what kAuto picks (tests and benchmarks of every copy on one machine).
+enum class CorrelatorIsa { kAuto, kBaseline, kAvx2, kAvx512 };
+bool correlator_isa_available(CorrelatorIsa isa);
 bool correlator_avx2_available();
+// The level kAuto resolves to in this process (after ULTRATRACK_CORRELATOR_ISA): kBaseline, kAvx2 or kAvx512.
+CorrelatorIsa correlator_auto_isa();
 
 // The replica over one block: prompt code phase at the first sample, chips, measured from a code period start
 // and within [-1023, 2046), with at most 1023 chips covered by the block (so that every tap stays in the
@@ -77,12 +83,12 @@ class CorrelatorEngine final {
   // halves of an epoch and every antenna share it).
   struct Rotation {
     static constexpr int kChunk = 1024;
-    alignas(32) std::int16_t re[kChunk];
-    alignas(32) std::int16_t im[kChunk];
+    alignas(64) std::int16_t re[kChunk];
+    alignas(64) std::int16_t im[kChunk];
     std::uint32_t step_q32 = 0;
     bool valid = false;
   };
-  using KernelI16 = void (*)(const std::int8_t* table, const double* offsets, int num_taps,
+  using KernelI16 = void (*)(const std::int8_t* table, const std::int16_t* table16, const double* offsets, int num_taps,
                              std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& replica,
                              const Rotation& rotation, double scale, std::span<TapSums> sums);
 
@@ -92,6 +98,7 @@ class CorrelatorEngine final {
   std::array<double, kMaxTaps> offsets_{};
   std::vector<float> table_;  // 5 code periods of +1/-1 chips (float: no conversion per sample): index = chip + 2046
   std::vector<std::int8_t> table_i8_;  // the same chips as int8 (the integer kernel's byte shuffles)
+  std::vector<std::int16_t> table_i16_;  // and as int16 (the AVX-512 copy's word permutes)
   Kernel kernel_ = nullptr;
   KernelI16 kernel_i16_ = nullptr;
   mutable Rotation rotation_;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <complex>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include "signals/ca_code.hpp"
@@ -377,6 +378,90 @@ TEST(CorrelatorEngine, IntegerKernelAvx2AndPortableAreBitIdentical) {
     }
   }
   EXPECT_EQ(compared, 12 * 2 * (1 + 3 + 4 + 5 + 6 + 2));
+}
+
+// Every copy of the integer kernel (portable, AVX2, AVX-512) must give bit-identical sums: integer sums are
+// exact whatever the lane order or the instruction (pmaddwd + add or vpdpwssd), and the double finish is
+// shared. Block lengths around the vector widths and the 1024-sample chunk (1..3001, tails of 1..31), code
+// rates of the receiver at 16 / 4 / 2.6 MHz and the 0.99 chip-per-sample limit (and 1.2, the portable
+// fallback), carrier steps of either sign, 1 and 3 antennas, 1/3/4/5/6 taps, noise-level and full-scale samples.
+TEST(CorrelatorEngine, IntegerKernelEveryCopyIsBitIdenticalToPortable) {
+  std::vector<CorrelatorIsa> copies;
+  if (correlator_isa_available(CorrelatorIsa::kAvx2)) copies.push_back(CorrelatorIsa::kAvx2);
+  if (correlator_isa_available(CorrelatorIsa::kAvx512)) copies.push_back(CorrelatorIsa::kAvx512);
+  if (copies.empty()) GTEST_SKIP() << "no vector copy on this CPU: nothing to compare";
+  std::mt19937 rng(23);
+  std::normal_distribution<float> noise(0.0f, 20.0f);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  // Tap sets whose taps are whole chips apart share chip indices in the vector copies (compiled patterns:
+  // E/P/L, P/E/L, E/P/L/noise, prompt/noise, five taps either order); the rest do not share.
+  const std::vector<std::vector<double>> layouts = {
+      {0.0}, {0.5, 0.0, -0.5}, {0.0, 0.5, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)},
+      {0.0, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0}, {0.0, 0.5, -0.5, 1.0, -1.0},
+      {0.1, 0.0, -0.9}, {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}};
+  const int lengths[] = {1, 7, 31, 32, 33, 100, 1023, 1024, 1025, 1300, 2049, 3001};
+  const double steps[] = {1.023e6 / 16e6, 1.023e6 / 4e6, 1.023e6 / 2.6e6, 0.99, 1.2};
+  int compared = 0;
+  for (const auto& offsets : layouts) {
+    const CorrelatorEngine portable(9, offsets, CorrelatorIsa::kBaseline);
+    std::vector<CorrelatorEngine> engines;
+    for (const auto isa : copies) engines.emplace_back(9, offsets, isa);
+    for (int trial = 0; trial < 2 * 12 * 5; ++trial) {
+      const int antennas = trial % 2 == 0 ? 1 : 3;
+      const int n = lengths[(trial / 2) % 12];
+      const float gain = trial % 3 == 2 ? 128.0f : 64.0f;  // 128: i8 full scale -> +-16384 (saturating wipe-off)
+      ReplicaSegment rep;
+      rep.code_step_chips = steps[(trial / 24) % 5] * (1.0 - 1e-4 * u(rng) * (trial % 5 != 3));
+      const double covered = rep.code_step_chips * n;
+      rep.code_phase_chips = -1000.0 + u(rng) * std::max(0.0, 3040.0 - covered);  // every tap inside the table
+      rep.carrier_phase_q32 = static_cast<std::uint32_t>(rng());
+      rep.carrier_step_q32 = static_cast<std::uint32_t>(static_cast<std::int32_t>(rng()) / 256);  // +-2^23: either sign
+      std::vector<Planar> x;
+      std::vector<PlanarI16> views;
+      const auto& chips = signals::ca_code(9);
+      for (int a = 0; a < antennas; ++a) {
+        std::vector<std::complex<float>> f(static_cast<std::size_t>(n));
+        for (int i = 0; i < n; ++i) {
+          const double chip = rep.code_phase_chips + rep.code_step_chips * i;
+          const int c = chips[static_cast<std::size_t>(((static_cast<long>(std::floor(chip)) % 1023) + 1023) % 1023)];
+          const float s = (gain > 100.0f ? 100.0f : 25.0f) * static_cast<float>(c);
+          f[static_cast<std::size_t>(i)] = {std::round(std::clamp(s + noise(rng), -128.0f, 127.0f)),
+                                            std::round(std::clamp(noise(rng), -128.0f, 127.0f))};
+        }
+        x.push_back(to_planar(f, gain));
+      }
+      for (const auto& p : x) views.push_back(p.view());
+      std::vector<TapSums> expected(static_cast<std::size_t>(antennas));
+      for (auto& s : expected) s.fill({1.0, -2.0});  // sums are added to what is there
+      portable.correlate_i16(views, n, rep, 1.0 / gain, expected);
+      for (std::size_t e = 0; e < engines.size(); ++e) {
+        std::vector<TapSums> got(static_cast<std::size_t>(antennas));
+        for (auto& s : got) s.fill({1.0, -2.0});
+        engines[e].correlate_i16(views, n, rep, 1.0 / gain, got);
+        for (int a = 0; a < antennas; ++a)
+          for (int t = 0; t < static_cast<int>(offsets.size()); ++t) {
+            ASSERT_EQ(got[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)], expected[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)])
+                << "copy " << static_cast<int>(copies[e]) << ", " << offsets.size() << " taps, tap " << t << ", antenna " << a
+                << ", n " << n << ", code step " << rep.code_step_chips << ", trial " << trial;
+            ++compared;
+          }
+      }
+    }
+  }
+  EXPECT_EQ(compared, static_cast<int>(copies.size()) * 60 * 4 * (1 + 3 + 3 + 4 + 2 + 5 + 5 + 3 + 6));  // 60 x 1 + 60 x 3 antennas
+}
+
+// A level the CPU lacks is refused, never silently replaced; kAuto resolves to an available level.
+TEST(CorrelatorEngine, NamedIsaIsHonouredOrRefused) {
+  const double offsets[] = {0.0};
+  for (const auto isa : {CorrelatorIsa::kBaseline, CorrelatorIsa::kAvx2, CorrelatorIsa::kAvx512}) {
+    if (correlator_isa_available(isa))
+      EXPECT_NO_THROW(CorrelatorEngine(3, offsets, isa));
+    else
+      EXPECT_THROW(CorrelatorEngine(3, offsets, isa), std::invalid_argument);
+  }
+  EXPECT_TRUE(correlator_isa_available(correlator_auto_isa()));
+  EXPECT_NE(correlator_auto_isa(), CorrelatorIsa::kAuto);
 }
 
 // Several antennas against one replica in the integer kernel: identical antennas give identical sums, and a
