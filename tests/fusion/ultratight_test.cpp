@@ -187,6 +187,47 @@ TEST(UltraTight, NeesMonteCarloEkfTcxo) {
   nees_monte_carlo(FilterKind::Ekf, nees_runs(), ClockNoiseModel{}.bias_psd_m2_per_s, "EKF, TCXO");
 }
 
+// A receiver channel's Costas PLL stays closed (receive --coupling ultra-tight): each period starts with the PLL's
+// residual phase error, not the realigned phase of the seed model. Simulated here as a phase drawn N(0, sigma^2)
+// per satellite and period (sigma = 0.05 rad: A^2 sigma^2 = 3.2 noise units at 45 dB-Hz). Told to the driver
+// (start_phase_var_rad2) the mean NIS of the 6-row I&Q updates must lie in the chi-square band of 6 N degrees of
+// freedom (updates after the first 1 s, independent tap noise); left out (the seed model) it lies above. The
+// clock's frequency noise is switched off in truth and model (its R term is deliberately conservative).
+double mean_iq_nis(double start_phase_sigma_rad, bool tell, int& count) {
+  CorrelationSimConfig cfg;
+  cfg.duration_s = 4.0;
+  cfg.seed = 31;
+  cfg.clock_bias_psd_m2_per_s = 1e-12;
+  cfg.clock_drift_psd_m2_per_s3 = 1e-12;
+  cfg.start_phase_sigma_rad = start_phase_sigma_rad;
+  cfg.tell_start_phase = tell;
+  const CorrelationRunResult r = run_correlation_simulation(cfg);
+  const std::size_t skip = r.nis.size() / 4;  // the first 1 s of 4 s: pull-in from the initial errors
+  double sum = 0.0;
+  count = 0;
+  for (std::size_t i = skip; i < r.nis.size(); ++i) {
+    sum += r.nis[i];
+    ++count;
+  }
+  return sum / std::max(count, 1);
+}
+
+TEST(UltraTight, ClosedPllStartPhaseInRKeepsIqNisInItsBand) {
+  int n = 0;
+  const double realigned = mean_iq_nis(0.0, true, n);
+  const double lo = chi_square_quantile(0.005, 6 * n) / n, hi = chi_square_quantile(0.995, 6 * n) / n;
+  int n1 = 0, n2 = 0;
+  const double told = mean_iq_nis(0.05, true, n1);
+  const double seed_model = mean_iq_nis(0.05, false, n2);
+  std::printf("mean I&Q NIS over %d updates (99 %% band [%.3f, %.3f]): realigned phase %.3f; PLL start phase "
+              "0.05 rad in R %.3f, left out %.3f\n", n, lo, hi, realigned, told, seed_model);
+  EXPECT_GT(realigned, lo);
+  EXPECT_LT(realigned, hi);
+  EXPECT_GT(told, lo);
+  EXPECT_LT(told, hi);
+  EXPECT_GT(seed_model, hi);
+}
+
 TEST(UltraTight, CoastingThroughTenSecondBlockageAndRelock) {
   for (auto f : {FilterKind::Ekf, FilterKind::Ukf}) {
     CorrelationSimConfig cfg;
