@@ -134,6 +134,7 @@ void check_options(const UltraTightOptions& o) {
 struct UltraTightCoreBase {
   virtual ~UltraTightCoreBase() = default;
   virtual void add_imu(const ins::ImuIncrement& inc) = 0;
+  virtual void add_ephemerides(const std::vector<signals::Ephemeris>& eph) = 0;
   virtual void start_period(double T) = 0;
   virtual void finish_period(const std::vector<ChannelCorrelation>& c) = 0;
   virtual NominalState nominal() const = 0;
@@ -180,6 +181,16 @@ class UltraTightCore final : public UltraTightCoreBase {
     nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
     fill_output();
+  }
+
+  void add_ephemerides(const std::vector<signals::Ephemeris>& eph) override {
+    for (const signals::Ephemeris& e : eph) {
+      const bool held = std::any_of(eph_.begin(), eph_.end(), [&](const signals::Ephemeris& h) {
+        return h.prn == e.prn && h.iode == e.iode && h.iodc == e.iodc && h.week == e.week && h.toe_s == e.toe_s &&
+               h.toc_s == e.toc_s;
+      });
+      if (!held) eph_.push_back(e);
+    }
   }
 
   void start_period(double T) override {
@@ -433,6 +444,9 @@ UltraTightIntegration::UltraTightIntegration(UltraTightIntegration&&) noexcept =
 UltraTightIntegration& UltraTightIntegration::operator=(UltraTightIntegration&&) noexcept = default;
 
 void UltraTightIntegration::add_imu(const ins::ImuIncrement& inc) { impl_->core->add_imu(inc); }
+void UltraTightIntegration::add_ephemerides(const std::vector<signals::Ephemeris>& eph) {
+  impl_->core->add_ephemerides(eph);
+}
 const std::vector<ReplicaCommand>& UltraTightIntegration::start_period(double T) {
   impl_->core->start_period(T);
   return impl_->core->replicas;

@@ -108,6 +108,10 @@ class UltraTightIntegration {
 
   // One IMU increment over (current t, inc.t_s]; non-finite or non-increasing ones are ignored.
   void add_imu(const ins::ImuIncrement& inc);
+  // Ephemerides received after the start (a satellite's first set, a new IODE): from the next start_period on,
+  // each satellite is predicted from the set valid at its transmit time (signals::select_ephemeris) among all
+  // held; a set already held (same PRN, IODE, IODC, toe, toc) is ignored.
+  void add_ephemerides(const std::vector<signals::Ephemeris>& ephemerides);
   // Predict the replicas of every satellite above the mask for the period [now, now + T), 1 ms <= T <= 20 ms
   // (std::invalid_argument otherwise). Channels keep their running carrier phase.
   const std::vector<ReplicaCommand>& start_period(double integration_time_s);

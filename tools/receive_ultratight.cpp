@@ -114,6 +114,7 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   for (int prn = 1; prn <= 32; ++prn)
     if (auto e = signals::select_ephemeris(*epoch.ephemerides, prn, epoch.receive_time)) eph.push_back(*e);
   ephemerides_ = eph;
+  ephemerides_seen_ = epoch.ephemerides->size();
   driver_.emplace(out.nav, std::move(eph), o);
   t_ins_ = out.nav.t_s;
   next_imu_ = 0;
@@ -298,6 +299,15 @@ void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
   feed_imu_to(t_k);
   const std::map<int, double> aid_change = propagated_doppler_change();
   if (period_open_) driver_->finish_period(correlations(epoch, t_k));
+  // Sets decoded since the hand-over (the engine appends them): a satellite without one at the hand-over, or a new
+  // IODE, is predicted from them from this period on (each from the set valid at its transmit time).
+  if (epoch.ephemerides && epoch.ephemerides->size() > ephemerides_seen_) {
+    const std::vector<signals::Ephemeris> fresh(epoch.ephemerides->begin() + static_cast<std::ptrdiff_t>(ephemerides_seen_),
+                                                epoch.ephemerides->end());
+    ephemerides_seen_ = epoch.ephemerides->size();
+    driver_->add_ephemerides(fresh);
+    ephemerides_.insert(ephemerides_.end(), fresh.begin(), fresh.end());
+  }
   driver_->start_period(ut_.period_s);
   period_open_ = true;
   for (const auto& in : epoch.channels) {

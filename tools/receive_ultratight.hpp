@@ -72,7 +72,8 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   ReceiveUltraTightOptions ut_;
   io::AtomicFile log_;
   std::optional<fusion::UltraTightIntegration> driver_;
-  std::vector<signals::Ephemeris> ephemerides_;  // the driver's (one per PRN)
+  std::vector<signals::Ephemeris> ephemerides_;  // the driver's: one per PRN at the hand-over, then every later one
+  std::size_t ephemerides_seen_ = 0;             // VectorEpochInput::ephemerides entries already considered
   signals::GpsTime origin_;
   double corrections_at_start_s_ = 0.0;  // the engine's clock corrections at the hand-over
   double t_ins_ = 0.0;                   // the driver's INS time (IMU rows split at vector epochs)
