@@ -56,10 +56,13 @@ void satellite_rows(const NominalState& nominal, const SatelliteObservable& sat,
   // Line-of-sight change with position: d(u . v_rel)/dr_ant = -v_rel' (I - u u') / rho; r_ant moves by -C_en dr.
   const Eigen::RowVector3d a = (v_rel.transpose() * (Eigen::Matrix3d::Identity() - u_e * u_e.transpose()) * C_en) / rho;
   h_rate.segment<3>(ix::kPos) = a;
-  h_rate.segment<3>(ix::kVel) = u_n.transpose();
+  // The antenna velocity enters as -(u - dT/dh up) . v_ant: the line of sight and the troposphere's height rate
+  // (its elevation-rate share through v_ant is ~1e-5 and left out).
+  const Eigen::Vector3d w_n = u_n - sat.troposphere_per_height * (C_en.transpose() * sat.up_e);
+  h_rate.segment<3>(ix::kVel) = w_n.transpose();
   // Attitude moves the antenna velocity (lever arm) and, through the antenna position, the line of sight.
-  h_rate.segment<3>(ix::kAtt) = -u_n.transpose() * Hv_psi + a * ins::skew(l_n);
-  h_rate.segment<3>(ix::kGyroBias) = -u_n.transpose() * C * ins::skew(l_b);
+  h_rate.segment<3>(ix::kAtt) = -w_n.transpose() * Hv_psi + a * ins::skew(l_n);
+  h_rate.segment<3>(ix::kGyroBias) = -w_n.transpose() * C * ins::skew(l_b);
   h_rate(ix::kClockDrift) = -1.0;
 }
 
@@ -110,7 +113,17 @@ std::vector<SatelliteObservable> prepare_satellites(const receiver::ObservationE
     if (opt.ionosphere && iono.valid)
       s.atmosphere_m += kSpeedOfLight_mps * signals::klobuchar_delay_s(iono, lat, lon, la.azimuth_rad,
                                                                       la.elevation_rad, t_tx.tow_s);
-    if (opt.troposphere) s.atmosphere_m += signals::troposphere_delay_m(lat, h, la.elevation_rad);
+    if (opt.troposphere) {
+      const double el = la.elevation_rad;
+      s.atmosphere_m += signals::troposphere_delay_m(lat, h, el);
+      // Central differences of the model (smooth in both: mapping 1 / sqrt(0.002 + sin^2), barometric height).
+      constexpr double kDel = 1e-4, kDh = 1.0;
+      s.troposphere_per_elevation_m =
+          (signals::troposphere_delay_m(lat, h, el + kDel) - signals::troposphere_delay_m(lat, h, el - kDel)) / (2.0 * kDel);
+      s.troposphere_per_height =
+          (signals::troposphere_delay_m(lat, h + kDh, el) - signals::troposphere_delay_m(lat, h - kDh, el)) / (2.0 * kDh);
+      s.up_e = Eigen::Vector3d(std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat));
+    }
     s.pseudorange_m = o.pseudorange_m;
     s.has_rate = opt.use_range_rate && std::isfinite(o.doppler_hz);
     s.range_rate_mps = s.has_rate ? -signals::kL1Wavelength_m * o.doppler_hz : 0.0;
@@ -133,7 +146,24 @@ double predicted_range_rate_mps(const SatelliteObservable& sat, const Eigen::Vec
   const double dtau = -u.dot(v_ant_e) / kSpeedOfLight_mps;
   const Eigen::Vector3d omega_e(0.0, 0.0, signals::kEarthRotationRate_radps);
   const Eigen::Vector3d v_sat = sat.v_sat_e - dtau * (sat.v_sat_e + omega_e.cross(sat.r_sat_e));
-  return u.dot(v_sat - v_ant_e) + clock_drift_mps - sat.sv_drift_mps;
+  return u.dot(v_sat - v_ant_e) + clock_drift_mps - sat.sv_drift_mps + troposphere_rate_mps(sat, r_ant_e, v_ant_e);
+}
+
+double troposphere_rate_mps(const SatelliteObservable& sat, const Eigen::Vector3d& r_ant_e,
+                            const Eigen::Vector3d& v_ant_e) {
+  if (sat.troposphere_per_elevation_m == 0.0 && sat.troposphere_per_height == 0.0) return 0.0;
+  const Eigen::Vector3d los = sat.r_sat_e - r_ant_e;
+  const double rho = los.norm();
+  const Eigen::Vector3d u = los / rho;
+  const Eigen::Vector3d& up = sat.up_e;
+  const Eigen::Vector3d v_rel = sat.v_sat_e - v_ant_e;
+  const Eigen::Vector3d du = (v_rel - u * u.dot(v_rel)) / rho;          // the line of sight turning
+  const double v_up = v_ant_e.dot(up);
+  const Eigen::Vector3d dup = (v_ant_e - up * v_up) / (r_ant_e.norm()); // the local vertical turning
+  const double sin_el = u.dot(up);
+  const double cos_el = std::sqrt(std::max(1e-12, 1.0 - sin_el * sin_el));
+  const double el_rate = (du.dot(up) + u.dot(dup)) / cos_el;
+  return sat.troposphere_per_elevation_m * el_rate + sat.troposphere_per_height * v_up;
 }
 
 SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, const SatelliteObservable& sat,

@@ -5,8 +5,9 @@
 // correction (af polynomial + relativistic - TGD), broadcast Klobuchar ionosphere and the standard
 // troposphere exactly as receiver/pvt. Pseudorange rate = -lambda_L1 * Doppler; prediction
 // u . (v_sat_apparent - v_ant_e) + clock drift - c * SV clock drift (pvt's apparent satellite velocity, plus the
-// receiver's own velocity in the travel-time rate, which pvt leaves out; like pvt, the rate of the atmospheric
-// delays, up to ~2 mm/s at low elevation, is not modelled).
+// receiver's own velocity in the travel-time rate, which pvt leaves out) plus the troposphere's rate (its delay
+// changes with the elevation, by the satellite's and the antenna's motion, and with the antenna height: up to
+// ~10 mm/s at 10 deg from the satellite alone; the Klobuchar ionosphere's rate, < 1 mm/s, is left out).
 // Metres, m/s, seconds.
 #pragma once
 
@@ -40,6 +41,10 @@ struct SatelliteObservable {
   double sv_clock_m = 0.0;     // c * (af polynomial + relativistic - TGD)
   double sv_drift_mps = 0.0;   // c * SV clock drift
   double atmosphere_m = 0.0;   // ionosphere + troposphere delay
+  // The troposphere model's slopes at the antenna (0 without troposphere): d delay / d elevation (m/rad) and
+  // d delay / d height (m/m), with the local up direction (ECEF unit vector) they refer to.
+  double troposphere_per_elevation_m = 0.0, troposphere_per_height = 0.0;
+  Eigen::Vector3d up_e = Eigen::Vector3d::Zero();
   double elevation_rad = 0.0, azimuth_rad = 0.0;
   double pseudorange_m = 0.0;
   double range_rate_mps = 0.0;  // -lambda * Doppler
@@ -64,6 +69,11 @@ std::vector<SatelliteObservable> prepare_satellites(const receiver::ObservationE
 double predicted_pseudorange_m(const SatelliteObservable& sat, const Eigen::Vector3d& r_ant_e, double clock_bias_m);
 double predicted_range_rate_mps(const SatelliteObservable& sat, const Eigen::Vector3d& r_ant_e,
                                 const Eigen::Vector3d& v_ant_e, double clock_drift_mps);
+// Rate of the troposphere delay (m/s) for an antenna at r_ant_e moving with v_ant_e (ECEF): the elevation's rate
+// from the line of sight turning (satellite minus antenna velocity) and the local vertical turning with the
+// antenna (spherical earth), and the height's rate; part of predicted_range_rate_mps.
+double troposphere_rate_mps(const SatelliteObservable& sat, const Eigen::Vector3d& r_ant_e,
+                            const Eigen::Vector3d& v_ant_e);
 
 // One satellite's pseudorange (row 0) and, when available and wanted, pseudorange rate (row 1), for the
 // 17-state error model. w_ib_b: compensated body rate (lever-arm velocity).

@@ -31,7 +31,8 @@ class PeriodIqMeasurement {
  public:
   PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
                       const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
-                      double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var)
+                      double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var,
+                      double start_phase_var)
       : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), M_(period_mixing(span_s)),
         R_(iq_noise_covariance(s)),
         code_sigma_(prior_code_sigma_chips) {
@@ -40,6 +41,11 @@ class PeriodIqMeasurement {
     if (rate_noise_var > 0.0) {
       const Eigen::Matrix<double, 6, 1> g = iq_jacobian(errors(StateVector<17>::Zero()), s_).col(1) / kLambda_m;
       R_ += rate_noise_var * g * g.transpose();
+    }
+    // The replica's unknown phase error at the period's start (a closed PLL's residual) turns all six taps.
+    if (start_phase_var > 0.0) {
+      const Eigen::Matrix<double, 6, 1> g = iq_phase_derivative(errors(StateVector<17>::Zero()), s_);
+      R_ += start_phase_var * g * g.transpose();
     }
     z_.resize(6);
     for (int k = 0; k < 3; ++k) {
@@ -93,11 +99,11 @@ class PeriodDiscriminatorMeasurement {
   PeriodDiscriminatorMeasurement(const NominalState& nominal, const SatelliteObservable& sat,
                                  const Eigen::Vector3d& lever_b, const Eigen::Vector3d& w_ib_b,
                                  const Eigen::Vector2d& offset, double span_s, const Eigen::Vector2d& measured,
-                                 const DiscriminatorNoise& noise, double rate_noise_var)
+                                 const DiscriminatorNoise& noise, double rate_noise_var, double start_phase_rate_var)
       : replica_(nominal, {sat}, lever_b, w_ib_b), offset_(offset), M_(period_mixing(span_s)), z_(measured),
         R_(Eigen::MatrixXd::Zero(2, 2)) {
     R_(0, 0) = noise.range_sigma_m * noise.range_sigma_m;
-    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps + rate_noise_var;
+    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps + rate_noise_var + start_phase_rate_var;
   }
   Eigen::VectorXd z() const { return z_; }
   Eigen::VectorXd h(const StateVector<17>& dx) const { return M_ * replica_.errors(dx) + offset_; }
@@ -128,6 +134,7 @@ void check_options(const UltraTightOptions& o) {
 struct UltraTightCoreBase {
   virtual ~UltraTightCoreBase() = default;
   virtual void add_imu(const ins::ImuIncrement& inc) = 0;
+  virtual void add_ephemerides(const std::vector<signals::Ephemeris>& eph) = 0;
   virtual void start_period(double T) = 0;
   virtual void finish_period(const std::vector<ChannelCorrelation>& c) = 0;
   virtual NominalState nominal() const = 0;
@@ -174,6 +181,16 @@ class UltraTightCore final : public UltraTightCoreBase {
     nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
     fill_output();
+  }
+
+  void add_ephemerides(const std::vector<signals::Ephemeris>& eph) override {
+    for (const signals::Ephemeris& e : eph) {
+      const bool held = std::any_of(eph_.begin(), eph_.end(), [&](const signals::Ephemeris& h) {
+        return h.prn == e.prn && h.iode == e.iode && h.iodc == e.iodc && h.week == e.week && h.toe_s == e.toe_s &&
+               h.toc_s == e.toc_s;
+      });
+      if (!held) eph_.push_back(e);
+    }
   }
 
   void start_period(double T) override {
@@ -280,12 +297,13 @@ class UltraTightCore final : public UltraTightCoreBase {
         const Eigen::Matrix<double, 1, 17> h_range = J.row(0) - 0.5 * span * J.row(1);
         const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
         ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code,
-                                         clock_rate_var));
+                                         clock_rate_var, c->start_phase_var_rad2));
       } else {
         const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
                                 frequency_discriminator_hz(c->taps, is) * kLambda_m);
         ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span, z,
-                                                   discriminator_noise(is), clock_rate_var));
+                                                   discriminator_noise(is), clock_rate_var,
+                                                   c->start_phase_var_rad2 * std::pow(kLambda_m / (M_PI * T_), 2)));
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
@@ -445,6 +463,9 @@ UltraTightIntegration::UltraTightIntegration(UltraTightIntegration&&) noexcept =
 UltraTightIntegration& UltraTightIntegration::operator=(UltraTightIntegration&&) noexcept = default;
 
 void UltraTightIntegration::add_imu(const ins::ImuIncrement& inc) { impl_->core->add_imu(inc); }
+void UltraTightIntegration::add_ephemerides(const std::vector<signals::Ephemeris>& eph) {
+  impl_->core->add_ephemerides(eph);
+}
 const std::vector<ReplicaCommand>& UltraTightIntegration::start_period(double T) {
   impl_->core->start_period(T);
   return impl_->core->replicas;

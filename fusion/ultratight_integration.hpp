@@ -7,7 +7,8 @@
 // C/N0 below the threshold) keep being predicted and are reported as coasting.
 // Time line: t_s of the IMU samples (GPS time minus gps_time_origin). Metres, m/s, chips, Hz, cycles.
 // Model assumption (iq_measurements.hpp): data bits known/wiped off, carrier NCO phase realigned at the start
-// of every period (the phase error inside a period is 2 pi df s). Over a period the taps see the mean range
+// of every period (the phase error inside a period is 2 pi df s), or its error at the start given as a variance
+// (ChannelCorrelation::start_phase_var_rad2: a closed PLL's residual, taken as noise in R). Over a period the taps see the mean range
 // error and the rate error at a third of the period (period_replica_errors), and the receiver clock's frequency
 // noise within the period (from options.model.clock) is part of R.
 #pragma once
@@ -73,6 +74,12 @@ struct ChannelCorrelation {
   // at that start and its constant carrier range rate. has_replica false: the ReplicaCommand of this PRN.
   bool has_replica = false;
   double replica_t_start_s = 0.0, replica_pseudorange_m = 0.0, replica_range_rate_mps = 0.0;
+  // Variance (rad^2) of the replica's carrier phase error at the period's start. 0: the NCO phase is realigned at
+  // every start, as the seed model assumes. A channel whose Costas PLL stays closed starts each period with the
+  // PLL's residual phase error (thermal jitter Bn / (C/N0) (1 + 1 / (2 T C/N0))): the taps turn by it, which the
+  // model takes as noise along the phase direction (iq_phase_derivative), the frequency discriminator as a rate
+  // error of variance (lambda / (pi T))^2 times it.
+  double start_phase_var_rad2 = 0.0;
 };
 
 // One satellite's update in the latest finish_period (for logs): the filter's innovation (Iq: I_E, I_P, I_L,
@@ -101,6 +108,10 @@ class UltraTightIntegration {
 
   // One IMU increment over (current t, inc.t_s]; non-finite or non-increasing ones are ignored.
   void add_imu(const ins::ImuIncrement& inc);
+  // Ephemerides received after the start (a satellite's first set, a new IODE): from the next start_period on,
+  // each satellite is predicted from the set valid at its transmit time (signals::select_ephemeris) among all
+  // held; a set already held (same PRN, IODE, IODC, toe, toc) is ignored.
+  void add_ephemerides(const std::vector<signals::Ephemeris>& ephemerides);
   // Predict the replicas of every satellite above the mask for the period [now, now + T), 1 ms <= T <= 20 ms
   // (std::invalid_argument otherwise). Channels keep their running carrier phase.
   const std::vector<ReplicaCommand>& start_period(double integration_time_s);

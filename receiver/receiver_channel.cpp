@@ -110,6 +110,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   in.replica_carrier_frequency_hz = (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * fs_hz_ / e.num_samples;
   if (e.noise_power > 0.0) {
     const double scale = 1.0 / std::sqrt(0.5 * e.noise_power);  // noise tap: variance 2 sigma^2 (I and Q)
+    in.iq_scale = scale;
     const std::array<std::complex<float>, 3> taps{e.early, e.prompt, e.late};
     for (int k = 0; k < 3; ++k) {
       in.iq_i[k] = taps[k].real() * scale;

@@ -57,6 +57,10 @@ struct VectorChannelInput {
   std::int64_t measurement_first_sample = 0;
   double replica_carrier_frequency_hz = 0.0;
   std::array<double, 3> iq_i{}, iq_q{};  // early, prompt, late
+  // The factor the taps were multiplied by (1 / the running noise sigma per I or Q; 0: no noise estimate yet). That
+  // estimate moves by +-16 % in power (a 0.05 average of one noise tap per epoch), and the normalised signal
+  // amplitude with it: a loop estimating the amplitude averages it on the raw scale (taps / iq_scale).
+  double iq_scale = 0.0;
 };
 
 struct VectorEpochInput {

@@ -114,6 +114,7 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   for (int prn = 1; prn <= 32; ++prn)
     if (auto e = signals::select_ephemeris(*epoch.ephemerides, prn, epoch.receive_time)) eph.push_back(*e);
   ephemerides_ = eph;
+  ephemerides_seen_ = epoch.ephemerides->size();
   driver_.emplace(out.nav, std::move(eph), o);
   t_ins_ = out.nav.t_s;
   next_imu_ = 0;
@@ -129,17 +130,28 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
   for (const auto& in : epoch.channels) {
     if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
     if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
-    if (in.iq_i == std::array<double, 3>{} && in.iq_q == std::array<double, 3>{}) continue;  // no noise estimate
+    if (!(in.iq_scale > 0.0)) continue;  // no noise estimate
     ++measurements_;
     fusion::ChannelCorrelation c;
     c.prn = in.prn;
     // The I&Q model's amplitude A = sqrt(2 C/N0 T) must be the one of these normalised taps: C/N0 by the moments
-    // of the same taps (E[I_P^2 + Q_P^2] = A^2 + 2), averaged over ~10 epochs (0.2 s, as the channel's estimator).
+    // of the same taps (E[I_P^2 + Q_P^2] = A^2 + 2), averaged over ~10 epochs (0.2 s, as the channel's estimator)
+    // on the raw scale and carried to this epoch's normalisation: the channel's noise estimate moves the
+    // normalised amplitude by +-8 % (+-2.8 noise sigmas at 45 dB-Hz) from epoch to epoch, which an average of the
+    // normalised power does not follow (I_P innovation variance 3.3 instead of 1: docs/validation.md). The
+    // average of the epochs before this one: with this epoch's prompt in it (weight 0.1) the I_P innovation
+    // would lose a tenth of its noise (variance 0.81).
     ChannelState& st = channels_[in.prn];
-    const double p2 = in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1];
+    const double scale2 = in.iq_scale * in.iq_scale;
+    const double p2 = (in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2;
+    const double a2 = (std::isfinite(st.prompt_power) ? st.prompt_power : p2) * scale2 - 2.0;
     st.prompt_power = std::isfinite(st.prompt_power) ? st.prompt_power + 0.1 * (p2 - st.prompt_power) : p2;
-    const double a2 = st.prompt_power - 2.0;
     c.cn0_dbhz = a2 > 0.0 ? 10.0 * std::log10(a2 / (2.0 * ut_.period_s)) : -100.0;
+    // The channel's PLL stays closed: the period starts with its residual phase error (thermal jitter of the
+    // coherent-epoch loop, design bandwidth), not the realigned phase of the seed model.
+    const double jitter_rad = receiver::pll_thermal_jitter_rad(
+        receiver::long_coherent_pll_bw_hz(options_.tracking, 1), ut_.period_s, c.cn0_dbhz);
+    c.start_phase_var_rad2 = a2 > 0.0 ? jitter_rad * jitter_rad : 0.0;
     c.integration_time_s = ut_.period_s;
     // Data wipe-off by the prompt's sign: the Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms:
     // Q(sqrt(2 C/N0 T)) = Q(6.3), none in practice).
@@ -287,6 +299,15 @@ void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
   feed_imu_to(t_k);
   const std::map<int, double> aid_change = propagated_doppler_change();
   if (period_open_) driver_->finish_period(correlations(epoch, t_k));
+  // Sets decoded since the hand-over (the engine appends them): a satellite without one at the hand-over, or a new
+  // IODE, is predicted from them from this period on (each from the set valid at its transmit time).
+  if (epoch.ephemerides && epoch.ephemerides->size() > ephemerides_seen_) {
+    const std::vector<signals::Ephemeris> fresh(epoch.ephemerides->begin() + static_cast<std::ptrdiff_t>(ephemerides_seen_),
+                                                epoch.ephemerides->end());
+    ephemerides_seen_ = epoch.ephemerides->size();
+    driver_->add_ephemerides(fresh);
+    ephemerides_.insert(ephemerides_.end(), fresh.begin(), fresh.end());
+  }
   driver_->start_period(ut_.period_s);
   period_open_ = true;
   for (const auto& in : epoch.channels) {

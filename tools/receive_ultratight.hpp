@@ -55,8 +55,8 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
     double coast_s = 0.0;
     bool ever = false;
     bool was_coasting = false;
-    double prompt_power = NAN;
-    double aid_hz = NAN;  // the carrier aiding sent (changes by the INS propagation only)  // running mean of I_P^2 + Q_P^2 (normalised taps): A^2 + 2
+    double prompt_power = NAN;  // running mean of I_P^2 + Q_P^2 on the raw scale (taps / iq_scale)
+    double aid_hz = NAN;  // the carrier aiding sent (changes by the INS propagation only)
   };
   void start(const receiver::VectorEpochInput& epoch, double t_k);
   double imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const;
@@ -72,7 +72,8 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   ReceiveUltraTightOptions ut_;
   io::AtomicFile log_;
   std::optional<fusion::UltraTightIntegration> driver_;
-  std::vector<signals::Ephemeris> ephemerides_;  // the driver's (one per PRN)
+  std::vector<signals::Ephemeris> ephemerides_;  // the driver's: one per PRN at the hand-over, then every later one
+  std::size_t ephemerides_seen_ = 0;             // VectorEpochInput::ephemerides entries already considered
   signals::GpsTime origin_;
   double corrections_at_start_s_ = 0.0;  // the engine's clock corrections at the hand-over
   double t_ins_ = 0.0;                   // the driver's INS time (IMU rows split at vector epochs)

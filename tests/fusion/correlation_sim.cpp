@@ -166,6 +166,10 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
             code[m] = (rep - sig) / kChip;
             phase[m] = 2.0 * M_PI * ((rep - r.pseudorange_m) - (sig - p0)) / kLambda;
           }
+          if (cfg.start_phase_sigma_rad > 0.0) {
+            const double start_phase = cfg.start_phase_sigma_rad * n01(rng);
+            for (double& p : phase) p += start_phase;
+          }
           max_code = std::max(max_code, std::abs(code[kSub / 2]));
           max_freq = std::max(max_freq, std::abs((r.range_rate_mps - (c1 + c2 * T)) / kLambda));
           ChannelCorrelation cc;
@@ -179,9 +183,11 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
             cc.taps.q[j] += nq(j);
           }
           cc.cn0_dbhz = blocked ? 0.0 : cfg.cn0_dbhz;  // the channel's estimate: blocked = nothing there
+          if (cfg.tell_start_phase) cc.start_phase_var_rad2 = cfg.start_phase_sigma_rad * cfg.start_phase_sigma_rad;
           corr.push_back(cc);
         }
         timed([&] { integ.finish_period(corr); });
+        for (const auto& u : integ.last_updates()) res.nis.push_back(u.nis);
         NominalState truth;
         truth.nav = run.truth[k].nav();
         truth.accel_bias_b = imu.accel_bias();

@@ -40,6 +40,11 @@ struct CorrelationSimConfig {
   double clock_bias_psd_m2_per_s = 9e-6;
   double clock_drift_psd_m2_per_s3 = 0.0355;
   bool troposphere = true;  // in the signal and in the filter's model alike
+  // A receiver channel whose Costas PLL stays closed starts each period with its residual phase error instead of
+  // the realigned phase: drawn N(0, sigma^2) per satellite and period (0: realigned); told to the driver as
+  // ChannelCorrelation::start_phase_var_rad2 when tell_start_phase.
+  double start_phase_sigma_rad = 0.0;
+  bool tell_start_phase = true;
 };
 
 struct CorrelationRunResult {
@@ -50,6 +55,7 @@ struct CorrelationRunResult {
   std::vector<double> max_code_err_chips;    // over the satellites, true error of the replica at mid-period
   std::vector<double> max_freq_err_hz;
   std::vector<int> coasting;                 // satellites reported coasting at the period's start
+  std::vector<double> nis;                   // every satellite update's NIS (accepted or not), in order
   Eigen::Matrix<double, 17, 1> last_error, last_sigma;  // error state and filter 1-sigma at the end
   int satellites = 0;
   double cpu_s = 0.0;                        // filter time (start/finish_period + IMU)

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 
 #include "correlation_sim.hpp"
 #include "fusion/chi_square.hpp"
 #include "fusion/iq_measurements.hpp"
 #include "fusion/ultratight_integration.hpp"
+#include "signals/gps_constants.hpp"
 #include "signals/nominal_constellation.hpp"
 
 namespace ultratrack::fusion {
@@ -75,6 +77,137 @@ TEST(UltraTight, SeveralEphemerisSetsPerSatellitePredictOneReplicaEach) {
     EXPECT_EQ(a[i].prn, b[i].prn);
     EXPECT_EQ(a[i].pseudorange_m, b[i].pseudorange_m);
     EXPECT_EQ(a[i].range_rate_mps, b[i].range_rate_mps);
+  }
+}
+
+// Ephemerides arriving after the start (add_ephemerides). Drivers at rest, no updates (every satellite coasting):
+// their predictions differ only by the ephemeris sets they hold, so a driver given a set later must predict
+// exactly as one that held it from the start.
+struct DriverAtRest {
+  UltraTightIntegration driver;
+  double t_s = 0.0;
+  DriverAtRest(const std::vector<signals::Ephemeris>& eph, const signals::GpsTime& origin)
+      : driver(start_nav(), eph, options(origin)) {}
+  static ins::NavState start_nav() {
+    ins::NavState nav;
+    nav.lat_rad = 35.27 * M_PI / 180.0;
+    nav.lon_rad = 137.01 * M_PI / 180.0;
+    nav.height_m = 100.0;
+    return nav;
+  }
+  static UltraTightOptions options(const signals::GpsTime& origin) {
+    UltraTightOptions opt;
+    opt.gps_time_origin = origin;
+    return opt;
+  }
+  // One 20 ms period: the replicas, then the IMU (at rest: the specific force holds the height) to its end.
+  std::vector<ReplicaCommand> period(const std::vector<ChannelCorrelation>& corr = {}) {
+    const std::vector<ReplicaCommand> r = driver.start_period(0.020);
+    for (int k = 0; k < 2; ++k) {
+      t_s += 0.010;
+      driver.add_imu({t_s, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, -9.7976 * 0.010)});
+    }
+    driver.finish_period(corr);
+    return r;
+  }
+};
+
+const ReplicaCommand* replica_of(const std::vector<ReplicaCommand>& v, int prn) {
+  for (const auto& r : v)
+    if (r.prn == prn) return &r;
+  return nullptr;
+}
+
+TEST(UltraTight, EphemerisArrivingAfterTheStartGivesTheSatelliteReplicasAndUpdates) {
+  const signals::GpsTime origin{2300, 200000.0};
+  const std::vector<signals::Ephemeris> all = signals::nominal_constellation(origin).ephemerides;
+  DriverAtRest reference(all, origin);
+  const std::vector<ReplicaCommand> first = reference.period();
+  ASSERT_GE(first.size(), 5u);
+  const int late_prn = first.front().prn;
+  std::vector<signals::Ephemeris> without;
+  signals::Ephemeris late;
+  for (const auto& e : all) (e.prn == late_prn ? late : without.emplace_back()) = e;
+  DriverAtRest later(without, origin);
+  EXPECT_EQ(replica_of(later.period(), late_prn), nullptr);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(replica_of(later.period(), late_prn), nullptr);
+    reference.period();
+  }
+  later.driver.add_ephemerides({late});
+  later.driver.add_ephemerides({late});  // held already: ignored
+  for (int k = 0; k < 3; ++k) {
+    const std::vector<ReplicaCommand> a = reference.period(), b = later.period();
+    ASSERT_EQ(a.size(), b.size());
+    const ReplicaCommand* r = replica_of(b, late_prn);
+    ASSERT_NE(r, nullptr);
+    EXPECT_EQ(r->pseudorange_m, replica_of(a, late_prn)->pseudorange_m);
+    EXPECT_EQ(r->range_rate_mps, replica_of(a, late_prn)->range_rate_mps);
+  }
+  // A correlation of it (taps of a replica on the signal at 45 dB-Hz, noise-free) is used: one accepted update.
+  IqSettings s;
+  ChannelCorrelation c;
+  c.prn = late_prn;
+  c.taps = expected_iq(TrackingErrors{}, s);
+  c.cn0_dbhz = s.cn0_dbhz;
+  later.period({c});
+  const auto& u = later.driver.last_updates();
+  ASSERT_EQ(u.size(), 1u);
+  EXPECT_EQ(u[0].prn, late_prn);
+  EXPECT_TRUE(u[0].accepted);
+}
+
+// A new upload (IODE 1 -> 2, its clock 1 us = 300 m different, toe 2 h later) given during the run: each period is
+// predicted from the set select_ephemeris takes at the transmit time, i.e. the old one until the transmit time
+// passes the middle of the two toes (198000 s), then the new one (here at ~0.27 s into the run).
+TEST(UltraTight, NewIodeAddedDuringTheRunSwitchesSetsAtTheSelectionTime) {
+  const signals::GpsTime origin{2300, 197999.8};
+  const std::vector<signals::Ephemeris> old_sets = signals::nominal_constellation({2300, 195000.0}).ephemerides;
+  std::vector<signals::Ephemeris> new_sets = signals::nominal_constellation({2300, 201000.0}).ephemerides;
+  ASSERT_EQ(old_sets.front().toe_s, 194400.0);
+  ASSERT_EQ(new_sets.front().toe_s, 201600.0);
+  for (auto& e : new_sets) {
+    e.iode = (e.iode + 1) % 256;
+    e.iodc = (e.iodc & 0x300) | e.iode;
+    e.af0_s += 1e-6;
+  }
+  std::vector<signals::Ephemeris> both = old_sets;
+  both.insert(both.end(), new_sets.begin(), new_sets.end());
+  DriverAtRest run(old_sets, origin), from_old(old_sets, origin), from_new(new_sets, origin), from_both(both, origin);
+  run.period();
+  from_old.period();
+  from_new.period();
+  from_both.period();
+  run.driver.add_ephemerides(new_sets);
+  std::map<int, int> switch_period;  // per PRN: the first period predicted from the new set
+  for (int k = 0; k < 25; ++k) {
+    const double receive_tow = origin.tow_s + run.t_s;  // the period's start (no clock bias)
+    const auto r = run.period(), o = from_old.period(), n = from_new.period(), b = from_both.period();
+    ASSERT_EQ(r.size(), b.size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      EXPECT_EQ(r[i].pseudorange_m, b[i].pseudorange_m);
+      const ReplicaCommand *ro = replica_of(o, r[i].prn), *rn = replica_of(n, r[i].prn);
+      ASSERT_TRUE(ro && rn);
+      ASSERT_GT(std::abs(ro->pseudorange_m - rn->pseudorange_m), 100.0);  // the sets are told apart
+      // Equal to the new or the old set's prediction; within 1 cm at the switch, where the transmit-time
+      // iteration's first pass may have used the other set (1 us of transmit time: the satellite moves 4 mm).
+      const bool is_new = std::abs(r[i].pseudorange_m - rn->pseudorange_m) < 0.01;
+      EXPECT_TRUE(is_new || std::abs(r[i].pseudorange_m - ro->pseudorange_m) < 0.01)
+          << "period " << k << " PRN " << r[i].prn;
+      // select_ephemeris at the transmit time: the new toe is nearer once it passes 198000 s.
+      const double transmit_tow = receive_tow - r[i].pseudorange_m / signals::kSpeedOfLight_mps;
+      EXPECT_EQ(is_new, transmit_tow > 198000.0) << "period " << k << " PRN " << r[i].prn;
+      if (is_new && !switch_period.count(r[i].prn)) switch_period[r[i].prn] = k;
+      if (!is_new) {
+        EXPECT_FALSE(switch_period.count(r[i].prn)) << "back to the old set, PRN " << r[i].prn;
+      }
+    }
+  }
+  // Transmit time = receive time - 67 to 85 ms: every satellite switched, 0.27-0.29 s into the run.
+  EXPECT_EQ(switch_period.size(), from_both.driver.replicas().size());
+  for (const auto& [prn, k] : switch_period) {
+    EXPECT_GE(k, 12) << prn;
+    EXPECT_LE(k, 14) << prn;
   }
 }
 
@@ -185,6 +318,47 @@ TEST(UltraTight, NeesMonteCarloUkf) { nees_monte_carlo(FilterKind::Ukf, nees_run
 // fusion's default TCXO (h0 = 2e-19: 0.009 m^2/s): ~1 m/s of frequency noise within 20 ms, in R.
 TEST(UltraTight, NeesMonteCarloEkfTcxo) {
   nees_monte_carlo(FilterKind::Ekf, nees_runs(), ClockNoiseModel{}.bias_psd_m2_per_s, "EKF, TCXO");
+}
+
+// A receiver channel's Costas PLL stays closed (receive --coupling ultra-tight): each period starts with the PLL's
+// residual phase error, not the realigned phase of the seed model. Simulated here as a phase drawn N(0, sigma^2)
+// per satellite and period (sigma = 0.05 rad: A^2 sigma^2 = 3.2 noise units at 45 dB-Hz). Told to the driver
+// (start_phase_var_rad2) the mean NIS of the 6-row I&Q updates must lie in the chi-square band of 6 N degrees of
+// freedom (updates after the first 1 s, independent tap noise); left out (the seed model) it lies above. The
+// clock's frequency noise is switched off in truth and model (its R term is deliberately conservative).
+double mean_iq_nis(double start_phase_sigma_rad, bool tell, int& count) {
+  CorrelationSimConfig cfg;
+  cfg.duration_s = 4.0;
+  cfg.seed = 31;
+  cfg.clock_bias_psd_m2_per_s = 1e-12;
+  cfg.clock_drift_psd_m2_per_s3 = 1e-12;
+  cfg.start_phase_sigma_rad = start_phase_sigma_rad;
+  cfg.tell_start_phase = tell;
+  const CorrelationRunResult r = run_correlation_simulation(cfg);
+  const std::size_t skip = r.nis.size() / 4;  // the first 1 s of 4 s: pull-in from the initial errors
+  double sum = 0.0;
+  count = 0;
+  for (std::size_t i = skip; i < r.nis.size(); ++i) {
+    sum += r.nis[i];
+    ++count;
+  }
+  return sum / std::max(count, 1);
+}
+
+TEST(UltraTight, ClosedPllStartPhaseInRKeepsIqNisInItsBand) {
+  int n = 0;
+  const double realigned = mean_iq_nis(0.0, true, n);
+  const double lo = chi_square_quantile(0.005, 6 * n) / n, hi = chi_square_quantile(0.995, 6 * n) / n;
+  int n1 = 0, n2 = 0;
+  const double told = mean_iq_nis(0.05, true, n1);
+  const double seed_model = mean_iq_nis(0.05, false, n2);
+  std::printf("mean I&Q NIS over %d updates (99 %% band [%.3f, %.3f]): realigned phase %.3f; PLL start phase "
+              "0.05 rad in R %.3f, left out %.3f\n", n, lo, hi, realigned, told, seed_model);
+  EXPECT_GT(realigned, lo);
+  EXPECT_LT(realigned, hi);
+  EXPECT_GT(told, lo);
+  EXPECT_LT(told, hi);
+  EXPECT_GT(seed_model, hi);
 }
 
 TEST(UltraTight, CoastingThroughTenSecondBlockageAndRelock) {
