@@ -152,6 +152,7 @@ class ReceiverChannel {
     double noise_power = 0.0;  // noise_power_ after this epoch
     double code_error_chips = 0.0;
     bool signal_present = false;  // this epoch's prompt power well above the noise tap's (see after_epoch)
+    int bit_sign = 0;             // the known bit's sign used for this epoch (0: none)
   };
   double noise_power_ = 0.0;  // running mean of |noise tap|^2 for the current epoch length
   int noise_periods_ = 0;
@@ -161,6 +162,7 @@ class ReceiverChannel {
   bool vector_jump_pending_ = false;
   double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
+  int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)
 
   double fs_hz_;
   bool week_trusted_;  // the reference week is the signal's: time tags usable before subframe 1
