@@ -9,7 +9,8 @@ SignalPresenceTest::SignalPresenceTest(int window_epochs, double threshold_dbhz)
     : window_(std::max(1, window_epochs)), threshold_dbhz_(threshold_dbhz) {}
 
 std::optional<bool> SignalPresenceTest::add(std::complex<float> prompt, std::complex<float> noise, double t_s) {
-  if (n_ > 0 && std::abs(t_s - t_s_) > 1e-9) reset();
+  // Epochs of one length vary by a sample with the code Doppler (20 code periods): 1 % tells another length.
+  if (n_ > 0 && std::abs(t_s - t_s_) > 0.01 * t_s_) reset();
   t_s_ = t_s;
   prompt_power_ += std::norm(std::complex<double>(prompt));
   noise_power_ += std::norm(std::complex<double>(noise));

@@ -14,7 +14,8 @@ class SignalPresenceTest final {
   // window_epochs >= 1; threshold in dB-Hz (converted with each epoch's length t_s).
   SignalPresenceTest(int window_epochs, double threshold_dbhz);
   // One epoch's prompt and noise-tap sums (same scale). Returns the verdict when a window completes (true:
-  // present), nothing otherwise. Epochs of another length than the window's first restart the window.
+  // present), nothing otherwise. Epochs of another length (by more than 1 %: the sample count of one length varies
+  // with the code Doppler) than the window's first restart the window.
   std::optional<bool> add(std::complex<float> prompt, std::complex<float> noise, double t_s);
   void reset() { n_ = 0; prompt_power_ = noise_power_ = 0.0; t_s_ = 0.0; }
   // The latest completed window's SNR per epoch, as C/N0 (dB-Hz; -inf-like -100 when not positive).

@@ -100,9 +100,12 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   const ReplicaState replica = channel_.replica();
   in.replica_pseudorange_m = pseudorange(replica.sample_index, replica.code_period, replica.code_phase_chips);
   const EpochSummary& e = last_epoch_;
-  // A filter-driven channel's epochs go to the filter whatever their power (its presence test and the filter's
-  // gate judge them); the per-epoch fade gate would keep only the noise peaks of a weak signal.
-  const bool present = e.signal_present || vector_.filter_driven;
+  // A filter-driven channel's epochs go to the filter whatever their power while its latest presence window read
+  // below 30 dB-Hz (its presence test and the filter's gate judge them; the per-epoch fade gate would keep only
+  // the noise peaks of a weak signal). Above, the gate stays: it drops a present 30 dB-Hz epoch with
+  // probability ~1e-3 and sees a tunnel at once, where the 1 s presence window takes 1-2 s.
+  constexpr double kGateFromDbHz = 30.0;
+  const bool present = e.signal_present || (vector_.filter_driven && loop_.presence_cn0_dbhz() < kGateFromDbHz);
   if (!fresh || !e.valid || !e.bit_synced || !present || e.num_code_periods < 2) return in;
   in.bit_sign = vector_.filter_driven ? e.bit_sign : 0;
   const int half = e.num_samples / 2;
@@ -152,6 +155,17 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
     tracked_s_ += e.integration_time_s;
   }
   if (report.bit) nav_.add_bit(report.bit->soft, report.bit->first_code_period);
+  if (nav_.polarity() != polarity_seen_) polarity_fix_ = 1;  // a new subframe resolved the half cycle
+  polarity_seen_ = nav_.polarity();
+  if (was_coasting_ && report.state == TrackingState::kBitSynced) {
+    polarity_votes_left_ = kPolarityVotes;
+    polarity_vote_ = 0;
+  }
+  was_coasting_ = report.state == TrackingState::kCoasting;
+  if (polarity_votes_left_ > 0 && epoch_bit_sign_ != 0 && report.state == TrackingState::kBitSynced) {
+    polarity_vote_ += (e.master().prompt.real() >= 0.0f ? 1 : -1) * epoch_bit_sign_;
+    if (--polarity_votes_left_ == 0 && polarity_vote_ < 0) polarity_fix_ = -polarity_fix_;
+  }
   previous_epoch_ = last_epoch_;
   EpochSummary& s = last_epoch_;
   s.valid = true;
@@ -221,7 +235,7 @@ KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
     const std::int64_t p = e.first_code_period + 20 * static_cast<std::int64_t>(i);
     const auto bit = predictor.bit_at(signals::add_seconds(tag.transmit_time, 1e-3 * static_cast<double>(p - tag.code_period)));
     if (!bit) break;
-    if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity();
+    if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity() * polarity_fix_;
     ++k.ahead;
   }
   epoch_bit_sign_ = k.sign;

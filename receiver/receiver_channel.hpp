@@ -163,6 +163,12 @@ class ReceiverChannel {
   double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
   int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)
+  // After a re-lock from coasting the Costas loop may sit half a cycle from where the frame's polarity was
+  // found: the first kPolarityVotes known-bit epochs vote (sign of I_P x known sign) and a negative vote inverts
+  // the known signs until a new subframe gives the polarity again.
+  static constexpr int kPolarityVotes = 10;
+  int polarity_fix_ = 1, polarity_votes_left_ = 0, polarity_vote_ = 0, polarity_seen_ = 1;
+  bool was_coasting_ = false;
 
   double fs_hz_;
   bool week_trusted_;  // the reference week is the signal's: time tags usable before subframe 1

@@ -199,6 +199,8 @@ class ScalarTracking final {
   // coherent sums use a pure PLL (see ScalarTrackingOptions::presence_window_s). Off: the scalar loss test.
   void set_filter_driven(bool driven);
   bool filter_driven() const { return filter_driven_; }
+  // The C/N0 of the latest completed presence window (dB-Hz; -100 before the first or without signal).
+  double presence_cn0_dbhz() const { return presence_.last_cn0_dbhz(); }
   bool relocking() const { return relocking_; }
   std::optional<double> cn0_dbhz() const { return cn0_dbhz_; }
   double pli() const { return pli_.value(); }

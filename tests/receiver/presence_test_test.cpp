@@ -77,7 +77,9 @@ TEST(SignalPresenceTest, FalseLossRateOnALongWeakButPresentSignal) {
     double phase = 0.3;
     for (int k = 0; k < windows * n; ++k) {
       phase += 0.7;  // a residual frequency of 5.6 Hz: energy unaffected
-      if (auto v = test.add(taps.prompt(rho, phase), taps.noise(), kT); v && !*v) ++absent;
+      // epoch lengths as a receiver's: 20 code periods at 2.6 MHz are 52000 +- 1 samples
+      const double t = kT + ((k % 3) - 1) / 2.6e6;
+      if (auto v = test.add(taps.prompt(rho, phase), taps.noise(), t); v && !*v) ++absent;
     }
     const double p = exact_absent_probability(cn0, n, 12.0);
     const double sigma = std::sqrt(windows * p * (1.0 - p));
