@@ -24,9 +24,12 @@
 #   benchmarks/tracking_threshold.sh [--levels "24 26 28 30 32"] [--files 4] [--duration 60] [--fs 2.6e6]
 #       [--seed0 100] [--out DIR] [--ultratrack build/tools/ultratrack] [--receive-args "..."]
 #       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep] [--coupling scalar|vector]
-#       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--scenario FILE]
+#       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--scenario FILE] [--reuse]
 # Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3 (the report). CPU: about 15 s per file at
-# 2.6 MHz on one core. Files are deleted after their receive unless --keep.
+# 2.6 MHz on one core. Files are deleted after their receive unless --keep. --reuse: a file kept by an earlier
+# --keep run in the same --out (same level, file number and options: the same seed and content) is received
+# again instead of simulated (e.g. a further coupling on the same files); runs.csv and positions.csv are
+# appended to, not restarted.
 #
 # Issue 7's protocol (--strong-s T0 > 0): every file is T0 + DURATION s long, all satellites at --strong-cn0
 # (45 dB-Hz) for the first T0 s, so that acquisition, bit and frame sync and a vector hand-over complete, then a
@@ -40,7 +43,8 @@
 # loose, tight and ultra-tight get --imu DIR/imu.csv --filter ekf (needs --scenario with [trajectory]); a
 # coupling that `receive` rejects is skipped with a message. Per coupling: the per-level table, the 90 %
 # threshold with its 68 % range, and the 3-D position RMS of solution.csv against truth.csv over the weak part
-# (fixes at and after T0, `ultratrack compare`): positions.csv, one row per file and coupling.
+# (fixes at and after T0, `ultratrack compare`): positions.csv, one row per file and coupling; for GNSS/INS
+# couplings also the fused nav.csv over the weak part (3-D RMS and maximum): nav_positions.csv.
 # --scenario FILE: the trajectory (and IMU) of an inertial scenario (e.g. scenarios/ultratight_circle.toml; its
 # trajectory must last T0 + DURATION s) instead of the static receiver; [signal] duration_s, cn0_dbhz and seed
 # are rewritten, relative paths made absolute.
@@ -49,7 +53,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
 levels="24 26 28 30 32"; files=4; duration=60; fs=2.6e6; seed0=100; out=/tmp/ultratrack_threshold
 ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$root/../shared/data/brdc0010.22n
-lock_deadline_s=5; extra_config=""; report_only=0
+lock_deadline_s=5; extra_config=""; report_only=0; reuse=0
 strong_s=0; strong_cn0=45; couplings=""; scenario=""
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -70,8 +74,9 @@ while [ $# -gt 0 ]; do
     --couplings) couplings=$2; shift 2 ;;
     --scenario) scenario=$(realpath "$2"); shift 2 ;;
     --keep) keep=1; shift ;;
+    --reuse) reuse=1; keep=1; shift ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
-    -h|--help) sed -n '2,49p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,52p' "$0"; exit 0 ;;
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -101,9 +106,10 @@ positions=$out/positions.csv
 file_s=$(python3 -c "print($strong_s + $duration)")
 # The coupling list: "" (one pass, the classic mode: receive_args alone) or the named couplings.
 [ -n "$couplings" ] || couplings="-"
-if [ "$report_only" = 1 ]; then levels=""; else
+if [ "$report_only" = 1 ]; then levels=""; elif [ "$reuse" = 0 ] || [ ! -f "$runs" ]; then
   echo "cn0_dbhz,file,prn,outcome,first_lock_s,lock_end_s,coupling" > "$runs"
   echo "cn0_dbhz,file,coupling,fixes,rms_3d_m" > "$positions"
+  echo "cn0_dbhz,file,coupling,rows,nav_rms_3d_m,nav_max_3d_m" > "$out/nav_positions.csv"
 fi
 skipped=" "
 for level in $levels; do
@@ -112,7 +118,10 @@ for level in $levels; do
     tow=$((518400 + 90 * k))  # different nav-bit content and geometry per file, inside the ephemerides' fit
     name=cn0_${level}_file_${k}
     sim=$out/$name.sim
-    rm -rf "$sim"
+    reused=0
+    if [ "$reuse" = 1 ] && [ -f "$sim/antenna0.i8.bin" ] && [ -f "$sim/summary.json" ]; then reused=1; else
+      rm -rf "$sim"
+    fi
     mkdir -p "$sim"
     file_cn0=$level
     [ "$strong_s" = 0 ] || file_cn0=$strong_cn0
@@ -160,7 +169,7 @@ troposphere = false
 TOML
     fi
     [ "$strong_s" = 0 ] || printf '\n[[cn0_step]]\nstart_s = %s\ncn0_dbhz = %s\n' "$strong_s" "$level" >> "$sim.toml"
-    nice -n 5 "$ultratrack" simulate --scenario "$sim.toml" --out "$sim" --quiet > /dev/null
+    [ "$reused" = 1 ] || nice -n 5 "$ultratrack" simulate --scenario "$sim.toml" --out "$sim" --quiet > /dev/null
     sim_fs=$(python3 -c "import json; print(json.load(open('$sim/summary.json'))['sample_rate_hz'])")
     prns=$(tail -n +2 "$sim/satellites.csv" | cut -d, -f1 | paste -sd, -)
     config_args=(--config "$acq_config")
@@ -267,6 +276,32 @@ PY
         fi
       fi
       echo "$level,$name,$label,$fixes,$rms" >> "$positions"
+      # GNSS/INS couplings: the fused position (nav.csv, IMU time = seconds since the file's first sample) over the
+      # weak part against truth.csv, in nav_positions.csv.
+      if [ -f "$rx/nav.csv" ]; then
+        [ -f "$out/nav_positions.csv" ] || echo "cn0_dbhz,file,coupling,rows,nav_rms_3d_m,nav_max_3d_m" > "$out/nav_positions.csv"
+        python3 - "$rx/nav.csv" "$sim/truth.csv" "$strong_s" "$level" "$name" "$label" >> "$out/nav_positions.csv" <<'PY'
+import bisect, csv, math, sys
+nav, truth, t0, level, name, label = sys.argv[1], sys.argv[2], float(sys.argv[3]), *sys.argv[4:7]
+def ecef(lat, lon, h):
+    a = 6378137.0; f = 1 / 298.257223563; e2 = f * (2 - f)
+    la, lo = math.radians(lat), math.radians(lon); n = a / math.sqrt(1 - e2 * math.sin(la) ** 2)
+    return ((n + h) * math.cos(la) * math.cos(lo), (n + h) * math.cos(la) * math.sin(lo), (n * (1 - e2) + h) * math.sin(la))
+rows = list(csv.DictReader(open(truth)))
+tt = [float(r["t_s"]) for r in rows]
+pp = [(float(r["ecef_x_m"]), float(r["ecef_y_m"]), float(r["ecef_z_m"])) for r in rows]
+s2, n, worst = 0.0, 0, 0.0
+for r in csv.DictReader(open(nav)):
+    t = float(r["t_s"])
+    i = bisect.bisect_left(tt, t)
+    if t < t0 or i <= 0 or i >= len(tt): continue
+    w = (t - tt[i - 1]) / (tt[i] - tt[i - 1])
+    q = ecef(float(r["lat_deg"]), float(r["lon_deg"]), float(r["height_m"]))
+    e2 = sum((pp[i - 1][k] + w * (pp[i][k] - pp[i - 1][k]) - q[k]) ** 2 for k in range(3))
+    s2 += e2; n += 1; worst = max(worst, math.sqrt(e2))
+print(f"{level},{name},{label},{n},{math.sqrt(s2 / n) if n else float('nan'):.3f},{worst:.3f}")
+PY
+      fi
       echo "tracking_threshold: $name${label:+ $label}: $(grep ",$name,.*,$label\$" "$runs" | grep -c .) runs," \
         "$(grep ",$name,.*,$label\$" "$runs" | grep -c ',kept,') kept, weak-part fixes $fixes, 3-D RMS ${rms:--} m" >&2
     done
@@ -278,6 +313,8 @@ python3 - "$runs" "$out/positions.csv" <<'PY'
 import csv, math, os, sys
 all_runs = list(csv.DictReader(open(sys.argv[1])))
 positions = list(csv.DictReader(open(sys.argv[2]))) if os.path.exists(sys.argv[2]) else []
+nav_file = os.path.join(os.path.dirname(sys.argv[2]), "nav_positions.csv")
+nav_positions = list(csv.DictReader(open(nav_file))) if os.path.exists(nav_file) else []
 def wilson(k, n, z=1.0):
     if n == 0:
         return (0.0, 1.0)
@@ -324,6 +361,9 @@ for coupling in sorted({r.get("coupling") or "" for r in all_runs}):
             fixes = sum(int(p["fixes"]) for p in ps)
             rms = " ".join(p["rms_3d_m"] or "-" for p in ps)
             line += f"  {count['not_locked_at_step']:18d}  {fixes:10d}  {rms}"
+            navs = [p for p in nav_positions if float(p["cn0_dbhz"]) == L and (p.get("coupling") or "") == coupling]
+            if navs:
+                line += "  nav.csv " + " ".join(p["nav_rms_3d_m"] for p in navs) + " m"
         print(line)
     for label, t in (("of acquired satellites (pull-in included)", table), ("of locked satellites (lock kept)", table_locked)):
         if step_mode and label.startswith("of acquired"):

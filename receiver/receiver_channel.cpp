@@ -1,5 +1,6 @@
 #include "receiver/receiver_channel.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "signals/gps_constants.hpp"
@@ -49,7 +50,10 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   if (vector_.vector && loop_.state() != TrackingState::kBitSynced && !loop_.coasting()) vector_ = {};
   // Only a channel whose replica the vector loop drives may coast; dropped from it while coasting, it is lost.
   loop_.allow_coasting(vector_.vector);
-  nav_.hold_time_tag(loop_.coasting());
+  loop_.set_filter_driven(vector_.vector && vector_.filter_driven);
+  // A filter-driven channel keeps its time tag too: its bits are known and its code-period count is the filter's
+  // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
+  nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
   // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
   // the command already computed for the next epoch (between epochs) gets it too.
@@ -96,7 +100,14 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   const ReplicaState replica = channel_.replica();
   in.replica_pseudorange_m = pseudorange(replica.sample_index, replica.code_period, replica.code_phase_chips);
   const EpochSummary& e = last_epoch_;
-  if (!fresh || !e.valid || !e.bit_synced || !e.signal_present || e.num_code_periods < 2) return in;
+  // A filter-driven channel's epochs go to the filter whatever their power while its latest presence window read
+  // below 30 dB-Hz (its presence test and the filter's gate judge them; the per-epoch fade gate would keep only
+  // the noise peaks of a weak signal). Above, the gate stays: it drops a present 30 dB-Hz epoch with
+  // probability ~1e-3 and sees a tunnel at once, where the 1 s presence window takes 1-2 s.
+  constexpr double kGateFromDbHz = 30.0;
+  const bool present = e.signal_present || (vector_.filter_driven && loop_.presence_cn0_dbhz() < kGateFromDbHz);
+  if (!fresh || !e.valid || !e.bit_synced || !present || e.num_code_periods < 2) return in;
+  in.bit_sign = vector_.filter_driven ? e.bit_sign : 0;
   const int half = e.num_samples / 2;
   in.has_measurement = true;
   in.measurement_sample = e.first_sample + half;
@@ -145,6 +156,17 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
     tracked_s_ += e.integration_time_s;
   }
   if (report.bit) nav_.add_bit(report.bit->soft, report.bit->first_code_period);
+  if (nav_.polarity() != polarity_seen_) polarity_fix_ = 1;  // a new subframe resolved the half cycle
+  polarity_seen_ = nav_.polarity();
+  if (was_coasting_ && report.state == TrackingState::kBitSynced) {
+    polarity_votes_left_ = kPolarityVotes;
+    polarity_vote_ = 0;
+  }
+  was_coasting_ = report.state == TrackingState::kCoasting;
+  if (polarity_votes_left_ > 0 && epoch_bit_sign_ != 0 && report.state == TrackingState::kBitSynced) {
+    polarity_vote_ += (e.master().prompt.real() >= 0.0f ? 1 : -1) * epoch_bit_sign_;
+    if (--polarity_votes_left_ == 0 && polarity_vote_ < 0) polarity_fix_ = -polarity_fix_;
+  }
   previous_epoch_ = last_epoch_;
   EpochSummary& s = last_epoch_;
   s.valid = true;
@@ -161,6 +183,7 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
   s.prompt = e.master().prompt;
   s.late = e.master().late;
   s.code_error_chips = report.code_error_chips;
+  s.bit_sign = epoch_bit_sign_;
   // A fade shows in one epoch's prompt long before the C/N0 estimate (0.2 s window) follows: vector tracking
   // takes no measurement from an epoch whose |P|^2 / mean |noise|^2 is below 1 + 10^(2.5) T (25 dB-Hz; noise
   // alone passes with probability exp(-7.3) = 0.07 % at T = 20 ms; a 45 dB-Hz signal sits ~19 dB above it).
@@ -197,7 +220,11 @@ TrackingRecord ReceiverChannel::record(const CorrelationEpoch& e, const Tracking
 // time from the frame's time tag, sign = polarity x (+1 for bit 0). Not while a vector loop drives the replica.
 KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
   KnownBits k;
-  if (wanted <= 0 || vector_.vector || e.num_code_periods != 20 || !nav_.synchronised()) return k;
+  epoch_bit_sign_ = 0;
+  // Filter-driven channels always want the epoch's own bit (the filter's wipe-off), and long sums when weak.
+  const bool driven = vector_.vector && vector_.filter_driven;
+  if (driven) wanted = std::max(wanted, 1);
+  if (wanted <= 0 || (vector_.vector && !driven) || e.num_code_periods != 20 || !nav_.synchronised()) return k;
   const TransmitTimeTag& tag = *nav_.time_tag();
   NavBitPredictor& predictor = nav_.bit_predictor();
   if (supplied_ && !supplied_tried_) {
@@ -209,9 +236,10 @@ KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
     const std::int64_t p = e.first_code_period + 20 * static_cast<std::int64_t>(i);
     const auto bit = predictor.bit_at(signals::add_seconds(tag.transmit_time, 1e-3 * static_cast<double>(p - tag.code_period)));
     if (!bit) break;
-    if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity();
+    if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity() * polarity_fix_;
     ++k.ahead;
   }
+  epoch_bit_sign_ = k.sign;
   return k;
 }
 

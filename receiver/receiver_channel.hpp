@@ -152,6 +152,7 @@ class ReceiverChannel {
     double noise_power = 0.0;  // noise_power_ after this epoch
     double code_error_chips = 0.0;
     bool signal_present = false;  // this epoch's prompt power well above the noise tap's (see after_epoch)
+    int bit_sign = 0;             // the known bit's sign used for this epoch (0: none)
   };
   double noise_power_ = 0.0;  // running mean of |noise tap|^2 for the current epoch length
   int noise_periods_ = 0;
@@ -161,6 +162,13 @@ class ReceiverChannel {
   bool vector_jump_pending_ = false;
   double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
+  int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)
+  // After a re-lock from coasting the Costas loop may sit half a cycle from where the frame's polarity was
+  // found: the first kPolarityVotes known-bit epochs vote (sign of I_P x known sign) and a negative vote inverts
+  // the known signs until a new subframe gives the polarity again.
+  static constexpr int kPolarityVotes = 10;
+  int polarity_fix_ = 1, polarity_votes_left_ = 0, polarity_vote_ = 0, polarity_seen_ = 1;
+  bool was_coasting_ = false;
 
   double fs_hz_;
   bool week_trusted_;  // the reference week is the signal's: time tags usable before subframe 1

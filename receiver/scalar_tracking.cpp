@@ -100,6 +100,9 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.coherent_hysteresis_db >= 0 && o.coherent_hysteresis_db <= 10, "coherent_hysteresis_db",
           o.coherent_hysteresis_db, "[0, 10] dB");
   c.check(o.coherent_max_bn_t > 0 && o.coherent_max_bn_t <= 0.25, "coherent_max_bn_t", o.coherent_max_bn_t, "(0, 0.25]");
+  c.check(o.presence_window_s >= 0.1 && o.presence_window_s <= 5, "presence_window_s", o.presence_window_s, "[0.1, 5] s");
+  c.check(o.presence_threshold_dbhz >= 0 && o.presence_threshold_dbhz <= 30, "presence_threshold_dbhz",
+          o.presence_threshold_dbhz, "[0, 30] dB-Hz");
   return c.error;
 }
 
@@ -169,7 +172,8 @@ ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCo
       command_(initial),
       pli_(options.pli_time_constant_s),
       cn0_(options.cn0_method, cn0_window_epochs(options.cn0_method, options.cn0_window_s, 1e-3)),
-      bit_sync_(options.bit_sync) {
+      bit_sync_(options.bit_sync),
+      presence_(epochs_in(options.presence_window_s, kBitPeriod_s), options.presence_threshold_dbhz) {
   command_.code_phase_jump_chips = 0.0;
   command_.carrier_phase_jump_cycles = 0.0;
   const bool search = opt_.pullin_search_hz > 0.0;
@@ -259,6 +263,14 @@ void ScalarTracking::start_aiding() {
   carrier_.reset(carrier_.frequency_hz(), 0.0);
 }
 
+void ScalarTracking::set_filter_driven(bool driven) {
+  if (driven == filter_driven_) return;
+  filter_driven_ = driven;
+  presence_.reset();
+  presence_absent_ = false;
+  loss_time_s_ = 0.0;
+}
+
 void ScalarTracking::allow_coasting(bool allowed) {
   coasting_allowed_ = allowed;
   if (!allowed && state_ == TrackingState::kCoasting) {
@@ -331,6 +343,13 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   }
   r.cn0_dbhz = cn0_dbhz_;
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
+  // Filter-driven: the presence test on every 20 ms epoch (long sums included: energy, not phase).
+  presence_absent_ = false;
+  if (filter_driven_ && state_ == TrackingState::kBitSynced && e.num_code_periods == 20) {
+    if (const auto present = presence_.add(taps.prompt, taps.noise, t)) presence_absent_ = !*present;
+  } else {
+    presence_.reset();
+  }
 
   r.phase_error_cycles = costas_atan_cycles(taps.prompt);
   // Frequency error from cross and dot averaged over ~4 epochs: halves of this epoch in the wide stage, this and
@@ -403,6 +422,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
                                    : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
   const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
+  if (filter_driven_ && state_ == TrackingState::kBitSynced) loss_time_s_ = presence_absent_ ? opt_.loss_of_lock_time_s : 0.0;
   if (loss_time_s_ >= opt_.loss_of_lock_time_s) {
     const bool coast = coasting_allowed_ && state_ == TrackingState::kBitSynced;
     state_ = coast ? TrackingState::kCoasting : TrackingState::kLost;
@@ -476,6 +496,22 @@ bool ScalarTracking::slow_cn0_below(double threshold_dbhz) const {
 // the loops, the PLI and the loss test run once on the block's sums with T = its length.
 TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign) {
   const CorrelatorTaps& taps = e.master();
+  if (filter_driven_ && presence_absent_) {  // the presence window just ended without signal: the block is void
+    block_count_ = 0;
+    loss_time_s_ = 0.0;
+    target_epochs_ = 1;
+    set_loop_epochs(1);
+    r.state = state_;
+    r.loop_integration_ms = 20;
+    if (coasting_allowed_) {
+      state_ = TrackingState::kCoasting;
+      return coast_epoch(e, r, true);
+    }
+    state_ = TrackingState::kLost;
+    r.state = state_;
+    r.command = command_;
+    return r;
+  }
   if (block_count_ == 0) {
     block_epochs_ = target_epochs_;
     block_early_ = block_prompt_ = block_late_ = {};
@@ -507,13 +543,15 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
   // The sum of n 20 ms epochs holds n times their noise power.
   r.pli = pli_.update(prompt, n * noise_power_, t);
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
-  r.phase_error_cycles = costas_atan_cycles(prompt);
+  // Bits wiped: a filter-driven channel's PLL takes the full phase (atan2, +-1/2 cycle, no squaring loss).
+  r.phase_error_cycles = filter_driven_ ? pll_atan2_cycles(prompt) : costas_atan_cycles(prompt);
   r.frequency_error_hz = 0.0;
   r.code_error_chips = dll_nelp_chips(std::complex<float>(block_early_), std::complex<float>(block_late_),
                                       opt_.early_late_offset_chips);
   const bool low_cn0 = slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(n));
   const bool low_pli = r.pli < opt_.pli_loss_threshold;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
+  if (filter_driven_) loss_time_s_ = 0.0;
   if (loss_time_s_ >= std::max(opt_.loss_of_lock_time_s, pli_tau_s_)) {
     loss_time_s_ = 0.0;
     target_epochs_ = 1;

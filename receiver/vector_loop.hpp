@@ -61,6 +61,9 @@ struct VectorChannelInput {
   // estimate moves by +-16 % in power (a 0.05 average of one noise tap per epoch), and the normalised signal
   // amplitude with it: a loop estimating the amplitude averages it on the raw scale (taps / iq_scale).
   double iq_scale = 0.0;
+  // The navigation bit of that epoch when known ahead (data wipe-off, filter-driven channels only): the sign
+  // (+1/-1, polarity applied) that makes the prompt's in-phase positive; 0: unknown.
+  int bit_sign = 0;
 };
 
 struct VectorEpochInput {
@@ -85,6 +88,10 @@ struct VectorChannelCommand {
   // Carrier aiding: the predicted carrier Doppler at next_epoch_sample, Hz; its change from one command to the
   // next is added to the channel's PLL (ScalarTracking::aid_frequency). NaN: no aiding.
   double carrier_frequency_hz = NAN;
+  // The loop's filter drives the replica and judges lock (ultra-tight): the channel's scalar loss test gives way
+  // to the presence test (ScalarTracking::set_filter_driven), its PLL sums N x 20 ms with the known bits wiped
+  // (pure PLL), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).
+  bool filter_driven = false;
 };
 
 class VectorLoop {

@@ -153,14 +153,17 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
         receiver::long_coherent_pll_bw_hz(options_.tracking, 1), ut_.period_s, c.cn0_dbhz);
     c.start_phase_var_rad2 = a2 > 0.0 ? jitter_rad * jitter_rad : 0.0;
     c.integration_time_s = ut_.period_s;
-    // Data wipe-off by the prompt's sign: the Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms:
-    // Q(sqrt(2 C/N0 T)) = Q(6.3), none in practice).
-    const double sign = in.iq_i[1] >= 0.0 ? 1.0 : -1.0;
+    // Data wipe-off by the known bit (decoded subframes or --nav: receiver/nav_bit_predictor.hpp), else by the
+    // prompt's sign: the Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms: Q(sqrt(2 C/N0 T)) =
+    // Q(6.3), none in practice; at 20 dB-Hz Q(2) = 2 %, hence the known bits).
+    const bool known = in.bit_sign != 0;
+    const double sign = known ? in.bit_sign : (in.iq_i[1] >= 0.0 ? 1.0 : -1.0);
     for (int k = 0; k < 3; ++k) {
       c.taps.i[k] = sign * in.iq_i[k];
       c.taps.q[k] = sign * in.iq_q[k];
     }
-    c.data_wiped = std::abs(in.iq_i[1]) > std::abs(in.iq_q[1]);  // else the sign is a guess: no update
+    c.data_wiped = known || std::abs(in.iq_i[1]) > std::abs(in.iq_q[1]);  // else the sign is a guess: no update
+    if (known) ++known_bits_;
     if (!c.data_wiped) ++not_wiped_;
     // The replica that ran over this epoch: code pseudorange (continuous clock) and the PLL's carrier rate.
     const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
@@ -239,6 +242,7 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
       vector = std::abs(jump) <= ut_.max_jump_chips && st.coast_s <= ut_.max_coast_s;
       if (vector) {
         commands[i].vector = true;
+        commands[i].filter_driven = true;
         commands[i].code_rate_chips_per_s = r.nco.code_rate_chips_per_s;
         commands[i].code_phase_jump_chips = jump;
         const auto change = aid_change.find(in.prn);
@@ -341,10 +345,10 @@ std::string ReceiveUltraTight::summary_json() const {
   const auto& o = driver_->output();
   j += fmt::format(", \"handover_t_s\": {:.3f}, \"handover_sample\": {}, \"end_t_s\": {:.3f}, \"channels_handed_over\": {}, "
                    "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
-                   "\"releases\": {}, \"measurements\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
+                   "\"releases\": {}, \"measurements\": {}, \"known_bits\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
                    "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}",
                    handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_,
-                   coasting_channel_epochs_, relocks_, releases_, measurements_, not_wiped_, k.periods, k.updates,
+                   coasting_channel_epochs_, relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates,
                    k.accepted, k.rejected, k.coasting);
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
                    "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",

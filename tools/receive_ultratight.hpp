@@ -88,7 +88,7 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   double handover_t_s_ = 0.0;
   std::int64_t handover_sample_ = 0;
   long long vector_epochs_ = 0, channel_epochs_ = 0, coasting_channel_epochs_ = 0, releases_ = 0, relocks_ = 0;
-  long long measurements_ = 0, not_wiped_ = 0;
+  long long measurements_ = 0, known_bits_ = 0, not_wiped_ = 0;
 };
 
 }  // namespace ultratrack::tools
