@@ -189,7 +189,9 @@ class UltraTightCore final : public UltraTightCoreBase {
         return h.prn == e.prn && h.iode == e.iode && h.iodc == e.iodc && h.week == e.week && h.toe_s == e.toe_s &&
                h.toc_s == e.toc_s;
       });
-      if (!held) eph_.push_back(e);
+      if (held) continue;
+      eph_.push_back(e);
+      now_valid_ = false;  // finish_period's satellites lack this set: the next start_period predicts afresh
     }
   }
 

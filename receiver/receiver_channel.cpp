@@ -108,6 +108,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   const bool present = e.signal_present || (vector_.filter_driven && loop_.presence_cn0_dbhz() < kGateFromDbHz);
   if (!fresh || !e.valid || !e.bit_synced || !present || e.num_code_periods < 2) return in;
   in.bit_sign = vector_.filter_driven ? e.bit_sign : 0;
+  in.pll_coherent_epochs = std::max(1, loop_.coherent_epochs());
   const int half = e.num_samples / 2;
   in.has_measurement = true;
   in.measurement_sample = e.first_sample + half;

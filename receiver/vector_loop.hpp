@@ -64,6 +64,9 @@ struct VectorChannelInput {
   // The navigation bit of that epoch when known ahead (data wipe-off, filter-driven channels only): the sign
   // (+1/-1, polarity applied) that makes the prompt's in-phase positive; 0: unknown.
   int bit_sign = 0;
+  // The channel PLL's coherent integration now, in 20 ms epochs (N x 20 ms with data wipe-off; 1 otherwise): its
+  // bandwidth, and so its residual phase at an epoch's start, follow N (scalar_tracking.hpp).
+  int pll_coherent_epochs = 1;
 };
 
 struct VectorEpochInput {

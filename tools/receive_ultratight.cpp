@@ -148,9 +148,11 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     st.prompt_power = std::isfinite(st.prompt_power) ? st.prompt_power + 0.1 * (p2 - st.prompt_power) : p2;
     c.cn0_dbhz = a2 > 0.0 ? 10.0 * std::log10(a2 / (2.0 * ut_.period_s)) : -100.0;
     // The channel's PLL stays closed: the period starts with its residual phase error (thermal jitter of the
-    // coherent-epoch loop, design bandwidth), not the realigned phase of the seed model.
-    const double jitter_rad = receiver::pll_thermal_jitter_rad(
-        receiver::long_coherent_pll_bw_hz(options_.tracking, 1), ut_.period_s, c.cn0_dbhz);
+    // loop at its design bandwidth for the coherent time it runs now, N x 20 ms), not the realigned phase of the
+    // seed model.
+    const int n = in.pll_coherent_epochs;
+    const double jitter_rad = receiver::pll_thermal_jitter_rad(receiver::long_coherent_pll_bw_hz(options_.tracking, n),
+                                                              n * ut_.period_s, c.cn0_dbhz);
     c.start_phase_var_rad2 = a2 > 0.0 ? jitter_rad * jitter_rad : 0.0;
     c.integration_time_s = ut_.period_s;
     // Data wipe-off by the known bit (decoded subframes or --nav: receiver/nav_bit_predictor.hpp), else by the
