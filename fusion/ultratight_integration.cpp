@@ -127,6 +127,7 @@ void check_options(const UltraTightOptions& o) {
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
     throw std::invalid_argument("ultra-tight: gate probability must lie in (0, 1)");
   if (!std::isfinite(o.coast_cn0_dbhz)) throw std::invalid_argument("ultra-tight: coasting threshold not finite");
+  if (std::isnan(o.measurement_mask_rad)) throw std::invalid_argument("ultra-tight: measurement mask is NaN");
 }
 
 }  // namespace
@@ -221,6 +222,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       r.carrier_phase_cycles = ch.carrier_phase_cycles;
       r.elevation_rad = s.elevation_rad;
       r.coasting = ch.coasting;
+      r.aided_only = s.elevation_rad < opt_.measurement_mask_rad;
       replicas.push_back(r);
     }
   }
@@ -247,7 +249,7 @@ class UltraTightCore final : public UltraTightCoreBase {
     for (const ReplicaCommand& r : replicas) {
       const ChannelCorrelation* c;
       const SatelliteObservable* s;
-      usable_count += lookup(r.prn, c, s) ? 1 : 0;
+      usable_count += lookup(r.prn, c, s) && !r.aided_only ? 1 : 0;
     }
     for (ReplicaCommand& command : replicas) {
       ChannelState& ch = channels_[command.prn];
@@ -260,6 +262,11 @@ class UltraTightCore final : public UltraTightCoreBase {
         r.t_start_s = c->replica_t_start_s;
         r.pseudorange_m = c->replica_pseudorange_m;
         r.range_rate_mps = c->replica_range_rate_mps;
+      }
+      if (usable && command.aided_only) {
+        ch.coasting = false;
+        ++counters.aided_only;
+        continue;
       }
       if (!usable) {
         ch.coasting = true;

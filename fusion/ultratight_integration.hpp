@@ -14,6 +14,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -39,6 +40,11 @@ struct UltraTightOptions {
   Discretisation discretisation = Discretisation::SecondOrderSeries;
   ins::StrapdownOptions strapdown;
   TightOptions tight;               // elevation mask, troposphere, ionosphere (with `iono`)
+  // Satellites between tight.elevation_mask_rad (above it: predicted, a replica command every period) and this
+  // mask are commanded but never update the filter ("aided only"): a low satellite's INS-predicted replica keeps
+  // its channel on the signal, while its measurements (multipath, troposphere mapping, fast line-of-sight
+  // geometry in a 10 g turn) stay out of the filter. -inf: every predicted satellite updates.
+  double measurement_mask_rad = -std::numeric_limits<double>::infinity();
   signals::KlobucharParameters iono;  // broadcast ionosphere (default: invalid, no ionospheric delay)
   double tap_offset_chips = 0.5;    // early/late offset d
   double coast_cn0_dbhz = 18.0;     // below: no update, the channel coasts on the INS
@@ -60,6 +66,7 @@ struct ReplicaCommand {
   double carrier_phase_cycles = 0.0;  // running replica carrier phase at t_start (continuous, integral of nco)
   double elevation_rad = 0.0;
   bool coasting = false;          // no accepted measurement in the last period
+  bool aided_only = false;        // below measurement_mask_rad: commanded, never used to update
 };
 
 // Measured correlations of one satellite over one period (normalised: unit noise variance per I or Q).
@@ -95,6 +102,7 @@ struct UltraTightCounters {
   long long periods = 0;
   long long updates = 0, accepted = 0, rejected = 0;
   long long coasting = 0;  // satellite-periods without a usable measurement
+  long long aided_only = 0;  // satellite-periods below the measurement mask (commanded, not used)
 };
 
 class UltraTightIntegration {

@@ -92,9 +92,11 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   o.sigma_att_rad = floor(out.sigma_att_rad, 1e-4);
   o.gate = c.gate;
   o.ukf = c.ukf;
-  // The PVT's mask: satellites below it stay scalar. (A 0 or 5 deg mask brought the two low satellites of the 10 g
-  // turn in and the position then diverged to 10 m RMS in the turn: docs/validation.md.)
-  o.tight.elevation_mask_rad = options_.pvt.elevation_mask_rad;
+  // Commanded above command_mask_deg, measured above the PVT's mask. (Used for updates, the two low satellites of
+  // the 10 g turn, at 6.5 and 8.4 deg, made the position diverge to 10 m RMS in the turn: docs/validation.md; left
+  // scalar, they were lost wherever the scalar loops are.)
+  o.tight.elevation_mask_rad = std::min(options_.pvt.elevation_mask_rad, ut_.command_mask_deg * M_PI / 180.0);
+  o.measurement_mask_rad = options_.pvt.elevation_mask_rad;
   o.tight.ionosphere = options_.pvt.ionosphere;
   o.tight.troposphere = options_.pvt.troposphere;
   if (epoch.iono) o.iono = *epoch.iono;
@@ -348,10 +350,10 @@ std::string ReceiveUltraTight::summary_json() const {
   j += fmt::format(", \"handover_t_s\": {:.3f}, \"handover_sample\": {}, \"end_t_s\": {:.3f}, \"channels_handed_over\": {}, "
                    "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
                    "\"releases\": {}, \"measurements\": {}, \"known_bits\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
-                   "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}",
+                   "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}, \"aided_only_satellite_periods\": {}",
                    handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_,
                    coasting_channel_epochs_, relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates,
-                   k.accepted, k.rejected, k.coasting);
+                   k.accepted, k.rejected, k.coasting, k.aided_only);
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
                    "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
                    o.sigma_pos_ned_m.x(), o.sigma_pos_ned_m.y(), o.sigma_pos_ned_m.z(), o.sigma_clock_bias_m,
@@ -365,11 +367,12 @@ std::string ReceiveUltraTight::report() const {
   long long channels = 0;
   for (const auto& [prn, st] : channels_) channels += st.ever;
   return fmt::format("receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
-                     "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}",
+                     "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
+                     "satellite-periods aided only (below the measurement mask) {}",
                      fusion_.settings().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
                      fusion_.settings().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
                      handover_t_s_, channels, channel_epochs_, coasting_channel_epochs_, relocks_, releases_,
-                     k.accepted, k.rejected);
+                     k.accepted, k.rejected, k.aided_only);
 }
 
 }  // namespace ultratrack::tools

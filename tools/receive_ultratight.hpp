@@ -32,6 +32,10 @@ struct ReceiveUltraTightOptions {
   double handover_after_s = 2.0;    // the tight integration runs this long (IMU time) before the hand-over
   double max_jump_chips = 0.5;      // a channel joins / stays only while prediction and replica agree this well
   double max_coast_s = 30.0;        // a coasting channel is released (scalar, then lost) after this
+  // Satellites above this elevation are commanded by the loop (INS-predicted replicas); only those above the
+  // PVT's mask update the filter (fusion::UltraTightOptions::measurement_mask_rad). Between the two masks a
+  // channel is "aided only": its replica follows the prediction, its correlations are not used.
+  double command_mask_deg = 5.0;
 };
 
 class ReceiveUltraTight final : public receiver::VectorLoop {

@@ -160,6 +160,53 @@ TEST(UltraTight, EphemerisArrivingAfterTheStartGivesTheSatelliteReplicasAndUpdat
   EXPECT_TRUE(u[0].accepted);
 }
 
+// Two masks: satellites above tight.elevation_mask_rad get replicas every period; those below
+// measurement_mask_rad are "aided only": commanded, never used to update, never reported coasting. Mask set between
+// the two lowest satellites: the lowest gets replicas and no update; every other satellite, given the same
+// noise-free correlations, updates.
+TEST(UltraTight, SatellitesBelowTheMeasurementMaskAreCommandedButNeverUpdate) {
+  const signals::GpsTime origin{2300, 200000.0};
+  const std::vector<signals::Ephemeris> all = signals::nominal_constellation(origin).ephemerides;
+  UltraTightOptions opt = DriverAtRest::options(origin);
+  opt.tight.elevation_mask_rad = 0.0;
+  std::vector<ReplicaCommand> first = UltraTightIntegration(DriverAtRest::start_nav(), all, opt).start_period(0.020);
+  ASSERT_GE(first.size(), 5u);
+  std::sort(first.begin(), first.end(),
+            [](const ReplicaCommand& a, const ReplicaCommand& b) { return a.elevation_rad < b.elevation_rad; });
+  const int low_prn = first[0].prn;
+  opt.measurement_mask_rad = 0.5 * (first[0].elevation_rad + first[1].elevation_rad);
+  UltraTightIntegration driver(DriverAtRest::start_nav(), all, opt);
+  IqSettings s;
+  double t_s = 0.0;
+  for (int period = 0; period < 3; ++period) {
+    const std::vector<ReplicaCommand> r = driver.start_period(0.020);
+    ASSERT_EQ(r.size(), first.size());
+    std::vector<ChannelCorrelation> corr;
+    for (const ReplicaCommand& x : r) {
+      EXPECT_EQ(x.aided_only, x.prn == low_prn) << "PRN " << x.prn;
+      EXPECT_FALSE(x.coasting) << "PRN " << x.prn;  // the first period: nothing measured yet, not coasting either
+      ChannelCorrelation c;
+      c.prn = x.prn;
+      c.taps = expected_iq(TrackingErrors{}, s);
+      c.cn0_dbhz = s.cn0_dbhz;
+      corr.push_back(c);
+    }
+    for (int k = 0; k < 2; ++k) {
+      t_s += 0.010;
+      driver.add_imu({t_s, Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, -9.7976 * 0.010)});
+    }
+    driver.finish_period(corr);
+    const auto& u = driver.last_updates();
+    EXPECT_EQ(u.size(), r.size() - 1);
+    for (const auto& x : u) {
+      EXPECT_NE(x.prn, low_prn);
+      EXPECT_TRUE(x.accepted) << "PRN " << x.prn;
+    }
+  }
+  EXPECT_EQ(driver.counters().aided_only, 3);
+  EXPECT_EQ(driver.counters().coasting, 0);
+}
+
 // A new upload (IODE 1 -> 2, its clock 1 us = 300 m different, toe 2 h later) given during the run: each period is
 // predicted from the set select_ephemeris takes at the transmit time, i.e. the old one until the transmit time
 // passes the middle of the two toes (198000 s), then the new one (here at ~0.27 s into the run).
