@@ -492,25 +492,30 @@ bool ScalarTracking::slow_cn0_below(double threshold_dbhz) const {
   return have_slow_cn0_ && cn0_slow_dbhz_ < threshold_dbhz;
 }
 
+// Lock lost during long coherent integration: back to 20 ms loops, then coasting (when allowed) or lost.
+TrackingReport ScalarTracking::lose_long_coherent_lock(const CorrelationEpoch& e, TrackingReport& r, bool add_bit) {
+  loss_time_s_ = 0.0;
+  target_epochs_ = 1;
+  set_loop_epochs(1);
+  if (coasting_allowed_) {
+    state_ = TrackingState::kCoasting;
+    return coast_epoch(e, r, add_bit);
+  }
+  state_ = TrackingState::kLost;
+  r.state = state_;
+  r.command = command_;
+  return r;
+}
+
 // One 20 ms epoch of long coherent integration: its taps, sign-corrected, go into the block; at the block's end
 // the loops, the PLI and the loss test run once on the block's sums with T = its length.
 TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign) {
   const CorrelatorTaps& taps = e.master();
   if (filter_driven_ && presence_absent_) {  // the presence window just ended without signal: the block is void
     block_count_ = 0;
-    loss_time_s_ = 0.0;
-    target_epochs_ = 1;
-    set_loop_epochs(1);
     r.state = state_;
     r.loop_integration_ms = 20;
-    if (coasting_allowed_) {
-      state_ = TrackingState::kCoasting;
-      return coast_epoch(e, r, true);
-    }
-    state_ = TrackingState::kLost;
-    r.state = state_;
-    r.command = command_;
-    return r;
+    return lose_long_coherent_lock(e, r, true);
   }
   if (block_count_ == 0) {
     block_epochs_ = target_epochs_;
@@ -552,19 +557,7 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
   const bool low_pli = r.pli < opt_.pli_loss_threshold;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
   if (filter_driven_) loss_time_s_ = 0.0;
-  if (loss_time_s_ >= std::max(opt_.loss_of_lock_time_s, pli_tau_s_)) {
-    loss_time_s_ = 0.0;
-    target_epochs_ = 1;
-    set_loop_epochs(1);
-    if (coasting_allowed_) {
-      state_ = TrackingState::kCoasting;
-      return coast_epoch(e, r, false);
-    }
-    state_ = TrackingState::kLost;
-    r.state = state_;
-    r.command = command_;
-    return r;
-  }
+  if (loss_time_s_ >= std::max(opt_.loss_of_lock_time_s, pli_tau_s_)) return lose_long_coherent_lock(e, r, false);
   const double f = carrier_.update(r.phase_error_cycles, 0.0, t);
   const double dll_bw = std::min(opt_.dll_bw_coherent_hz, opt_.coherent_max_bn_t / t);
   command_.carrier_frequency_hz = f;

@@ -212,6 +212,7 @@ class ScalarTracking final {
   double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
   double search_frequency_offset_hz() const;
   TrackingReport coast_epoch(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
+  TrackingReport lose_long_coherent_lock(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
   TrackingReport long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign);
   void set_loop_epochs(int epochs);
   bool slow_cn0_below(double threshold_dbhz) const;

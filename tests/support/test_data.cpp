@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -76,6 +78,12 @@ std::vector<std::string> split_csv_line(const std::string& line) {
   std::string f;
   while (std::getline(s, f, ',')) fields.push_back(f);
   return fields;
+}
+
+std::size_t csv_column(const std::vector<std::string>& header, const std::string& name) {
+  const auto it = std::find(header.begin(), header.end(), name);
+  if (it == header.end()) throw std::runtime_error("CSV column " + name + " not in the header");
+  return static_cast<std::size_t>(it - header.begin());
 }
 
 }  // namespace ultratrack::test

@@ -20,6 +20,8 @@ std::filesystem::path scratch_dir();
 std::string read_text_file(const std::filesystem::path& file);
 // The comma-separated fields of one CSV line, as written (no quoting).
 std::vector<std::string> split_csv_line(const std::string& line);
+// The index of column `name` in a CSV header; std::runtime_error naming it when absent.
+std::size_t csv_column(const std::vector<std::string>& header, const std::string& name);
 
 }  // namespace ultratrack::test
 

@@ -119,9 +119,7 @@ std::map<int, std::vector<Row>> read_log(const fs::path& rx) {
   std::string line;
   std::getline(in, line);
   const auto header = test::split_csv_line(line);
-  const auto col = [&](const std::string& name) {
-    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-  };
+  const auto col = [&](const std::string& name) { return test::csv_column(header, name); };
   const std::size_t t = col("time_s"), prn = col("prn"), ut = col("ultratight"), co = col("coasting"),
                     acc = col("accepted"), upd = col("updated");
   std::map<int, std::vector<Row>> out;
@@ -138,9 +136,7 @@ double prompt_i_innovation_variance(const fs::path& rx, double t0, double t1, in
   std::string line;
   std::getline(in, line);
   const auto header = test::split_csv_line(line);
-  const auto col = [&](const std::string& name) {
-    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
-  };
+  const auto col = [&](const std::string& name) { return test::csv_column(header, name); };
   const std::size_t t = col("time_s"), upd = col("updated"), ip = col("innovation_2");
   double s = 0.0, s2 = 0.0;
   n = 0;
