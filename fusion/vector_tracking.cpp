@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "receiver/vector_frequency_discriminator.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::fusion {
@@ -34,6 +35,8 @@ double costas_phase_variance_cycles2(double cn0_hz, double t_s) {
   const double rad2 = bn / cn0_hz * (1.0 + 1.0 / (2.0 * t_s * cn0_hz));
   return rad2 / (4.0 * M_PI * M_PI);
 }
+
+const char* to_string(VectorCarrier carrier) { return carrier == VectorCarrier::kFll ? "fll" : "aided-pll"; }
 
 VectorState propagate(const VectorState& x, double dt) {
   VectorState y = x;
@@ -233,8 +236,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     if (opt_.use_doppler && ch.has_doppler) {
       {
         const double delta_d = static_cast<double>(in.sample - ch.doppler_sample) / in.fs_hz;
-        const double sigma_hz = std::sqrt(2.0 * costas_phase_variance_cycles2(cn0, ch.integration_time_s)) /
-                                ch.doppler_interval_s;
+        const double sigma_hz = std::sqrt(
+            receiver::phase_change_frequency_variance_hz2(cn0, ch.integration_time_s, ch.doppler_interval_s));
         const double sigma_rate = signals::kL1Wavelength_m * sigma_hz;
         const double z = -signals::kL1Wavelength_m * ch.measured_doppler_hz;
         const UpdateResult rr = ekf_->update(VectorRangeMeasurement(shifted(*now, -delta_d), delta_d, true, z, sigma_rate));
@@ -304,7 +307,16 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     commands[i].vector = true;
     commands[i].code_rate_chips_per_s = p.code_rate_chips_per_s;
     commands[i].code_phase_jump_chips = jump;
-    if (opt_.carrier_aiding) commands[i].carrier_frequency_hz = p.doppler_hz;
+    if (opt_.carrier == VectorCarrier::kFll) {
+      // The NCO holds one frequency over the epoch: the predicted Doppler at its middle (the Doppler moves up to
+      // ~100 Hz/s in a 2 g turn: 1 Hz over half an epoch).
+      const double half_epoch_s = 0.5 * (ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02);
+      commands[i].carrier_frequency_hz =
+          predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
+      commands[i].carrier_commanded = true;
+    } else if (opt_.carrier_aiding) {
+      commands[i].carrier_frequency_hz = p.doppler_hz;
+    }
     log.vector = true;
     ++vector;
   }

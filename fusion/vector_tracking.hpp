@@ -81,6 +81,14 @@ struct ReplicaPrediction {
 };
 ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorState& x);
 
+// How the filter treats the vector channels' carriers: kAidedPll, each channel's Costas PLL closes its carrier,
+// aided by the predicted Doppler's changes (carrier_aiding); kFll, the filter closes it (a vector FLL): every
+// vector epoch each channel's carrier NCO is commanded to the predicted Doppler at the middle of its next epoch,
+// and the channel's frequency discriminator (receiver/vector_frequency_discriminator.hpp) is the pseudorange-rate
+// measurement that keeps the prediction honest.
+enum class VectorCarrier { kAidedPll, kFll };
+const char* to_string(VectorCarrier carrier);
+
 struct VectorTrackingOptions {
   VectorProcessNoise process;
   GateOptions gate{true, 0.9999};
@@ -90,6 +98,7 @@ struct VectorTrackingOptions {
   double code_spacing_chips = 1.0;    // E-L spacing of the channels (2 x early_late_offset_chips)
   bool use_doppler = true;            // pseudorange-rate rows
   bool carrier_aiding = true;         // the predicted Doppler's changes aid each vector channel's PLL
+  VectorCarrier carrier = VectorCarrier::kAidedPll;  // kFll: the filter commands the carrier NCOs
   int join_after_updates = 25;        // accepted pseudorange updates (20 ms each) before a channel is commanded
   int max_rejections = 10;            // consecutive gate rejections that return a channel to scalar
   double max_jump_chips = 0.3;        // a prediction further than this from the replica returns it to scalar

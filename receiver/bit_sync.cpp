@@ -104,17 +104,34 @@ std::optional<NavBit> BitAssembler::add(const CorrelationEpoch& epoch) {
   if (!active_) return std::nullopt;
   if (phase != periods_) {  // a gap or misaligned epoch: drop the partial bit
     active_ = false;
+    have_previous_ = false;
     return std::nullopt;
   }
   sum_ += std::complex<double>(epoch.master().prompt);
   periods_ += epoch.num_code_periods;
   if (periods_ < 20) return std::nullopt;
   active_ = false;
-  if (periods_ > 20) return std::nullopt;
+  if (periods_ > 20) {
+    have_previous_ = false;
+    return std::nullopt;
+  }
+  // A bit that does not follow the previous one (a bit start missed) breaks the differential chain.
+  const bool follows = have_previous_ && current_.first_code_period == previous_period_ + 20;
   const double magnitude = std::abs(sum_);
   amplitude_ = amplitude_ == 0.0 ? magnitude : amplitude_ + 0.05 * (magnitude - amplitude_);
-  current_.value = sum_.real() >= 0.0 ? 1 : -1;
-  current_.soft = amplitude_ > 0.0 ? static_cast<float>(sum_.real() / amplitude_) : 0.0f;
+  const double previous_magnitude = std::abs(previous_sum_);
+  if (differential_ && follows && previous_magnitude > 0.0) {
+    const double projection = (sum_ * std::conj(previous_sum_)).real() / previous_magnitude;  // on the previous bit
+    current_.value = previous_value_ * (projection >= 0.0 ? 1 : -1);
+    current_.soft = amplitude_ > 0.0 ? static_cast<float>(previous_value_ * projection / amplitude_) : 0.0f;
+  } else {
+    current_.value = sum_.real() >= 0.0 ? 1 : -1;
+    current_.soft = amplitude_ > 0.0 ? static_cast<float>(sum_.real() / amplitude_) : 0.0f;
+  }
+  previous_sum_ = sum_;
+  previous_value_ = current_.value;
+  previous_period_ = current_.first_code_period;
+  have_previous_ = true;
   return current_;
 }
 

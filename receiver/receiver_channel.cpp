@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "receiver/vector_frequency_discriminator.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::receiver {
@@ -51,13 +52,22 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   // Only a channel whose replica the vector loop drives may coast; dropped from it while coasting, it is lost.
   loop_.allow_coasting(vector_.vector);
   loop_.set_filter_driven(vector_.vector && vector_.filter_driven);
+  // Vector FLL: the loop's frequency is the NCO's; the channel's own carrier loop stands still.
+  const bool fll = vector_.vector && vector_.carrier_commanded && std::isfinite(vector_.carrier_frequency_hz);
+  loop_.set_carrier_commanded(fll);
+  if (fll) {
+    loop_.command_carrier(vector_.carrier_frequency_hz);
+    last_scalar_.carrier_frequency_hz = vector_.carrier_frequency_hz;
+    previous_aid_hz_ = NAN;  // a later aided command starts aiding afresh
+  }
   // A filter-driven channel keeps its time tag too: its bits are known and its code-period count is the filter's
   // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
   nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
   // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
   // the command already computed for the next epoch (between epochs) gets it too.
-  if (vector_.vector && std::isfinite(vector_.carrier_frequency_hz)) {
+  if (fll) {
+  } else if (vector_.vector && std::isfinite(vector_.carrier_frequency_hz)) {
     if (std::isfinite(previous_aid_hz_)) {
       const double delta = vector_.carrier_frequency_hz - previous_aid_hz_;
       loop_.aid_frequency(delta);
@@ -137,9 +147,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
       return s.carrier_phase_start_cycles + (s.carrier_phase_end_cycles - s.carrier_phase_start_cycles) * h / s.num_samples;
     };
     // Costas phases are bit-insensitive, within +-1/4 cycle: their change is taken within +-1/4 cycle.
-    double dphi = costas_atan_cycles(e.prompt) - costas_atan_cycles(p.prompt);
-    if (dphi > 0.25) dphi -= 0.5;
-    if (dphi <= -0.25) dphi += 0.5;
+    const double dphi = costas_phase_change_cycles(p.prompt, e.prompt);
     const std::int64_t p_mid = p.first_sample + p_half;
     in.doppler_interval_s = static_cast<double>(in.measurement_sample - p_mid) / fs_hz_;
     in.measured_doppler_hz = (middle_phase(e, half) - middle_phase(p, p_half) + dphi) / in.doppler_interval_s;
@@ -267,6 +275,9 @@ std::optional<ChannelMeasurement> ReceiverChannel::measure() {
   m.lock_time_s =
       lock_start_sample_ ? static_cast<double>(replica.sample_index - *lock_start_sample_) / fs_hz_ : 0.0;
   m.new_track = !reported_;
+  // Vector FLL: the phase is the NCO's accumulated Doppler, which drifts from the signal's by the integral of the
+  // filter's frequency error (no phase lock): every epoch carries the loss-of-lock flag.
+  m.phase_unlocked = loop_.carrier_commanded();
   reported_ = true;
   return m;
 }

@@ -63,6 +63,7 @@ struct ChannelMeasurement {
   double cn0_dbhz = 0.0;
   double lock_time_s = 0.0;
   bool new_track = false;             // first measurement of this track (RINEX loss of lock)
+  bool phase_unlocked = false;        // the carrier phase is not phase-locked (vector FLL): RINEX loss of lock
 };
 
 class ReceiverChannel {
@@ -90,6 +91,7 @@ class ReceiverChannel {
         if (report.state != TrackingState::kBitSynced && report.state != TrackingState::kCoasting) {
           vector_ = {};
           previous_aid_hz_ = NAN;
+          loop_.set_carrier_commanded(false);
         }
         channel_.command(merged_command());
         if (report.set_coherent) channel_.set_coherent_periods(report.coherent_periods, report.aligned_period);

@@ -477,7 +477,7 @@ void ReceiverEngine::observation_epoch(std::int64_t sample) {
     o.doppler_hz = m.doppler_hz;
     o.cn0_dbhz = m.cn0_dbhz;
     o.lock_time_s = m.lock_time_s;
-    o.loss_of_lock = m.new_track;
+    o.loss_of_lock = m.new_track || m.phase_unlocked;
     o.half_cycle_resolved = true;  // measure() needs frame sync, which fixes the polarity
     epoch_.observations.push_back(o);
     const double smoothed = smoothing_.update(o.prn, epoch_index_, o.pseudorange_m, o.carrier_phase_cycles, o.loss_of_lock);

@@ -271,6 +271,30 @@ void ScalarTracking::set_filter_driven(bool driven) {
   loss_time_s_ = 0.0;
 }
 
+void ScalarTracking::set_carrier_commanded(bool commanded) {
+  if (commanded == carrier_commanded_) return;
+  carrier_commanded_ = commanded;
+  if (bits_) bits_->set_differential(commanded);
+  block_count_ = 0;  // a partial long sum of the PLL is void either way
+  if (commanded) {
+    target_epochs_ = 1;
+    if (long_enabled() && state_ == TrackingState::kBitSynced) set_loop_epochs(1);
+    return;
+  }
+  // Back to the PLL: it starts from the commanded frequency with no rate; the PLI, which read the FLL's wandering
+  // phase, restarts (empty, it reads 0: the loss test waits loss_of_lock_time_s while the PLL pulls in).
+  carrier_.reset(command_.carrier_frequency_hz, 0.0);
+  pli_.reset();
+  loss_time_s_ = 0.0;
+}
+
+void ScalarTracking::command_carrier(double frequency_hz) {
+  if (!carrier_commanded_ || !std::isfinite(frequency_hz)) return;
+  if (state_ != TrackingState::kBitSynced && state_ != TrackingState::kCoasting) return;
+  carrier_.reset(frequency_hz, 0.0);
+  command_.carrier_frequency_hz = frequency_hz;
+}
+
 void ScalarTracking::allow_coasting(bool allowed) {
   coasting_allowed_ = allowed;
   if (!allowed && state_ == TrackingState::kCoasting) {
@@ -280,7 +304,7 @@ void ScalarTracking::allow_coasting(bool allowed) {
 }
 
 int ScalarTracking::known_bits_wanted() const {
-  if (!long_enabled() || state_ != TrackingState::kBitSynced) return 0;
+  if (!long_enabled() || state_ != TrackingState::kBitSynced || carrier_commanded_) return 0;
   return target_epochs_ > 1 || block_count_ > 0 ? std::max(target_epochs_, block_epochs_) : 0;
 }
 
@@ -309,7 +333,8 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   r.loop_integration_ms = e.num_code_periods;
   // Long coherent integration: a block of target_epochs_ epochs starts only where that many bits are known; a
   // gap or an unknown bit inside a block drops its partial sum (the command given stays in force).
-  const bool long_ready = long_enabled() && state_ == TrackingState::kBitSynced && e.num_code_periods == 20;
+  const bool long_ready =
+      long_enabled() && state_ == TrackingState::kBitSynced && e.num_code_periods == 20 && !carrier_commanded_;
   if (block_count_ > 0 && (!long_ready || known.sign == 0 || e.first_code_period != block_next_period_)) block_count_ = 0;
   const bool long_path = long_ready && known.sign != 0 &&
                          (block_count_ > 0 || (target_epochs_ > 1 && known.ahead >= target_epochs_));
@@ -420,7 +445,9 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   const bool weak_bridge = bridging();
   const bool low_cn0 = weak_bridge ? slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(target_epochs_))
                                    : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
-  const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold;
+  // (A carrier the vector FLL commands is not phase-locked: its PLI says nothing about the signal.)
+  const bool fll = carrier_commanded_ && state_ == TrackingState::kBitSynced;
+  const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold && !fll;
   loss_time_s_ = (low_cn0 || low_pli) ? loss_time_s_ + t : 0.0;
   if (filter_driven_ && state_ == TrackingState::kBitSynced) loss_time_s_ = presence_absent_ ? opt_.loss_of_lock_time_s : 0.0;
   if (loss_time_s_ >= opt_.loss_of_lock_time_s) {
@@ -467,6 +494,8 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
     f = carrier_.update_fll_only(r.frequency_error_hz, wide_stage ? opt_.fll_bw_hz : opt_.fll_narrow_bw_hz, t);
   } else if (fine_stage) {
     f = fine_fll(taps.prompt, t, &r.frequency_error_hz);
+  } else if (coherent && carrier_commanded_) {
+    f = command_.carrier_frequency_hz;  // the vector FLL's (command_carrier)
   } else {
     f = carrier_.update(r.phase_error_cycles, 0.0, t);
   }
@@ -589,7 +618,15 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
     relocking_ = false;  // faded again: hold the frequency the PLL reached
   }
   double f = command_.carrier_frequency_hz;
-  if (relocking_) {
+  if (carrier_commanded_) {
+    // Vector FLL: the carrier is the filter's whether the signal is there or not; once the C/N0 is back the
+    // channel is bit-synced again (no phase to re-lock; the differential bits restart after the gap).
+    relocking_ = false;
+    if (strong) {
+      state_ = TrackingState::kBitSynced;
+      loss_time_s_ = 0.0;
+    }
+  } else if (relocking_) {
     // Frequency error from the epoch's two halves (bit-edge free: +-1 / t, i.e. +-50 Hz at 20 ms, where the
     // successive-epoch discriminator is bit-ambiguous beyond +-1 / (4 t) and would let the PLL lock 1 / t off).
     const CrossDot cd = cross_dot(e.prompt_halves[0], e.prompt_halves[1]);

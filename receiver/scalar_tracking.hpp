@@ -199,6 +199,17 @@ class ScalarTracking final {
   // coherent sums use a pure PLL (see ScalarTrackingOptions::presence_window_s). Off: the scalar loss test.
   void set_filter_driven(bool driven);
   bool filter_driven() const { return filter_driven_; }
+  // Vector FLL (VectorChannelCommand::carrier_commanded): while set and bit-synced or coasting, the carrier NCO's
+  // frequency is the external loop's (command_carrier), the channel's carrier loop does not run, long coherent
+  // integration is off, bits are detected differentially (BitAssembler::set_differential: the replica's phase
+  // wanders by the frequency error's integral), the loss test is the C/N0 alone (the PLI reads the wandering
+  // phase), and coasting ends as soon as the C/N0 is back (nothing to re-lock). Clearing it hands the carrier
+  // back to the PLL from the commanded frequency (its frequency-rate state cleared, the PLI restarted).
+  void set_carrier_commanded(bool commanded);
+  bool carrier_commanded() const { return carrier_commanded_; }
+  // The commanded carrier frequency (Hz), for the next command; ignored unless carrier_commanded() and bit-synced
+  // or coasting.
+  void command_carrier(double frequency_hz);
   // The C/N0 of the latest completed presence window (dB-Hz; -100 before the first or without signal).
   double presence_cn0_dbhz() const { return presence_.last_cn0_dbhz(); }
   bool relocking() const { return relocking_; }
@@ -238,6 +249,7 @@ class ScalarTracking final {
   bool ever_locked_ = false;
   bool coasting_allowed_ = false, relocking_ = false;
   bool filter_driven_ = false;
+  bool carrier_commanded_ = false;
   SignalPresenceTest presence_;
   bool presence_absent_ = false;  // the latest completed presence window found no signal
   CrossDot relock_fll_{};

@@ -2,7 +2,8 @@
 // a VectorLoop every channel's latest correlation results, as pseudorange and Doppler measurements on the
 // receiver's clock, and the replica's state; the loop answers one VectorChannelCommand per channel, which the
 // channel applies through its NcoCommand at the start of its next epoch (code rate and a code phase jump; the
-// carrier stays with the channel's Costas PLL). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
+// carrier either stays with the channel's Costas PLL, aided by the loop's predicted Doppler, or, with
+// carrier_commanded, is the loop's: a vector FLL). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
 #pragma once
 
 #include <array>
@@ -91,6 +92,12 @@ struct VectorChannelCommand {
   // Carrier aiding: the predicted carrier Doppler at next_epoch_sample, Hz; its change from one command to the
   // next is added to the channel's PLL (ScalarTracking::aid_frequency). NaN: no aiding.
   double carrier_frequency_hz = NAN;
+  // Vector FLL: carrier_frequency_hz (finite) is the carrier NCO's frequency from the next epoch start on, not an
+  // aid; the channel runs no carrier loop of its own (ScalarTracking::set_carrier_commanded): the loop closes the
+  // carrier through the channel's frequency discriminator (measured_doppler_hz), the channel's bits are detected
+  // differentially, its lock test is the C/N0 alone, and its carrier phase is reported with loss of lock (the
+  // NCO's accumulated Doppler, not a phase-locked observable).
+  bool carrier_commanded = false;
   // The loop's filter drives the replica and judges lock (ultra-tight): the channel's scalar loss test gives way
   // to the presence test (ScalarTracking::set_filter_driven), its PLL sums N x 20 ms with the known bits wiped
   // (pure PLL), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).

@@ -59,6 +59,7 @@ struct SigintGuard {
 struct ReceiveArgs {
   std::string input, fs, if_hz = "0", config, nav, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
+  std::string vector_carrier;  // --vector-carrier aided-pll|fll (with --coupling vector)
   FormatArgs format;
   ReceiveFusionArgs fusion;
   bool iq_swap = false, q_negate = false, quiet = false;
@@ -182,8 +183,13 @@ void run_receive(const ReceiveArgs& args) {
   if (fusion) fusion->attach(engine);
   if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
   const ReceiveCoupling coupling = parse_receive_coupling(args.fusion.coupling);
+  if (!args.vector_carrier.empty() && coupling != ReceiveCoupling::Vector)
+    throw signals::InputError("command line", "--vector-carrier needs --coupling vector");
+  const fusion::VectorCarrier vector_carrier =
+      args.vector_carrier.empty() ? fusion::VectorCarrier::kAidedPll : parse_vector_carrier(args.vector_carrier);
   std::unique_ptr<ReceiveVector> vector;  // --coupling vector: the vector tracking filter closes the code loops
-  if (coupling == ReceiveCoupling::Vector) (vector = std::make_unique<ReceiveVector>(options, args.out))->attach(engine);
+  if (coupling == ReceiveCoupling::Vector)
+    (vector = std::make_unique<ReceiveVector>(options, args.out, vector_carrier))->attach(engine);
   std::unique_ptr<ReceiveUltraTight> ultratight;  // --coupling ultra-tight: the INS-predicted replica drives them
   if (coupling == ReceiveCoupling::UltraTight)
     (ultratight = std::make_unique<ReceiveUltraTight>(*fusion, options, args.out))->attach(engine);
@@ -291,6 +297,9 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--skip", args->skip, "seconds of signal to skip at the start");
   cmd->add_option("--reference-week", args->reference_week,
                   "full GPS week near the recording, for the 10-bit week (default: nav file or build date)");
+  cmd->add_option("--vector-carrier", args->vector_carrier,
+                  "with --coupling vector: aided-pll (default: each channel's PLL, aided) or fll (the filter "
+                  "commands the carrier NCOs: vector FLL)");
   cmd->add_flag("--iq-swap", args->iq_swap, "exchange I and Q (complex formats)");
   cmd->add_flag("--q-negate", args->q_negate, "negate Q (complex) / invert the spectrum (real IF)");
   add_receive_fusion_options(cmd, args->fusion);

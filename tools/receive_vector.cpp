@@ -3,10 +3,20 @@
 #include <fmt/core.h>
 #include <fmt/ostream.h>
 
+#include "io/input_error.hpp"
+
 namespace ultratrack::tools {
 
-fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options) {
+fusion::VectorCarrier parse_vector_carrier(const std::string& text) {
+  if (text == "aided-pll") return fusion::VectorCarrier::kAidedPll;
+  if (text == "fll") return fusion::VectorCarrier::kFll;
+  throw io::InputError("command line", "--vector-carrier must be aided-pll or fll, got '" + text + "'");
+}
+
+fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
+                                                     fusion::VectorCarrier carrier) {
   fusion::VectorTrackingOptions v;
+  v.carrier = carrier;
   v.ionosphere = options.pvt.ionosphere;
   v.troposphere = options.pvt.troposphere;
   v.code_spacing_chips = 2.0 * options.tracking.early_late_offset_chips;
@@ -14,9 +24,11 @@ fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOp
   return v;
 }
 
-ReceiveVector::ReceiveVector(const receiver::ReceiverOptions& options, const std::filesystem::path& dir)
+ReceiveVector::ReceiveVector(const receiver::ReceiverOptions& options, const std::filesystem::path& dir,
+                             fusion::VectorCarrier carrier)
     : fs_hz_(options.fs_hz),
-      filter_(vector_tracking_options(options)),
+      carrier_(carrier),
+      filter_(vector_tracking_options(options, carrier)),
       channels_(dir / "vector.csv"),
       state_(dir / "vector_state.csv") {
   channels_.stream() << "sample,time_s,prn,vector,cn0_dbhz,pr_used,pr_innovation_m,pr_sigma_m,rate_used,"
@@ -54,9 +66,9 @@ void ReceiveVector::log(const fusion::VectorEpochLog& e) {
 }
 
 std::string ReceiveVector::summary_json() const {
-  return fmt::format("\"vector\": {{\"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
+  return fmt::format("\"vector\": {{\"carrier\": \"{}\", \"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
                      "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}}}",
-                     vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_, filter_.initialisations(),
+                     fusion::to_string(carrier_), vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_, filter_.initialisations(),
                      filter_.resets());
 }
 

@@ -16,12 +16,16 @@
 namespace ultratrack::tools {
 
 // The filter's options for a receiver configuration (the PVT's atmosphere models, the channels' E-L spacing).
-fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options);
+fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
+                                                     fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
+// --vector-carrier's value: "aided-pll" or "fll" (InputError naming the option otherwise).
+fusion::VectorCarrier parse_vector_carrier(const std::string& text);
 
 class ReceiveVector {
  public:
   // Opens the two logs in dir (InputError when they cannot be created).
-  ReceiveVector(const receiver::ReceiverOptions& options, const std::filesystem::path& dir);
+  ReceiveVector(const receiver::ReceiverOptions& options, const std::filesystem::path& dir,
+                fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
   // Attach before the first process() call; the object must outlive the engine's use of it.
   void attach(receiver::ReceiverEngine& engine, double interval_s = 0.02);
   // Commits the logs.
@@ -32,13 +36,15 @@ class ReceiveVector {
   long long vector_channel_epochs() const { return vector_channel_epochs_; }
   // Channel-epochs commanded while coasting (faded: from the prediction alone).
   long long coasting_channel_epochs() const { return coasting_channel_epochs_; }
-  // summary.json member: "vector": {epochs, channel-epochs in vector mode and coasting, filter starts, resets}.
+  // summary.json member: "vector": {carrier mode, epochs, channel-epochs in vector mode and coasting, filter
+  // starts, resets}.
   std::string summary_json() const;
 
  private:
   void log(const fusion::VectorEpochLog& e);
 
   double fs_hz_;
+  fusion::VectorCarrier carrier_;
   fusion::VectorTrackingFilter filter_;
   io::AtomicFile channels_, state_;
   long long vector_epochs_ = 0, vector_channel_epochs_ = 0, coasting_channel_epochs_ = 0;

@@ -1,0 +1,280 @@
+// `ultratrack receive --coupling vector --vector-carrier fll` end to end (issue 7, vector FLL): the filter commands
+// every vector channel's carrier NCO from its predicted Doppler and closes the carrier through the channels'
+// frequency discriminators. Against the simulator's truth (truth.csv's trajectory and clock, the broadcast orbits):
+// each channel's carrier NCO frequency over each epoch (tracking.csv doppler_hz, the replica's frequency, with the
+// epoch's start time) minus the true Doppler at the epoch's middle. Same scenarios as receive_vector_test.cpp
+// (static 45 dB-Hz, 2 g turn step); the aided-PLL mode runs on the same files for the printed comparison.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "run_command.hpp"
+#include "solution_compare.hpp"
+#include "signals/ephemeris_selection.hpp"
+#include "signals/gps_constants.hpp"
+#include "signals/rinex_nav.hpp"
+#include "signals/satellite_state.hpp"
+#include "support/test_data.hpp"
+
+namespace fs = std::filesystem;
+namespace signals = ultratrack::signals;
+
+namespace {
+
+void run(const std::string& command, std::vector<std::string> args) {
+  ultratrack::test_support::run_command(command, std::move(args));
+}
+
+// truth.csv rows: t_s, GPS time, ECEF position, NED velocity turned to ECEF, clock drift.
+struct TruthRow {
+  double t = 0.0;
+  signals::GpsTime time;
+  Eigen::Vector3d r, v;
+  double drift = 0.0;
+};
+std::vector<TruthRow> read_truth(const fs::path& path) {
+  std::vector<TruthRow> rows;
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    const auto f = ultratrack::test::split_csv_line(line);
+    TruthRow r;
+    r.t = std::stod(f[0]);
+    r.time = {std::stoi(f[1]), std::stod(f[2])};
+    r.r = {std::stod(f[3]), std::stod(f[4]), std::stod(f[5])};
+    const double lat = std::stod(f[6]) * M_PI / 180.0, lon = std::stod(f[7]) * M_PI / 180.0;
+    const Eigen::Vector3d n(-std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat));
+    const Eigen::Vector3d e(-std::sin(lon), std::cos(lon), 0.0);
+    const Eigen::Vector3d d(-std::cos(lat) * std::cos(lon), -std::cos(lat) * std::sin(lon), -std::sin(lat));
+    r.v = std::stod(f[9]) * n + std::stod(f[10]) * e + std::stod(f[11]) * d;
+    r.drift = std::stod(f[13]);
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// The true carrier Doppler of `prn` at t seconds into the file (truth interpolated linearly between its 10 Hz
+// rows): -(u . (v_sat - v) + clock drift - c SV clock drift) / lambda, the satellite at its transmit time in the
+// receive-time frame (two travel-time iterations). Neglected: the frame rotation's effect on the velocity and
+// the receiver acceleration within 50 ms, both below 0.02 m/s (0.1 Hz) even in the 2 g turn.
+double true_doppler_hz(const std::vector<TruthRow>& truth, const std::vector<signals::Ephemeris>& ephs, int prn, double t) {
+  const auto it = std::lower_bound(truth.begin(), truth.end(), t, [](const TruthRow& r, double x) { return r.t < x; });
+  const std::size_t k = std::clamp<std::size_t>(static_cast<std::size_t>(it - truth.begin()), 1, truth.size() - 1);
+  const TruthRow& a = truth[k - 1];
+  const TruthRow& b = truth[k];
+  const double w = (t - a.t) / (b.t - a.t);
+  const Eigen::Vector3d r = a.r + w * (b.r - a.r), v = a.v + w * (b.v - a.v);
+  const double drift = a.drift + w * (b.drift - a.drift);
+  const signals::GpsTime rx = signals::add_seconds(a.time, t - a.t);
+  const auto eph = signals::select_ephemeris(ephs, prn, rx);
+  if (!eph) return NAN;
+  double tau = 0.075;
+  signals::SatelliteState s;
+  Eigen::Vector3d rs;
+  for (int i = 0; i < 3; ++i) {
+    s = signals::satellite_state(*eph, signals::add_seconds(rx, -tau));
+    rs = signals::rotate_to_receive_frame(s.r_e_m, tau);
+    tau = (rs - r).norm() / signals::kSpeedOfLight_mps;
+  }
+  const Eigen::Vector3d u = (rs - r).normalized();
+  const Eigen::Vector3d vs = signals::rotate_to_receive_frame(s.v_e_mps, tau);
+  return -(u.dot(vs - v) + drift - signals::kSpeedOfLight_mps * s.clock_drift_sps) / signals::kL1Wavelength_m;
+}
+
+struct DopplerErrors {
+  int epochs = 0;
+  double rms_hz = 0.0, max_hz = 0.0;
+  std::map<int, int> per_prn;  // epochs checked per PRN
+};
+// Every bit-synced 20 ms epoch (tracking.csv) starting in [from_s, to_s): NCO frequency minus the true Doppler
+// at the epoch's middle.
+DopplerErrors doppler_errors(const fs::path& tracking, const std::vector<TruthRow>& truth,
+                             const std::vector<signals::Ephemeris>& ephs, double from_s, double to_s) {
+  DopplerErrors d;
+  std::ifstream in(tracking);
+  std::string line;
+  std::getline(in, line);
+  double sum2 = 0.0;
+  while (std::getline(in, line)) {
+    const auto f = ultratrack::test::split_csv_line(line);
+    const double t = std::stod(f[2]);
+    if (t < from_s || t >= to_s || f[9] != "bit-synced" || f[5] != "20") continue;
+    const int prn = std::stoi(f[0]);
+    const double truth_hz = true_doppler_hz(truth, ephs, prn, t + 0.01);
+    if (!std::isfinite(truth_hz)) continue;
+    const double e = std::stod(f[7]) - truth_hz;
+    sum2 += e * e;
+    d.max_hz = std::max(d.max_hz, std::abs(e));
+    ++d.epochs;
+    ++d.per_prn[prn];
+  }
+  d.rms_hz = d.epochs ? std::sqrt(sum2 / d.epochs) : NAN;
+  return d;
+}
+
+int total_losses(const fs::path& out, int* satellites) {
+  const std::string summary = ultratrack::test::read_text_file(out / "summary.json");
+  int total = 0;
+  *satellites = 0;
+  for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1)) {
+    total += std::stoi(summary.substr(at + 10));
+    ++*satellites;
+  }
+  return total;
+}
+
+// Per PRN of vector.csv: in vector mode at some time and never back to scalar afterwards.
+std::map<int, bool> kept_in_vector_mode(const fs::path& vector_csv) {
+  std::map<int, bool> in_vector, dropped;
+  std::ifstream in(vector_csv);
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) {
+    const auto f = ultratrack::test::split_csv_line(line);
+    const int prn = std::stoi(f[2]);
+    if (f[3] == "1") in_vector[prn] = true;
+    else if (in_vector[prn]) dropped[prn] = true;
+  }
+  std::map<int, bool> kept;
+  for (const auto& [prn, v] : in_vector) kept[prn] = v && !dropped[prn];
+  return kept;
+}
+
+std::string scenario(const fs::path& brdc, double height_m, double duration_s, const std::string& trajectory) {
+  return "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " + std::to_string(duration_s) +
+         "\ncn0_dbhz = 45.0\nseed = 4\n[time]\ngps_week = 2190\ntow_s = 518772.0\n[navigation]\nrinex = \"" +
+         brdc.generic_string() + "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, " + std::to_string(height_m) +
+         "]\n[atmosphere]\nionosphere = true\ntroposphere = false\n" + trajectory;
+}
+
+void receive(const fs::path& sim, const fs::path& brdc, const fs::path& out, const char* carrier) {
+  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
+                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--vector-carrier", carrier, "--out",
+                  out.string()});
+}
+
+}  // namespace
+
+// Static, 45 dB-Hz, 16 s hot (channels handed to the filter at ~12.6 s; checked from 13.5 s). The filter's
+// predicted Doppler is averaged over all channels' discriminators: each gives sigma 0.32 Hz per 20 ms at 45 dB-Hz
+// (phase_change_frequency_variance_hz2), so the commanded frequency must be well inside that: RMS <= 0.3 Hz (no
+// worse than one discriminator output), and no epoch beyond 1.5 Hz (a 0.03-cycle phase change per epoch; the
+// discriminator's range is +-12.5 Hz). Every satellite kept, in vector mode to the end, none lost; the RINEX
+// carrier phase of every FLL epoch carries the loss-of-lock flag.
+TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "static.toml") << scenario(brdc, 100.0, 16.0, "");
+  const auto sim = dir / "sim", fll = dir / "fll", pll = dir / "pll";
+  run("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
+  receive(sim, brdc, fll, "fll");
+  receive(sim, brdc, pll, "aided-pll");
+  fs::remove(sim / "antenna0.i8.bin");
+  EXPECT_NE(ultratrack::test::read_text_file(fll / "summary.json").find("\"carrier\": \"fll\""), std::string::npos);
+
+  int satellites = 0;
+  EXPECT_EQ(total_losses(fll, &satellites), 0);
+  EXPECT_GE(satellites, 10);
+  const auto kept = kept_in_vector_mode(fll / "vector.csv");
+  EXPECT_EQ(static_cast<int>(kept.size()), satellites);
+  for (const auto& [prn, k] : kept) EXPECT_TRUE(k) << "PRN " << prn << " fell back to scalar";
+
+  const auto truth = read_truth(sim / "truth.csv");
+  const auto ephs = signals::read_rinex_nav(brdc).ephemerides;
+  const DopplerErrors f = doppler_errors(fll / "tracking.csv", truth, ephs, 13.5, 16.0);
+  const DopplerErrors p = doppler_errors(pll / "tracking.csv", truth, ephs, 13.5, 16.0);
+  std::printf("static 45 dB-Hz: NCO Doppler - truth, FLL: RMS %.3f Hz, max %.3f Hz over %d epochs; aided PLL: RMS "
+              "%.3f Hz, max %.3f Hz over %d epochs\n", f.rms_hz, f.max_hz, f.epochs, p.rms_hz, p.max_hz, p.epochs);
+  EXPECT_EQ(static_cast<int>(f.per_prn.size()), satellites);
+  for (const auto& [prn, n] : f.per_prn) EXPECT_GE(n, 100) << "PRN " << prn;  // 2.5 s of 20 ms epochs
+  EXPECT_LE(f.rms_hz, 0.3);
+  EXPECT_LE(f.max_hz, 1.5);
+
+  // observations.rnx, its last epoch (all channels in vector mode): every L1C phase of the FLL run carries LLI 1
+  // (the 15th character of its 16-character field; the satellite's first field is C1C), none of the aided PLL's.
+  const auto last_epoch_lli = [](const fs::path& rinex) {
+    std::ifstream obs(rinex);
+    std::string line;
+    std::vector<char> lli;
+    bool header = true;
+    while (std::getline(obs, line)) {
+      if (header) {
+        header = line.find("END OF HEADER") == std::string::npos;
+      } else if (line.rfind(">", 0) == 0) {
+        lli.clear();
+      } else if (line.size() >= 35) {
+        lli.push_back(line[19 + 14]);
+      }
+    }
+    return lli;
+  };
+  const auto fll_lli = last_epoch_lli(fll / "observations.rnx");
+  const auto pll_lli = last_epoch_lli(pll / "observations.rnx");
+  EXPECT_EQ(static_cast<int>(fll_lli.size()), satellites);
+  for (char c : fll_lli) EXPECT_EQ(c, '1');
+  EXPECT_FALSE(pll_lli.empty());
+  for (char c : pll_lli) EXPECT_EQ(c, ' ');
+}
+
+// The 2 g turn step of receive_vector_test.cpp (139 m/s, a 8.09 deg/s turn entered at 15 s: up to 19.6 m/s^2, 103
+// Hz/s on a line of sight, held to the end). The filter has no acceleration state: its commanded frequency is a
+// constant-velocity extrapolation from Doppler measurements centred 10-30 ms before the vector epoch to the middle
+// of an epoch 10-40 ms after it, so it lags a sustained line-of-sight acceleration a by a h / lambda with h ~20-70
+// ms (~45 ms on average): 4.6 Hz on average, up to 7.2 Hz, for a line of sight along the 19.6 m/s^2 (measured: 3.0
+// Hz RMS, 5.6 Hz max; the aided PLLs' own loops remove it: 0.3 Hz). Bounds: every epoch within half the
+// discriminator's +-12.5 Hz range (6.25 Hz, far from its Costas ambiguity), the RMS over the turn within the
+// 4.6 Hz average-horizon lag of a line of sight along the acceleration, the straight part before it as static
+// (0.3 Hz). No satellite lost, every channel in vector mode to the end, fixes to the end.
+TEST(ReceiveVectorFll, TwoGTurnKeepsEveryChannelWithTheCommandedDopplerOnTheTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "turn.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
+                                     "15.0,0.0,0.0,0.0,0.0\n5.0,0.0,8.09,0.0,0.0\n";
+  std::ofstream(dir / "turn.toml") << scenario(brdc, 1000.0, 20.0,
+                                               "[trajectory]\nfile = \"turn.csv\"\nspeed_mps = 138.9\nheading_deg = 0.0\n");
+  const auto sim = dir / "sim", fll = dir / "fll", pll = dir / "pll";
+  run("simulate", {"--scenario", (dir / "turn.toml").string(), "--out", sim.string()});
+  receive(sim, brdc, fll, "fll");
+  receive(sim, brdc, pll, "aided-pll");
+  fs::remove(sim / "antenna0.i8.bin");
+
+  int satellites = 0;
+  EXPECT_EQ(total_losses(fll, &satellites), 0);
+  EXPECT_GE(satellites, 8);
+  const auto kept = kept_in_vector_mode(fll / "vector.csv");
+  EXPECT_EQ(static_cast<int>(kept.size()), satellites);
+  for (const auto& [prn, k] : kept) EXPECT_TRUE(k) << "PRN " << prn << " fell back to scalar";
+
+  const auto truth = read_truth(sim / "truth.csv");
+  const auto ephs = signals::read_rinex_nav(brdc).ephemerides;
+  const DopplerErrors f = doppler_errors(fll / "tracking.csv", truth, ephs, 15.0, 20.0);
+  const DopplerErrors p = doppler_errors(pll / "tracking.csv", truth, ephs, 15.0, 20.0);
+  const DopplerErrors fs_ = doppler_errors(fll / "tracking.csv", truth, ephs, 13.5, 15.0);
+  std::printf("2 g turn (15-20 s): NCO Doppler - truth, FLL: RMS %.3f Hz, max %.3f Hz over %d epochs (straight "
+              "13.5-15 s: RMS %.3f Hz); aided PLL: RMS %.3f Hz, max %.3f Hz over %d epochs\n",
+              f.rms_hz, f.max_hz, f.epochs, fs_.rms_hz, p.rms_hz, p.max_hz, p.epochs);
+  EXPECT_EQ(static_cast<int>(f.per_prn.size()), satellites);
+  for (const auto& [prn, n] : f.per_prn) EXPECT_GE(n, 240) << "PRN " << prn;  // ~5 s of 20 ms epochs
+  EXPECT_LE(f.rms_hz, 4.6);
+  EXPECT_LE(f.max_hz, 6.25);
+  EXPECT_LE(fs_.rms_hz, 0.3);
+  using namespace ultratrack::tools;
+  EXPECT_GE(read_solution_csv(fll / "solution.csv").size(), 75u);
+}
+
+TEST(ReceiveVectorFll, RejectsAnUnknownCarrierModeAndOneWithoutVectorCoupling) {
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "x.bin", std::ios::binary) << std::string(400000, '\0');
+  EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6", "--coupling",
+                                   "vector", "--vector-carrier", "pll", "--out", (dir / "rx").string()}));
+  EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
+                                   "--vector-carrier", "fll", "--out", (dir / "ry").string()}));
+}
