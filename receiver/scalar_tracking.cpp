@@ -620,7 +620,8 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
   double f = command_.carrier_frequency_hz;
   if (carrier_commanded_) {
     // Vector FLL: the carrier is the filter's whether the signal is there or not; once the C/N0 is back the
-    // channel is bit-synced again (no phase to re-lock; the differential bits restart after the gap).
+    // channel is bit-synced again (no phase to re-lock). The differential bit chain runs on through the fade on
+    // noise: its polarity may come back inverted, which the decoder's next preamble resolves.
     relocking_ = false;
     if (strong) {
       state_ = TrackingState::kBitSynced;
