@@ -43,6 +43,23 @@ int cn0_window_epochs(Cn0Method method, double window_s, double t_s) {
   return method == Cn0Method::kMoments ? std::max(n, 50) : n;
 }
 
+// The 1 s estimate's spread at 16-18 dB-Hz is ~1.5 dB (the level averages up to three): 2 dB of margin.
+constexpr double kPresenceMarginDb = 2.0;
+constexpr int kPresenceRelockWindows = 2;
+
+PresenceMonitorOptions presence_options(const ScalarTrackingOptions& o) {
+  PresenceMonitorOptions p;
+  p.window_epochs = epochs_in(o.presence_window_s, kBitPeriod_s);
+  p.epoch_s = kBitPeriod_s;
+  p.threshold_dbhz = o.presence_threshold_dbhz;
+  p.max_windows = o.presence_max_windows;
+  p.false_loss_per_min = o.presence_false_loss_per_min;
+  p.margin_db = kPresenceMarginDb;
+  p.relock_threshold_dbhz = o.presence_relock_dbhz;
+  p.relock_windows = kPresenceRelockWindows;
+  return p;
+}
+
 }  // namespace
 
 std::string validation_error(const ScalarTrackingOptions& o) {
@@ -103,6 +120,12 @@ std::string validation_error(const ScalarTrackingOptions& o) {
   c.check(o.presence_window_s >= 0.1 && o.presence_window_s <= 5, "presence_window_s", o.presence_window_s, "[0.1, 5] s");
   c.check(o.presence_threshold_dbhz >= 0 && o.presence_threshold_dbhz <= 30, "presence_threshold_dbhz",
           o.presence_threshold_dbhz, "[0, 30] dB-Hz");
+  c.check(o.presence_max_windows >= 1 && o.presence_max_windows <= 10, "presence_max_windows", o.presence_max_windows,
+          "[1, 10]");
+  c.check(o.presence_false_loss_per_min > 0 && o.presence_false_loss_per_min < 1, "presence_false_loss_per_min",
+          o.presence_false_loss_per_min, "(0, 1)");
+  c.check(o.presence_relock_dbhz >= o.presence_threshold_dbhz && o.presence_relock_dbhz <= 40, "presence_relock_dbhz",
+          o.presence_relock_dbhz, "[presence_threshold_dbhz, 40] dB-Hz");
   return c.error;
 }
 
@@ -173,7 +196,7 @@ ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCo
       pli_(options.pli_time_constant_s),
       cn0_(options.cn0_method, cn0_window_epochs(options.cn0_method, options.cn0_window_s, 1e-3)),
       bit_sync_(options.bit_sync),
-      presence_(epochs_in(options.presence_window_s, kBitPeriod_s), options.presence_threshold_dbhz) {
+      presence_(presence_options(options)) {
   command_.code_phase_jump_chips = 0.0;
   command_.carrier_phase_jump_cycles = 0.0;
   const bool search = opt_.pullin_search_hz > 0.0;
@@ -368,10 +391,15 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   }
   r.cn0_dbhz = cn0_dbhz_;
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
-  // Filter-driven: the presence test on every 20 ms epoch (long sums included: energy, not phase).
-  presence_absent_ = false;
-  if (filter_driven_ && state_ == TrackingState::kBitSynced && e.num_code_periods == 20) {
-    if (const auto present = presence_.add(taps.prompt, taps.noise, t)) presence_absent_ = !*present;
+  // Filter-driven: the presence test on every 20 ms epoch (long sums included: energy, not phase); while
+  // coasting it looks for the signal's return.
+  presence_absent_ = presence_found_ = false;
+  if (filter_driven_ && (state_ == TrackingState::kBitSynced || state_ == TrackingState::kCoasting) &&
+      e.num_code_periods == 20) {
+    if (presence_.add(taps.prompt, taps.noise, t)) {
+      presence_absent_ = state_ == TrackingState::kBitSynced && presence_.lost();
+      presence_found_ = state_ == TrackingState::kCoasting && presence_.found();
+    }
   } else {
     presence_.reset();
   }
@@ -600,8 +628,35 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
 // vector loop's commands replace it) while the signal is gone; once the C/N0 estimate is back above the loss
 // threshold plus relock_margin_dbhz, an FLL-assisted Costas PLL starts from that frequency, and a PLI held for
 // pullin_lock_time_s ends coasting. Bits keep being assembled on the known bit edges (noise while faded).
+// A filter-driven channel whose presence test finds the signal again: bit-synced at once, the carrier loop
+// restarted (20 ms, no rate) from the frequency it coasted on (the filter's prediction); long coherent
+// integration resumes with the next C/N0 estimate. No frequency pull-in: the replica never left the prediction,
+// and at the weak levels this serves (15-20 dB-Hz) the relock FLL's two 10 ms halves carry no usable phase.
+void ScalarTracking::relock_from_presence() {
+  state_ = TrackingState::kBitSynced;
+  relocking_ = false;
+  loss_time_s_ = 0.0;
+  locked_time_s_ = 0.0;
+  target_epochs_ = 1;
+  block_count_ = 0;
+  loop_epochs_ = 1;
+  carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
+  carrier_.reset(command_.carrier_frequency_hz, 0.0);
+  pli_.reset();
+  pli_.set_time_constant(opt_.pli_time_constant_s);
+  pli_tau_s_ = opt_.pli_time_constant_s;
+  presence_.reset();
+}
+
 TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingReport& r, bool add_bit) {
   const double t = e.integration_time_s;
+  if (filter_driven_ && presence_found_) {
+    relock_from_presence();
+    if (bits_ && add_bit) r.bit = bits_->add(e);
+    r.state = state_;
+    r.command = command_;
+    return r;
+  }
   const bool strong = cn0_dbhz_ && *cn0_dbhz_ >= opt_.cn0_loss_threshold_dbhz + opt_.relock_margin_dbhz;
   if (strong && !relocking_) {
     relocking_ = true;

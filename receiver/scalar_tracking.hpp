@@ -116,8 +116,19 @@ struct ScalarTrackingOptions {
   // a 60 s run is falsely lost with 8.7 % at 18, 0.45 % at 19, 0.006 % at 20 dB-Hz; an absent signal is declared
   // lost at the end of the first window without it with 91.5 % (1-2 s after it goes), one window later with 99.3 %.
   // Long coherent sums of such a channel use a pure (atan2) PLL discriminator: the bits are wiped.
+  // Below ~22 dB-Hz one failing window no longer ends the lock: a loss needs k consecutive failing windows, k
+  // the smallest up to presence_max_windows whose false-loss probability in a minute, exact at the channel's
+  // level less 2 dB (the level: its latest windows reading >= presence_relock_dbhz), is at most
+  // presence_false_loss_per_min (defaults: k = 1 for a level above 21.4 dB-Hz, as before; 2 down to 19.6, 3 to
+  // 18.6, 4 to 17.8, then 5: a minute at 16 dB-Hz holds a false loss with probability 1.8e-5 (k = 5) instead of
+  // 0.95, at 15 dB-Hz 1.9e-3, at 14 0.039; receiver/presence_test.hpp). A coasting
+  // filter-driven channel re-locks when two consecutive windows read at least presence_relock_dbhz (noise does
+  // so with probability 5.6e-5 per pair, a 16 dB-Hz signal with 0.48), as well as by the C/N0 rule above.
   double presence_window_s = 1.0;        // [0.1, 5]
   double presence_threshold_dbhz = 12.0; // [0, 30]
+  int presence_max_windows = 5;          // [1, 10]
+  double presence_false_loss_per_min = 1e-3;  // (0, 1)
+  double presence_relock_dbhz = 15.0;    // [presence_threshold_dbhz, 40]
 };
 
 // Thermal phase jitter of a Costas PLL, radians: sqrt(Bn / c (1 + 1 / (2 T c))), c = 10^(cn0_dbhz / 10).
@@ -212,6 +223,8 @@ class ScalarTracking final {
   void command_carrier(double frequency_hz);
   // The C/N0 of the latest completed presence window (dB-Hz; -100 before the first or without signal).
   double presence_cn0_dbhz() const { return presence_.last_cn0_dbhz(); }
+  // The absent windows a filter-driven channel's loss needs at its current level (PresenceMonitor).
+  int presence_required_windows() const { return presence_.required_windows(); }
   bool relocking() const { return relocking_; }
   std::optional<double> cn0_dbhz() const { return cn0_dbhz_; }
   double pli() const { return pli_.value(); }
@@ -223,6 +236,7 @@ class ScalarTracking final {
   double fine_fll(std::complex<float> prompt, double t_s, double* frequency_error_hz);
   double search_frequency_offset_hz() const;
   TrackingReport coast_epoch(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
+  void relock_from_presence();
   TrackingReport lose_long_coherent_lock(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
   TrackingReport long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign);
   void set_loop_epochs(int epochs);
@@ -250,8 +264,9 @@ class ScalarTracking final {
   bool coasting_allowed_ = false, relocking_ = false;
   bool filter_driven_ = false;
   bool carrier_commanded_ = false;
-  SignalPresenceTest presence_;
-  bool presence_absent_ = false;  // the latest completed presence window found no signal
+  PresenceMonitor presence_;
+  bool presence_absent_ = false;  // the latest completed presence window ended a run of absent ones: lost
+  bool presence_found_ = false;   // ... ended a run of present ones (re-lock while coasting)
   CrossDot relock_fll_{};
   double relock_s_ = 0.0;
   std::complex<float> previous_prompt_{};
