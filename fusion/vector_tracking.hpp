@@ -108,16 +108,16 @@ struct VectorTrackingOptions {
   // held, and its epochs reach the filter without the per-epoch fade gate below 30 dB-Hz. Such a channel's
   // discriminators keep updating the filter below min_cn0_dbhz (down to whatever the presence test keeps), with
   // their variances from the lower of the channel's 0.2 s C/N0 and its weak_cn0_average_s running mean (linear):
-  // a 0.2 s estimate reads +-2 dB at 20 dB-Hz and the DLL variance grows as 1 / C/N0^2 there, so an estimate
-  // reading high would give the gate a sigma too small by up to ~1.6x. Joining (join_after_updates) still needs
+  // at 22 dB-Hz the 0.2 s estimates span 16-25 dB-Hz (threshold runs) and the DLL variance grows as 1 / C/N0^2
+  // there, so an estimate reading high would give the gate far too small a sigma. Joining (join_after_updates) still needs
   // min_cn0_dbhz. false: vector channels keep the scalar loss test and are used only above min_cn0_dbhz.
   bool filter_driven = true;
   double weak_cn0_average_s = 1.0;
   // False PLL lock of a weak channel (running mean C/N0 below false_lock_below_dbhz): the mean over
   // doppler_bias_average_s of its measured minus predicted Doppler. Above doppler_bias_hz its Doppler rows are left
   // out; above false_lock_hz (after at least one averaging time) its carrier aiding steps once by that mean,
-  // putting the PLL back on the predicted frequency. Normal weak tracking keeps the mean within ~2 Hz (the PLL's
-  // own noise averaged, and the prediction's error); false locks sit at 10 or 25 Hz. Strong channels are left
+  // putting the PLL back on the predicted frequency. Locked channels of the threshold runs kept 15 s means within
+  // 2 Hz (the PLL's own noise averaged, and the prediction's error); false locks sat at 20-25 Hz. Strong channels are left
   // alone: in a 2 g step turn the prediction, not the PLL, is what lags.
   double false_lock_below_dbhz = 35.0;
   double doppler_bias_average_s = 0.5;

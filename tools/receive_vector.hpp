@@ -32,7 +32,8 @@ class ReceiveVector {
   long long vector_channel_epochs() const { return vector_channel_epochs_; }
   // Channel-epochs commanded while coasting (faded: from the prediction alone).
   long long coasting_channel_epochs() const { return coasting_channel_epochs_; }
-  // summary.json member: "vector": {epochs, channel-epochs in vector mode and coasting, filter starts, resets}.
+  // summary.json member: "vector": {epochs, channel-epochs in vector mode and coasting, filter starts, resets,
+  // carrier-aiding steps of false PLL locks (frequency_resets)}.
   std::string summary_json() const;
 
  private:
