@@ -177,6 +177,13 @@ bool VectorTrackingFilter::initialise(const receiver::VectorEpochInput& in) {
   return true;
 }
 
+bool VectorTrackingFilter::usable(const receiver::VectorChannelInput& ch, const PrnState& st) const {
+  if (!std::isfinite(ch.cn0_dbhz) || ch.coasting) return false;
+  if (ch.cn0_dbhz >= opt_.min_cn0_dbhz) return true;
+  // Weak: only a filter-driven channel the filter already commands (its presence test judges lock).
+  return opt_.filter_driven && ch.vector_mode && st.accepted >= opt_.join_after_updates;
+}
+
 void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
                                   std::span<receiver::VectorChannelCommand> commands) {
   for (auto& c : commands) c = {};
@@ -207,12 +214,19 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log.cn0_dbhz = ch.cn0_dbhz;
     log.replica_code_rate_chips_per_s = ch.code_rate_chips_per_s;
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
-    const bool strong = std::isfinite(ch.cn0_dbhz) && ch.cn0_dbhz >= opt_.min_cn0_dbhz && !ch.coasting;
+    const bool strong = usable(ch, st);
     // A faded channel the filter commands keeps its standing (it coasts, commanded below); others restart.
     const bool joined = st.accepted >= opt_.join_after_updates && ch.vector_mode;
     if (!ch.synchronised || (!strong && !joined)) st = {};
+    if (ch.synchronised && std::isfinite(ch.cn0_dbhz)) {
+      const double a = std::min(1.0, (step_s > 0.0 ? step_s : 0.02) / opt_.weak_cn0_average_s);
+      st.cn0_mean_hz = std::isfinite(st.cn0_mean_hz) ? st.cn0_mean_hz + a * (ratio_hz(ch.cn0_dbhz) - st.cn0_mean_hz)
+                                                     : ratio_hz(ch.cn0_dbhz);
+    }
     if (!ch.synchronised || !strong || !ch.has_measurement) continue;
-    const double cn0 = ratio_hz(ch.cn0_dbhz);
+    // Weak (filter-driven below min_cn0_dbhz): the lower of the 0.2 s estimate and its running mean.
+    const double cn0 = ch.cn0_dbhz >= opt_.min_cn0_dbhz ? ratio_hz(ch.cn0_dbhz)
+                                                        : std::min(ratio_hz(ch.cn0_dbhz), st.cn0_mean_hz);
     const auto now = observable(in, ch.prn, in.sample, ch.replica_pseudorange_m);
     if (!now) {
       st = {};
@@ -234,18 +248,29 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       ++st.rejections;
     }
     if (opt_.use_doppler && ch.has_doppler) {
-      {
-        const double delta_d = static_cast<double>(in.sample - ch.doppler_sample) / in.fs_hz;
-        const double sigma_hz = std::sqrt(
-            receiver::phase_change_frequency_variance_hz2(cn0, ch.integration_time_s, ch.doppler_interval_s));
-        const double sigma_rate = signals::kL1Wavelength_m * sigma_hz;
-        const double z = -signals::kL1Wavelength_m * ch.measured_doppler_hz;
-        const UpdateResult rr = ekf_->update(VectorRangeMeasurement(shifted(*now, -delta_d), delta_d, true, z, sigma_rate));
+      const double delta_d = static_cast<double>(in.sample - ch.doppler_sample) / in.fs_hz;
+      const double sigma_hz = std::sqrt(
+          receiver::phase_change_frequency_variance_hz2(cn0, ch.integration_time_s, ch.doppler_interval_s));
+      const double sigma_rate = signals::kL1Wavelength_m * sigma_hz;
+      const double z = -signals::kL1Wavelength_m * ch.measured_doppler_hz;
+      const VectorRangeMeasurement m(shifted(*now, -delta_d), delta_d, true, z, sigma_rate);
+      // The channel PLL's frequency against the prediction (Hz), averaged: a weak channel whose PLL sits on a
+      // false lock (25 Hz off: a half cycle per 20 ms epoch; 10 Hz at 100 ms sums) gives Doppler rows biased by
+      // ~2-5 m/s that a 3.9-sigma gate passes at 20-30 dB-Hz; they would drag the velocity, and with it every
+      // replica. Its rows are left out while the mean is off by more than doppler_bias_hz (see the commands).
+      const double off_hz = (m.z() - m.h(ekf_->x()))(0) / -signals::kL1Wavelength_m;
+      const double a = std::min(1.0, (step_s > 0.0 ? step_s : 0.02) / opt_.doppler_bias_average_s);
+      st.doppler_bias_hz += a * (off_hz - st.doppler_bias_hz);
+      ++st.doppler_epochs;
+      // (An FLL channel has no PLL to lock falsely: its offset is the filter's own lag, which its rows correct.)
+      const bool weak = opt_.carrier != VectorCarrier::kFll && st.cn0_mean_hz < ratio_hz(opt_.false_lock_below_dbhz);
+      if (!(weak && std::abs(st.doppler_bias_hz) > opt_.doppler_bias_hz)) {
+        const UpdateResult rr = ekf_->update(m);
         log.rate_innovation_mps = rr.innovation.size() ? rr.innovation(0) : NAN;
-        log.rate_sigma_mps = sigma_rate;
         log.rate_used = rr.accepted;
-        log.measured_doppler_hz = ch.measured_doppler_hz;
       }
+      log.rate_sigma_mps = sigma_rate;
+      log.measured_doppler_hz = ch.measured_doppler_hz;
     }
   }
 
@@ -269,7 +294,7 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     const receiver::VectorChannelInput& ch = in.channels[i];
     VectorChannelLog& log = log_epoch_.channels[i];
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
-    const bool strong = std::isfinite(ch.cn0_dbhz) && ch.cn0_dbhz >= opt_.min_cn0_dbhz && !ch.coasting;
+    const bool strong = usable(ch, st);
     if (!ch.synchronised || (!strong && st.accepted < opt_.join_after_updates)) continue;
     // Coasting: no measurement to keep it honest, only the prediction (bounded in time and uncertainty).
     const bool coasting = !strong || !log.pr_used;
@@ -309,13 +334,26 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     commands[i].code_phase_jump_chips = jump;
     if (opt_.carrier == VectorCarrier::kFll) {
       // The NCO holds one frequency over the epoch: the predicted Doppler at its middle (the Doppler moves up to
-      // ~100 Hz/s in a 2 g turn: 1 Hz over half an epoch).
+      // ~100 Hz/s in a 2 g turn: 1 Hz over half an epoch). Not filter-driven: the FLL channel has its own C/N0
+      // lock test and differential bits, which the presence test and the known-bit pure PLL would contradict.
       const double half_epoch_s = 0.5 * (ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02);
       commands[i].carrier_frequency_hz =
           predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
       commands[i].carrier_commanded = true;
-    } else if (opt_.carrier_aiding) {
-      commands[i].carrier_frequency_hz = p.doppler_hz;
+    } else {
+      commands[i].filter_driven = opt_.filter_driven;
+      // A weak channel's PLL held off the prediction for doppler_bias_average_s (a false lock): its aiding steps by
+      // the mean offset once, which moves the PLL's frequency onto the prediction (the channel adds each change of
+      // the aiding to its PLL); the offset is kept in later commands, so it acts once.
+      if (opt_.carrier_aiding && st.cn0_mean_hz < ratio_hz(opt_.false_lock_below_dbhz) &&
+          std::abs(st.doppler_bias_hz) > opt_.false_lock_hz &&
+          st.doppler_epochs * step_s >= opt_.doppler_bias_average_s) {
+        st.aid_offset_hz -= st.doppler_bias_hz;
+        st.doppler_bias_hz = 0.0;
+        st.doppler_epochs = 0;
+        ++frequency_resets_;
+      }
+      if (opt_.carrier_aiding) commands[i].carrier_frequency_hz = p.doppler_hz + st.aid_offset_hz;
     }
     log.vector = true;
     ++vector;

@@ -111,6 +111,27 @@ struct VectorTrackingOptions {
   // fewer than min_satellites updates propagates instead of restarting.
   double max_coast_s = 30.0;
   double max_coast_sigma_chips = 0.5;
+  // Channels in vector mode are filter-driven (receiver::VectorChannelCommand::filter_driven, as ultra-tight's):
+  // the channel's scalar loss test (C/N0 below min_cn0_dbhz or PLI below 0.3 for 0.3 s) gives way to the presence
+  // test (1 s windows, 12 dB-Hz), its PLL sums N x 20 ms with the known bits wiped (pure PLL), its time tag is
+  // held, and its epochs reach the filter without the per-epoch fade gate below 30 dB-Hz. Such a channel's
+  // discriminators keep updating the filter below min_cn0_dbhz (down to whatever the presence test keeps), with
+  // their variances from the lower of the channel's 0.2 s C/N0 and its weak_cn0_average_s running mean (linear):
+  // at 22 dB-Hz the 0.2 s estimates span 16-25 dB-Hz (threshold runs) and the DLL variance grows as 1 / C/N0^2
+  // there, so an estimate reading high would give the gate far too small a sigma. Joining (join_after_updates) still needs
+  // min_cn0_dbhz. false: vector channels keep the scalar loss test and are used only above min_cn0_dbhz.
+  bool filter_driven = true;
+  double weak_cn0_average_s = 1.0;
+  // False PLL lock of a weak channel (running mean C/N0 below false_lock_below_dbhz): the mean over
+  // doppler_bias_average_s of its measured minus predicted Doppler. Above doppler_bias_hz its Doppler rows are left
+  // out; above false_lock_hz (after at least one averaging time) its carrier aiding steps once by that mean,
+  // putting the PLL back on the predicted frequency. Locked channels of the threshold runs kept 15 s means within
+  // 2 Hz (the PLL's own noise averaged, and the prediction's error); false locks sat at 20-25 Hz. Strong channels are left
+  // alone: in a 2 g step turn the prediction, not the PLL, is what lags.
+  double false_lock_below_dbhz = 35.0;
+  double doppler_bias_average_s = 0.5;
+  double doppler_bias_hz = 4.0;
+  double false_lock_hz = 7.0;
   double initial_sigma_pos_m = 10.0, initial_sigma_vel_mps = 0.5;
   double initial_sigma_bias_m = 10.0, initial_sigma_drift_mps = 0.5;
 };
@@ -151,6 +172,8 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   const StateMatrix<8>& P() const { return ekf_->P(); }
   int resets() const { return resets_; }
   int initialisations() const { return initialisations_; }
+  // Carrier aiding steps given to weak channels found on a false PLL lock (VectorTrackingOptions::false_lock_hz).
+  int frequency_resets() const { return frequency_resets_; }
   // Called at the end of every update once the filter runs.
   void set_log(std::function<void(const VectorEpochLog&)> log) { log_ = std::move(log); }
 
@@ -159,7 +182,13 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
     int accepted = 0;     // pseudorange updates accepted since it (re)joined
     int rejections = 0;   // consecutive rejections
     double coast_s = 0.0;  // commanded without a usable measurement (faded, coasting) this long
+    double cn0_mean_hz = NAN;  // running mean of the channel's C/N0 estimates (ratio-Hz), while synchronised
+    double doppler_bias_hz = 0.0;  // running mean of measured minus predicted Doppler
+    int doppler_epochs = 0;        // Doppler measurements in that mean
+    double aid_offset_hz = 0.0;    // steps given to the carrier aiding (false-lock resets)
   };
+  // Whether a channel's measurements may update the filter and keep it commanded as tracked (not faded).
+  bool usable(const receiver::VectorChannelInput& ch, const PrnState& st) const;
   std::optional<SatelliteObservable> observable(const receiver::VectorEpochInput& in, int prn, std::int64_t sample,
                                                 double pseudorange_m) const;
   bool initialise(const receiver::VectorEpochInput& in);
@@ -170,7 +199,7 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   std::int64_t sample_ = 0;
   double clock_corrections_s_ = 0.0;
   double starved_s_ = 0.0;
-  int resets_ = 0, initialisations_ = 0;
+  int resets_ = 0, initialisations_ = 0, frequency_resets_ = 0;
   std::array<PrnState, 33> prn_{};
   VectorEpochLog log_epoch_;
   std::function<void(const VectorEpochLog&)> log_;

@@ -67,9 +67,9 @@ void ReceiveVector::log(const fusion::VectorEpochLog& e) {
 
 std::string ReceiveVector::summary_json() const {
   return fmt::format("\"vector\": {{\"carrier\": \"{}\", \"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
-                     "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}}}",
-                     fusion::to_string(carrier_), vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_, filter_.initialisations(),
-                     filter_.resets());
+                     "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}, \"frequency_resets\": {}}}",
+                     fusion::to_string(carrier_), vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_,
+                     filter_.initialisations(), filter_.resets(), filter_.frequency_resets());
 }
 
 void ReceiveVector::finish() {

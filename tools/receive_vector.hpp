@@ -37,7 +37,7 @@ class ReceiveVector {
   // Channel-epochs commanded while coasting (faded: from the prediction alone).
   long long coasting_channel_epochs() const { return coasting_channel_epochs_; }
   // summary.json member: "vector": {carrier mode, epochs, channel-epochs in vector mode and coasting, filter
-  // starts, resets}.
+  // starts, resets, carrier-aiding steps of false PLL locks (frequency_resets)}.
   std::string summary_json() const;
 
  private:

@@ -174,6 +174,63 @@ TEST(VectorTracking, DiscriminatorVariancesMatchMonteCarlo) {
   }
 }
 
+// The same Monte Carlo where filter-driven vector channels now update the filter (below the 25 dB-Hz at which the
+// scalar loss test used to stop them): 18-24 dB-Hz, 20 ms. Both discriminators are bounded there (the normalised
+// envelope DLL within +-0.5 chip, the Costas arctangent within +-1/4 cycle). The DLL's gain g (its mean output per
+// chip of true code error, from offsets of +-0.1 chip) falls as the noise fills the E + L normaliser, and its
+// variance with it: the closed form is then the variance of the gain-normalised output (var / g^2) within
+// +4..+27 % (g = 0.63 at 24 dB-Hz, 0.33 at 20; pinned: [0.95, 1.35]), while the raw output's variance is far below it (0.41 at 24 dB-Hz, 0.07 at
+// 18). So the filter's code weights are conservative, and its code update moves the state by g of what the
+// weights imply (a slower code loop, not a wrong one). The Costas formula is within 6 % at 22-24 dB-Hz and
+// overstates from 20 dB-Hz down (the wrap folds the tails: 0.74 at 18): [0.6, 1.1]. 20000 draws per point: sampling sigma of a variance ratio ~1-2 %, of g ~2 %.
+TEST(VectorTracking, WeakSignalDiscriminatorVariancesAgainstMonteCarlo) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const double t = 0.02;
+  double last_gain = 1.0;
+  for (double cn0_dbhz : {24.0, 22.0, 20.0, 18.0}) {
+    const double cn0 = std::pow(10.0, cn0_dbhz / 10.0);
+    const double a = std::sqrt(2.0 * cn0 * t);
+    const int n = 20000;
+    // Mean and variance of the DLL output with the signal `offset` chips later than the replica (E at -0.5, L at
+    // +0.5 chip: triangle correlations), and of the Costas phase at zero phase error.
+    const auto dll = [&](double offset, double& mean, double& var) {
+      double s = 0.0, s2 = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const double ea = a * std::max(0.0, 1.0 - std::abs(offset + 0.5)), la = a * std::max(0.0, 1.0 - std::abs(offset - 0.5));
+        const auto e = std::complex<float>(std::complex<double>(ea + g(rng), g(rng)));
+        const auto l = std::complex<float>(std::complex<double>(la + g(rng), g(rng)));
+        const double c = receiver::dll_nelp_chips(e, l, 0.5);
+        s += c;
+        s2 += c * c;
+      }
+      mean = s / n;
+      var = s2 / n - mean * mean;
+    };
+    double m_minus, m_plus, m0, var0, unused;
+    dll(-0.1, m_minus, unused);
+    dll(0.1, m_plus, unused);
+    dll(0.0, m0, var0);
+    const double gain = std::abs(m_plus - m_minus) / 0.2;
+    double phase2 = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const double f = receiver::costas_atan_cycles(std::complex<float>(std::complex<double>(a + g(rng), g(rng))));
+      phase2 += f * f;
+    }
+    const double code_model = fusion::code_discriminator_variance_chips2(cn0, t, 1.0);
+    const double phase_ratio = phase2 / n / fusion::costas_phase_variance_cycles2(cn0, t);
+    std::printf("%.0f dB-Hz: DLL gain %.3f, variance / model %.3f, variance / gain^2 / model %.3f; phase variance / "
+                "model %.3f\n", cn0_dbhz, gain, var0 / code_model, var0 / (gain * gain) / code_model, phase_ratio);
+    EXPECT_LT(gain, last_gain) << cn0_dbhz;
+    EXPECT_LT(var0 / code_model, 0.5) << cn0_dbhz;  // raw: conservative weights
+    EXPECT_GT(var0 / (gain * gain) / code_model, 0.95) << cn0_dbhz;
+    EXPECT_LT(var0 / (gain * gain) / code_model, 1.35) << cn0_dbhz;
+    EXPECT_GT(phase_ratio, 0.6) << cn0_dbhz;
+    EXPECT_LT(phase_ratio, 1.1) << cn0_dbhz;
+    last_gain = gain;
+  }
+}
+
 // Process model: f is the discretisation of F (x(t + dt) = Phi x), and the clock's noise densities are the
 // Allan-coefficient forms (c^2 h0 / 2, c^2 2 pi^2 h-2).
 TEST(VectorTracking, ProcessModelIsConstantVelocityWithAllanClockNoise) {

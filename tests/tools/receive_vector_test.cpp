@@ -263,7 +263,11 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
 // absent from 14 s to 17 s (a [[blockage]] of the only antenna), then PRN 24 alone absent from 18.5 s to 20.5 s
 // (a [[cycle_slip]] of 0 cycles: only its fade). The channels are in vector mode from ~12.6 s; when a signal goes
 // its channel must coast on the filter's prediction (tracking.csv state "coasting", vector.csv, summary.json), not
-// be released: no satellite acquired a second time, none lost. When the signal returns each must re-lock from
+// be released: no satellite acquired a second time, none lost. Vector channels are filter-driven: their loss
+// test is the presence test (1 s windows, 12 dB-Hz: receiver/presence_test.hpp), which declares an absent signal
+// at the end of the first whole window without it (1-2 s after it goes) with probability 0.915 and by the next
+// with 0.993, so coasting must start 1-3 s into a fade (the scalar loss test took 0.5-0.7 s; the per-epoch fade
+// gate keeps the faded epochs out of the filter from the first one either way). When the signal returns each must re-lock from
 // the predicted replica (leave "coasting") within 1 s (the issue's bound); the fixes, which resume after the
 // blockage and continue through the single fade on the other nine, stay within 2 m 3-D RMS of the truth (issue
 // 3's fix tolerance).
@@ -302,8 +306,8 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
   EXPECT_TRUE(faded_present);
   const auto c = summary.find("\"coasting_channel_epochs\": ");
   ASSERT_NE(c, std::string::npos);
-  // ~3 s of 20 ms vector epochs per channel, plus PRN 24's ~2 s
-  EXPECT_GE(std::stoi(summary.substr(c + 27)), satellites * 120 + 70);
+  // At least the last 1 s of the 3 s blockage in 20 ms vector epochs per channel (coasting from 1-2 s into it)
+  EXPECT_GE(std::stoi(summary.substr(c + 27)), satellites * 50);
 
   // tracking.csv: per PRN, its coasting windows (first and last rows of each run of "coasting" rows).
   std::map<int, std::vector<std::pair<double, double>>> windows;
@@ -326,14 +330,14 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
   double worst = 0.0, faded_relock = -1.0;
   for (const auto& [prn, w] : windows) {
     ASSERT_EQ(w.size(), prn == kFaded ? 2u : 1u) << "PRN " << prn;
-    EXPECT_GT(w[0].first, kGapStart) << "PRN " << prn;
-    EXPECT_LT(w[0].first, kGapStart + 1.0) << "PRN " << prn << " noticed the blockage late";
+    EXPECT_GE(w[0].first, kGapStart + 1.0) << "PRN " << prn << " coasting before a presence window could end";
+    EXPECT_LT(w[0].first, kGapStart + 3.0) << "PRN " << prn << " noticed the blockage late";
     // A row is an epoch's start; the epoch that re-locks ends 20 ms later.
     worst = std::max(worst, w[0].second + 0.02 - kGapEnd);
     EXPECT_LE(w[0].second + 0.02, kGapEnd + 1.0) << "PRN " << prn << " re-locked later than 1 s after the return";
     if (prn == kFaded) {
       EXPECT_GT(w[1].first, kFadeStart);
-      EXPECT_LT(w[1].first, kFadeStart + 1.0);
+      EXPECT_LT(w[1].first, kFadeEnd);  // the 2 s fade holds one whole 1 s window
       faded_relock = w[1].second + 0.02 - kFadeEnd;
       EXPECT_LE(faded_relock, 1.0) << "PRN " << prn << " re-locked later than 1 s after its fade";
     }
@@ -346,6 +350,97 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
               v.rms_3d_m);
   EXPECT_GE(fixes.size(), 65u);  // ~19 before the blockage, ~48 after (at 10 Hz)
   EXPECT_LE(v.rms_3d_m, 2.0);
+}
+
+// Weak signal after the hand-over (issue 7's threshold protocol, short): the static 45 dB-Hz receiver of the first
+// test with every satellite stepped down to kWeak dB-Hz at 15 s ([[cn0_step]], sample-exact) until the end at
+// 25 s. Vector channels are filter-driven: the scalar loss test (0.2 s C/N0 below 25 dB-Hz for 0.3 s), which
+// lost every vector channel within ~0.5 s of a step to <= 25 dB-Hz, gives way to the presence test (a 60 s run at
+// 22 dB-Hz is falsely lost with probability 4e-11: docs/validation.md), their PLLs integrate 100 ms with the
+// known bits (--nav) wiped, and their discriminators keep updating the filter with C/N0-weighted noise. So every
+// channel handed over must stay in vector mode and locked (bit-synced, never coasting or lost) to the end. Against
+// the simulator's truth: the filter's position RMS over the weak part within 5 m (the threshold runs at 22-24
+// dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code loop is slow and its sigma optimistic).
+TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 22.0;
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "weak.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " << kEnd
+                                   << "\ncn0_dbhz = 45.0\nseed = 4\n"
+                                      "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                      "[navigation]\nrinex = \""
+                                   << brdc.generic_string()
+                                   << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+                                      "[atmosphere]\nionosphere = true\ntroposphere = false\n"
+                                      "[[cn0_step]]\nstart_s = "
+                                   << kStep << "\ncn0_dbhz = " << kWeak << "\n";
+  const auto sim = dir / "sim", vector = dir / "vector";
+  run("simulate", {"--scenario", (dir / "weak.toml").string(), "--out", sim.string()});
+  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
+                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
+  fs::remove(sim / "antenna0.i8.bin");
+
+  // vector.csv: the PRNs commanded at the step, and any of them not commanded (or coasting) afterwards.
+  std::map<int, bool> at_step, left;
+  {
+    std::ifstream in(vector / "vector.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      const auto f = ultratrack::test::split_csv_line(line);
+      const double t = std::stod(f[1]);
+      const int prn = std::stoi(f[2]);
+      if (t >= kStep - 0.1 && t < kStep) at_step[prn] = f[3] == "1";
+      if (t >= kStep && at_step[prn] && (f[3] != "1" || f[16] == "1")) left[prn] = true;
+    }
+  }
+  int handed = 0;
+  for (const auto& [prn, v] : at_step) handed += v;
+  EXPECT_GE(handed, 8);
+  for (const auto& [prn, v] : at_step)
+    if (v) EXPECT_FALSE(left[prn]) << "PRN " << prn << " left vector mode or coasted in the weak part";
+  // tracking.csv: every record of those PRNs after the step is bit-synced (locked, not coasting or lost), to the end.
+  std::map<int, double> last;
+  {
+    std::ifstream in(vector / "tracking.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      const auto f = ultratrack::test::split_csv_line(line);
+      const int prn = std::stoi(f[0]);
+      const double t = std::stod(f[2]);
+      if (t < kStep || !at_step[prn]) continue;
+      EXPECT_EQ(f[9], "bit-synced") << "PRN " << prn << " at " << t << " s";
+      last[prn] = t;
+    }
+  }
+  for (const auto& [prn, v] : at_step)
+    if (v) EXPECT_GT(last[prn], kEnd - 0.2) << "PRN " << prn << " stopped early";
+
+  // The filter's position over the weak part against the static truth.
+  std::ifstream truth_in(sim / "truth.csv");
+  std::string line;
+  std::getline(truth_in, line);
+  std::getline(truth_in, line);
+  const auto t0 = ultratrack::test::split_csv_line(line);
+  const double tx = std::stod(t0[3]), ty = std::stod(t0[4]), tz = std::stod(t0[5]);
+  std::ifstream state(vector / "vector_state.csv");
+  std::getline(state, line);
+  double sum2 = 0.0;
+  int n = 0;
+  while (std::getline(state, line)) {
+    const auto f = ultratrack::test::split_csv_line(line);
+    if (std::stod(f[1]) < kStep) continue;
+    const double dx = std::stod(f[4]) - tx, dy = std::stod(f[5]) - ty, dz = std::stod(f[6]) - tz;
+    sum2 += dx * dx + dy * dy + dz * dz;
+    ++n;
+  }
+  ASSERT_GT(n, 400);  // 10 s of 20 ms epochs, the filter never restarted
+  const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
+  std::printf("step to %.0f dB-Hz at %.0f s: %d channels filter-driven kept to the end; filter position 3-D RMS %.2f m "
+              "over %d epochs; %s\n", kWeak, kStep, handed, std::sqrt(sum2 / n), n,
+              summary.substr(summary.find("\"frequency_resets\""), 24).c_str());
+  EXPECT_LE(std::sqrt(sum2 / n), 5.0);
 }
 
 TEST(ReceiveVector, RejectsAnUnknownCoupling) {
