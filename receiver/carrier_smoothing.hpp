@@ -3,7 +3,11 @@
 //     P_s(k) = P(k) / n + (n - 1) / n * (P_s(k-1) + lambda (L(k) - L(k-1))),  n = min(k, window)
 // with L in RINEX sense (cycles, grows with range). The raw pseudoranges still go to RINEX; only the PVT sees
 // the smoothed ones. Restarts on a new track (loss of lock), on a jump of the code-minus-carrier beyond
-// a threshold (a cycle slip or a half-cycle flip), and after a gap. The ionosphere makes code and carrier
+// a threshold, and after a gap. The threshold is max(slip_threshold_m, 6 code_sigma_m): a gross jump (a
+// carrier count off by hundreds of cycles, a code or time-tag slip), never the code's own noise. (A fixed 20 m
+// was 2.3 sigma of the DLL noise at 28 dB-Hz: the filter restarted every ~3 s at 28 dB-Hz, every ~1.3 s at 26,
+// and the PVT saw nearly raw pseudoranges.) A cycle slip (0.19 m) is far below any code-based test: the
+// tracking loop's lock detectors report it as a new track. The ionosphere makes code and carrier
 // diverge at twice its rate (<= ~0.1 m over a 10 s window at mid latitudes), which bounds the window.
 // Units: metres, cycles, seconds.
 #pragma once
@@ -20,7 +24,10 @@ class CarrierSmoothing {
 
   // One epoch of one PRN; returns the smoothed pseudorange. epoch_index counts observation epochs (a gap in it
   // restarts the filter).
-  double update(int prn, std::int64_t epoch_index, double pseudorange_m, double carrier_phase_cycles, bool new_track);
+  // code_sigma_m: the pseudorange's expected thermal noise (1 sigma, e.g. dll_thermal_jitter_chips at the
+  // measured C/N0), 0 when unknown (the fixed threshold alone).
+  double update(int prn, std::int64_t epoch_index, double pseudorange_m, double carrier_phase_cycles, bool new_track,
+                double code_sigma_m = 0.0);
   // The receiver clock jumped by dt_s (its reading decreased by dt_s): every pseudorange drops by c dt_s.
   void clock_jump(double dt_s);
 

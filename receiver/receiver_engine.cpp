@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "receiver/antenna_phase_tracker.hpp"
+#include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/look_angles.hpp"
@@ -480,7 +481,16 @@ void ReceiverEngine::observation_epoch(std::int64_t sample) {
     o.loss_of_lock = m.new_track || m.phase_unlocked;
     o.half_cycle_resolved = true;  // measure() needs frame sync, which fixes the polarity
     epoch_.observations.push_back(o);
-    const double smoothed = smoothing_.update(o.prn, epoch_index_, o.pseudorange_m, o.carrier_phase_cycles, o.loss_of_lock);
+    // The code noise expected at this C/N0 (the DLL after bit sync, 20 ms: the larger squaring loss) sets the
+    // Hatch filter's jump test (carrier_smoothing.hpp).
+    const ScalarTrackingOptions& to = options_.tracking;
+    const double code_sigma_m =
+        std::isfinite(o.cn0_dbhz) && o.cn0_dbhz > 0.0
+            ? dll_thermal_jitter_chips(to.dll_bw_coherent_hz, std::min(1.0, 2.0 * to.early_late_offset_chips), 0.02, o.cn0_dbhz) *
+                  signals::kSpeedOfLight_mps / signals::kCaChipRate_hz
+            : 0.0;
+    const double smoothed =
+        smoothing_.update(o.prn, epoch_index_, o.pseudorange_m, o.carrier_phase_cycles, o.loss_of_lock, code_sigma_m);
     smoothed_m_[static_cast<std::size_t>(o.prn)] = options_.smoothing_window_s > 0.0 ? smoothed : o.pseudorange_m;
     auto& stats = stats_.satellites[static_cast<std::size_t>(m.prn)];
     ++stats.observations;

@@ -338,6 +338,7 @@ void ScalarTracking::set_loop_epochs(int epochs) {
   const int pli_epochs = epochs > 1 || bridging() ? std::max(epochs, target_epochs_) : 1;
   const double tau = pli_epochs == 1 ? opt_.pli_time_constant_s
                                      : std::max(opt_.pli_time_constant_s, kPliUpdates * pli_epochs * kBitPeriod_s);
+  rereference_carrier_state(epochs);  // also when a block of another length was dropped before its update
   if (epochs == loop_epochs_ && tau == pli_tau_s_) return;
   if (epochs != loop_epochs_) {
     carrier_.set_bandwidths(epochs == 1 ? opt_.pll_bw_coherent_hz : long_coherent_pll_bw_hz(opt_, epochs), 0.0);
@@ -346,6 +347,18 @@ void ScalarTracking::set_loop_epochs(int epochs) {
   loop_epochs_ = epochs;
   pli_tau_s_ = tau;
   pli_.set_time_constant(tau);
+}
+
+// The carrier loop filter's frequency state leads the command it gives by one update: tracking a Doppler ramp
+// (rate rho) in steady state, the command for the next update of length T is the true Doppler at that update's
+// middle, f(t + T / 2), and the state is f(t + T) (loop_filters.hpp: the output is the mean of the state before
+// and after the update, which steps by rho T). A new T re-references the state by rho (T_new - T_old). Without
+// it a switch from 20 to 100 ms at 4 Hz/s started the 2 Hz loop 0.32 Hz off: a 40-80 deg phase excursion.
+void ScalarTracking::rereference_carrier_state(int epochs) {
+  if (epochs == state_epochs_) return;
+  const double rate = carrier_.frequency_rate_hzps();
+  carrier_.reset(carrier_.frequency_hz() + rate * (epochs - state_epochs_) * kBitPeriod_s, rate);
+  state_epochs_ = epochs;
 }
 
 TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known) {
@@ -578,6 +591,16 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
     block_epochs_ = target_epochs_;
     block_early_ = block_prompt_ = block_late_ = {};
     block_time_s_ = 0.0;
+    if (block_epochs_ != state_epochs_) {
+      // A block of a new length: the command held through it is the loop's state for that length, f(t + T / 2)
+      // (the first epoch already ran on the previous command). The previous command carries the last shorter
+      // update's proportional term, noise there (+-0.5-1 Hz on 20 ms updates at 30 dB-Hz), 5x as much phase
+      // when held 100 ms: a 30-45 deg excursion before the first long update.
+      rereference_carrier_state(block_epochs_);
+      const double f = carrier_.frequency_hz() - 0.5 * carrier_.frequency_rate_hzps() * block_epochs_ * kBitPeriod_s;
+      command_.code_rate_chips_per_s += signals::kCaChipRate_hz * (f - command_.carrier_frequency_hz) / signals::kL1Frequency_hz;
+      command_.carrier_frequency_hz = f;
+    }
   }
   const double s = sign;
   block_early_ += s * std::complex<double>(taps.early);
@@ -667,6 +690,7 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
     pli_.set_time_constant(opt_.pli_time_constant_s);
     pli_tau_s_ = opt_.pli_time_constant_s;
     loop_epochs_ = 1;
+    state_epochs_ = 1;
     relock_fll_ = {};
     relock_s_ = 0.0;
   } else if (!strong && relocking_) {

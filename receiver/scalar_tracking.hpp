@@ -240,6 +240,7 @@ class ScalarTracking final {
   TrackingReport lose_long_coherent_lock(const CorrelationEpoch& e, TrackingReport& r, bool add_bit);
   TrackingReport long_coherent_epoch(const CorrelationEpoch& e, TrackingReport& r, int sign);
   void set_loop_epochs(int epochs);
+  void rereference_carrier_state(int epochs);
   bool slow_cn0_below(double threshold_dbhz) const;
   bool bridging() const;
   bool long_enabled() const { return opt_.max_coherent_ms > 20 && opt_.coherent_ms == 20; }
@@ -288,6 +289,7 @@ class ScalarTracking final {
   // long coherent integration
   int target_epochs_ = 1;   // chosen from the C/N0
   int loop_epochs_ = 1;     // of the loops' settings in effect
+  int state_epochs_ = 1;    // the update length (x 20 ms) the carrier loop's frequency state is referenced to
   double pli_tau_s_ = 0.0;  // PLI time constant set by set_loop_epochs (0: the option's)
   double cn0_slow_dbhz_ = 0.0;  // C/N0 estimates low-passed over 1 s
   bool have_slow_cn0_ = false;
