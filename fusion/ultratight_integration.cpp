@@ -32,10 +32,10 @@ class PeriodIqMeasurement {
   PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
                       const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
                       double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var,
-                      double start_phase_var)
+                      double start_phase_rad, double start_phase_var)
       : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), M_(period_mixing(span_s)),
         R_(iq_noise_covariance(s)),
-        code_sigma_(prior_code_sigma_chips) {
+        code_sigma_(prior_code_sigma_chips), start_phase_(start_phase_rad) {
     // Frequency noise of the receiver clock within the period (common to every satellite; see finish_period)
     // enters the taps through their frequency derivative.
     if (rate_noise_var > 0.0) {
@@ -82,7 +82,9 @@ class PeriodIqMeasurement {
  private:
   TrackingErrors errors(const StateVector<17>& dx) const {
     const Eigen::Vector2d e = M_ * replica_.errors(dx) + offset_;
-    return tracking_errors(e(0), e(1));
+    TrackingErrors te = tracking_errors(e(0), e(1));
+    te.phase_rad = start_phase_;
+    return te;
   }
   ReplicaErrors17 replica_;
   IqSettings s_;
@@ -91,6 +93,7 @@ class PeriodIqMeasurement {
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
   double code_sigma_ = 0.0;
+  double start_phase_ = 0.0;
 };
 
 // Discriminator form: range and rate errors of the replica that ran, h(dx) = replica errors + offset.
@@ -151,6 +154,11 @@ namespace {
 struct ChannelState {
   double carrier_phase_cycles = 0.0;
   bool coasting = false;
+  // The carrier phase error (signal minus replica, rad) at the end of this channel's last measured epoch, for a
+  // continuous-carrier channel (ChannelCorrelation::continuous_carrier): its measured mean phase plus the
+  // end-minus-mean phase of the filter's rate-error profile; its variance; the epoch's end time (s).
+  bool has_end_phase = false;
+  double end_phase_rad = 0.0, end_phase_var_rad2 = 0.0, end_phase_t_s = 0.0;
 };
 
 template <class Filter>
@@ -263,6 +271,8 @@ class UltraTightCore final : public UltraTightCoreBase {
         r.pseudorange_m = c->replica_pseudorange_m;
         r.range_rate_mps = c->replica_range_rate_mps;
       }
+      const bool had_end_phase = ch.has_end_phase;
+      ch.has_end_phase = false;
       if (usable && command.aided_only) {
         ch.coasting = false;
         ++counters.aided_only;
@@ -299,20 +309,42 @@ class UltraTightCore final : public UltraTightCoreBase {
       is.cn0_dbhz = c->cn0_dbhz;
       is.integration_time_s = T_;
       is.tap_offset_chips = opt_.tap_offset_chips;
+      // Start phase: the previous epoch's end phase when the carrier ran on from it (ChannelCorrelation).
+      double start_phase = 0.0, start_phase_var = c->start_phase_var_rad2;
+      if (c->continuous_carrier && had_end_phase && std::abs(ch.end_phase_t_s - r.t_start_s) < 1e-5) {
+        start_phase = ch.end_phase_rad;
+        start_phase_var = ch.end_phase_var_rad2;
+      }
+      const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
       bool ok = false;
       if (opt_.form == UltraTightForm::Iq) {
-        const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
         const MeasurementJacobian<17> J = rep.jacobian();
         const Eigen::Matrix<double, 1, 17> h_range = J.row(0) - 0.5 * span * J.row(1);
         const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
         ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code,
-                                         clock_rate_var, c->start_phase_var_rad2));
+                                         clock_rate_var, start_phase, start_phase_var));
       } else {
-        const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
-                                frequency_discriminator_hz(c->taps, is) * kLambda_m);
+        // The frequency discriminator reads the mean phase, start phase + pi T f(T / 3): the start phase comes off.
+        const double f_hz = frequency_discriminator_hz(c->taps, is) - start_phase / (M_PI * T_);
+        const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m, f_hz * kLambda_m);
         ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span, z,
                                                    discriminator_noise(is), clock_rate_var,
-                                                   c->start_phase_var_rad2 * std::pow(kLambda_m / (M_PI * T_), 2)));
+                                                   start_phase_var * std::pow(kLambda_m / (M_PI * T_), 2)));
+      }
+      if (c->continuous_carrier) {
+        // This epoch's end phase: its measured mean phase (data wiped: the prompt near the I axis) plus the
+        // end-minus-mean phase pi T f(2 T / 3) of the rate-error profile after the update (f = replica minus
+        // signal rate / lambda; the replica holds its rate, the signal's changes by rate_slope T over the period).
+        const double theta = std::atan2(c->taps.q[1], c->taps.i[1]);
+        const double a2 = std::pow(iq_amplitude(is), 2);
+        if (std::abs(theta) < 0.5 * M_PI && a2 > 0.0) {
+          const double e13 = rep.errors(ok ? last_dx_ : StateVector<17>::Zero())(1) + offset(1);
+          const double e23 = e13 - rate_slope * T_ / 3.0;
+          ch.has_end_phase = true;
+          ch.end_phase_rad = theta + M_PI * T_ * e23 / kLambda_m;
+          ch.end_phase_var_rad2 = (1.0 + 1.0 / a2) / a2;
+          ch.end_phase_t_s = r.t_start_s + T_;
+        }
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
@@ -401,6 +433,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       return false;
     }
     ++counters.accepted;
+    last_dx_ = filter_.x();
     nominal_ = corrected<17>(nominal_, filter_.x());
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<17>::Zero());
@@ -438,6 +471,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;
   UpdateResult last_result_;
+  StateVector<17> last_dx_ = StateVector<17>::Zero();  // the correction of the latest accepted update
 };
 
 }  // namespace

@@ -87,6 +87,15 @@ struct ChannelCorrelation {
   // model takes as noise along the phase direction (iq_phase_derivative), the frequency discriminator as a rate
   // error of variance (lambda / (pi T))^2 times it.
   double start_phase_var_rad2 = 0.0;
+  // The replica's carrier phase runs on continuously from this channel's previous 20 ms epoch (a closed PLL that
+  // changes only the NCO frequency): the period then starts with the phase error the previous one ended with,
+  // which in dynamics is not zero (in steady state the PLL holds the mean phase at zero, so under a line-of-sight
+  // acceleration a the start phase is -pi a T^2 / 6 / lambda, 0.11 rad in a 10 g turn). With the previous epoch
+  // of the same channel adjacent (its replica ended where this one starts), the driver takes as the start phase
+  // that epoch's measured mean phase atan2(Q_P, I_P) plus its end-minus-mean phase pi T f(2 T / 3) from the
+  // filter's rate-error profile after its update, with the measured phase's thermal variance (1 + 1 / A^2) / A^2
+  // in place of start_phase_var_rad2. Otherwise (first epoch, a gap, false) start_phase_var_rad2 as above.
+  bool continuous_carrier = false;
 };
 
 // One satellite's update in the latest finish_period (for logs): the filter's innovation (Iq: I_E, I_P, I_L,
