@@ -9,8 +9,11 @@
 // Model assumption (iq_measurements.hpp): data bits known/wiped off, carrier NCO phase realigned at the start
 // of every period (the phase error inside a period is 2 pi df s), or its error at the start given as a variance
 // (ChannelCorrelation::start_phase_var_rad2: a closed PLL's residual, taken as noise in R). Over a period the taps see the mean range
-// error and the rate error at a third of the period (period_replica_errors), and the receiver clock's frequency
-// noise within the period (from options.model.clock) is part of R.
+// error and the rate error at a third of the period (period_replica_errors). The receiver clock's frequency within
+// the period differs from the drift state by a noise e common to the period's satellites (from options.model.clock):
+// the period's updates run on x' = x + u e (u the drift axis), after which e is conditioned out (exact for a linear
+// measurement; no 18th state). A continuous-carrier channel (ChannelCorrelation::continuous_carrier) starts each
+// period with the phase its previous epoch ended with.
 #pragma once
 
 #include <Eigen/Core>
