@@ -1,5 +1,6 @@
 #include "fusion/ultratight_integration.hpp"
 
+#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -32,10 +33,10 @@ class PeriodIqMeasurement {
   PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
                       const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
                       double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var,
-                      double start_phase_var)
+                      double start_phase_rad, double start_phase_var)
       : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), M_(period_mixing(span_s)),
         R_(iq_noise_covariance(s)),
-        code_sigma_(prior_code_sigma_chips) {
+        code_sigma_(prior_code_sigma_chips), start_phase_(start_phase_rad) {
     // Frequency noise of the receiver clock within the period (common to every satellite; see finish_period)
     // enters the taps through their frequency derivative.
     if (rate_noise_var > 0.0) {
@@ -82,7 +83,9 @@ class PeriodIqMeasurement {
  private:
   TrackingErrors errors(const StateVector<17>& dx) const {
     const Eigen::Vector2d e = M_ * replica_.errors(dx) + offset_;
-    return tracking_errors(e(0), e(1));
+    TrackingErrors te = tracking_errors(e(0), e(1));
+    te.phase_rad = start_phase_;
+    return te;
   }
   ReplicaErrors17 replica_;
   IqSettings s_;
@@ -91,6 +94,7 @@ class PeriodIqMeasurement {
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
   double code_sigma_ = 0.0;
+  double start_phase_ = 0.0;
 };
 
 // Discriminator form: range and rate errors of the replica that ran, h(dx) = replica errors + offset.
@@ -151,6 +155,11 @@ namespace {
 struct ChannelState {
   double carrier_phase_cycles = 0.0;
   bool coasting = false;
+  // The carrier phase error (signal minus replica, rad) at the end of this channel's last measured epoch, for a
+  // continuous-carrier channel (ChannelCorrelation::continuous_carrier): its measured mean phase plus the
+  // end-minus-mean phase of the filter's rate-error profile; its variance; the epoch's end time (s).
+  bool has_end_phase = false;
+  double end_phase_rad = 0.0, end_phase_var_rad2 = 0.0, end_phase_t_s = 0.0;
 };
 
 template <class Filter>
@@ -251,6 +260,35 @@ class UltraTightCore final : public UltraTightCoreBase {
       const SatelliteObservable* s;
       usable_count += lookup(r.prn, c, s) && !r.aided_only ? 1 : 0;
     }
+    // The receiver clock's frequency within the period differs from the drift state by e, common to every
+    // satellite of the period (variance v, clock_rate_noise_var): the measurements see drift + e. Exact
+    // treatment without an 18th state: the period's updates run on x' = x + u e (u the drift axis; prior
+    // covariance P + v u u'), then e is conditioned on the posterior x' and taken out (end_common_clock).
+    // e is correlated with this period's clock process noise, already in P: for the random-walk FM (S_d)
+    // e = (T/3-weighted drift) - (end drift) has covariance -2 S_d T / 3 with the drift's increment (correlation
+    // -0.91: the frequency the taps see is nearly the drift at the period's start); for the white FM (S_b) the
+    // mean phase's rate equivalent (2 / T^2) int (T - s) db(s) has covariance S_b with the bias increment.
+    const double common_var = usable_count > 0 ? clock_rate_noise_var(T_) : 0.0;
+    StateMatrix<17> P_prime;
+    StateVector<17> cov_xe = StateVector<17>::Zero();
+    if (common_var > 0.0) {
+      cov_xe(ix::kClockBias) = opt_.model.clock.bias_psd_m2_per_s;
+      cov_xe(ix::kClockDrift) = -2.0 * opt_.model.clock.drift_psd_m2_per_s3 * T_ / 3.0;
+      P_prime = filter_.P();
+      StateVector<17> u = StateVector<17>::Zero();
+      u(ix::kClockDrift) = 1.0;
+      P_prime += common_var * u * u.transpose() + u * cov_xe.transpose() + cov_xe * u.transpose();
+      filter_.set_P(P_prime);
+    }
+    period_dx_.setZero();
+    struct EndPhase {
+      ChannelState* ch;
+      ReplicaErrors17 rep;  // at the nominal of the satellite's update
+      Eigen::Vector2d offset;
+      double theta, var, slope_mps, t_end;
+      StateVector<17> dx_before;  // the period's corrections before the satellite's update
+    };
+    std::vector<EndPhase> end_phases;
     for (ReplicaCommand& command : replicas) {
       ChannelState& ch = channels_[command.prn];
       ReplicaCommand r = command;
@@ -263,6 +301,8 @@ class UltraTightCore final : public UltraTightCoreBase {
         r.pseudorange_m = c->replica_pseudorange_m;
         r.range_rate_mps = c->replica_range_rate_mps;
       }
+      const bool had_end_phase = ch.has_end_phase;
+      ch.has_end_phase = false;
       if (usable && command.aided_only) {
         ch.coasting = false;
         ++counters.aided_only;
@@ -294,30 +334,58 @@ class UltraTightCore final : public UltraTightCoreBase {
       const Eigen::Vector2d offset = period_replica_errors(r.pseudorange_m, r.range_rate_mps, range_end,
                                                            rate_end - rate_slope * T_, rate_end, T_);
       const double span = 2.0 * (nominal_.nav.t_s - r.t_start_s) - T_;  // the mean range sits span / 2 back
-      const double clock_rate_var = clock_rate_noise_var(T_, usable_count);
+      const double clock_rate_var = 0.0;  // the common clock term is in P for this period (above)
       IqSettings is;
       is.cn0_dbhz = c->cn0_dbhz;
       is.integration_time_s = T_;
       is.tap_offset_chips = opt_.tap_offset_chips;
+      // Start phase: the previous epoch's end phase when the carrier ran on from it (ChannelCorrelation).
+      double start_phase = 0.0, start_phase_var = c->start_phase_var_rad2;
+      if (c->continuous_carrier && had_end_phase && std::abs(ch.end_phase_t_s - r.t_start_s) < 1e-5) {
+        start_phase = ch.end_phase_rad;
+        start_phase_var = ch.end_phase_var_rad2;
+      }
+      const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
+      const StateVector<17> dx_before = period_dx_;
       bool ok = false;
       if (opt_.form == UltraTightForm::Iq) {
-        const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
         const MeasurementJacobian<17> J = rep.jacobian();
         const Eigen::Matrix<double, 1, 17> h_range = J.row(0) - 0.5 * span * J.row(1);
         const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
         ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code,
-                                         clock_rate_var, c->start_phase_var_rad2));
+                                         clock_rate_var, start_phase, start_phase_var));
       } else {
-        const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m,
-                                frequency_discriminator_hz(c->taps, is) * kLambda_m);
+        // The frequency discriminator reads the mean phase, start phase + pi T f(T / 3): the start phase comes off.
+        const double f_hz = frequency_discriminator_hz(c->taps, is) - start_phase / (M_PI * T_);
+        const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m, f_hz * kLambda_m);
         ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span, z,
                                                    discriminator_noise(is), clock_rate_var,
-                                                   c->start_phase_var_rad2 * std::pow(kLambda_m / (M_PI * T_), 2)));
+                                                   start_phase_var * std::pow(kLambda_m / (M_PI * T_), 2)));
+      }
+      if (c->continuous_carrier) {
+        // This epoch's end phase (after the period's last update, below): its measured mean phase (data wiped:
+        // the prompt near the I axis) plus the end-minus-mean phase pi T f(2 T / 3) of the rate-error profile.
+        const double theta = std::atan2(c->taps.q[1], c->taps.i[1]);
+        const double a2 = std::pow(iq_amplitude(is), 2);
+        if (std::abs(theta) < 0.5 * M_PI && a2 > 0.0)
+          end_phases.push_back({&ch, rep, offset, theta, (1.0 + 1.0 / a2) / a2, rate_slope * T_, r.t_start_s + T_,
+                                dx_before});
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
       last_updates.push_back({r.prn, ok, last_result_.nis, last_result_.innovation});
     }
+    // End phases from the period's final profile (x', whose drift includes the common e the taps saw): the rate
+    // error at 2 T / 3 (replica minus signal; the replica holds its rate, the signal's changes by slope over the
+    // period) under the corrections from the satellite's own update on.
+    for (const EndPhase& p : end_phases) {
+      const double e13 = p.rep.errors(period_dx_ - p.dx_before)(1) + p.offset(1);
+      p.ch->has_end_phase = true;
+      p.ch->end_phase_rad = p.theta + M_PI * T_ * (e13 - p.slope_mps / 3.0) / kLambda_m;
+      p.ch->end_phase_var_rad2 = p.var;
+      p.ch->end_phase_t_s = p.t_end;
+    }
+    if (common_var > 0.0) end_common_clock(P_prime, common_var, cov_xe);
     fill_output();
   }
 
@@ -374,14 +442,34 @@ class UltraTightCore final : public UltraTightCoreBase {
   // The receiver clock's frequency inside the period is not the drift state at its end: the white FM (phase
   // random walk, PSD S_b) adds a mean phase whose rate equivalent has variance 4 S_b / (3 T), the random-walk
   // FM (S_d) a difference between the T/3-weighted drift and the end drift of variance 8 S_d T / 15. That
-  // error is common to the n satellites of the period; updated one by one as independent, each gets n times
-  // the variance, so that their mean (the clock drift direction) carries the whole of it (conservative in
-  // the directions where it cancels between satellites: velocity).
-  double clock_rate_noise_var(double T, int satellites) const {
+  // error is common to the satellites of the period (finish_period).
+  double clock_rate_noise_var(double T) const {
     if (!(T > 0.0)) return 0.0;
     const ClockNoiseModel& c = opt_.model.clock;
-    const double v = 4.0 * c.bias_psd_m2_per_s / (3.0 * T) + 8.0 * c.drift_psd_m2_per_s3 * T / 15.0;
-    return v * std::max(satellites, 1);
+    return 4.0 * c.bias_psd_m2_per_s / (3.0 * T) + 8.0 * c.drift_psd_m2_per_s3 * T / 15.0;
+  }
+
+  // After the period's updates on x' = x + u e (e ~ N(0, v), Cov(x, e) = c0; prior covariance
+  // P' = P + v u u' + u c0' + c0 u'): the measurements depend on x' alone, so e given the data is e given x'.
+  // With g = Cov(x', e) = c0 + v u and w = P'^-1 g: E[e | x'] = w' x', Var(e | x') = v - g' w. With the
+  // posterior x' (mean delta = the period's corrections, covariance P'_post): mean m = w' delta, variance
+  // v - g' w + w' P'_post w, Cov(x', e) = P'_post w. The state is x = x' - u e: the nominal's drift loses m,
+  // P = P'_post - c u' - u c' + var u u' (c = P'_post w). With no update this returns P exactly.
+  void end_common_clock(const StateMatrix<17>& P_prime, double v, const StateVector<17>& c0) {
+    StateVector<17> u = StateVector<17>::Zero();
+    u(ix::kClockDrift) = 1.0;
+    const StateVector<17> g = c0 + v * u;
+    const StateVector<17> w = P_prime.ldlt().solve(g);
+    const StateMatrix<17> P_post = filter_.P();
+    const double m = w.dot(period_dx_);
+    const double var = std::max(0.0, v - g.dot(w) + w.dot(P_post * w));
+    const StateVector<17> c = P_post * w;
+    StateMatrix<17> P = P_post - c * u.transpose() - u * c.transpose() + var * u * u.transpose();
+    filter_.set_P(0.5 * (P + P.transpose()));
+    if (m != 0.0) {
+      nominal_ = corrected<17>(nominal_, StateVector<17>(-m * u));
+      ins_.set_state(nominal_.nav);
+    }
   }
 
   void propagate() {
@@ -401,6 +489,8 @@ class UltraTightCore final : public UltraTightCoreBase {
       return false;
     }
     ++counters.accepted;
+    last_dx_ = filter_.x();
+    period_dx_ += last_dx_;
     nominal_ = corrected<17>(nominal_, filter_.x());
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<17>::Zero());
@@ -438,6 +528,8 @@ class UltraTightCore final : public UltraTightCoreBase {
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;
   UpdateResult last_result_;
+  StateVector<17> last_dx_ = StateVector<17>::Zero();  // the correction of the latest accepted update
+  StateVector<17> period_dx_ = StateVector<17>::Zero();  // the corrections of this period's updates, summed
 };
 
 }  // namespace

@@ -9,8 +9,11 @@
 // Model assumption (iq_measurements.hpp): data bits known/wiped off, carrier NCO phase realigned at the start
 // of every period (the phase error inside a period is 2 pi df s), or its error at the start given as a variance
 // (ChannelCorrelation::start_phase_var_rad2: a closed PLL's residual, taken as noise in R). Over a period the taps see the mean range
-// error and the rate error at a third of the period (period_replica_errors), and the receiver clock's frequency
-// noise within the period (from options.model.clock) is part of R.
+// error and the rate error at a third of the period (period_replica_errors). The receiver clock's frequency within
+// the period differs from the drift state by a noise e common to the period's satellites (from options.model.clock):
+// the period's updates run on x' = x + u e (u the drift axis), after which e is conditioned out (exact for a linear
+// measurement; no 18th state). A continuous-carrier channel (ChannelCorrelation::continuous_carrier) starts each
+// period with the phase its previous epoch ended with.
 #pragma once
 
 #include <Eigen/Core>
@@ -87,6 +90,15 @@ struct ChannelCorrelation {
   // model takes as noise along the phase direction (iq_phase_derivative), the frequency discriminator as a rate
   // error of variance (lambda / (pi T))^2 times it.
   double start_phase_var_rad2 = 0.0;
+  // The replica's carrier phase runs on continuously from this channel's previous 20 ms epoch (a closed PLL that
+  // changes only the NCO frequency): the period then starts with the phase error the previous one ended with,
+  // which in dynamics is not zero (in steady state the PLL holds the mean phase at zero, so under a line-of-sight
+  // acceleration a the start phase is -pi a T^2 / 6 / lambda, 0.11 rad in a 10 g turn). With the previous epoch
+  // of the same channel adjacent (its replica ended where this one starts), the driver takes as the start phase
+  // that epoch's measured mean phase atan2(Q_P, I_P) plus its end-minus-mean phase pi T f(2 T / 3) from the
+  // filter's rate-error profile after its update, with the measured phase's thermal variance (1 + 1 / A^2) / A^2
+  // in place of start_phase_var_rad2. Otherwise (first epoch, a gap, false) start_phase_var_rad2 as above.
+  bool continuous_carrier = false;
 };
 
 // One satellite's update in the latest finish_period (for logs): the filter's innovation (Iq: I_E, I_P, I_L,

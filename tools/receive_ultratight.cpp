@@ -156,6 +156,9 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     const double jitter_rad = receiver::pll_thermal_jitter_rad(receiver::long_coherent_pll_bw_hz(options_.tracking, n),
                                                               n * ut_.period_s, c.cn0_dbhz);
     c.start_phase_var_rad2 = a2 > 0.0 ? jitter_rad * jitter_rad : 0.0;
+    // The NCO phase is never jumped (only its frequency changes): each epoch starts where the previous one ended,
+    // and the driver carries the previous epoch's measured phase over (ChannelCorrelation::continuous_carrier).
+    c.continuous_carrier = true;
     c.integration_time_s = ut_.period_s;
     // Data wipe-off by the known bit (decoded subframes or --nav: receiver/nav_bit_predictor.hpp), else by the
     // prompt's sign: the Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms: Q(sqrt(2 C/N0 T)) =

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <random>
 #include <cstdio>
 
@@ -136,6 +137,12 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
   std::vector<ReplicaCommand> replicas;
   std::vector<ChannelCorrelation> corr;
   std::vector<double> code(kSub), phase(kSub);
+  struct Pll {
+    double phase_rad = 0.0;  // carrier phase error (signal minus replica, as phase[]) at the period's start
+    double integrator_hz = 0.0, correction_hz = 0.0;
+  };
+  std::map<int, Pll> plls;
+  const double wn = cfg.pll_bw_hz / 0.53;  // 2nd order, zeta = 0.707: Bn = 0.53 wn
   for (std::size_t k = 0; k <= n_steps; ++k) {
     if (k % steps == 0) {
       if (k > 0) {
@@ -159,12 +166,17 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
           // Quadratic through the true pseudoranges at 0, T/2, T.
           const double p0 = a->pseudorange_m, pm = b->pseudorange_m, p1 = c->pseudorange_m;
           const double c1 = (4.0 * pm - 3.0 * p0 - p1) / T, c2 = 2.0 * (p1 - 2.0 * pm + p0) / (T * T);
+          Pll& pll = plls[r.prn];
+          // The replica's rate: the command's, less the PLL's correction (a higher carrier frequency is a lower
+          // pseudorange rate).
+          const double rep_rate = r.range_rate_mps - (cfg.pll_bw_hz > 0.0 ? kLambda * pll.correction_hz : 0.0);
           for (int m = 0; m < kSub; ++m) {
             const double s = (m + 0.5) * T / kSub;
             const double sig = p0 + c1 * s + c2 * s * s;
-            const double rep = r.pseudorange_m + r.range_rate_mps * s;
+            const double rep = r.pseudorange_m + rep_rate * s;
             code[m] = (rep - sig) / kChip;
             phase[m] = 2.0 * M_PI * ((rep - r.pseudorange_m) - (sig - p0)) / kLambda;
+            if (cfg.pll_bw_hz > 0.0) phase[m] += pll.phase_rad;
           }
           if (cfg.start_phase_sigma_rad > 0.0) {
             const double start_phase = cfg.start_phase_sigma_rad * n01(rng);
@@ -184,6 +196,21 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
           }
           cc.cn0_dbhz = blocked ? 0.0 : cfg.cn0_dbhz;  // the channel's estimate: blocked = nothing there
           if (cfg.tell_start_phase) cc.start_phase_var_rad2 = cfg.start_phase_sigma_rad * cfg.start_phase_sigma_rad;
+          if (cfg.pll_bw_hz > 0.0) {
+            cc.has_replica = true;
+            cc.replica_t_start_s = r.t_start_s;
+            cc.replica_pseudorange_m = r.pseudorange_m;
+            cc.replica_range_rate_mps = rep_rate;
+            cc.continuous_carrier = cfg.tell_continuous_carrier;
+            // The phase runs on to the period's end (exact quadratic signal); the PLL then steers the frequency
+            // from the measured mean phase (its thermal jitter at Bn: the start-phase variance it leaves).
+            pll.phase_rad += 2.0 * M_PI * (rep_rate * T - (p1 - p0)) / kLambda;
+            const double theta = std::atan2(cc.taps.q[1], cc.taps.i[1]);
+            pll.integrator_hz += wn * wn * theta * T / (2.0 * M_PI);
+            pll.correction_hz = pll.integrator_hz + 2.0 * 0.707 * wn * theta / (2.0 * M_PI);
+            if (!cfg.tell_start_phase) cc.start_phase_var_rad2 = 0.0;
+            else cc.start_phase_var_rad2 = cfg.pll_bw_hz / std::pow(10.0, 0.1 * cfg.cn0_dbhz);
+          }
           corr.push_back(cc);
         }
         timed([&] { integ.finish_period(corr); });

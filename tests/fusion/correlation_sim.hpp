@@ -45,6 +45,12 @@ struct CorrelationSimConfig {
   // ChannelCorrelation::start_phase_var_rad2 when tell_start_phase.
   double start_phase_sigma_rad = 0.0;
   bool tell_start_phase = true;
+  // > 0: each channel's carrier runs on continuously (no realignment) and a closed 2nd-order PLL of this noise
+  // bandwidth (zeta 0.707) on the prompt's mean phase adds a frequency correction to the commanded replica, as a
+  // receiver channel whose Costas PLL stays closed; the replica that ran is given to the driver (has_replica).
+  // ChannelCorrelation::continuous_carrier = tell_continuous_carrier.
+  double pll_bw_hz = 0.0;
+  bool tell_continuous_carrier = true;
 };
 
 struct CorrelationRunResult {
