@@ -1,10 +1,12 @@
 #include "receive_ultratight.hpp"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <fmt/ostream.h>
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "fusion/clock_model.hpp"
 #include "fusion/ins_error_model.hpp"
@@ -220,6 +222,9 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
   previous.swap(period_replicas_);
   for (const auto& r : driver_->replicas()) period_replicas_[r.prn] = r;
   int commanded = 0;
+  // The epoch's ultratight.csv rows, formatted into one buffer and written at once (fmt::print on the stream
+  // formats each call into a temporary string first).
+  fmt::memory_buffer rows;
   for (std::size_t i = 0; i < epoch.channels.size(); ++i) {
     const receiver::VectorChannelInput& in = epoch.channels[i];
     ChannelState& st = channels_[in.prn];
@@ -265,8 +270,7 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
     st.commanded = vector;
     const auto u = updates.find(in.prn);
     const fusion::UltraTightSatelliteUpdate* up = u == updates.end() ? nullptr : u->second;
-    auto& s = log_.stream();
-    fmt::print(s, "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
+    fmt::format_to(std::back_inserter(rows), "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
                epoch.sample, static_cast<double>(epoch.sample) / epoch.fs_hz, in.prn, in.synchronised, vector,
                in.coasting, st.coast_s, in.cn0_dbhz, measured_m, predicted_m,
                in.has_doppler ? in.measured_doppler_hz : NAN, predicted_doppler,
@@ -274,9 +278,10 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
                vector ? commands[i].code_rate_chips_per_s : NAN, jump, up != nullptr, up && up->accepted,
                up ? up->nis : NAN);
     for (int k = 0; k < 6; ++k)
-      fmt::print(s, ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
-    s << '\n';
+      fmt::format_to(std::back_inserter(rows), ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
+    rows.push_back('\n');
   }
+  log_.stream().write(rows.data(), static_cast<std::streamsize>(rows.size()));
   if (commanded > 0) ++vector_epochs_;
 }
 
