@@ -193,7 +193,7 @@ TEST(TightMeasurement, SigmaPointFormEqualsCorrectedNominalComposition) {
   const ins::TruthInterpolator interp(run.truth);
   const Eigen::Vector3d w(0.2, -0.1, 0.3);
   std::srand(5);
-  for (const Eigen::Vector3d lever : {Eigen::Vector3d(1.5, -0.4, -2.0), Eigen::Vector3d::Zero()}) {
+  for (const Eigen::Vector3d lever : {Eigen::Vector3d(1.5, -0.4, -2.0), Eigen::Vector3d(Eigen::Vector3d::Zero())}) {
     const auto se = test::simulate_epoch(interp, lever, constellation.ephemerides, constellation.klobuchar, t0, 1.0,
                                          {1200.0, 15.0});
     const auto sats = prepare_satellites(se.epoch, constellation.ephemerides, constellation.klobuchar,
