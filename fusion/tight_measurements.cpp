@@ -1,5 +1,6 @@
 #include "fusion/tight_measurements.hpp"
 
+#include <GeographicLib/Constants.hpp>
 #include <GeographicLib/Geocentric.hpp>
 
 #include <algorithm>
@@ -170,6 +171,10 @@ SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, cons
                                                const Eigen::Vector3d& lever_arm_b, const Eigen::Vector3d& w_ib_b,
                                                bool use_rate)
     : nominal_(nominal), sat_(sat), lever_b_(lever_arm_b), w_ib_b_(w_ib_b), rate_(use_rate && sat.has_rate) {
+  has_lever_ = !lever_b_.isZero(0.0);
+  const ins::Radii radii = ins::radii_of_curvature(nominal.nav.lat_rad);
+  meridian_plus_h_ = radii.meridian_m + nominal.nav.height_m;
+  transverse_plus_h_ = radii.transverse_m + nominal.nav.height_m;
   const int k = rate_ ? 2 : 1;
   z_.resize(k);
   R_ = Eigen::MatrixXd::Zero(k, k);
@@ -182,13 +187,45 @@ SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, cons
 }
 
 Eigen::VectorXd SatelliteMeasurement17::h(const StateVector<17>& dx) const {
-  const NominalState s = corrected<17>(nominal_, dx);
-  const Eigen::Vector3d r_ant = antenna_position_e(s.nav, lever_b_);
+  // fusion::corrected's position step (ins::correct_position), with the nominal's radii computed once.
+  const ins::NavState& n0 = nominal_.nav;
+  const double lat = n0.lat_rad - dx(ix::kPos) / meridian_plus_h_;
+  const double sl = std::sin(lat), cl = std::cos(lat);
+  const double lon = n0.lon_rad - dx(ix::kPos + 1) / (transverse_plus_h_ * cl);
+  const double so = std::sin(lon), co = std::cos(lon);
+  const double height = n0.height_m + dx(ix::kPos + 2);
+  // WGS-84 geodetic -> ECEF and C_en (ins::ecef_from_geodetic, ins::C_en) from the one pair of each.
+  static const double a = GeographicLib::Constants::WGS84_a(), f = GeographicLib::Constants::WGS84_f();
+  static const double e2 = f * (2.0 - f);
+  const double w2 = 1.0 - e2 * sl * sl, w = std::sqrt(w2);
+  const double transverse = a / w;
+  Eigen::Vector3d r_ant((transverse + height) * cl * co, (transverse + height) * cl * so,
+                        (transverse * (1.0 - e2) + height) * sl);
+  Eigen::Matrix3d C_en;
+  // clang-format off
+  C_en << -sl * co, -so, -cl * co,
+          -sl * so,  co, -cl * so,
+                cl, 0.0,      -sl;
+  // clang-format on
+  Eigen::Quaterniond q_nb = n0.q_nb;
+  if (has_lever_) {
+    q_nb = (ins::quaternion_from_rotation_vector(dx.segment<3>(ix::kAtt)) * n0.q_nb).normalized();
+    r_ant += C_en * (q_nb * lever_b_);
+  }
   Eigen::VectorXd out(z_.size());
-  out(0) = predicted_pseudorange_m(sat_, r_ant, s.clock_bias_m);
+  out(0) = predicted_pseudorange_m(sat_, r_ant, nominal_.clock_bias_m - dx(ix::kClockBias));
   if (rate_) {
-    const Eigen::Vector3d w = w_ib_b_ - dx.segment<3>(ix::kGyroBias);
-    out(1) = predicted_range_rate_mps(sat_, r_ant, antenna_velocity_e(s.nav, w, lever_b_), s.clock_drift_mps);
+    const Eigen::Vector3d v_n = n0.v_n - dx.segment<3>(ix::kVel);
+    Eigen::Vector3d v_ant_n = v_n;
+    if (has_lever_) {  // antenna_velocity_n: the earth and transport rates at the corrected position
+      const double meridian = a * (1.0 - e2) / (w2 * w);
+      const double re = transverse + height;
+      const Eigen::Vector3d w_in(ins::kEarthRate_rps * cl + v_n.y() / re, -v_n.x() / (meridian + height),
+                                 -ins::kEarthRate_rps * sl - v_n.y() * (sl / cl) / re);
+      const Eigen::Vector3d w_ib = w_ib_b_ - dx.segment<3>(ix::kGyroBias);
+      v_ant_n += q_nb * (w_ib - q_nb.conjugate() * w_in).cross(lever_b_);
+    }
+    out(1) = predicted_range_rate_mps(sat_, r_ant, C_en * v_ant_n, nominal_.clock_drift_mps - dx(ix::kClockDrift));
   }
   return out;
 }

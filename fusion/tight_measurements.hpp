@@ -77,6 +77,12 @@ double troposphere_rate_mps(const SatelliteObservable& sat, const Eigen::Vector3
 
 // One satellite's pseudorange (row 0) and, when available and wanted, pseudorange rate (row 1), for the
 // 17-state error model. w_ib_b: compensated body rate (lever-arm velocity).
+// h(dx) is evaluated at every sigma point of the UKF (35 per satellite update), so it does not go through
+// fusion::corrected + antenna_position_e + antenna_velocity_e (four sine/cosine pairs of the same latitude and
+// longitude, GeographicLib's degree-based conversion): the nominal's radii of curvature (what correct_position
+// uses) are computed once here, and per dx one sine/cosine pair each of the corrected latitude and longitude
+// gives the ECEF position, C_en, the earth and transport rates. Equal to that composition within rounding
+// (tests/fusion/error_model_test.cpp `TightMeasurement.SigmaPointFormEqualsCorrectedNominalComposition`).
 class SatelliteMeasurement17 {
  public:
   SatelliteMeasurement17(const NominalState& nominal, const SatelliteObservable& sat,
@@ -94,6 +100,8 @@ class SatelliteMeasurement17 {
   SatelliteObservable sat_;
   Eigen::Vector3d lever_b_, w_ib_b_;
   bool rate_ = false;
+  bool has_lever_ = false;  // a zero lever arm makes the attitude error move nothing (skipped: same bits)
+  double meridian_plus_h_ = 0.0, transverse_plus_h_ = 0.0;  // the nominal's R_M + h, R_N + h (correct_position)
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
 };

@@ -302,9 +302,16 @@ void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples,
       convert_part_to_i16(view_.num_samples);
     }
   }
-  // Channels are independent given the block: each job touches only its own channel and record buffer.
-  auto job = [this](int slot) { feed_channel(slot); };
-  pool_.parallel_for(static_cast<int>(channels_.size()), job);
+  // Channels are independent given the block: each job touches only its own channel and record buffer. A
+  // pipelined vector loop's update is job 0 (the caller takes it first): it reads only its copied inputs.
+  const int loop_job = pipelined_.queued ? 1 : 0;
+  auto job = [this, loop_job](int i) {
+    if (i < loop_job)
+      run_pipelined_vector();
+    else
+      feed_channel(i - loop_job);
+  };
+  pool_.parallel_for(static_cast<int>(channels_.size()) + loop_job, job);
   // Everything shared, in channel order, on this thread: the same sequence as one thread feeding them in turn.
   for (std::size_t slot = 0; slot < channels_.size(); ++slot) {
     if (!channels_[slot]) continue;
@@ -563,46 +570,95 @@ void ReceiverEngine::solve(const ObservationEpoch& epoch) {
   last_fix_ = std::move(fix);
 }
 
-void ReceiverEngine::set_vector_loop(VectorLoop* loop, double interval_s) {
+void ReceiverEngine::set_vector_loop(VectorLoop* loop, double interval_s, bool pipelined) {
   if (!(interval_s >= 0.001 && interval_s <= 1.0)) throw std::invalid_argument("ReceiverEngine: vector interval outside [0.001, 1] s");
   if (!loop)
     for (auto& channel : channels_)
       if (channel) channel->set_vector_command({});
   vector_loop_ = loop;
+  vector_pipelined_ = pipelined;
+  pipelined_.queued = pipelined_.answered = false;
   vector_step_ = std::max<std::int64_t>(1, std::llround(interval_s * options_.fs_hz));
   next_vector_ = (started_ ? next_sample_ : stats_.first_sample) + vector_step_;
 }
 
-// The vector loop's turn: every channel's state and latest measurements in slot order, its commands back.
-void ReceiverEngine::vector_epoch(std::int64_t sample) {
-  vector_in_.clear();
+void ReceiverEngine::finish_vector_loop() {
+  if (vector_loop_ && pipelined_.queued) run_pipelined_vector();
+  pipelined_.answered = false;
+}
+
+void ReceiverEngine::collect_vector_inputs(std::int64_t sample, std::vector<VectorChannelInput>& in,
+                                           VectorEpochInput& epoch) {
+  in.clear();
   for (std::size_t slot = 0; slot < channels_.size(); ++slot) {
     auto& channel = channels_[slot];
     if (!channel) continue;
     if (clock_) {
-      vector_in_.push_back(channel->vector_input(*clock_, static_cast<int>(slot)));
+      in.push_back(channel->vector_input(*clock_, static_cast<int>(slot)));
     } else {  // no receive time yet: nothing can be measured
-      VectorChannelInput in;
-      in.slot = static_cast<int>(slot);
-      in.prn = channel->prn();
-      vector_in_.push_back(in);
+      VectorChannelInput c;
+      c.slot = static_cast<int>(slot);
+      c.prn = channel->prn();
+      in.push_back(c);
     }
   }
-  vector_out_.assign(vector_in_.size(), VectorChannelCommand{});
-  VectorEpochInput epoch;
+  epoch = VectorEpochInput{};
   epoch.sample = sample;
+  epoch.command_sample = vector_pipelined_ ? sample + vector_step_ : sample;
   epoch.fs_hz = options_.fs_hz;
   if (clock_) epoch.receive_time = clock_->time_at(sample);
   epoch.clock_corrections_s = clock_corrections_s_;
+  epoch.last_fix_clock_corrections_s = fix_clock_corrections_s_;
+}
+
+// The vector loop's turn: every channel's state and latest measurements in slot order, its commands back.
+void ReceiverEngine::vector_epoch(std::int64_t sample) {
+  if (vector_pipelined_) {
+    if (pipelined_.queued) run_pipelined_vector();  // not run yet (no block since): in turn
+    apply_pipelined_vector();
+    PipelinedVector& p = pipelined_;
+    collect_vector_inputs(sample, p.in, p.epoch);
+    p.ephemerides = ephemerides_;
+    p.iono = iono_;
+    p.last_fix = last_fix_;
+    p.epoch.ephemerides = &p.ephemerides;
+    p.epoch.iono = &p.iono;
+    p.epoch.last_fix = p.last_fix ? &*p.last_fix : nullptr;
+    p.epoch.channels = p.in;
+    p.out.assign(p.in.size(), VectorChannelCommand{});
+    p.queued = clock_.has_value();
+    return;
+  }
+  VectorEpochInput epoch;
+  collect_vector_inputs(sample, vector_in_, epoch);
+  vector_out_.assign(vector_in_.size(), VectorChannelCommand{});
   epoch.ephemerides = &ephemerides_;
   epoch.iono = &iono_;
   epoch.last_fix = last_fix_ ? &*last_fix_ : nullptr;
-  epoch.last_fix_clock_corrections_s = fix_clock_corrections_s_;
   epoch.channels = vector_in_;
   if (clock_) vector_loop_->update(epoch, vector_out_);
   for (std::size_t i = 0; i < vector_in_.size(); ++i) {
     const bool ok = vector_in_[i].synchronised;
     channels_[static_cast<std::size_t>(vector_in_[i].slot)]->set_vector_command(ok ? vector_out_[i] : VectorChannelCommand{});
+  }
+}
+
+void ReceiverEngine::run_pipelined_vector() {
+  pipelined_.queued = false;
+  vector_loop_->update(pipelined_.epoch, pipelined_.out);
+  pipelined_.answered = true;
+}
+
+// A channel released since the inputs were copied gets nothing; a new one in its slot (another PRN, or the same
+// PRN re-acquired: not bit-synced, so ReceiverChannel::set_vector_command drops a vector command) stays scalar.
+void ReceiverEngine::apply_pipelined_vector() {
+  if (!pipelined_.answered) return;
+  pipelined_.answered = false;
+  for (std::size_t i = 0; i < pipelined_.in.size(); ++i) {
+    const VectorChannelInput& in = pipelined_.in[i];
+    auto& channel = channels_[static_cast<std::size_t>(in.slot)];
+    if (!channel || channel->prn() != in.prn) continue;
+    channel->set_vector_command(in.synchronised ? pipelined_.out[i] : VectorChannelCommand{});
   }
 }
 

@@ -101,7 +101,14 @@ class ReceiverEngine {
   // caller's thread, after the channels' parallel work, with every channel (receiver/vector_loop.hpp); nullptr
   // detaches it (channels go back to scalar). The loop must outlive its use. Throws std::invalid_argument for a
   // bad interval.
-  void set_vector_loop(VectorLoop* loop, double interval_s = 0.02);
+  // pipelined: the epoch's inputs are copied at the vector epoch s and the loop runs as the first job of the next
+  // block's parallel correlation (on the caller thread, beside the workers: off the critical path with 2 threads);
+  // its commands reach the channels at the next vector epoch s + interval (VectorEpochInput::command_sample), one
+  // channel epoch later than unpipelined. --threads 1 runs the job in turn: the same results for any thread count.
+  void set_vector_loop(VectorLoop* loop, double interval_s = 0.02, bool pipelined = false);
+  // End of the stream: runs a pipelined loop's update of the last vector epoch if it has not run (its commands
+  // go nowhere). Nothing otherwise.
+  void finish_vector_loop();
 
   const ReceiverStats& stats() const { return stats_; }
   const std::optional<PvtSolution>& last_fix() const { return last_fix_; }
@@ -153,6 +160,10 @@ class ReceiverEngine {
   void observation_epoch(std::int64_t sample);
   void solve(const ObservationEpoch& epoch);
   void vector_epoch(std::int64_t sample);
+  // The vector epoch's inputs into in/epoch (epoch.channels, ephemerides etc. still to be pointed at storage).
+  void collect_vector_inputs(std::int64_t sample, std::vector<VectorChannelInput>& in, VectorEpochInput& epoch);
+  void run_pipelined_vector();    // the pipelined loop's update on its copied inputs
+  void apply_pipelined_vector();  // its commands to the channels that are still the ones it saw
 
   ReceiverOptions options_;
   ReceiverObserver& observer_;
@@ -216,6 +227,20 @@ class ReceiverEngine {
   double fix_clock_corrections_s_ = 0.0;  // clock_corrections_s_ when last_fix_ was solved
   std::vector<VectorChannelInput> vector_in_;
   std::vector<VectorChannelCommand> vector_out_;
+  // Pipelined loop: one epoch's inputs, copied (the engine changes ephemerides_, iono_, last_fix_ and the channels
+  // while the loop runs), and its commands until the next vector epoch applies them.
+  struct PipelinedVector {
+    bool queued = false;    // inputs captured, update not yet run
+    bool answered = false;  // update run, commands not yet applied
+    VectorEpochInput epoch;
+    std::vector<VectorChannelInput> in;
+    std::vector<VectorChannelCommand> out;
+    std::vector<signals::Ephemeris> ephemerides;
+    signals::KlobucharParameters iono;
+    std::optional<PvtSolution> last_fix;
+  };
+  bool vector_pipelined_ = false;
+  PipelinedVector pipelined_;
 };
 
 }  // namespace ultratrack::receiver

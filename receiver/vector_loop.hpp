@@ -82,6 +82,12 @@ struct VectorEpochInput {
   const PvtSolution* last_fix = nullptr;  // nullptr before the first fix
   double last_fix_clock_corrections_s = 0.0;  // clock_corrections_s when last_fix was solved (before its jump)
   std::span<const VectorChannelInput> channels;
+  // The sample at which the engine hands the answered commands to the channels: `sample` (the loop runs between
+  // blocks: each command takes effect at the channel's next_epoch_sample) or, for a pipelined loop
+  // (ReceiverEngine::set_vector_loop), the next vector epoch: the command then takes effect at the channel's first
+  // epoch start at or after command_sample, one channel epoch after next_epoch_sample, where the command of the
+  // previous vector epoch takes effect first.
+  std::int64_t command_sample = 0;
 };
 
 // What the loop tells one channel. vector false: the channel's own DLL closes its code loop (scalar).
@@ -108,7 +114,9 @@ class VectorLoop {
  public:
   virtual ~VectorLoop() = default;
   // Called on the engine's caller thread at every vector epoch with every occupied channel (in slot order);
-  // `commands` has one entry per input channel, default-initialised (scalar).
+  // `commands` has one entry per input channel, default-initialised (scalar). A pipelined loop is called while
+  // the worker threads correlate the next block: the inputs are copies, and it must touch nothing the engine or
+  // the channels use.
   virtual void update(const VectorEpochInput& epoch, std::span<VectorChannelCommand> commands) = 0;
 };
 

@@ -207,6 +207,7 @@ void run_receive(const ReceiveArgs& args) {
     reader.set_i16_gain(engine.i16_gain());
     progress.update(engine);
   }
+  engine.finish_vector_loop();  // a pipelined loop's last update
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   progress.update(engine, true);
 

@@ -46,6 +46,7 @@ struct ImuTimeOrigin {
 // The command-line text of the fusion options (parsed by parse_receive_fusion).
 struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement;
+  bool ut_pipelined = false;
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 
@@ -57,6 +58,9 @@ struct ReceiveFusionSettings {
   std::string imu_file;
   ImuTimeOrigin time_origin;
   fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;  // --ut-measurement iq|discriminator
+  // --ut-pipelined: the loop runs beside the next block's correlation (receiver::ReceiverEngine::set_vector_loop),
+  // its commands one 20 ms vector epoch later.
+  bool ut_pipelined = false;
 };
 
 // Checks and parses the options (InputError naming the option or the configuration file). Nothing for

@@ -1,10 +1,12 @@
 #include "receive_ultratight.hpp"
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <fmt/ostream.h>
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "fusion/clock_model.hpp"
 #include "fusion/ins_error_model.hpp"
@@ -22,6 +24,7 @@ namespace {
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kLambda_m = signals::kL1Wavelength_m;
 constexpr double kChip_m = kC / signals::kCaChipRate_hz;
+constexpr double kEpochChips = 20.0 * 1023.0;  // a 20 ms channel epoch of C/A code
 
 }  // namespace
 
@@ -34,7 +37,9 @@ ReceiveUltraTight::ReceiveUltraTight(ReceiveFusion& fusion, const receiver::Rece
                    "nis,innovation_1,innovation_2,innovation_3,innovation_4,innovation_5,innovation_6\n";
 }
 
-void ReceiveUltraTight::attach(receiver::ReceiverEngine& engine) { engine.set_vector_loop(this, ut_.period_s); }
+void ReceiveUltraTight::attach(receiver::ReceiverEngine& engine) {
+  engine.set_vector_loop(this, ut_.period_s, fusion_.settings().ut_pipelined);
+}
 
 // IMU time of a receiver sample: the receive time on the clock continuous since the hand-over, less the
 // driver's clock bias (carried to that time by its drift).
@@ -223,6 +228,9 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
   previous.swap(period_replicas_);
   for (const auto& r : driver_->replicas()) period_replicas_[r.prn] = r;
   int commanded = 0;
+  // The epoch's ultratight.csv rows, formatted into one buffer and written at once (fmt::print on the stream
+  // formats each call into a temporary string first).
+  fmt::memory_buffer rows;
   for (std::size_t i = 0; i < epoch.channels.size(); ++i) {
     const receiver::VectorChannelInput& in = epoch.channels[i];
     ChannelState& st = channels_[in.prn];
@@ -239,10 +247,27 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
     if (in.synchronised && rep != period_replicas_.end()) {
       const fusion::ReplicaCommand& r = rep->second;
       predicted_doppler = r.nco.carrier_frequency_hz;
-      const double dt = static_cast<double>(in.next_epoch_sample - epoch.sample) / epoch.fs_hz;
+      double dt = static_cast<double>(in.next_epoch_sample - epoch.sample) / epoch.fs_hz;
       // Both on the receiver clock as it reads now: the replica left at its code rate vs the prediction.
-      const double replica_m =
+      double replica_m =
           in.replica_pseudorange_m + kC * (1.0 - in.code_rate_chips_per_s / signals::kCaChipRate_hz) * dt;
+      if (epoch.command_sample > epoch.sample) {
+        // Pipelined: this command reaches the channel at command_sample; the one sent at the previous epoch takes
+        // effect at next_epoch_sample (its jump there, its code rate from there), and this one at the first epoch
+        // start at or after command_sample (20 ms of code at that rate later; a start that lands within half a
+        // sample of command_sample counts as after it).
+        double rate = in.code_rate_chips_per_s;
+        if (st.commanded) {
+          replica_m -= st.sent_jump_chips * kChip_m;
+          rate = st.sent_code_rate_chips_per_s;
+        }
+        const double epoch_s = kEpochChips / rate;
+        const double until_s = (static_cast<double>(epoch.command_sample - epoch.sample) - 0.5) / epoch.fs_hz;
+        while (dt < until_s) {
+          dt += epoch_s;
+          replica_m += kC * (1.0 - rate / signals::kCaChipRate_hz) * epoch_s;
+        }
+      }
       const double prediction_m = r.pseudorange_m + r.range_rate_mps * dt - shift_m;
       jump = (replica_m - prediction_m) / kChip_m;  // replica too far away: advance it
       st.coast_s = in.coasting ? st.coast_s + ut_.period_s : 0.0;
@@ -252,12 +277,18 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
         commands[i].filter_driven = true;
         commands[i].code_rate_chips_per_s = r.nco.code_rate_chips_per_s;
         commands[i].code_phase_jump_chips = jump;
+        st.sent_code_rate_chips_per_s = r.nco.code_rate_chips_per_s;
+        st.sent_jump_chips = jump;
         const auto change = aid_change.find(in.prn);
         if (!st.commanded || !std::isfinite(st.aid_hz) || change == aid_change.end())
           st.aid_hz = r.nco.carrier_frequency_hz;  // joins (the channel only uses changes of it)
         else
           st.aid_hz += change->second;
         commands[i].carrier_frequency_hz = st.aid_hz;
+        // Pipelined, the aid reaches the PLL one period later: lead it by the period's change (the propagated
+        // Doppler's ramp continued; 10 Hz per period in the 10 g turn, which lagging cost lock there).
+        if (epoch.command_sample > epoch.sample && st.commanded && change != aid_change.end())
+          commands[i].carrier_frequency_hz += change->second;
         ++commanded;
         ++channel_epochs_;
         if (in.coasting) ++coasting_channel_epochs_;
@@ -268,8 +299,7 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
     st.commanded = vector;
     const auto u = updates.find(in.prn);
     const fusion::UltraTightSatelliteUpdate* up = u == updates.end() ? nullptr : u->second;
-    auto& s = log_.stream();
-    fmt::print(s, "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
+    fmt::format_to(std::back_inserter(rows), "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
                epoch.sample, static_cast<double>(epoch.sample) / epoch.fs_hz, in.prn, in.synchronised, vector,
                in.coasting, st.coast_s, in.cn0_dbhz, measured_m, predicted_m,
                in.has_doppler ? in.measured_doppler_hz : NAN, predicted_doppler,
@@ -277,9 +307,10 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
                vector ? commands[i].code_rate_chips_per_s : NAN, jump, up != nullptr, up && up->accepted,
                up ? up->nis : NAN);
     for (int k = 0; k < 6; ++k)
-      fmt::print(s, ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
-    s << '\n';
+      fmt::format_to(std::back_inserter(rows), ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
+    rows.push_back('\n');
   }
+  log_.stream().write(rows.data(), static_cast<std::streamsize>(rows.size()));
   if (commanded > 0) ++vector_epochs_;
 }
 

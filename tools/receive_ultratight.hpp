@@ -61,6 +61,8 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
     bool was_coasting = false;
     double prompt_power = NAN;  // running mean of I_P^2 + Q_P^2 on the raw scale (taps / iq_scale)
     double aid_hz = NAN;  // the carrier aiding sent (changes by the INS propagation only)
+    // The command sent last (vector): a pipelined loop's is still pending when the next inputs are taken.
+    double sent_code_rate_chips_per_s = 0.0, sent_jump_chips = 0.0;
   };
   void start(const receiver::VectorEpochInput& epoch, double t_k);
   double imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const;

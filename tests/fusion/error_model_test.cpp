@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 
 #include "fusion/discretisation.hpp"
 #include "fusion/ins_error_model.hpp"
@@ -175,6 +176,55 @@ TEST(TightMeasurement, JacobianMatchesNumericalDifferentiation) {
     const SatelliteMeasurement17 one(nom, s, lever, w, true);
     EXPECT_LT((one.H(StateVector<17>::Zero()) - numerical_jacobian<17>(one, steps)).cwiseAbs().maxCoeff(),
               1e-4);
+  }
+}
+
+// SatelliteMeasurement17::h computes the corrected nominal's ECEF position, C_en and the earth/transport rates
+// from one sine/cosine pair of latitude and longitude (it runs at every UKF sigma point); the reference here is
+// the composition it replaces: fusion::corrected, then antenna_position_e / antenna_velocity_n (GeographicLib's
+// conversion) and the prediction functions. Error states of sigma-point size and far beyond (km, 0.1 rad,
+// 100 m/s), with and without a lever arm (without one the attitude correction is skipped, not computed).
+TEST(TightMeasurement, SigmaPointFormEqualsCorrectedNominalComposition) {
+  const NominalState nom = perturbed_nominal();
+  const signals::GpsTime t0{2300, 300000.0};
+  const auto constellation = signals::nominal_constellation(t0);
+  const ins::TrajectorySpec spec = ins::profile_spec("straight", 5.0, nom.nav.lat_rad, nom.nav.lon_rad, 1500.0);
+  const ins::SimulatedRun run = ins::simulate(spec, 100.0);
+  const ins::TruthInterpolator interp(run.truth);
+  const Eigen::Vector3d w(0.2, -0.1, 0.3);
+  std::srand(5);
+  for (const Eigen::Vector3d& lever : {Eigen::Vector3d(1.5, -0.4, -2.0), Eigen::Vector3d(Eigen::Vector3d::Zero())}) {
+    const auto se = test::simulate_epoch(interp, lever, constellation.ephemerides, constellation.klobuchar, t0, 1.0,
+                                         {1200.0, 15.0});
+    const auto sats = prepare_satellites(se.epoch, constellation.ephemerides, constellation.klobuchar,
+                                         antenna_position_e(nom.nav, lever), TightOptions{});
+    ASSERT_GE(sats.size(), 5u);
+    for (const auto& sat : sats) {
+      const SatelliteMeasurement17 m(nom, sat, lever, w, true);
+      for (const double scale : {1e-3, 1.0, 100.0}) {
+        for (int trial = 0; trial < 20; ++trial) {
+          StateVector<17> dx = StateVector<17>::Random();
+          dx.segment<3>(ix::kPos) *= 10.0 * scale;     // m
+          dx.segment<3>(ix::kVel) *= 1.0 * scale;      // m/s
+          dx.segment<3>(ix::kAtt) *= 1e-3 * scale;     // rad
+          dx.segment<3>(ix::kAccelBias) *= 1e-2;
+          dx.segment<3>(ix::kGyroBias) *= 1e-4 * scale;
+          dx(ix::kClockBias) *= 30.0 * scale;
+          dx(ix::kClockDrift) *= 3.0 * scale;
+          const NominalState c = corrected<17>(nom, dx);
+          const Eigen::Vector3d r = antenna_position_e(c.nav, lever);
+          const Eigen::Vector3d v = ins::C_en(c.nav.lat_rad, c.nav.lon_rad) *
+                                    antenna_velocity_n(c.nav, w - dx.segment<3>(ix::kGyroBias), lever);
+          const Eigen::VectorXd h = m.h(dx);
+          ASSERT_EQ(h.size(), 2);
+          // Rounding: the ECEF position is ~6.4e6 m (one unit in the last place 1e-9 m) and the two conversions
+          // round differently (GeographicLib works in degrees): a few ulps of the range; the rate's terms are
+          // ~1e3 m/s (2e-13) times the same relative rounding of the line of sight.
+          EXPECT_NEAR(h(0), predicted_pseudorange_m(sat, r, c.clock_bias_m), 2e-8) << "PRN " << sat.prn;
+          EXPECT_NEAR(h(1), predicted_range_rate_mps(sat, r, v, c.clock_drift_mps), 1e-9) << "PRN " << sat.prn;
+        }
+      }
+    }
   }
 }
 

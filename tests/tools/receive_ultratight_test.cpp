@@ -6,7 +6,8 @@
 // over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
 // loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
 // signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
-// UKF + discriminators both; the same bytes with one thread and two. Bad option combinations give one InputError.
+// UKF + discriminators both, and both again with the pipelined loop (--ut-pipelined: its commands 20 ms later);
+// the same bytes with one thread and two (pipelined or not). Bad option combinations give one InputError.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -152,10 +153,11 @@ double prompt_i_innovation_variance(const fs::path& rx, double t0, double t1, in
   return n > 1 ? (s2 - s * s / n) / (n - 1) : NAN;
 }
 
-void check_run(const std::string& filter, const std::string& form) {
-  const auto rx = sim().dir / ("rx_" + filter + "_" + form);
+void check_run(const std::string& filter, const std::string& form, const std::vector<std::string>& extra = {}) {
+  const auto rx = sim().dir / ("rx_" + filter + "_" + form + (extra.empty() ? "" : "_" + extra.front().substr(2)));
   auto args = receive_args(rx);
   args.insert(args.end(), {"--coupling", "ultra-tight", "--filter", filter, "--ut-measurement", form});
+  args.insert(args.end(), extra.begin(), extra.end());
   test_support::run_command("receive", args);
   const std::string summary = test::read_text_file(rx / "summary.json");
   ASSERT_NE(summary.find("\"ultratight\": {\"filter\": \"" + filter + "\", \"measurement\": \"" + form +
@@ -292,6 +294,41 @@ TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
 }
 
+// Pipelined (--ut-pipelined): the loop runs beside the workers' correlation of the next block, its commands one
+// 20 ms vector epoch later; every thread count runs the same jobs on the same inputs: the same bytes. The lock,
+// coasting, re-lock, NIS and accuracy checks of the unpipelined runs hold with the added latency.
+TEST(ReceiveUltraTight, PipelinedOneThreadAndTwoGiveTheSameBytes) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  std::string text[2][2];
+  for (int threads : {1, 2}) {
+    const auto rx = sim().dir / ("rx_pipelined_threads" + std::to_string(threads));
+    auto args = receive_args(rx);
+    args.insert(args.end(), {"--coupling", "ultra-tight", "--ut-pipelined", "--threads", std::to_string(threads)});
+    test_support::run_command("receive", args);
+    text[threads - 1][0] = test::read_text_file(rx / "ultratight.csv");
+    text[threads - 1][1] = test::read_text_file(rx / "nav.csv");
+  }
+  EXPECT_GT(text[0][0].size(), 10000u);
+  EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
+  EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
+  // The latency is real: the commands, and so the log, differ from the unpipelined loop's.
+  const auto rx = sim().dir / "rx_unpipelined";
+  auto args = receive_args(rx);
+  args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", "2"});
+  test_support::run_command("receive", args);
+  EXPECT_FALSE(test::read_text_file(rx / "ultratight.csv") == text[0][0]);
+}
+
+TEST(ReceiveUltraTight, PipelinedEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ekf", "iq", {"--ut-pipelined"});
+}
+
+TEST(ReceiveUltraTight, PipelinedUkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ukf", "discriminator", {"--ut-pipelined"});
+}
+
 TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ukf", "discriminator");
@@ -318,6 +355,9 @@ TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
   expect_error("form_without_ut", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-measurement", "iq"},
                "--ut-measurement needs --coupling ultra-tight");
   expect_error("form_scalar", {"--ut-measurement", "iq"}, "--ut-measurement needs --coupling ultra-tight");
+  expect_error("pipelined_scalar", {"--ut-pipelined"}, "--ut-pipelined needs --coupling ultra-tight");
+  expect_error("pipelined_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-pipelined"},
+               "--ut-pipelined needs --coupling ultra-tight");
   expect_error("bad_form", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement",
                             "phase"},
                "--ut-measurement must be iq or discriminator");
