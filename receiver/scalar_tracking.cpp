@@ -663,6 +663,7 @@ void ScalarTracking::relock_from_presence() {
   target_epochs_ = 1;
   block_count_ = 0;
   loop_epochs_ = 1;
+  state_epochs_ = 1;  // the state below is for 20 ms updates (rereference_carrier_state)
   carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, 0.0);
   carrier_.reset(command_.carrier_frequency_hz, 0.0);
   pli_.reset();

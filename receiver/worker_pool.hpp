@@ -39,6 +39,8 @@ class WorkerPool final {
 
   // Calls job(i) for every i in [0, n), each exactly once, spread over the workers and the caller; returns
   // when all have finished. The first exception a job throws is rethrown here (after all jobs finished).
+  // Job 0 always runs on the caller (it claims it before any worker can see the batch): the receiver engine's
+  // pipelined vector loop relies on this to keep its output on the caller thread.
   template <class Job>
   void parallel_for(int n, Job& job) {
     run_batch(n, &job, [](void* j, int i) { (*static_cast<Job*>(j))(i); });

@@ -26,6 +26,20 @@ TEST(WorkerPool, EveryJobRunsExactlyOnceForAnyThreadCount) {
   }
 }
 
+// The pipelined vector loop is job 0 and writes the receiver's outputs: it must run on the caller's thread.
+TEST(WorkerPool, JobZeroAlwaysRunsOnTheCaller) {
+  for (int threads : {1, 2, 3, 8}) {
+    WorkerPool pool(threads);
+    const std::thread::id caller = std::this_thread::get_id();
+    int elsewhere = 0;
+    auto job = [&](int i) {
+      if (i == 0 && std::this_thread::get_id() != caller) ++elsewhere;
+    };
+    for (int round = 0; round < 500; ++round) pool.parallel_for(1 + round % 9, job);
+    EXPECT_EQ(elsewhere, 0) << threads << " threads";
+  }
+}
+
 TEST(WorkerPool, UsesSeveralThreadsWhenGiven) {
   WorkerPool pool(2);
   std::atomic<int> inside{0}, overlap{0};
