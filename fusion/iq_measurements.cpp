@@ -1,10 +1,12 @@
 #include "fusion/iq_measurements.hpp"
 
+#include <array>
 #include <cmath>
 #include <complex>
 
 #include "io/input_error.hpp"
 #include "receiver/discriminators.hpp"
+#include "signals/ca_code.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::fusion {
@@ -40,6 +42,8 @@ void check(const IqSettings& s) {
   if (!(s.integration_time_s > 0.0) || !std::isfinite(s.cn0_dbhz) || !(s.tap_offset_chips > 0.0) ||
       !(s.tap_offset_chips <= 0.5))
     throw io::InputError("I&Q settings", "need T > 0, finite C/N0 and 0 < tap offset <= 0.5 chip");
+  if (!(std::abs(s.code_lag1_correlation) < 1.0))
+    throw io::InputError("I&Q settings", "the code's one-chip autocorrelation must lie in (-1, 1)");
 }
 
 // Early replica = code advanced by d chips: it correlates with the signal at lag tau - d (E = R(tau - d)).
@@ -57,6 +61,39 @@ double triangle_slope(double x) {
   if (a > 1.0) return 0.0;
   const double one_sided = x < 0.0 ? 1.0 : -1.0;
   return a == 1.0 ? 0.5 * one_sided : one_sided;
+}
+
+double code_correlation(double x, double lag1) {
+  const double a = std::abs(x);
+  if (a < 1.0) return 1.0 - a * (1.0 - lag1);
+  if (a < 2.0) return lag1 * (2.0 - a);
+  return 0.0;
+}
+
+double code_correlation_slope(double x, double lag1) {
+  const double a = std::abs(x);
+  if (a == 0.0 || a > 2.0) return 0.0;
+  const double toward = x < 0.0 ? 1.0 : -1.0;  // sign of d|x|/dx, negated
+  if (a < 1.0) return toward * (1.0 - lag1);
+  if (a == 1.0) return toward * 0.5 * ((1.0 - lag1) + lag1);
+  if (a < 2.0) return toward * lag1;
+  return toward * 0.5 * lag1;  // a == 2
+}
+
+double ca_code_lag1_correlation(int prn) {
+  if (prn < 1 || prn > 32) return 0.0;
+  static const std::array<double, 33> table = [] {
+    std::array<double, 33> r{};
+    for (int p = 1; p <= 32; ++p) {
+      const auto& c = signals::ca_code(p);
+      long sum = 0;
+      for (int i = 0; i < signals::kCaCodeLength_chips; ++i)
+        sum += c[static_cast<std::size_t>(i)] * c[static_cast<std::size_t>((i + 1) % signals::kCaCodeLength_chips)];
+      r[static_cast<std::size_t>(p)] = static_cast<double>(sum) / signals::kCaCodeLength_chips;
+    }
+    return r;
+  }();
+  return table[static_cast<std::size_t>(prn)];
 }
 
 TrackingErrors tracking_errors(double range_error_m, double range_rate_error_mps) {
@@ -79,7 +116,7 @@ IqTaps expected_iq(const TrackingErrors& e, const IqSettings& s) {
   const auto o = tap_offsets(s);
   IqTaps t;
   for (int k = 0; k < 3; ++k) {
-    const double c = A * triangle_correlation(e.code_chips - o[k]);
+    const double c = A * code_correlation(e.code_chips - o[k], s.code_lag1_correlation);
     t.i[k] = c * r.c;
     t.q[k] = c * r.s;
   }
@@ -101,8 +138,8 @@ Eigen::Matrix<double, 6, 2> iq_jacobian(const TrackingErrors& e, const IqSetting
   const auto o = tap_offsets(s);
   Eigen::Matrix<double, 6, 2> J;
   for (int k = 0; k < 3; ++k) {
-    const double R = A * triangle_correlation(e.code_chips - o[k]);
-    const double dR = A * triangle_slope(e.code_chips - o[k]);
+    const double R = A * code_correlation(e.code_chips - o[k], s.code_lag1_correlation);
+    const double dR = A * code_correlation_slope(e.code_chips - o[k], s.code_lag1_correlation);
     J(k, 0) = dR * r.c;
     J(k, 1) = R * r.dc * dx_df;
     J(3 + k, 0) = dR * r.s;
@@ -117,7 +154,7 @@ Eigen::Matrix<double, 6, 6> iq_noise_covariance(const IqSettings& s) {
   Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
   for (int j = 0; j < 3; ++j)
     for (int k = 0; k < 3; ++k) {
-      C(j, k) = triangle_correlation(o[j] - o[k]);
+      C(j, k) = code_correlation(o[j] - o[k], s.code_lag1_correlation);
       C(3 + j, 3 + k) = C(j, k);
     }
   return C;

@@ -27,6 +27,10 @@ struct IqSettings {
   // the absolute carrier phase is a range measurement with a known integer ambiguity (an idealisation: the
   // 17-state model has no ambiguity states). Default off: the NCO phase is realigned every interval.
   bool absolute_carrier_phase = false;
+  // The code's periodic autocorrelation at one chip, R1 (C/A codes: -1/1023 for most PRNs, +63/1023 for 7, 15, 17,
+  // 21, 24, -65/1023 for 8, 22: ca_code_lag1_correlation). With rectangular chips the correlation between lags 0
+  // and 1 chip is 1 - |x| (1 - R1) instead of the ideal triangle (0: the triangle, as the seed model). |R1| < 1.
+  double code_lag1_correlation = 0.0;
 };
 
 // Signal minus replica, as receiver/discriminators.hpp: positive code error = the signal leads the replica.
@@ -48,6 +52,15 @@ double iq_amplitude(const IqSettings& s);  // sqrt(2 C/N0 T)
 double triangle_correlation(double x_chips);
 // dR/dx, with the mean of the one-sided slopes at the corners (0 at the peak, -+1/2 at +-1 chip).
 double triangle_slope(double x_chips);
+
+// Correlation of a rectangular-chip code with itself shifted by x chips, from its periodic autocorrelation at 0
+// (1) and one chip (lag1): 1 - |x| (1 - lag1) within one chip, lag1 (2 - |x|) between one and two (the two-chip
+// value taken as 0), 0 beyond; lag1 = 0 is triangle_correlation. Slope: as triangle_slope (mean of the one-sided
+// slopes at the corners).
+double code_correlation(double x_chips, double lag1);
+double code_correlation_slope(double x_chips, double lag1);
+// R1 of the GPS C/A code of a PRN (1..32; 0 for others), from signals::ca_code.
+double ca_code_lag1_correlation(int prn);
 
 // Replica errors from the range and range-rate errors of the replica (replica minus signal, m and m/s):
 // code = e_rho / chip length, frequency = e_rhodot / L1 wavelength.

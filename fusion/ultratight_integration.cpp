@@ -339,6 +339,7 @@ class UltraTightCore final : public UltraTightCoreBase {
       is.cn0_dbhz = c->cn0_dbhz;
       is.integration_time_s = T_;
       is.tap_offset_chips = opt_.tap_offset_chips;
+      if (opt_.ca_code_correlation) is.code_lag1_correlation = ca_code_lag1_correlation(r.prn);
       // Start phase: the previous epoch's end phase when the carrier ran on from it (ChannelCorrelation).
       double start_phase = 0.0, start_phase_var = c->start_phase_var_rad2;
       if (c->continuous_carrier && had_end_phase && std::abs(ch.end_phase_t_s - r.t_start_s) < 1e-5) {

@@ -50,6 +50,10 @@ struct UltraTightOptions {
   double measurement_mask_rad = -std::numeric_limits<double>::infinity();
   signals::KlobucharParameters iono;  // broadcast ionosphere (default: invalid, no ionospheric delay)
   double tap_offset_chips = 0.5;    // early/late offset d
+  // true: the taps' code correlation is the C/A code's own (its one-chip autocorrelation, IqSettings::
+  // code_lag1_correlation: E and L 3.1 % of A higher for PRN 7, 15, 17, 21, 24 at d = 0.5); false: the ideal
+  // triangle (the correlation-level simulator's truth).
+  bool ca_code_correlation = false;
   double coast_cn0_dbhz = 18.0;     // below: no update, the channel coasts on the INS
   signals::GpsTime gps_time_origin;
   double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;

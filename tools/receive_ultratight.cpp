@@ -106,6 +106,7 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   o.tight.troposphere = options_.pvt.troposphere;
   if (epoch.iono) o.iono = *epoch.iono;
   o.tap_offset_chips = options_.tracking.early_late_offset_chips;
+  o.ca_code_correlation = true;  // the channels correlate C/A codes, not the ideal triangle
   o.gps_time_origin = origin_;
   o.initial_accel_bias_b = out.accel_bias_b;
   o.initial_gyro_bias_b = out.gyro_bias_b;

@@ -8,12 +8,16 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <random>
+#include <vector>
 
 #include "ins/earth_model.hpp"
 #include "signals/ca_code.hpp"
 #include "signals/gps_constants.hpp"
+#include "signals/synth_kernels.hpp"
 
 namespace {
 
@@ -134,6 +138,15 @@ TEST(IqModel, TapNoiseCorrelationIsTheCodeAutocorrelation) {
     EXPECT_NEAR(C(3, 5), r2, 0.07) << d;
     EXPECT_EQ(C(0, 3), 0.0);  // I and Q independent
     EXPECT_EQ(C(2, 2), 1.0);
+    // With the code's own one-chip autocorrelation in the model the match is exact: at 20 samples per chip and
+    // lags of whole samples, the sampled correlation is (1 - lag) + lag R1 (lag in chips, <= 1) to rounding.
+    IqSettings s7 = settings(45.0, 0.02, d);
+    s7.code_lag1_correlation = ca_code_lag1_correlation(7);
+    const auto C7 = iq_noise_covariance(s7);
+    EXPECT_NEAR(C7(0, 1), r1, 1e-12) << d;
+    EXPECT_NEAR(C7(1, 2), r1, 1e-12) << d;
+    EXPECT_NEAR(C7(0, 2), r2, 1e-12) << d;
+    EXPECT_NEAR(C7(3, 5), r2, 1e-12) << d;
   }
 }
 
@@ -349,8 +362,68 @@ TEST(IqMeasurement17, AbsolutePhaseJacobianMatchesNumericalDifferentiation) {
 TEST(IqMeasurement17, BadSettingsAreInputErrors) {
   EXPECT_ANY_THROW(expected_iq(TrackingErrors{}, settings(45.0, 0.0, 0.5)));
   EXPECT_ANY_THROW(iq_noise_covariance(settings(45.0, 0.02, 0.7)));
+  IqSettings bad_r1 = settings();
+  bad_r1.code_lag1_correlation = 1.0;  // the tap covariance would be singular
+  EXPECT_ANY_THROW(iq_noise_covariance(bad_r1));
   const Scene sc = scene();
   EXPECT_ANY_THROW(IqEpochMeasurement17(sc.nominal, sc.sats, sc.lever_b, sc.w_ib_b, settings(), {}));
+}
+
+// The taps' code correlation against a brute-force correlation of the C/A chips sampled as the simulator makes
+// them (signals::synth::add_code_carrier: rectangular chips, no band limit, chip = floor(code phase), 2.6 MHz) with
+// a replica made the same way x chips later. At exactly 2600 samples per 1023-chip period the grid repeats every
+// millisecond, so one start samples each chip at the same 2-3 fractions and the result depends on where the chip
+// transitions fall (off by up to 0.01 from one start, 0.0096 for PRN 8 at x = 0.2). In the receiver code Doppler
+// moves the grid; here the correlation is averaged over M evenly spaced grid offsets (start + j q / M, q = 1023 /
+// 2600 chip the sample step), which together form one uniform grid of spacing h = q / M over the period. Bound (exact, from that grid,
+// for |x| <= 1): the replica is in the neighbouring chip for the samples of chip i that lie in an interval of
+// length |x|, whose count is |x| / h +- less than 1, so the mean differs from 1 - |x| (1 - R1) by less than
+// h (1 - R1) (1.6e-3 at M = 256). The ideal triangle is off by 0.031 at the E/L offset for PRN 15 and 24
+// (+63/1023 at one chip), which the bound excludes.
+TEST(IqModel, CodeCorrelationMatchesTheSampledCaCode) {
+  const double fs = 2.6e6, q = signals::kCaChipRate_hz / fs;  // chips per sample
+  const int per_period = 2600, M = 256;
+  const double h = q / M;
+  EXPECT_NEAR(ca_code_lag1_correlation(15), 63.0 / 1023.0, 1e-12);
+  EXPECT_NEAR(ca_code_lag1_correlation(24), 63.0 / 1023.0, 1e-12);
+  EXPECT_NEAR(ca_code_lag1_correlation(7), 63.0 / 1023.0, 1e-12);
+  EXPECT_NEAR(ca_code_lag1_correlation(8), -65.0 / 1023.0, 1e-12);
+  EXPECT_NEAR(ca_code_lag1_correlation(22), -65.0 / 1023.0, 1e-12);
+  EXPECT_NEAR(ca_code_lag1_correlation(1), -1.0 / 1023.0, 1e-12);
+  EXPECT_EQ(ca_code_lag1_correlation(0), 0.0);
+  EXPECT_EQ(ca_code_lag1_correlation(33), 0.0);
+  std::vector<std::complex<float>> sig(per_period), rep(per_period);
+  for (int prn : {1, 8, 15, 24}) {
+    const auto& c = signals::ca_code(prn);
+    std::vector<float> chips(c.begin(), c.end());
+    const double r1 = ca_code_lag1_correlation(prn);
+    for (double x : {-1.0, -0.75, -0.5, -0.3, 0.0, 0.2, 0.5, 0.8, 1.0}) {
+      double sum = 0.0;
+      for (int j = 0; j < M; ++j) {
+        const double start = 123.4567 + j * h;  // chips
+        std::fill(sig.begin(), sig.end(), std::complex<float>{});
+        std::fill(rep.begin(), rep.end(), std::complex<float>{});
+        signals::synth::add_code_carrier(sig.data(), sig.size(), chips.data(), 1.0f, start, q, 0.0, 0.0, true);
+        const double replica_start = std::fmod(start + x + 1023.0, 1023.0);
+        signals::synth::add_code_carrier(rep.data(), rep.size(), chips.data(), 1.0f, replica_start, q, 0.0, 0.0, true);
+        for (int k = 0; k < per_period; ++k) sum += static_cast<double>(sig[k].real()) * rep[k].real();
+      }
+      const double brute = sum / (static_cast<double>(M) * per_period);
+      EXPECT_NEAR(code_correlation(x, r1), brute, h * (1.0 - r1)) << "PRN " << prn << " x " << x;
+      if ((prn == 15 || prn == 24) && std::abs(x) == 0.5) {
+        EXPECT_GT(std::abs(triangle_correlation(x) - brute), 0.025) << "PRN " << prn << " x " << x;
+      }
+    }
+  }
+  // lag1 = 0 is the triangle, slopes included.
+  for (double x : {-2.5, -1.0, -0.4, 0.0, 0.3, 1.0, 1.7}) {
+    EXPECT_EQ(code_correlation(x, 0.0), triangle_correlation(x)) << x;
+    EXPECT_EQ(code_correlation_slope(x, 0.0), triangle_slope(x)) << x;
+  }
+  // Slope against central differences inside the pieces.
+  for (double x : {-1.5, -0.6, 0.4, 1.3})
+    EXPECT_NEAR(code_correlation_slope(x, 0.06),
+                (code_correlation(x + 1e-6, 0.06) - code_correlation(x - 1e-6, 0.06)) / 2e-6, 1e-8);
 }
 
 }  // namespace
