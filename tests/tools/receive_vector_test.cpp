@@ -397,8 +397,11 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   int handed = 0;
   for (const auto& [prn, v] : at_step) handed += v;
   EXPECT_GE(handed, 8);
-  for (const auto& [prn, v] : at_step)
-    if (v) EXPECT_FALSE(left[prn]) << "PRN " << prn << " left vector mode or coasted in the weak part";
+  for (const auto& [prn, v] : at_step) {
+    if (v) {
+      EXPECT_FALSE(left[prn]) << "PRN " << prn << " left vector mode or coasted in the weak part";
+    }
+  }
   // tracking.csv: every record of those PRNs after the step is bit-synced (locked, not coasting or lost), to the end.
   std::map<int, double> last;
   {
@@ -414,8 +417,11 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
       last[prn] = t;
     }
   }
-  for (const auto& [prn, v] : at_step)
-    if (v) EXPECT_GT(last[prn], kEnd - 0.2) << "PRN " << prn << " stopped early";
+  for (const auto& [prn, v] : at_step) {
+    if (v) {
+      EXPECT_GT(last[prn], kEnd - 0.2) << "PRN " << prn << " stopped early";
+    }
+  }
 
   // The filter's position over the weak part against the static truth.
   std::ifstream truth_in(sim / "truth.csv");
