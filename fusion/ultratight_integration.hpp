@@ -50,7 +50,7 @@ struct UltraTightOptions {
   double measurement_mask_rad = -std::numeric_limits<double>::infinity();
   signals::KlobucharParameters iono;  // broadcast ionosphere (default: invalid, no ionospheric delay)
   double tap_offset_chips = 0.5;    // early/late offset d
-  double coast_cn0_dbhz = 18.0;     // below: no update, the channel coasts on the INS
+  double coast_cn0_dbhz = 14.0;     // below: no update, the channel coasts on the INS (on a ~1 s C/N0)
   signals::GpsTime gps_time_origin;
   double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;
   // IMU biases already estimated (e.g. by the tight filter the receiver hands over from); the filter's bias
