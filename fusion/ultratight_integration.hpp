@@ -54,7 +54,7 @@ struct UltraTightOptions {
   // code_lag1_correlation: E and L 3.1 % of A higher for PRN 7, 15, 17, 21, 24 at d = 0.5); false: the ideal
   // triangle (the correlation-level simulator's truth).
   bool ca_code_correlation = false;
-  double coast_cn0_dbhz = 18.0;     // below: no update, the channel coasts on the INS
+  double coast_cn0_dbhz = 14.0;     // below: no update, the channel coasts on the INS (on a ~1 s C/N0)
   signals::GpsTime gps_time_origin;
   double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;
   // IMU biases already estimated (e.g. by the tight filter the receiver hands over from); the filter's bias

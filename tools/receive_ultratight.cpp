@@ -143,7 +143,7 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     fusion::ChannelCorrelation c;
     c.prn = in.prn;
     // The I&Q model's amplitude A = sqrt(2 C/N0 T) must be the one of these normalised taps: C/N0 by the moments
-    // of the same taps (E[I_P^2 + Q_P^2] = A^2 + 2), averaged over ~10 epochs (0.2 s, as the channel's estimator)
+    // of the same taps (E[I_P^2 + Q_P^2] = A^2 + 2), averaged over the epochs (PromptPowerAverage)
     // on the raw scale and carried to this epoch's normalisation: the channel's noise estimate moves the
     // normalised amplitude by +-8 % (+-2.8 noise sigmas at 45 dB-Hz) from epoch to epoch, which an average of the
     // normalised power does not follow (I_P innovation variance 3.3 instead of 1: docs/validation.md). The
@@ -152,8 +152,9 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     ChannelState& st = channels_[in.prn];
     const double scale2 = in.iq_scale * in.iq_scale;
     const double p2 = (in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2;
-    const double a2 = (std::isfinite(st.prompt_power) ? st.prompt_power : p2) * scale2 - 2.0;
-    st.prompt_power = std::isfinite(st.prompt_power) ? st.prompt_power + 0.1 * (p2 - st.prompt_power) : p2;
+    // PromptPowerAverage: the ~1 s mean while the C/N0 holds (the 0.2 s mean's spread made the gate below,
+    // coast_cn0_dbhz, pass only its upper tail at 16 dB-Hz: A^2 ~1.9 x the taps'), the 0.2 s one after a step.
+    const double a2 = st.prompt_power.update(p2, scale2);
     c.cn0_dbhz = a2 > 0.0 ? 10.0 * std::log10(a2 / (2.0 * ut_.period_s)) : -100.0;
     // The channel's PLL stays closed: the period starts with its residual phase error (thermal jitter of the
     // loop at its design bandwidth for the coherent time it runs now, N x 20 ms), not the realigned phase of the
