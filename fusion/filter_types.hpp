@@ -53,6 +53,14 @@ concept MeasurementModel = requires(const M& m, const StateVector<N>& x) {
   { m.R() } -> std::convertible_to<Eigen::MatrixXd>;
 };
 
+// The number of rows of a measurement model: M::kMeasurementSize when the model declares one (every z it
+// gives then has that many rows), else Eigen::Dynamic (the size is z().size() at run time).
+template <class M>
+inline constexpr int measurement_size_v = Eigen::Dynamic;
+template <class M>
+  requires requires { M::kMeasurementSize; }
+inline constexpr int measurement_size_v<M> = M::kMeasurementSize;
+
 // Innovation chi-square gate: a measurement is rejected (no state change) when its normalised innovation
 // squared nu' S^-1 nu exceeds the chi-square quantile with k degrees of freedom at `probability` (the
 // probability that a measurement consistent with the model passes).

@@ -36,8 +36,9 @@ inline double gate_threshold(double probability, int dof) {
   return memo_q[i];
 }
 
-inline bool passes_innovation_gate(const GateOptions& gate, const Eigen::MatrixXd& S, UpdateResult& r,
-                                   Eigen::LLT<Eigen::MatrixXd>& llt) {
+// SMatrix: Eigen::MatrixXd, or a fixed k x k matrix when the measurement's size is known at compile time.
+template <class SMatrix>
+bool passes_innovation_gate(const GateOptions& gate, const SMatrix& S, UpdateResult& r, Eigen::LLT<SMatrix>& llt) {
   r.threshold = gate.enabled ? gate_threshold(gate.probability, r.dof) : std::numeric_limits<double>::infinity();
   llt.compute(S);
   if (llt.info() != Eigen::Success || !r.innovation.allFinite()) {

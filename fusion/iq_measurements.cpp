@@ -192,13 +192,17 @@ ReplicaErrors17::ReplicaErrors17(const NominalState& nominal, const std::vector<
   }
   nominal_.resize(2 * size());
   const StateVector<17> zero = StateVector<17>::Zero();
-  for (int i = 0; i < size(); ++i) nominal_.segment<2>(2 * i) = rows_[i].h(zero);
+  for (int i = 0; i < size(); ++i) nominal_.segment<2>(2 * i) = rows_[i].range_and_rate(zero);
 }
 
 Eigen::VectorXd ReplicaErrors17::errors(const StateVector<17>& dx) const {
   Eigen::VectorXd out(2 * size());
-  for (int i = 0; i < size(); ++i) out.segment<2>(2 * i) = nominal_.segment<2>(2 * i) - rows_[i].h(dx);
+  for (int i = 0; i < size(); ++i) out.segment<2>(2 * i) = errors(i, dx);
   return out;
+}
+
+Eigen::Vector2d ReplicaErrors17::errors(int satellite, const StateVector<17>& dx) const {
+  return nominal_.segment<2>(2 * satellite) - rows_[satellite].range_and_rate(dx);
 }
 
 MeasurementJacobian<17> ReplicaErrors17::jacobian() const {

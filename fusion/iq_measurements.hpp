@@ -121,6 +121,7 @@ class ReplicaErrors17 {
   int size() const { return static_cast<int>(rows_.size()); }
   // Rows 2 i, 2 i + 1: range error (m), range-rate error (m/s) of satellite i.
   Eigen::VectorXd errors(const StateVector<17>& dx) const;
+  Eigen::Vector2d errors(int satellite, const StateVector<17>& dx) const;  // rows 2 i, 2 i + 1 only
   MeasurementJacobian<17> jacobian() const;  // d errors / d dx (independent of dx to first order)
 
  private:

@@ -175,6 +175,10 @@ SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, cons
   const ins::Radii radii = ins::radii_of_curvature(nominal.nav.lat_rad);
   meridian_plus_h_ = radii.meridian_m + nominal.nav.height_m;
   transverse_plus_h_ = radii.transverse_m + nominal.nav.height_m;
+  sin_lat0_ = std::sin(nominal.nav.lat_rad);
+  cos_lat0_ = std::cos(nominal.nav.lat_rad);
+  sin_lon0_ = std::sin(nominal.nav.lon_rad);
+  cos_lon0_ = std::cos(nominal.nav.lon_rad);
   const int k = rate_ ? 2 : 1;
   z_.resize(k);
   R_ = Eigen::MatrixXd::Zero(k, k);
@@ -187,12 +191,20 @@ SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, cons
 }
 
 Eigen::VectorXd SatelliteMeasurement17::h(const StateVector<17>& dx) const {
+  return predicted(dx, rate_).head(size());
+}
+
+Eigen::Vector2d SatelliteMeasurement17::predicted(const StateVector<17>& dx, bool with_rate) const {
   // fusion::corrected's position step (ins::correct_position), with the nominal's radii computed once.
   const ins::NavState& n0 = nominal_.nav;
+  // With a zero north (east) error the latitude (longitude) is the nominal's bit for bit (x - 0 / y == x for
+  // finite y), so its cached sin and cos are the same numbers std::sin and std::cos would return.
   const double lat = n0.lat_rad - dx(ix::kPos) / meridian_plus_h_;
-  const double sl = std::sin(lat), cl = std::cos(lat);
+  const bool same_lat = dx(ix::kPos) == 0.0;
+  const double sl = same_lat ? sin_lat0_ : std::sin(lat), cl = same_lat ? cos_lat0_ : std::cos(lat);
   const double lon = n0.lon_rad - dx(ix::kPos + 1) / (transverse_plus_h_ * cl);
-  const double so = std::sin(lon), co = std::cos(lon);
+  const bool same_lon = dx(ix::kPos + 1) == 0.0 && cl != 0.0;
+  const double so = same_lon ? sin_lon0_ : std::sin(lon), co = same_lon ? cos_lon0_ : std::cos(lon);
   const double height = n0.height_m + dx(ix::kPos + 2);
   // WGS-84 geodetic -> ECEF and C_en (ins::ecef_from_geodetic, ins::C_en) from the one pair of each.
   static const double a = GeographicLib::Constants::WGS84_a(), f = GeographicLib::Constants::WGS84_f();
@@ -212,9 +224,8 @@ Eigen::VectorXd SatelliteMeasurement17::h(const StateVector<17>& dx) const {
     q_nb = (ins::quaternion_from_rotation_vector(dx.segment<3>(ix::kAtt)) * n0.q_nb).normalized();
     r_ant += C_en * (q_nb * lever_b_);
   }
-  Eigen::VectorXd out(z_.size());
-  out(0) = predicted_pseudorange_m(sat_, r_ant, nominal_.clock_bias_m - dx(ix::kClockBias));
-  if (rate_) {
+  Eigen::Vector2d out(predicted_pseudorange_m(sat_, r_ant, nominal_.clock_bias_m - dx(ix::kClockBias)), 0.0);
+  if (with_rate) {
     const Eigen::Vector3d v_n = n0.v_n - dx.segment<3>(ix::kVel);
     Eigen::Vector3d v_ant_n = v_n;
     if (has_lever_) {  // antenna_velocity_n: the earth and transport rates at the corrected position

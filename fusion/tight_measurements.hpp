@@ -90,18 +90,25 @@ class SatelliteMeasurement17 {
 
   Eigen::VectorXd z() const { return z_; }
   Eigen::VectorXd h(const StateVector<17>& dx) const;
+  // h's pseudorange (m) and range rate (m/s) without a heap allocation; the rate is computed whether or not
+  // the measurement uses it (the satellite must have one: sat.has_rate).
+  Eigen::Vector2d range_and_rate(const StateVector<17>& dx) const { return predicted(dx, true); }
   MeasurementJacobian<17> H(const StateVector<17>& dx) const;
   Eigen::MatrixXd R() const { return R_; }
   int size() const { return static_cast<int>(z_.size()); }
   int prn() const { return sat_.prn; }
 
  private:
+  Eigen::Vector2d predicted(const StateVector<17>& dx, bool with_rate) const;  // (range, rate or 0)
   NominalState nominal_;
   SatelliteObservable sat_;
   Eigen::Vector3d lever_b_, w_ib_b_;
   bool rate_ = false;
   bool has_lever_ = false;  // a zero lever arm makes the attitude error move nothing (skipped: same bits)
   double meridian_plus_h_ = 0.0, transverse_plus_h_ = 0.0;  // the nominal's R_M + h, R_N + h (correct_position)
+  // sin and cos of the nominal's latitude and longitude: h reuses them for hypotheses that leave the position
+  // unchanged (most UKF sigma points: exactly the same values, no sincos call).
+  double sin_lat0_ = 0.0, cos_lat0_ = 1.0, sin_lon0_ = 0.0, cos_lon0_ = 1.0;
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
 };

@@ -100,21 +100,26 @@ class Ukf {
   }
 
   // Sigma points of the current (x, P) through h; Kalman gain from the cross covariance.
+  // A model with a compile-time size (static constexpr int kMeasurementSize, measurement_size_v) runs on
+  // fixed-size matrices: no heap allocation in the sums over the sigma points.
   template <class M>
     requires MeasurementModel<M, N>
   UpdateResult update(const M& model) {
+    constexpr int K = measurement_size_v<M>;
+    using ZVector = Eigen::Matrix<double, K, 1>;
+    using ZMatrix = Eigen::Matrix<double, K, K>;
     UpdateResult r;
-    const Eigen::VectorXd z = model.z();
-    const Eigen::MatrixXd R = model.R();
+    const ZVector z = model.z();
+    const ZMatrix R = model.R();
     const int k = static_cast<int>(z.size());
     r.dof = k;
     const Sigmas X = sigma_points();
-    Eigen::MatrixXd Z(k, 2 * N + 1);
+    Eigen::Matrix<double, K, 2 * N + 1> Z(k, 2 * N + 1);
     for (int i = 0; i < 2 * N + 1; ++i) Z.col(i) = model.h(Vector(X.col(i)));
-    Eigen::VectorXd zbar = w_.mean0 * Z.col(0);
+    ZVector zbar = w_.mean0 * Z.col(0);
     for (int i = 1; i < 2 * N + 1; ++i) zbar += w_.other * Z.col(i);
-    Eigen::MatrixXd S = R;
-    Eigen::Matrix<double, N, Eigen::Dynamic> Pxz = Eigen::Matrix<double, N, Eigen::Dynamic>::Zero(N, k);
+    ZMatrix S = R;
+    Eigen::Matrix<double, N, K> Pxz = Eigen::Matrix<double, N, K>::Zero(N, k);
     Z.colwise() -= zbar;  // the deviations, in place (no temporary per sigma point)
     for (int i = 0; i < 2 * N + 1; ++i) {
       const double wc = i == 0 ? w_.cov0 : w_.other;
@@ -123,14 +128,14 @@ class Ukf {
     }
     S = 0.5 * (S + S.transpose());
     r.innovation = z - zbar;
-    Eigen::LLT<Eigen::MatrixXd> llt;
+    Eigen::LLT<ZMatrix> llt;
     if (!passes_innovation_gate(opt_.gate, S, r, llt)) {
       ++counters_.rejected;
       return r;
     }
-    const Eigen::Matrix<double, N, Eigen::Dynamic> K = llt.solve(Pxz.transpose()).transpose();
-    x_ += K * r.innovation;
-    P_ -= K * S * K.transpose();
+    const Eigen::Matrix<double, N, K> gain = llt.solve(Pxz.transpose()).transpose();
+    x_ += gain * r.innovation;
+    P_ -= gain * S * gain.transpose();
     keep_psd();
     r.accepted = true;
     ++counters_.accepted;

@@ -30,6 +30,8 @@ Eigen::Matrix2d period_mixing(double span_s) {
 // One satellite's I&Q (6 rows) over the period with the replica actually held.
 class PeriodIqMeasurement {
  public:
+  static constexpr int kMeasurementSize = kIqRowsPerChannel;
+  using Vector6 = Eigen::Matrix<double, 6, 1>;
   PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
                       const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
                       double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var,
@@ -48,16 +50,15 @@ class PeriodIqMeasurement {
       const Eigen::Matrix<double, 6, 1> g = iq_phase_derivative(errors(StateVector<17>::Zero()), s_);
       R_ += start_phase_var * g * g.transpose();
     }
-    z_.resize(6);
     for (int k = 0; k < 3; ++k) {
       z_(k) = measured.i[k];
       z_(3 + k) = measured.q[k];
     }
   }
-  Eigen::VectorXd z() const { return z_; }
-  Eigen::VectorXd h(const StateVector<17>& dx) const {
+  const Vector6& z() const { return z_; }
+  Vector6 h(const StateVector<17>& dx) const {
     const IqTaps t = expected_iq(errors(dx), s_);
-    Eigen::VectorXd out(6);
+    Vector6 out;
     for (int k = 0; k < 3; ++k) {
       out(k) = t.i[k];
       out(3 + k) = t.q[k];
@@ -78,11 +79,11 @@ class PeriodIqMeasurement {
     const Eigen::Matrix<double, 2, 2> D = Eigen::Vector2d(1.0 / kChip_m, 1.0 / kLambda_m).asDiagonal();
     return J * D * M_ * replica_.jacobian();
   }
-  Eigen::MatrixXd R() const { return R_; }
+  const Eigen::Matrix<double, 6, 6>& R() const { return R_; }
 
  private:
   TrackingErrors errors(const StateVector<17>& dx) const {
-    const Eigen::Vector2d e = M_ * replica_.errors(dx) + offset_;
+    const Eigen::Vector2d e = M_ * replica_.errors(0, dx) + offset_;
     TrackingErrors te = tracking_errors(e(0), e(1));
     te.phase_rad = start_phase_;
     return te;
@@ -91,8 +92,8 @@ class PeriodIqMeasurement {
   IqSettings s_;
   Eigen::Vector2d offset_;
   Eigen::Matrix2d M_;
-  Eigen::VectorXd z_;
-  Eigen::MatrixXd R_;
+  Vector6 z_;
+  Eigen::Matrix<double, 6, 6> R_;
   double code_sigma_ = 0.0;
   double start_phase_ = 0.0;
 };
