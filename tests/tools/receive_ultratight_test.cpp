@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -279,18 +280,30 @@ TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTru
   check_run("ekf", "iq");
 }
 
-// The loop runs on the engine's caller thread after the channels' parallel work: one thread gives the same bytes.
-TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
-  std::string text[2][2];
+namespace {
+
+// ultratight.csv and nav.csv of the ultra-tight receive with 1 and with 2 threads: {threads - 1} x {ut, nav}.
+std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::string& name,
+                                                                  const std::vector<std::string>& extra) {
+  std::array<std::array<std::string, 2>, 2> text;
   for (int threads : {1, 2}) {
-    const auto rx = sim().dir / ("rx_threads" + std::to_string(threads));
+    const auto rx = sim().dir / (name + std::to_string(threads));
     auto args = receive_args(rx);
     args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", std::to_string(threads)});
+    args.insert(args.end(), extra.begin(), extra.end());
     test_support::run_command("receive", args);
     text[threads - 1][0] = test::read_text_file(rx / "ultratight.csv");
     text[threads - 1][1] = test::read_text_file(rx / "nav.csv");
   }
+  return text;
+}
+
+}  // namespace
+
+// The loop runs on the engine's caller thread after the channels' parallel work: one thread gives the same bytes.
+TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto text = outputs_by_thread_count("rx_threads", {});
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
@@ -301,15 +314,7 @@ TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
 // coasting, re-lock, NIS and accuracy checks of the unpipelined runs hold with the added latency.
 TEST(ReceiveUltraTight, PipelinedOneThreadAndTwoGiveTheSameBytes) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
-  std::string text[2][2];
-  for (int threads : {1, 2}) {
-    const auto rx = sim().dir / ("rx_pipelined_threads" + std::to_string(threads));
-    auto args = receive_args(rx);
-    args.insert(args.end(), {"--coupling", "ultra-tight", "--ut-pipelined", "--threads", std::to_string(threads)});
-    test_support::run_command("receive", args);
-    text[threads - 1][0] = test::read_text_file(rx / "ultratight.csv");
-    text[threads - 1][1] = test::read_text_file(rx / "nav.csv");
-  }
+  const auto text = outputs_by_thread_count("rx_pipelined_threads", {"--ut-pipelined"});
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";

@@ -21,6 +21,7 @@
 #include "signals/gps_constants.hpp"
 #include "signals/rinex_nav.hpp"
 #include "signals/satellite_state.hpp"
+#include "receive_output_readers.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -309,22 +310,7 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   int also = 0;
   EXPECT_EQ(total_losses(fll, &also), 0);
 
-  std::map<int, std::vector<std::pair<double, double>>> windows;  // coasting runs of tracking.csv rows per PRN
-  {
-    std::ifstream in(fll / "tracking.csv");
-    std::string line;
-    std::getline(in, line);
-    std::map<int, bool> in_window;
-    while (std::getline(in, line)) {
-      const auto f = ultratrack::test::split_csv_line(line);
-      const int prn = std::stoi(f[0]);
-      const double t = std::stod(f[2]);
-      const bool coasting = f[9] == "coasting";
-      if (coasting && !in_window[prn]) windows[prn].push_back({t, t});
-      if (coasting) windows[prn].back().second = t;
-      in_window[prn] = coasting;
-    }
-  }
+  const auto windows = ultratrack::test::coasting_windows(fll / "tracking.csv");  // coasting runs per PRN
   EXPECT_EQ(static_cast<int>(windows.size()), satellites);
   double worst = 0.0;
   for (const auto& [prn, w] : windows) {

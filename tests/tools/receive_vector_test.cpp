@@ -17,6 +17,7 @@
 
 #include "run_command.hpp"
 #include "solution_compare.hpp"
+#include "receive_output_readers.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -147,26 +148,10 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
   EXPECT_LE(v.rms_3d_m, s.rms_3d_m + 1.0);
 
   // The filter's own position (vector_state.csv) against the static truth.
-  std::ifstream truth_in(sim / "truth.csv");
-  std::string line;
-  std::getline(truth_in, line);
-  std::getline(truth_in, line);
-  const auto t0 = ultratrack::test::split_csv_line(line);
-  const double tx = std::stod(t0[3]), ty = std::stod(t0[4]), tz = std::stod(t0[5]);
-  std::ifstream state(vector / "vector_state.csv");
-  std::getline(state, line);
-  double sum2 = 0.0;
-  int n = 0;
-  while (std::getline(state, line)) {
-    const auto f = ultratrack::test::split_csv_line(line);
-    if (std::stod(f[1]) < 13.5) continue;
-    const double dx = std::stod(f[4]) - tx, dy = std::stod(f[5]) - ty, dz = std::stod(f[6]) - tz;
-    sum2 += dx * dx + dy * dy + dz * dz;
-    ++n;
-  }
-  ASSERT_GT(n, 100);
-  std::printf("vector filter position: 3-D RMS %.3f m over %d epochs\n", std::sqrt(sum2 / n), n);
-  EXPECT_LE(std::sqrt(sum2 / n), 2.0);
+  const auto filter = ultratrack::test::static_filter_position_rms(vector / "vector_state.csv", sim / "truth.csv", 13.5);
+  ASSERT_GT(filter.epochs, 100);
+  std::printf("vector filter position: 3-D RMS %.3f m over %d epochs\n", filter.rms_3d_m, filter.epochs);
+  EXPECT_LE(filter.rms_3d_m, 2.0);
 }
 
 // Dynamics (the "keeps lock where scalar loops with their default bandwidths lose it"): 139 m/s straight,
@@ -310,22 +295,7 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
   EXPECT_GE(std::stoi(summary.substr(c + 27)), satellites * 50);
 
   // tracking.csv: per PRN, its coasting windows (first and last rows of each run of "coasting" rows).
-  std::map<int, std::vector<std::pair<double, double>>> windows;
-  {
-    std::ifstream in(vector / "tracking.csv");
-    std::string line;
-    std::getline(in, line);
-    std::map<int, bool> in_window;
-    while (std::getline(in, line)) {
-      const auto f = ultratrack::test::split_csv_line(line);
-      const int prn = std::stoi(f[0]);
-      const double t = std::stod(f[2]);
-      const bool coasting = f[9] == "coasting";
-      if (coasting && !in_window[prn]) windows[prn].push_back({t, t});
-      if (coasting) windows[prn].back().second = t;
-      in_window[prn] = coasting;
-    }
-  }
+  const auto windows = ultratrack::test::coasting_windows(vector / "tracking.csv");
   EXPECT_EQ(static_cast<int>(windows.size()), satellites);
   double worst = 0.0, faded_relock = -1.0;
   for (const auto& [prn, w] : windows) {
@@ -424,29 +394,13 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   }
 
   // The filter's position over the weak part against the static truth.
-  std::ifstream truth_in(sim / "truth.csv");
-  std::string line;
-  std::getline(truth_in, line);
-  std::getline(truth_in, line);
-  const auto t0 = ultratrack::test::split_csv_line(line);
-  const double tx = std::stod(t0[3]), ty = std::stod(t0[4]), tz = std::stod(t0[5]);
-  std::ifstream state(vector / "vector_state.csv");
-  std::getline(state, line);
-  double sum2 = 0.0;
-  int n = 0;
-  while (std::getline(state, line)) {
-    const auto f = ultratrack::test::split_csv_line(line);
-    if (std::stod(f[1]) < kStep) continue;
-    const double dx = std::stod(f[4]) - tx, dy = std::stod(f[5]) - ty, dz = std::stod(f[6]) - tz;
-    sum2 += dx * dx + dy * dy + dz * dz;
-    ++n;
-  }
-  ASSERT_GT(n, 400);  // 10 s of 20 ms epochs, the filter never restarted
+  const auto filter = ultratrack::test::static_filter_position_rms(vector / "vector_state.csv", sim / "truth.csv", kStep);
+  ASSERT_GT(filter.epochs, 400);  // 10 s of 20 ms epochs, the filter never restarted
   const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
   std::printf("step to %.0f dB-Hz at %.0f s: %d channels filter-driven kept to the end; filter position 3-D RMS %.2f m "
-              "over %d epochs; %s\n", kWeak, kStep, handed, std::sqrt(sum2 / n), n,
+              "over %d epochs; %s\n", kWeak, kStep, handed, filter.rms_3d_m, filter.epochs,
               summary.substr(summary.find("\"frequency_resets\""), 24).c_str());
-  EXPECT_LE(std::sqrt(sum2 / n), 5.0);
+  EXPECT_LE(filter.rms_3d_m, 5.0);
 }
 
 TEST(ReceiveVector, RejectsAnUnknownCoupling) {

@@ -1,0 +1,65 @@
+// Readers of the receive outputs that several tools tests check against the truth: the coasting windows of
+// tracking.csv and the vector filter's position error (vector_state.csv) against a static truth.csv.
+#pragma once
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "support/test_data.hpp"
+
+namespace ultratrack::test {
+
+// Per PRN, its coasting windows: the times (s) of the first and last rows of each run of "coasting" rows.
+inline std::map<int, std::vector<std::pair<double, double>>> coasting_windows(const std::filesystem::path& tracking_csv) {
+  std::map<int, std::vector<std::pair<double, double>>> windows;
+  std::ifstream in(tracking_csv);
+  std::string line;
+  std::getline(in, line);
+  std::map<int, bool> in_window;
+  while (std::getline(in, line)) {
+    const auto f = split_csv_line(line);
+    const int prn = std::stoi(f[0]);
+    const double t = std::stod(f[2]);
+    const bool coasting = f[9] == "coasting";
+    if (coasting && !in_window[prn]) windows[prn].push_back({t, t});
+    if (coasting) windows[prn].back().second = t;
+    in_window[prn] = coasting;
+  }
+  return windows;
+}
+
+struct PositionErrorRms {
+  double rms_3d_m = NAN;
+  int epochs = 0;
+};
+
+// The vector filter's ECEF position (vector_state.csv) from from_s on against the first row of a static truth.csv.
+inline PositionErrorRms static_filter_position_rms(const std::filesystem::path& vector_state_csv,
+                                                    const std::filesystem::path& truth_csv, double from_s) {
+  std::ifstream truth_in(truth_csv);
+  std::string line;
+  std::getline(truth_in, line);
+  std::getline(truth_in, line);
+  const auto t0 = split_csv_line(line);
+  const double tx = std::stod(t0[3]), ty = std::stod(t0[4]), tz = std::stod(t0[5]);
+  std::ifstream state(vector_state_csv);
+  std::getline(state, line);
+  double sum2 = 0.0;
+  PositionErrorRms r;
+  while (std::getline(state, line)) {
+    const auto f = split_csv_line(line);
+    if (std::stod(f[1]) < from_s) continue;
+    const double dx = std::stod(f[4]) - tx, dy = std::stod(f[5]) - ty, dz = std::stod(f[6]) - tz;
+    sum2 += dx * dx + dy * dy + dz * dz;
+    ++r.epochs;
+  }
+  if (r.epochs > 0) r.rms_3d_m = std::sqrt(sum2 / r.epochs);
+  return r;
+}
+
+}  // namespace ultratrack::test
