@@ -36,7 +36,13 @@ double costas_phase_variance_cycles2(double cn0_hz, double t_s) {
   return rad2 / (4.0 * M_PI * M_PI);
 }
 
-const char* to_string(VectorCarrier carrier) { return carrier == VectorCarrier::kFll ? "fll" : "aided-pll"; }
+const char* to_string(VectorCarrier carrier) {
+  switch (carrier) {
+    case VectorCarrier::kFll: return "fll";
+    case VectorCarrier::kPll: return "pll";
+    default: return "aided-pll";
+  }
+}
 
 VectorState propagate(const VectorState& x, double dt) {
   VectorState y = x;
@@ -124,6 +130,7 @@ ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorSt
 
 VectorTrackingFilter::VectorTrackingFilter(const VectorTrackingOptions& options) : opt_(options) {
   model_.noise = opt_.process;
+  phase_.fill(VectorCarrierPhase(opt_.pll));
 }
 
 std::optional<SatelliteObservable> VectorTrackingFilter::observable(const receiver::VectorEpochInput& in, int prn,
@@ -173,6 +180,7 @@ bool VectorTrackingFilter::initialise(const receiver::VectorEpochInput& in) {
   clock_corrections_s_ = in.clock_corrections_s;
   starved_s_ = 0.0;
   prn_.fill({});
+  phase_.fill(VectorCarrierPhase(opt_.pll));
   ++initialisations_;
   return true;
 }
@@ -213,6 +221,10 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log.prn = ch.prn;
     log.cn0_dbhz = ch.cn0_dbhz;
     log.replica_code_rate_chips_per_s = ch.code_rate_chips_per_s;
+    if (ch.has_measurement) {
+      log.measurement_sample = ch.measurement_sample;
+      log.replica_phase_mid_cycles = ch.replica_carrier_phase_mid_cycles;
+    }
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
     const bool strong = usable(ch, st);
     // A faded channel the filter commands keeps its standing (it coasts, commanded below); others restart.
@@ -262,8 +274,9 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       const double a = std::min(1.0, (step_s > 0.0 ? step_s : 0.02) / opt_.doppler_bias_average_s);
       st.doppler_bias_hz += a * (off_hz - st.doppler_bias_hz);
       ++st.doppler_epochs;
-      // (An FLL channel has no PLL to lock falsely: its offset is the filter's own lag, which its rows correct.)
-      const bool weak = opt_.carrier != VectorCarrier::kFll && st.cn0_mean_hz < ratio_hz(opt_.false_lock_below_dbhz);
+      // (An FLL or vector-PLL channel has no PLL of its own to lock falsely: its offset is the filter's own lag,
+      // which its rows correct.)
+      const bool weak = opt_.carrier == VectorCarrier::kAidedPll && st.cn0_mean_hz < ratio_hz(opt_.false_lock_below_dbhz);
       if (!(weak && std::abs(st.doppler_bias_hz) > opt_.doppler_bias_hz)) {
         const UpdateResult rr = ekf_->update(m);
         log.rate_innovation_mps = rr.innovation.size() ? rr.innovation(0) : NAN;
@@ -332,7 +345,7 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     commands[i].vector = true;
     commands[i].code_rate_chips_per_s = p.code_rate_chips_per_s;
     commands[i].code_phase_jump_chips = jump;
-    if (opt_.carrier == VectorCarrier::kFll) {
+    if (opt_.carrier == VectorCarrier::kFll || opt_.carrier == VectorCarrier::kPll) {
       // The NCO holds one frequency over the epoch: the predicted Doppler at its middle (the Doppler moves up to
       // ~100 Hz/s in a 2 g turn: 1 Hz over half an epoch). Not filter-driven: the FLL channel has its own C/N0
       // lock test and differential bits, which the presence test and the known-bit pure PLL would contradict.
@@ -340,6 +353,19 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       commands[i].carrier_frequency_hz =
           predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
       commands[i].carrier_commanded = true;
+      if (opt_.carrier == VectorCarrier::kPll) {
+        const auto doppler_at = [&](std::int64_t sample) {
+          const double d = static_cast<double>(sample - in.sample) / in.fs_hz;
+          return predict_replica(shifted(*now, d), propagate(ekf_->x(), d)).doppler_hz;
+        };
+        const double cn0 = ch.cn0_dbhz >= opt_.min_cn0_dbhz || !std::isfinite(st.cn0_mean_hz)
+                               ? ratio_hz(ch.cn0_dbhz)
+                               : std::min(ratio_hz(ch.cn0_dbhz), st.cn0_mean_hz);
+        // The prediction's Doppler variance (Hz^2): the rate row's Jacobian through the covariance.
+        const MeasurementJacobian<8> Hr = VectorRangeMeasurement(*now, 0.0, true, 0.0, 1.0).H(ekf_->x());
+        const double var_hz2 = (Hr * ekf_->P() * Hr.transpose())(0, 0) / (signals::kL1Wavelength_m * signals::kL1Wavelength_m);
+        command_pll(ch, doppler_at, var_hz2, strong, cn0, step_s, in.fs_hz, commands[i], log);
+      }
     } else {
       commands[i].filter_driven = opt_.filter_driven;
       // A weak channel's PLL held off the prediction for doppler_bias_average_s (a false lock): its aiding steps by
@@ -358,6 +384,10 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log.vector = true;
     ++vector;
   }
+  // A channel the filter does not command (scalar, dropped) has no carrier states: a later hand-over starts anew.
+  if (opt_.carrier == VectorCarrier::kPll)
+    for (std::size_t i = 0; i < in.channels.size(); ++i)
+      if (!commands[i].vector) phase_[static_cast<std::size_t>(in.channels[i].prn)] = VectorCarrierPhase(opt_.pll);
   if (log_) {
     log_epoch_.receive_time = in.receive_time;
     log_epoch_.x = ekf_->x();
@@ -366,6 +396,71 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log_epoch_.vector = vector;
     log_(log_epoch_);
   }
+}
+
+}  // namespace ultratrack::fusion
+
+namespace ultratrack::fusion {
+
+void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
+                                       const std::function<double(std::int64_t)>& doppler_at,
+                                       double prediction_variance_hz2, bool usable_now,
+                                       double cn0_hz, double step_s, double fs_hz,
+                                       receiver::VectorChannelCommand& command, VectorChannelLog& log) {
+  VectorCarrierPhase& ph = phase_[static_cast<std::size_t>(ch.prn)];
+  const double t = ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02;
+  const double variance = costas_phase_variance_cycles2(cn0_hz, t);
+  // A discriminator this epoch: a fresh, usable (not faded) epoch with normalised taps.
+  const bool fresh = usable_now && ch.has_measurement && ch.integration_time_s > 0.0 && ch.iq_scale > 0.0;
+  if (ph.active()) {
+    if (fresh && ch.measurement_sample > ph.sample()) {
+      const std::int64_t mid = (ph.sample() + ch.measurement_sample) / 2;
+      const double base = ph.commanded_base_hz(mid);
+      ph.propagate(ch.measurement_sample, fs_hz, std::isfinite(base) ? base : doppler_at(mid), prediction_variance_hz2);
+      ph.update(ch.iq_i[1], ch.iq_q[1], ch.replica_carrier_phase_mid_cycles, variance, t);
+      log.phase_disc_cycles = ph.last_discriminator_cycles();
+      log.phase_innovation_cycles = ph.last_innovation_cycles();
+      if (!ph.locked()) {  // phase lock failed: the FLL from now on (a new arc after relock_after_s)
+        ph.stop();
+        ++phase_losses_;
+      }
+    }
+  } else if (fresh) {
+    // Hand-over (never tracked since it joined) at once; after a loss, once usable and strong for relock_after_s.
+    const bool strong = cn0_hz >= ratio_hz(opt_.min_cn0_dbhz + opt_.pll.relock_margin_dbhz);
+    ph.fallback_s = strong ? ph.fallback_s + step_s : 0.0;
+    if (!ph.fell_back() || ph.fallback_s >= opt_.pll.relock_after_s) {
+      const double nu0 = ch.has_doppler ? ch.measured_doppler_hz - doppler_at(ch.doppler_sample) : 0.0;
+      ph.start(ch.measurement_sample, ch.replica_carrier_phase_mid_cycles,
+               costas_discriminator_cycles(ch.iq_i[1], ch.iq_q[1]), std::isfinite(nu0) ? nu0 : 0.0, variance);
+      ++phase_arcs_;
+    }
+  }
+  if (!ph.active()) return;  // the FLL's command (carrier_phase_locked false)
+  // The replica's phase at its next epoch start: the carrier states' phase there; the frequency over that epoch:
+  // the prediction at its middle plus the residual.
+  const std::int64_t next = ch.next_epoch_sample;
+  const std::int64_t mid = (ph.sample() + next) / 2;
+  const double base = ph.commanded_base_hz(mid);
+  const double want = ph.phase_at(next, fs_hz, std::isfinite(base) ? base : doppler_at(mid));
+  const double jump = want - ch.replica_carrier_phase_next_cycles;
+  // A correction beyond half a cycle means the states no longer describe this replica (a stale or diverged
+  // state): the channel falls back rather than drag its replica.
+  if (!(std::abs(jump) <= 0.5)) {
+    ph.stop();
+    ++phase_losses_;
+    return;
+  }
+  ph.record_command(next, command.carrier_frequency_hz);
+  command.carrier_phase_locked = true;
+  command.carrier_phase_jump_cycles = jump;
+  command.carrier_frequency_hz += ph.nu_hz();
+  log.phase_tracking = true;
+  log.phase_jump_cycles = jump;
+  log.phase_sigma_cycles = ph.sigma_phase_cycles();
+  log.phase_nu_hz = ph.nu_hz();
+  log.phase_lock = ph.lock_indicator();
+  log.phase_bn_hz = ph.last_bandwidth_hz();
 }
 
 }  // namespace ultratrack::fusion

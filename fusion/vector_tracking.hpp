@@ -14,6 +14,7 @@
 
 #include "fusion/ekf.hpp"
 #include "fusion/tight_measurements.hpp"
+#include "fusion/vector_carrier_phase.hpp"
 #include "receiver/vector_loop.hpp"
 
 namespace ultratrack::fusion {
@@ -85,8 +86,12 @@ ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorSt
 // aided by the predicted Doppler's changes (carrier_aiding); kFll, the filter closes it (a vector FLL): every
 // vector epoch each channel's carrier NCO is commanded to the predicted Doppler at the middle of its next epoch,
 // and the channel's frequency discriminator (receiver/vector_frequency_discriminator.hpp) is the pseudorange-rate
-// measurement that keeps the prediction honest.
-enum class VectorCarrier { kAidedPll, kFll };
+// measurement that keeps the prediction honest; kPll, a vector PLL (fusion/vector_carrier_phase.hpp): as kFll, plus
+// per-channel carrier states in the filter, updated by each channel's Costas discriminator, that add a phase jump
+// and a frequency residual to every command, so that the replica stays phase-locked with no loop in the channel
+// (the pseudorange-rate rows are then phase-locked delta ranges); a channel whose phase lock fails is commanded as
+// in kFll (and re-enters after VectorPllOptions::relock_after_s).
+enum class VectorCarrier { kAidedPll, kFll, kPll };
 const char* to_string(VectorCarrier carrier);
 
 struct VectorTrackingOptions {
@@ -98,7 +103,8 @@ struct VectorTrackingOptions {
   double code_spacing_chips = 1.0;    // E-L spacing of the channels (2 x early_late_offset_chips)
   bool use_doppler = true;            // pseudorange-rate rows
   bool carrier_aiding = true;         // the predicted Doppler's changes aid each vector channel's PLL
-  VectorCarrier carrier = VectorCarrier::kAidedPll;  // kFll: the filter commands the carrier NCOs
+  VectorCarrier carrier = VectorCarrier::kAidedPll;  // kFll, kPll: the filter commands the carrier NCOs
+  VectorPllOptions pll;                                // kPll's per-channel carrier states
   int join_after_updates = 25;        // accepted pseudorange updates (20 ms each) before a channel is commanded
   int max_rejections = 10;            // consecutive gate rejections that return a channel to scalar
   double max_jump_chips = 0.3;        // a prediction further than this from the replica returns it to scalar
@@ -150,6 +156,15 @@ struct VectorChannelLog {
   bool coasting = false;             // commanded from the prediction alone (faded or coasting)
   double coast_s = 0.0;              // time since it last had a usable measurement while commanded
   double predicted_sigma_chips = NAN;  // 1-sigma of the predicted pseudorange
+  // kPll: the channel's carrier phase closed by the filter this epoch (false: not in kPll, or fallen back to the
+  // FLL); its discriminator (cycles), gated innovation, state 1-sigma, frequency residual nu (Hz), lock indicator,
+  // loop noise bandwidth of the latest gains (Hz), the commanded phase jump (cycles). In every mode, for truth
+  // comparisons: the replica's carrier phase (cycles) at the middle of the epoch measured (measurement_sample).
+  bool phase_tracking = false;
+  double phase_disc_cycles = NAN, phase_innovation_cycles = NAN, phase_sigma_cycles = NAN, phase_nu_hz = NAN;
+  double phase_lock = NAN, phase_bn_hz = NAN, phase_jump_cycles = NAN;
+  std::int64_t measurement_sample = 0;
+  double replica_phase_mid_cycles = NAN;
 };
 struct VectorEpochLog {
   std::int64_t sample = 0;
@@ -174,6 +189,9 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   int initialisations() const { return initialisations_; }
   // Carrier aiding steps given to weak channels found on a false PLL lock (VectorTrackingOptions::false_lock_hz).
   int frequency_resets() const { return frequency_resets_; }
+  // kPll: phase arcs started (hand-overs and re-entries) and phase locks lost (fallbacks to the FLL).
+  int phase_arcs() const { return phase_arcs_; }
+  int phase_losses() const { return phase_losses_; }
   // Called at the end of every update once the filter runs.
   void set_log(std::function<void(const VectorEpochLog&)> log) { log_ = std::move(log); }
 
@@ -192,6 +210,12 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   std::optional<SatelliteObservable> observable(const receiver::VectorEpochInput& in, int prn, std::int64_t sample,
                                                 double pseudorange_m) const;
   bool initialise(const receiver::VectorEpochInput& in);
+  // kPll: one channel's carrier states (discriminator update, lock test, fallback/re-entry) and its carrier
+  // command; doppler_at(sample) is the filter's predicted Doppler of the channel at a receiver sample, with error
+  // variance prediction_variance_hz2.
+  void command_pll(const receiver::VectorChannelInput& ch, const std::function<double(std::int64_t)>& doppler_at,
+                   double prediction_variance_hz2, bool usable_now, double cn0_hz, double step_s, double fs_hz, receiver::VectorChannelCommand& command,
+                   VectorChannelLog& log);
 
   VectorTrackingOptions opt_;
   VectorProcessModel model_;
@@ -200,7 +224,9 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   double clock_corrections_s_ = 0.0;
   double starved_s_ = 0.0;
   int resets_ = 0, initialisations_ = 0, frequency_resets_ = 0;
+  int phase_arcs_ = 0, phase_losses_ = 0;
   std::array<PrnState, 33> prn_{};
+  std::array<VectorCarrierPhase, 33> phase_{};  // kPll, per PRN
   VectorEpochLog log_epoch_;
   std::function<void(const VectorEpochLog&)> log_;
 };

@@ -42,6 +42,8 @@ NcoCommand ReceiverChannel::merged_command() {
   cmd.code_rate_chips_per_s = vector_.code_rate_chips_per_s;
   if (vector_jump_pending_) cmd.code_phase_jump_chips = vector_.code_phase_jump_chips;
   vector_jump_pending_ = false;
+  if (vector_carrier_jump_pending_) cmd.carrier_phase_jump_cycles = vector_.carrier_phase_jump_cycles;
+  vector_carrier_jump_pending_ = false;
   return cmd;
 }
 
@@ -54,7 +56,7 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   loop_.set_filter_driven(vector_.vector && vector_.filter_driven);
   // Vector FLL: the loop's frequency is the NCO's; the channel's own carrier loop stands still.
   const bool fll = vector_.vector && vector_.carrier_commanded && std::isfinite(vector_.carrier_frequency_hz);
-  loop_.set_carrier_commanded(fll);
+  loop_.set_carrier_commanded(fll, fll && vector_.carrier_phase_locked);
   if (fll) {
     loop_.command_carrier(vector_.carrier_frequency_hz);
     last_scalar_.carrier_frequency_hz = vector_.carrier_frequency_hz;
@@ -64,6 +66,7 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
   nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
+  vector_carrier_jump_pending_ = fll && vector_.carrier_phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
   // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
   // the command already computed for the next epoch (between epochs) gets it too.
   if (fll) {
@@ -130,6 +133,10 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   in.measured_pseudorange_m = in.replica_pseudorange_mid_m - e.code_error_chips * kChip_m;
   in.measurement_first_sample = e.first_sample;
   in.replica_carrier_frequency_hz = (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * fs_hz_ / e.num_samples;
+  in.replica_carrier_phase_mid_cycles =
+      e.carrier_phase_start_cycles + (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * half / e.num_samples;
+  in.replica_carrier_phase_next_cycles =
+      replica.carrier_phase_cycles + in.carrier_frequency_hz * static_cast<double>(in.next_epoch_sample - replica.sample_index) / fs_hz_;
   if (e.noise_power > 0.0) {
     const double scale = 1.0 / std::sqrt(0.5 * e.noise_power);  // noise tap: variance 2 sigma^2 (I and Q)
     in.iq_scale = scale;
@@ -276,8 +283,11 @@ std::optional<ChannelMeasurement> ReceiverChannel::measure() {
       lock_start_sample_ ? static_cast<double>(replica.sample_index - *lock_start_sample_) / fs_hz_ : 0.0;
   m.new_track = !reported_;
   // Vector FLL: the phase is the NCO's accumulated Doppler, which drifts from the signal's by the integral of the
-  // filter's frequency error (no phase lock): every epoch carries the loss-of-lock flag.
-  m.phase_unlocked = loop_.carrier_commanded();
+  // filter's frequency error (no phase lock): every epoch carries the loss-of-lock flag. A vector PLL's phase is
+  // locked; its first epoch after unlocked ones starts a new arc (its phase was re-aligned): flagged too.
+  const bool unlocked = loop_.carrier_commanded() && !loop_.carrier_phase_locked();
+  m.phase_unlocked = unlocked || last_phase_unlocked_;
+  last_phase_unlocked_ = unlocked;
   reported_ = true;
   return m;
 }

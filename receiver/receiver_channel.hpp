@@ -63,7 +63,7 @@ struct ChannelMeasurement {
   double cn0_dbhz = 0.0;
   double lock_time_s = 0.0;
   bool new_track = false;             // first measurement of this track (RINEX loss of lock)
-  bool phase_unlocked = false;        // the carrier phase is not phase-locked (vector FLL): RINEX loss of lock
+  bool phase_unlocked = false;        // the carrier phase is not phase-locked (vector FLL), or is the first locked one after such (vector PLL re-lock): RINEX loss of lock
 };
 
 class ReceiverChannel {
@@ -162,6 +162,8 @@ class ReceiverChannel {
   bool last_epoch_new_ = false;
   VectorChannelCommand vector_;
   bool vector_jump_pending_ = false;
+  bool vector_carrier_jump_pending_ = false;  // vector PLL: carrier_phase_jump_cycles not applied yet
+  bool last_phase_unlocked_ = false;          // the previous measurement's carrier phase was not phase-locked
   double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
   int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)

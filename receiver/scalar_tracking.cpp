@@ -294,10 +294,16 @@ void ScalarTracking::set_filter_driven(bool driven) {
   loss_time_s_ = 0.0;
 }
 
-void ScalarTracking::set_carrier_commanded(bool commanded) {
-  if (commanded == carrier_commanded_) return;
+void ScalarTracking::set_carrier_commanded(bool commanded, bool phase_locked) {
+  phase_locked = commanded && phase_locked;
+  if (commanded == carrier_commanded_) {
+    if (commanded && phase_locked != carrier_phase_locked_ && bits_) bits_->set_differential(!phase_locked);
+    carrier_phase_locked_ = phase_locked;
+    return;
+  }
   carrier_commanded_ = commanded;
-  if (bits_) bits_->set_differential(commanded);
+  carrier_phase_locked_ = phase_locked;
+  if (bits_) bits_->set_differential(commanded && !phase_locked);
   block_count_ = 0;  // a partial long sum of the PLL is void either way
   if (commanded) {
     target_epochs_ = 1;

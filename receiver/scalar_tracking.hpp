@@ -216,8 +216,12 @@ class ScalarTracking final {
   // wanders by the frequency error's integral), the loss test is the C/N0 alone (the PLI reads the wandering
   // phase), and coasting ends as soon as the C/N0 is back (nothing to re-lock). Clearing it hands the carrier
   // back to the PLL from the commanded frequency (its frequency-rate state cleared, the PLI restarted).
-  void set_carrier_commanded(bool commanded);
+  // phase_locked (vector PLL, VectorChannelCommand::carrier_phase_locked): the external loop closes the phase too,
+  // so the bits are detected coherently (Costas sign, polarity from the preamble) rather than differentially;
+  // everything else as the FLL. Changing it alone switches the bit detection.
+  void set_carrier_commanded(bool commanded, bool phase_locked = false);
   bool carrier_commanded() const { return carrier_commanded_; }
+  bool carrier_phase_locked() const { return carrier_commanded_ && carrier_phase_locked_; }
   // The commanded carrier frequency (Hz), for the next command; ignored unless carrier_commanded() and bit-synced
   // or coasting.
   void command_carrier(double frequency_hz);
@@ -265,6 +269,7 @@ class ScalarTracking final {
   bool coasting_allowed_ = false, relocking_ = false;
   bool filter_driven_ = false;
   bool carrier_commanded_ = false;
+  bool carrier_phase_locked_ = false;
   PresenceMonitor presence_;
   bool presence_absent_ = false;  // the latest completed presence window ended a run of absent ones: lost
   bool presence_found_ = false;   // ... ended a run of present ones (re-lock while coasting)

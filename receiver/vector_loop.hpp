@@ -3,7 +3,8 @@
 // receiver's clock, and the replica's state; the loop answers one VectorChannelCommand per channel, which the
 // channel applies through its NcoCommand at the start of its next epoch (code rate and a code phase jump; the
 // carrier either stays with the channel's Costas PLL, aided by the loop's predicted Doppler, or, with
-// carrier_commanded, is the loop's: a vector FLL). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
+// carrier_commanded, is the loop's: a vector FLL, or with carrier_phase_locked too, a vector PLL whose phase the
+// loop closes through carrier_phase_jump_cycles). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
 #pragma once
 
 #include <array>
@@ -58,6 +59,11 @@ struct VectorChannelInput {
   std::int64_t measurement_first_sample = 0;
   double replica_carrier_frequency_hz = 0.0;
   std::array<double, 3> iq_i{}, iq_q{};  // early, prompt, late
+  // The replica carrier's accumulated phase (cycles, the NCO's: +Doppler, jumps included) at measurement_sample,
+  // and the phase it will have at next_epoch_sample if left on its current command (no new jump): a loop that
+  // closes the carrier phase (vector PLL) commands the jump between what it wants there and this.
+  double replica_carrier_phase_mid_cycles = 0.0;
+  double replica_carrier_phase_next_cycles = 0.0;
   // The factor the taps were multiplied by (1 / the running noise sigma per I or Q; 0: no noise estimate yet). That
   // estimate moves by +-16 % in power (a 0.05 average of one noise tap per epoch), and the normalised signal
   // amplitude with it: a loop estimating the amplitude averages it on the raw scale (taps / iq_scale).
@@ -104,6 +110,13 @@ struct VectorChannelCommand {
   // differentially, its lock test is the C/N0 alone, and its carrier phase is reported with loss of lock (the
   // NCO's accumulated Doppler, not a phase-locked observable).
   bool carrier_commanded = false;
+  // Vector PLL (with carrier_commanded): the loop also closes the carrier phase. carrier_phase_jump_cycles (positive
+  // advances the replica carrier) is applied once at next_epoch_sample, on top of carrier_frequency_hz; the channel
+  // detects its bits coherently (Costas: polarity from the preamble) and reports its carrier phase as locked (no
+  // RINEX loss-of-lock flag, except on the first epoch after unlocked ones). carrier_phase_locked false with
+  // carrier_commanded: the FLL above (the jump is ignored).
+  bool carrier_phase_locked = false;
+  double carrier_phase_jump_cycles = 0.0;
   // The loop's filter drives the replica and judges lock (ultra-tight): the channel's scalar loss test gives way
   // to the presence test (ScalarTracking::set_filter_driven), its PLL sums N x 20 ms with the known bits wiped
   // (pure PLL), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).

@@ -59,7 +59,7 @@ struct SigintGuard {
 struct ReceiveArgs {
   std::string input, fs, if_hz = "0", config, nav, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
-  std::string vector_carrier;  // --vector-carrier aided-pll|fll (with --coupling vector)
+  std::string vector_carrier;  // --vector-carrier aided-pll|fll|pll (with --coupling vector)
   FormatArgs format;
   ReceiveFusionArgs fusion;
   bool iq_swap = false, q_negate = false, quiet = false;
@@ -299,8 +299,9 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--reference-week", args->reference_week,
                   "full GPS week near the recording, for the 10-bit week (default: nav file or build date)");
   cmd->add_option("--vector-carrier", args->vector_carrier,
-                  "with --coupling vector: aided-pll (default: each channel's PLL, aided) or fll (the filter "
-                  "commands the carrier NCOs: vector FLL)");
+                  "with --coupling vector: aided-pll (default: each channel's PLL, aided), fll (the filter "
+                  "commands the carrier NCOs: vector FLL) or pll (the filter commands the carrier NCOs' frequency "
+                  "and phase from per-channel carrier states its Costas discriminators update: vector PLL)");
   cmd->add_flag("--iq-swap", args->iq_swap, "exchange I and Q (complex formats)");
   cmd->add_flag("--q-negate", args->q_negate, "negate Q (complex) / invert the spectrum (real IF)");
   add_receive_fusion_options(cmd, args->fusion);

@@ -10,7 +10,8 @@ namespace ultratrack::tools {
 fusion::VectorCarrier parse_vector_carrier(const std::string& text) {
   if (text == "aided-pll") return fusion::VectorCarrier::kAidedPll;
   if (text == "fll") return fusion::VectorCarrier::kFll;
-  throw io::InputError("command line", "--vector-carrier must be aided-pll or fll, got '" + text + "'");
+  if (text == "pll") return fusion::VectorCarrier::kPll;
+  throw io::InputError("command line", "--vector-carrier must be aided-pll, fll or pll, got '" + text + "'");
 }
 
 fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
@@ -34,7 +35,8 @@ ReceiveVector::ReceiveVector(const receiver::ReceiverOptions& options, const std
   channels_.stream() << "sample,time_s,prn,vector,cn0_dbhz,pr_used,pr_innovation_m,pr_sigma_m,rate_used,"
                         "rate_innovation_mps,rate_sigma_mps,measured_doppler_hz,predicted_doppler_hz,"
                         "replica_code_rate_chips_per_s,predicted_code_rate_chips_per_s,code_jump_chips,coasting,coast_s,"
-                        "predicted_sigma_chips\n";
+                        "predicted_sigma_chips,phase_tracking,phase_disc_cycles,phase_innovation_cycles,phase_sigma_cycles,"
+                        "phase_nu_hz,phase_lock,phase_bn_hz,phase_jump_cycles,measurement_sample,replica_phase_mid_cycles\n";
   state_.stream() << "sample,time_s,week,tow_s,x_m,y_m,z_m,vx_mps,vy_mps,vz_mps,clock_bias_m,clock_drift_mps,"
                      "sigma_x_m,sigma_y_m,sigma_z_m,sigma_vx_mps,sigma_vy_mps,sigma_vz_mps,sigma_bias_m,"
                      "sigma_drift_mps,used,vector\n";
@@ -48,11 +50,13 @@ void ReceiveVector::attach(receiver::ReceiverEngine& engine, double interval_s) 
 void ReceiveVector::log(const fusion::VectorEpochLog& e) {
   const double t = static_cast<double>(e.sample) / fs_hz_;
   for (const auto& c : e.channels)
-    fmt::print(channels_.stream(), "{},{:.3f},{},{:d},{:.2f},{:d},{:.3f},{:.3f},{:d},{:.4f},{:.4f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:d},{:.3f},{:.4f}\n",
+    fmt::print(channels_.stream(), "{},{:.3f},{},{:d},{:.2f},{:d},{:.3f},{:.3f},{:d},{:.4f},{:.4f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:d},{:.3f},{:.4f},{:d},{:.5f},{:.5f},{:.5f},{:.3f},{:.3f},{:.2f},{:.5f},{},{:.5f}\n",
                e.sample, t, c.prn, c.vector, c.cn0_dbhz, c.pr_used, c.pr_innovation_m, c.pr_sigma_m, c.rate_used,
                c.rate_innovation_mps, c.rate_sigma_mps, c.measured_doppler_hz, c.predicted_doppler_hz,
                c.replica_code_rate_chips_per_s, c.predicted_code_rate_chips_per_s, c.code_jump_chips, c.coasting,
-               c.coast_s, c.predicted_sigma_chips);
+               c.coast_s, c.predicted_sigma_chips, c.phase_tracking, c.phase_disc_cycles, c.phase_innovation_cycles,
+               c.phase_sigma_cycles, c.phase_nu_hz, c.phase_lock, c.phase_bn_hz, c.phase_jump_cycles, c.measurement_sample,
+               c.replica_phase_mid_cycles);
   for (const auto& c : e.channels) coasting_channel_epochs_ += c.vector && c.coasting;
   const auto& x = e.x;
   const auto& s = e.sigma;
@@ -67,9 +71,11 @@ void ReceiveVector::log(const fusion::VectorEpochLog& e) {
 
 std::string ReceiveVector::summary_json() const {
   return fmt::format("\"vector\": {{\"carrier\": \"{}\", \"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
-                     "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}, \"frequency_resets\": {}}}",
+                     "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}, \"frequency_resets\": {}, "
+                     "\"phase_arcs\": {}, \"phase_losses\": {}}}",
                      fusion::to_string(carrier_), vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_,
-                     filter_.initialisations(), filter_.resets(), filter_.frequency_resets());
+                     filter_.initialisations(), filter_.resets(), filter_.frequency_resets(), filter_.phase_arcs(),
+                     filter_.phase_losses());
 }
 
 void ReceiveVector::finish() {

@@ -1,7 +1,8 @@
 // `ultratrack receive --coupling vector`: the vector tracking filter (fusion/vector_tracking.hpp) attached to the
 // receiver engine through receiver::VectorLoop, and its logs in the output folder: vector.csv (one row per
 // channel per vector epoch: predicted vs measured Doppler and code rate, code jump, innovations and their
-// sigmas) and vector_state.csv (the filter's ECEF position/velocity, clock bias/drift and 1-sigmas).
+// sigmas; with --vector-carrier pll the carrier states: discriminator, innovation, sigma, frequency residual, lock
+// indicator, loop bandwidth, phase jump, and the replica's phase at the measured epoch's middle) and vector_state.csv (the filter's ECEF position/velocity, clock bias/drift and 1-sigmas).
 // Units: s, m, m/s, Hz, chips/s, chips.
 #pragma once
 
@@ -18,7 +19,7 @@ namespace ultratrack::tools {
 // The filter's options for a receiver configuration (the PVT's atmosphere models, the channels' E-L spacing).
 fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
                                                      fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
-// --vector-carrier's value: "aided-pll" or "fll" (InputError naming the option otherwise).
+// --vector-carrier's value: "aided-pll", "fll" or "pll" (InputError naming the option otherwise).
 fusion::VectorCarrier parse_vector_carrier(const std::string& text);
 
 class ReceiveVector {
@@ -37,7 +38,8 @@ class ReceiveVector {
   // Channel-epochs commanded while coasting (faded: from the prediction alone).
   long long coasting_channel_epochs() const { return coasting_channel_epochs_; }
   // summary.json member: "vector": {carrier mode, epochs, channel-epochs in vector mode and coasting, filter
-  // starts, resets, carrier-aiding steps of false PLL locks (frequency_resets)}.
+  // starts, resets, carrier-aiding steps of false PLL locks (frequency_resets), vector-PLL phase arcs and phase
+  // locks lost (phase_arcs, phase_losses)}.
   std::string summary_json() const;
 
  private:

@@ -275,7 +275,7 @@ TEST(ReceiveVectorFll, RejectsAnUnknownCarrierModeAndOneWithoutVectorCoupling) {
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "x.bin", std::ios::binary) << std::string(400000, '\0');
   EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6", "--coupling",
-                                   "vector", "--vector-carrier", "pll", "--out", (dir / "rx").string()}));
+                                   "vector", "--vector-carrier", "vpll", "--out", (dir / "rx").string()}));
   EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
                                    "--vector-carrier", "fll", "--out", (dir / "ry").string()}));
 }
