@@ -412,6 +412,12 @@ void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
   const double variance = costas_phase_variance_cycles2(cn0_hz, t);
   // A discriminator this epoch: a fresh, usable (not faded) epoch with normalised taps.
   const bool fresh = usable_now && ch.has_measurement && ch.integration_time_s > 0.0 && ch.iq_scale > 0.0;
+  // A faded channel (not usable: below min_cn0_dbhz, or coasting) has no discriminator to hold its phase: the arc
+  // ends at once and it is commanded as in the FLL (its phase flagged) until it re-enters after relock_after_s.
+  if (ph.active() && !usable_now) {
+    ph.stop();
+    ++phase_losses_;
+  }
   if (ph.active()) {
     if (fresh && ch.measurement_sample > ph.sample()) {
       const std::int64_t mid = (ph.sample() + ch.measurement_sample) / 2;

@@ -284,3 +284,45 @@ TEST(ReceiveVectorPll, RejectsAnUnknownCarrierMode) {
   EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
                                    "--vector-carrier", "pll", "--out", (dir / "ry").string()}));
 }
+
+// Fades (the blockage scenario of ReceiveVectorFll.ChannelsCoastThroughFadesAndReturnWithoutAcquisition: every
+// signal absent 14-17 s, PRN 24 alone 18.5-20.5 s, 22 s): a faded channel's phase arc ends at once (no
+// discriminator holds it) and it is commanded as in the FLL, coasting on the filter; back above the loss threshold
+// + 3 dB for 1 s it starts a new arc. So: no satellite acquired twice or lost, every satellite's arc lost once in
+// the blockage (PRN 24 twice), each re-entered (arcs = satellites + losses, the last fade ending 1.5 s before the
+// end), and the last epoch's phases locked again (no LLI) with fixes to the end.
+TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "gap.toml") << scenario(brdc, 100.0, 22.0,
+                                              "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
+                                              "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
+                                              "fade_s = 2.0\n");
+  const auto sim = dir / "sim", pll = dir / "pll";
+  run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});
+  receive(sim, brdc, pll, "pll");
+  fs::remove(sim / "antenna0.i8.bin");
+  const std::string summary = ultratrack::test::read_text_file(pll / "summary.json");
+  int satellites = 0;
+  for (auto at = summary.find("\"acquisitions\": "); at != std::string::npos;
+       at = summary.find("\"acquisitions\": ", at + 1)) {
+    EXPECT_EQ(std::stoi(summary.substr(at + 16)), 1);
+    ++satellites;
+  }
+  EXPECT_GE(satellites, 8);
+  EXPECT_EQ(total_losses(pll), 0);
+  const int losses = summary_int(pll, "phase_losses"), arcs = summary_int(pll, "phase_arcs");
+  std::printf("fades, vector PLL: %d satellites, %d phase arcs, %d phase losses\n", satellites, arcs, losses);
+  EXPECT_EQ(losses, satellites + 1);
+  EXPECT_EQ(arcs, satellites + losses);
+  std::ifstream obs(pll / "observations.rnx");
+  std::vector<char> lli;
+  bool header = true;
+  for (std::string line; std::getline(obs, line);) {
+    if (header) header = line.find("END OF HEADER") == std::string::npos;
+    else if (line.rfind(">", 0) == 0) lli.clear();
+    else if (line.size() >= 35) lli.push_back(line[19 + 14]);
+  }
+  EXPECT_EQ(static_cast<int>(lli.size()), satellites);
+  for (char c : lli) EXPECT_EQ(c, ' ');
+}
