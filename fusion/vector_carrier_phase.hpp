@@ -43,8 +43,9 @@ namespace ultratrack::fusion {
 
 struct VectorPllOptions {
   // nu's driving noise, Hz^2/s (random-walk part), and its correlation time (it decays to the prediction when no
-  // discriminator updates it). 0.5 Hz^2/s: the loop's natural frequency ~33 rad/s at 45 dB-Hz, enough to take a
-  // 2 g turn entry (the prediction's lag grows to ~4.6 Hz within ~50 ms) at a ~0.06-cycle peak.
+  // discriminator updates it). 0.5 Hz^2/s: with the prediction's variance, a loop of Bn ~13 Hz (w0 ~ 24 rad/s) at
+  // 45 dB-Hz and ~6 Hz at 30, which takes a 2 g turn entry (the prediction's lag grows to ~4.6 Hz within ~50 ms)
+  // at a ~0.1-cycle peak (measured 0.125, ReceiveVectorPll.TwoGTurnKeepsEveryPhaseArcWithoutSlips).
   double frequency_psd_hz2ps = 0.5;
   double frequency_correlation_s = 2.0;
   double initial_sigma_frequency_hz = 1.0;  // nu at the hand-over (from the measured minus predicted Doppler)

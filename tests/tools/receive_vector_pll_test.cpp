@@ -251,9 +251,9 @@ TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitt
 // acceleration state: the vector FLL's 2.7 Hz RMS, 5.6 Hz max NCO error); the carrier states' frequency residual
 // takes the lag up, at a transient phase error. Bounds: no phase lock lost, no satellite lost, every arc kept;
 // no epoch beyond 0.2 cycles from its arc's mean (a Costas slip needs 0.25, and leaves a 0.5-cycle step); the RMS
-// over 14-20 s within 0.03 cycles (a second-order loop of ~12 Hz, w0 ~ 33 rad/s, takes a 4.6 Hz frequency step
-// at a peak of ~0.5 x 4.6 / 33 = 0.07 cycles decaying within ~0.1 s, and the straight second and the 5 s of
-// turn at the static level, 0.01 cycles). NCO Doppler within the FLL's (the residual removes the lag): RMS below
+// over 14-20 s within 0.03 cycles (a second-order loop of ~13 Hz, w0 ~ 24 rad/s, takes a 4.6 Hz frequency step
+// at a peak of ~0.5 x 4.6 / 24 = 0.1 cycles decaying within ~0.15 s, and the straight second and the rest of the
+// turn near the static level, 0.01 cycles). NCO Doppler within the FLL's (the residual removes the lag): RMS below
 // half the FLL's.
 TEST(ReceiveVectorPll, TwoGTurnKeepsEveryPhaseArcWithoutSlips) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
