@@ -46,8 +46,10 @@ struct ImuTimeOrigin {
 // The command-line text of the fusion options (parsed by parse_receive_fusion).
 struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement;
-  bool ut_serial = false;     // --ut-serial
-  bool ut_pipelined = false;  // --ut-pipelined (the default; accepted so that older command lines still run)
+  bool ut_serial = false;  // --ut-serial
+  // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
+  bool ut_pipelined = true;
+  const CLI::Option* ut_pipelined_option = nullptr;  // set by add_receive_fusion_options: was it given?
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 

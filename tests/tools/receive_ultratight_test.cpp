@@ -338,7 +338,7 @@ TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
 
 // Serial (--ut-serial): the loop runs on the engine's caller thread after the channels' parallel work: the same
 // bytes for one thread and two. The latency is real: its commands, and so its log, differ from the pipelined
-// loop's.
+// loop's. --ut-pipelined=false selects it too.
 TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipelined) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto text = outputs_by_thread_count("rx_serial_threads", {"--ut-serial"});
@@ -350,6 +350,12 @@ TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipeli
   args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", "2"});
   test_support::run_command("receive", args);
   EXPECT_FALSE(test::read_text_file(rx / "ultratight.csv") == text[0][0]);
+  // --ut-pipelined=false is --ut-serial.
+  const auto rx_false = sim().dir / "rx_pipelined_false";
+  auto args_false = receive_args(rx_false);
+  args_false.insert(args_false.end(), {"--coupling", "ultra-tight", "--threads", "2", "--ut-pipelined=false"});
+  test_support::run_command("receive", args_false);
+  EXPECT_TRUE(test::read_text_file(rx_false / "ultratight.csv") == text[0][0]) << "--ut-pipelined=false is not serial";
 }
 
 TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
