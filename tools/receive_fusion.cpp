@@ -98,27 +98,38 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
                   "the GPS time of week) or a GPS time of week in seconds");
   cmd->add_option("--ut-measurement", a.ut_measurement,
                   "with --coupling ultra-tight: iq (default: the E/P/L I&Q, seed 001 eqs. 11-17) or discriminator");
-  cmd->add_flag("--ut-pipelined", a.ut_pipelined,
-                "with --coupling ultra-tight: run the loop beside the correlation of the next block (faster with 2 "
-                "or more threads; its commands reach the channels 20 ms later; the same output for any --threads)");
+  cmd->add_flag("--ut-serial", a.ut_serial,
+                "with --coupling ultra-tight: run the loop between blocks, its commands at once (by default it runs "
+                "beside the correlation of the next block, its commands reaching the channels one 20 ms loop "
+                "period later: faster with 2 or more threads; either way the same output for any --threads)");
+  a.ut_pipelined_option =
+      cmd->add_flag("--ut-pipelined", a.ut_pipelined,
+                    "with --coupling ultra-tight: the pipelined loop, which is the default (kept for older command "
+                    "lines; --ut-pipelined=false is --ut-serial)");
 }
 
 std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& a) {
   ReceiveFusionSettings s;
+  const bool pipelined_given = a.ut_pipelined_option && a.ut_pipelined_option->count() > 0;
   s.coupling = parse_receive_coupling(a.coupling);
   if (s.coupling == ReceiveCoupling::Scalar || s.coupling == ReceiveCoupling::Vector) {
     if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
       throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
                                            "--coupling loose, tight or ultra-tight");
     if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
-    if (a.ut_pipelined) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
+    if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
+    if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
     return std::nullopt;
   }
   if (!a.ut_measurement.empty() && s.coupling != ReceiveCoupling::UltraTight)
     throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
-  if (a.ut_pipelined && s.coupling != ReceiveCoupling::UltraTight)
+  if (a.ut_serial && s.coupling != ReceiveCoupling::UltraTight)
+    throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
+  if (pipelined_given && s.coupling != ReceiveCoupling::UltraTight)
     throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
-  s.ut_pipelined = a.ut_pipelined;
+  if (a.ut_serial && pipelined_given && a.ut_pipelined)
+    throw io::InputError("command line", "--ut-serial and --ut-pipelined exclude each other");
+  s.ut_pipelined = a.ut_pipelined && !a.ut_serial;
   if (a.ut_measurement.empty() || a.ut_measurement == "iq") {
     s.ut_form = fusion::UltraTightForm::Iq;
   } else if (a.ut_measurement == "discriminator") {

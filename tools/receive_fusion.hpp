@@ -46,7 +46,10 @@ struct ImuTimeOrigin {
 // The command-line text of the fusion options (parsed by parse_receive_fusion).
 struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement;
-  bool ut_pipelined = false;
+  bool ut_serial = false;  // --ut-serial
+  // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
+  bool ut_pipelined = true;
+  const CLI::Option* ut_pipelined_option = nullptr;  // set by add_receive_fusion_options: was it given?
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 
@@ -58,9 +61,11 @@ struct ReceiveFusionSettings {
   std::string imu_file;
   ImuTimeOrigin time_origin;
   fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;  // --ut-measurement iq|discriminator
-  // --ut-pipelined: the loop runs beside the next block's correlation (receiver::ReceiverEngine::set_vector_loop),
-  // its commands one 20 ms vector epoch later.
-  bool ut_pipelined = false;
+  // Ultra-tight only. Pipelined (the default): the loop runs beside the next block's correlation
+  // (receiver::ReceiverEngine::set_vector_loop), its commands one 20 ms vector epoch later, as a real-time
+  // receiver runs its navigation filter concurrently with the correlators. --ut-serial: the loop runs on the
+  // caller between blocks, its commands at the epoch that produced them (slower with 2 or more threads).
+  bool ut_pipelined = true;
 };
 
 // Checks and parses the options (InputError naming the option or the configuration file). Nothing for

@@ -375,9 +375,10 @@ void ReceiveUltraTight::finish(std::int64_t end_sample) {
 std::string ReceiveUltraTight::summary_json() const {
   const ReceiveFusionSettings& s = fusion_.settings();
   std::string j = fmt::format(
-      "\"ultratight\": {{\"filter\": \"{}\", \"measurement\": \"{}\", \"handed_over\": {}",
+      "\"ultratight\": {{\"filter\": \"{}\", \"measurement\": \"{}\", \"handed_over\": {}, \"loop\": \"{}\"",
       s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf",
-      s.ut_form == fusion::UltraTightForm::Iq ? "iq" : "discriminator", driver_.has_value());
+      s.ut_form == fusion::UltraTightForm::Iq ? "iq" : "discriminator", driver_.has_value(),
+      s.ut_pipelined ? "pipelined" : "serial");
   if (!driver_) return j + "}";
   long long channels = 0;
   for (const auto& [prn, st] : channels_) channels += st.ever;

@@ -6,8 +6,9 @@
 // over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
 // loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
 // signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
-// UKF + discriminators both, and both again with the pipelined loop (--ut-pipelined: its commands 20 ms later);
-// the same bytes with one thread and two (pipelined or not). Bad option combinations give one InputError.
+// UKF + discriminators both with the default pipelined loop (its commands one 20 ms period later), and both again
+// with the serial loop (--ut-serial); the same bytes with one thread and two (either loop). Bad option combinations
+// give one InputError.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -158,13 +159,14 @@ double prompt_i_innovation_variance(const fs::path& rx, double t0, double t1, in
 
 void check_run(const std::string& filter, const std::string& form, const std::vector<std::string>& extra = {}) {
   const auto rx = sim().dir / ("rx_" + filter + "_" + form + (extra.empty() ? "" : "_" + extra.front().substr(2)));
+  const bool serial = std::find(extra.begin(), extra.end(), "--ut-serial") != extra.end();
   auto args = receive_args(rx);
   args.insert(args.end(), {"--coupling", "ultra-tight", "--filter", filter, "--ut-measurement", form});
   args.insert(args.end(), extra.begin(), extra.end());
   test_support::run_command("receive", args);
   const std::string summary = test::read_text_file(rx / "summary.json");
   ASSERT_NE(summary.find("\"ultratight\": {\"filter\": \"" + filter + "\", \"measurement\": \"" + form +
-                         "\", \"handed_over\": true"),
+                         "\", \"handed_over\": true, \"loop\": \"" + (serial ? "serial" : "pipelined") + "\""),
             std::string::npos)
       << summary;
   const double handover_s = json_number(summary, "handover_t_s");
@@ -266,8 +268,8 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
     EXPECT_LT(v, 1.3);
   }
   const NavError e = nav_error(rx, handover_s + 0.5);
-  std::printf("ultra-tight %s %s: hand-over %.2f s, %zu channels, nav 3-D RMS %.3f m (stated %.3f m) over %d rows\n",
-              filter.c_str(), form.c_str(), handover_s, handed.size(), e.rms_m, e.sigma_m, e.rows);
+  std::printf("ultra-tight %s %s %s: hand-over %.2f s, %zu channels, nav 3-D RMS %.3f m (stated %.3f m) over %d rows\n",
+              filter.c_str(), form.c_str(), serial ? "serial" : "pipelined", handover_s, handed.size(), e.rms_m, e.sigma_m, e.rows);
   EXPECT_GE(e.rows, 500);
   EXPECT_LT(e.rms_m, 2.0);
   EXPECT_LT(e.rms_m, 3.0 * e.sigma_m);
@@ -275,9 +277,27 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
 
 }  // namespace
 
+// The default loop is pipelined: job 0 of the next block's correlation, its commands one 20 ms vector epoch later.
+// The lock, coasting, re-lock, NIS and accuracy checks hold with that latency.
 TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ekf", "iq");
+}
+
+TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ukf", "discriminator");
+}
+
+// The serial loop (--ut-serial: on the caller between blocks, its commands at once) passes the same checks.
+TEST(ReceiveUltraTight, SerialEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ekf", "iq", {"--ut-serial"});
+}
+
+TEST(ReceiveUltraTight, SerialUkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  check_run("ukf", "discriminator", {"--ut-serial"});
 }
 
 namespace {
@@ -300,45 +320,42 @@ std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::str
 
 }  // namespace
 
-// The loop runs on the engine's caller thread after the channels' parallel work: one thread gives the same bytes.
+// Pipelined (the default): every thread count runs the same jobs on the same inputs (--threads 1 runs the loop's
+// job in turn): the same bytes.
 TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto text = outputs_by_thread_count("rx_threads", {});
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
+  // --ut-pipelined names the default: the same bytes.
+  const auto rx = sim().dir / "rx_pipelined_flag";
+  auto args = receive_args(rx);
+  args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", "2", "--ut-pipelined"});
+  test_support::run_command("receive", args);
+  EXPECT_TRUE(test::read_text_file(rx / "ultratight.csv") == text[0][0]) << "--ut-pipelined is not the default";
 }
 
-// Pipelined (--ut-pipelined): the loop runs beside the workers' correlation of the next block, its commands one
-// 20 ms vector epoch later; every thread count runs the same jobs on the same inputs: the same bytes. The lock,
-// coasting, re-lock, NIS and accuracy checks of the unpipelined runs hold with the added latency.
-TEST(ReceiveUltraTight, PipelinedOneThreadAndTwoGiveTheSameBytes) {
+// Serial (--ut-serial): the loop runs on the engine's caller thread after the channels' parallel work: the same
+// bytes for one thread and two. The latency is real: its commands, and so its log, differ from the pipelined
+// loop's. --ut-pipelined=false selects it too.
+TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipelined) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
-  const auto text = outputs_by_thread_count("rx_pipelined_threads", {"--ut-pipelined"});
+  const auto text = outputs_by_thread_count("rx_serial_threads", {"--ut-serial"});
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
-  // The latency is real: the commands, and so the log, differ from the unpipelined loop's.
-  const auto rx = sim().dir / "rx_unpipelined";
+  const auto rx = sim().dir / "rx_pipelined_default";
   auto args = receive_args(rx);
   args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", "2"});
   test_support::run_command("receive", args);
   EXPECT_FALSE(test::read_text_file(rx / "ultratight.csv") == text[0][0]);
-}
-
-TEST(ReceiveUltraTight, PipelinedEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
-  check_run("ekf", "iq", {"--ut-pipelined"});
-}
-
-TEST(ReceiveUltraTight, PipelinedUkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
-  check_run("ukf", "discriminator", {"--ut-pipelined"});
-}
-
-TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
-  check_run("ukf", "discriminator");
+  // --ut-pipelined=false is --ut-serial.
+  const auto rx_false = sim().dir / "rx_pipelined_false";
+  auto args_false = receive_args(rx_false);
+  args_false.insert(args_false.end(), {"--coupling", "ultra-tight", "--threads", "2", "--ut-pipelined=false"});
+  test_support::run_command("receive", args_false);
+  EXPECT_TRUE(test::read_text_file(rx_false / "ultratight.csv") == text[0][0]) << "--ut-pipelined=false is not serial";
 }
 
 TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
@@ -363,6 +380,12 @@ TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
                "--ut-measurement needs --coupling ultra-tight");
   expect_error("form_scalar", {"--ut-measurement", "iq"}, "--ut-measurement needs --coupling ultra-tight");
   expect_error("pipelined_scalar", {"--ut-pipelined"}, "--ut-pipelined needs --coupling ultra-tight");
+  expect_error("serial_scalar", {"--ut-serial"}, "--ut-serial needs --coupling ultra-tight");
+  expect_error("serial_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-serial"},
+               "--ut-serial needs --coupling ultra-tight");
+  expect_error("serial_and_pipelined", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight",
+                                        "--ut-serial", "--ut-pipelined"},
+               "--ut-serial and --ut-pipelined exclude each other");
   expect_error("pipelined_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-pipelined"},
                "--ut-pipelined needs --coupling ultra-tight");
   expect_error("bad_form", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement",
