@@ -363,9 +363,10 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       // A weak channel's PLL held off the prediction for doppler_bias_average_s (a false lock): its aiding steps by
       // the mean offset once, which moves the PLL's frequency onto the prediction (the channel adds each change of
       // the aiding to its PLL); the offset is kept in later commands, so it acts once.
-      // (The lower of the estimate and its mean, as for the weights: the linear mean alone stays above 35 dB-Hz for 2.3 s
-      // after a step from 45 to 22 dB-Hz.)
-      const double low_cn0 = std::isfinite(ch.cn0_dbhz) ? std::min(ratio_hz(ch.cn0_dbhz), st.cn0_mean_hz) : st.cn0_mean_hz;
+      // (The lower of the estimate and its mean, as for the weights: the linear mean alone stays above 35 dB-Hz
+      // for 2.3 s after a step from 45 to 22 dB-Hz.)
+      const double low_cn0 =
+          std::isfinite(ch.cn0_dbhz) ? std::min(ratio_hz(ch.cn0_dbhz), st.cn0_mean_hz) : st.cn0_mean_hz;
       if (opt_.carrier_aiding && low_cn0 < ratio_hz(opt_.false_lock_below_dbhz) &&
           std::abs(st.doppler_bias_hz) > opt_.false_lock_hz &&
           st.doppler_epochs * step_s >= opt_.doppler_bias_average_s) {
