@@ -29,7 +29,8 @@
 # 2.6 MHz on one core. Files are deleted after their receive unless --keep. --reuse: a file kept by an earlier
 # --keep run in the same --out (same level, file number and options: the same seed and content) is received
 # again instead of simulated (e.g. a further coupling on the same files); runs.csv and positions.csv are
-# appended to, not restarted.
+# appended to, not restarted. A file and coupling received again (e.g. the same --out with a larger --files)
+# replaces its earlier rows in runs.csv, positions.csv and nav_positions.csv instead of counting twice.
 #
 # Issue 7's protocol (--strong-s T0 > 0): every file is T0 + DURATION s long, all satellites at --strong-cn0
 # (45 dB-Hz) for the first T0 s, so that acquisition, bit and frame sync and a vector hand-over complete, then a
@@ -76,7 +77,7 @@ while [ $# -gt 0 ]; do
     --keep) keep=1; shift ;;
     --reuse) reuse=1; keep=1; shift ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
-    -h|--help) sed -n '2,52p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,51p' "$0"; exit 0 ;;
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -194,6 +195,20 @@ TOML
         esac
       fi
       rx=$out/$name${label:+.$label}.rx
+      if [ "$reuse" = 1 ]; then
+        # --reuse: drop this file's and coupling's earlier rows (a second receive would count it twice).
+        python3 - "$name" "$label" "$runs" "$positions" "$out/nav_positions.csv" <<'PY'
+import os, sys
+name, label = sys.argv[1:3]
+for path, coupling_col in zip(sys.argv[3:], (6, 2, 2)):  # runs.csv: coupling last; the others: third
+    if not os.path.exists(path):
+        continue
+    lines = open(path).read().splitlines()
+    keep = [lines[0]] + [l for l in lines[1:] if not (l.split(",")[1] == name and l.split(",")[coupling_col] == label)]
+    if len(keep) != len(lines):
+        open(path, "w").write("\n".join(keep) + "\n")
+PY
+      fi
       rm -rf "$rx"
       rc=0
       # shellcheck disable=SC2086
