@@ -50,6 +50,8 @@ NcoCommand ReceiverChannel::merged_command() {
 void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   const bool was_vector = vector_.vector;
   vector_ = command;
+  // Held until the next measurement (commands come every 20 ms, measurements at the observation rate).
+  if (vector_.vector && vector_.carrier_slip) carrier_slip_pending_ = true;
   if (vector_.vector && loop_.state() != TrackingState::kBitSynced && !loop_.coasting()) vector_ = {};
   // Only a channel whose replica the vector loop drives may coast; dropped from it while coasting, it is lost.
   loop_.allow_coasting(vector_.vector);
@@ -286,7 +288,9 @@ std::optional<ChannelMeasurement> ReceiverChannel::measure() {
   // filter's frequency error (no phase lock): every epoch carries the loss-of-lock flag. A vector PLL's phase is
   // locked; its first epoch after unlocked ones starts a new arc (its phase was re-aligned): flagged too.
   const bool unlocked = loop_.carrier_commanded() && !loop_.carrier_phase_locked();
-  m.phase_unlocked = unlocked || last_phase_unlocked_;
+  // A slip the vector loop reported (VectorChannelCommand::carrier_slip) flags this epoch's phase as well.
+  m.phase_unlocked = unlocked || last_phase_unlocked_ || carrier_slip_pending_;
+  carrier_slip_pending_ = false;
   last_phase_unlocked_ = unlocked;
   reported_ = true;
   return m;

@@ -164,6 +164,7 @@ class ReceiverChannel {
   bool vector_jump_pending_ = false;
   bool vector_carrier_jump_pending_ = false;  // vector PLL: carrier_phase_jump_cycles not applied yet
   bool last_phase_unlocked_ = false;          // the previous measurement's carrier phase was not phase-locked
+  bool carrier_slip_pending_ = false;         // a vector command said carrier_slip since the last measurement
   double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
   int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)

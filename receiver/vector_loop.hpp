@@ -117,6 +117,10 @@ struct VectorChannelCommand {
   // carrier_commanded: the FLL above (the jump is ignored).
   bool carrier_phase_locked = false;
   double carrier_phase_jump_cycles = 0.0;
+  // The loop judges the channel's carrier phase not to follow the signal now (an aided PLL run away from the
+  // predicted Doppler, or just stepped back onto it: tools/receive_ultratight.hpp, CarrierRunawayMonitor): the
+  // channel's next measurement carries the loss-of-lock flag (RINEX LLI, Hatch smoother restart), as a cycle slip.
+  bool carrier_slip = false;
   // The loop's filter drives the replica and judges lock (ultra-tight): the channel's scalar loss test gives way
   // to the presence test (ScalarTracking::set_filter_driven), its PLL sums N x 20 ms with the known bits wiped
   // (pure PLL), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).

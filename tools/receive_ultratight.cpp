@@ -34,7 +34,8 @@ ReceiveUltraTight::ReceiveUltraTight(ReceiveFusion& fusion, const receiver::Rece
   log_.stream() << "sample,time_s,prn,synchronised,ultratight,coasting,coast_s,cn0_dbhz,measured_pseudorange_m,"
                    "predicted_pseudorange_m,measured_doppler_hz,predicted_doppler_hz,replica_carrier_hz,"
                    "replica_code_rate_chips_per_s,predicted_code_rate_chips_per_s,code_jump_chips,updated,accepted,"
-                   "nis,innovation_1,innovation_2,innovation_3,innovation_4,innovation_5,innovation_6\n";
+                   "nis,innovation_1,innovation_2,innovation_3,innovation_4,innovation_5,innovation_6,carrier_offset_hz,"
+                   "carrier_runaway\n";
 }
 
 void ReceiveUltraTight::attach(receiver::ReceiverEngine& engine) {
@@ -139,6 +140,16 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
     if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
     if (!(in.iq_scale > 0.0)) continue;  // no noise estimate
+    const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
+    const double t_start_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz;
+    // A channel whose PLL ran away from the prediction correlates mostly noise against a replica carrier tens of
+    // Hz off the signal; the I&Q (and discriminator) model takes that replica carrier as given and reads the
+    // difference as the filter's Doppler error (16-34 Hz innovations were accepted: docs/validation.md), so its
+    // correlations are left out until it is back.
+    if (runaway_check(in, t_start_s + half_s)) {
+      ++runaway_left_out_;
+      continue;
+    }
     ++measurements_;
     fusion::ChannelCorrelation c;
     c.prn = in.prn;
@@ -180,14 +191,51 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     if (known) ++known_bits_;
     if (!c.data_wiped) ++not_wiped_;
     // The replica that ran over this epoch: code pseudorange (continuous clock) and the PLL's carrier rate.
-    const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
     c.has_replica = true;
     c.replica_range_rate_mps = -kLambda_m * in.replica_carrier_frequency_hz;
-    c.replica_t_start_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz;
+    c.replica_t_start_s = t_start_s;
     c.replica_pseudorange_m = in.replica_pseudorange_mid_m + shift_m - c.replica_range_rate_mps * half_s;
     out.push_back(c);
   }
   return out;
+}
+
+// The filter's predicted Doppler of a satellite at IMU time t_s: linear through the starts of the open period's
+// replica and the one before (the measured epoch of a pipelined loop may start in the period before). NaN: none.
+double ReceiveUltraTight::predicted_doppler_at(int prn, double t_s) const {
+  const auto cur = period_replicas_.find(prn);
+  if (cur == period_replicas_.end()) return NAN;
+  const double f1 = cur->second.nco.carrier_frequency_hz, t1 = cur->second.t_start_s;
+  const auto prev = previous_replicas_.find(prn);
+  if (prev == previous_replicas_.end() || !(t1 - prev->second.t_start_s > 1e-6)) return f1;
+  const double f0 = prev->second.nco.carrier_frequency_hz, t0 = prev->second.t_start_s;
+  return f1 + (f1 - f0) / (t1 - t0) * (t_s - t1);
+}
+
+// Carrier runaway of one channel with a 20 ms measurement (t_mid_s: its middle, IMU time); returns whether the
+// channel is judged off its signal (its correlations are then not used). Only a commanded, not coasting channel
+// below runaway_below_dbhz is checked; anything else starts the monitor afresh. A 1 s mean beyond runaway_hz sets
+// the aiding step (sent with the next command) and keeps the channel off until a later 1 s mean is within it.
+bool ReceiveUltraTight::runaway_check(const receiver::VectorChannelInput& in, double t_mid_s) {
+  ChannelState& st = channels_[in.prn];
+  st.last_offset_hz = in.replica_carrier_frequency_hz - predicted_doppler_at(in.prn, t_mid_s);
+  if (!st.commanded || in.coasting || !(in.cn0_dbhz < ut_.runaway_below_dbhz)) {
+    st.runaway.reset();
+    st.runaway_off = false;
+    st.pending_step_hz = 0.0;
+    return false;
+  }
+  if (st.runaway.add(st.last_offset_hz, ut_.period_s, ut_.runaway_average_s)) {
+    const double mean = st.runaway.mean_hz();
+    st.runaway_off = std::abs(mean) > ut_.runaway_hz;
+    if (st.runaway_off) {
+      st.pending_step_hz = -st.runaway.recent_hz();
+      // The step reaches the PLL with the next command (a pipelined one a period later) and shows in the
+      // measurement after that: 3 epochs are left out of the next mean.
+      st.runaway.reset(3);
+    }
+  }
+  return st.runaway_off;
 }
 
 // The change of each satellite's predicted Doppler over the period just ended caused by the INS propagation alone
@@ -228,6 +276,7 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
   for (const auto& u : driver_->last_updates()) updates[u.prn] = &u;
   std::map<int, fusion::ReplicaCommand> previous;
   previous.swap(period_replicas_);
+  previous_replicas_ = previous;
   for (const auto& r : driver_->replicas()) period_replicas_[r.prn] = r;
   int commanded = 0;
   // The epoch's ultratight.csv rows, formatted into one buffer and written at once (fmt::print on the stream
@@ -286,6 +335,15 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
           st.aid_hz = r.nco.carrier_frequency_hz;  // joins (the channel only uses changes of it)
         else
           st.aid_hz += change->second;
+        // Carrier runaway: the aiding steps once by minus the offset of the last 5 epochs, which the channel adds to its PLL's
+        // frequency (ScalarTracking::aid_frequency), putting it back on the prediction; the phase is flagged while
+        // the channel is judged off (its phase is not the signal's, and the step starts a new arc).
+        if (st.pending_step_hz != 0.0) {
+          st.aid_hz += st.pending_step_hz;
+          st.pending_step_hz = 0.0;
+          ++runaway_recentres_;
+        }
+        commands[i].carrier_slip = st.runaway_off;
         commands[i].carrier_frequency_hz = st.aid_hz;
         // Pipelined, the aid reaches the PLL one period later: lead it by the period's change (the propagated
         // Doppler's ramp continued; 10 Hz per period in the 10 g turn, which lagging cost lock there).
@@ -297,6 +355,11 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
       }
     }
     if (st.commanded && !vector) ++releases_;
+    if (!vector) {
+      st.runaway.reset();
+      st.runaway_off = false;
+      st.pending_step_hz = 0.0;
+    }
     st.ever = st.ever || vector;
     st.commanded = vector;
     const auto u = updates.find(in.prn);
@@ -310,7 +373,8 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
                up ? up->nis : NAN);
     for (int k = 0; k < 6; ++k)
       fmt::format_to(std::back_inserter(rows), ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
-    rows.push_back('\n');
+    fmt::format_to(std::back_inserter(rows), ",{:.3f},{:d}\n", in.has_measurement ? st.last_offset_hz : NAN,
+                   vector && st.runaway_off);
   }
   log_.stream().write(rows.data(), static_cast<std::streamsize>(rows.size()));
   if (commanded > 0) ++vector_epochs_;
@@ -342,6 +406,7 @@ void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
   if (t_k > fusion_.imu().back().t_s + 1e-9 && t_k <= fusion_.imu().back().t_s + 0.1) return;
   feed_imu_to(t_k);
   const std::map<int, double> aid_change = propagated_doppler_change();
+  for (auto& [prn, st] : channels_) st.last_offset_hz = NAN;  // set again by this epoch's measurements
   if (period_open_) driver_->finish_period(correlations(epoch, t_k));
   // Sets decoded since the hand-over (the engine appends them): a satellite without one at the hand-over, or a new
   // IODE, is predicted from them from this period on (each from the set valid at its transmit time).
@@ -387,10 +452,11 @@ std::string ReceiveUltraTight::summary_json() const {
   j += fmt::format(", \"handover_t_s\": {:.3f}, \"handover_sample\": {}, \"end_t_s\": {:.3f}, \"channels_handed_over\": {}, "
                    "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
                    "\"releases\": {}, \"measurements\": {}, \"known_bits\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
-                   "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}, \"aided_only_satellite_periods\": {}",
+                   "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}, \"aided_only_satellite_periods\": {}, "
+                   "\"carrier_recentres\": {}, \"runaway_left_out\": {}",
                    handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_,
                    coasting_channel_epochs_, relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates,
-                   k.accepted, k.rejected, k.coasting, k.aided_only);
+                   k.accepted, k.rejected, k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_);
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
                    "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
                    o.sigma_pos_ned_m.x(), o.sigma_pos_ned_m.y(), o.sigma_pos_ned_m.z(), o.sigma_clock_bias_m,
@@ -405,11 +471,11 @@ std::string ReceiveUltraTight::report() const {
   for (const auto& [prn, st] : channels_) channels += st.ever;
   return fmt::format("receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
                      "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
-                     "satellite-periods aided only (below the measurement mask) {}",
+                     "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}",
                      fusion_.settings().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
                      fusion_.settings().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
                      handover_t_s_, channels, channel_epochs_, coasting_channel_epochs_, relocks_, releases_,
-                     k.accepted, k.rejected, k.aided_only);
+                     k.accepted, k.rejected, k.aided_only, runaway_recentres_);
 }
 
 }  // namespace ultratrack::tools

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -38,6 +39,62 @@ struct ReceiveUltraTightOptions {
   // PVT's mask update the filter (fusion::UltraTightOptions::measurement_mask_rad). Between the two masks a
   // channel is "aided only": its replica follows the prediction, its correlations are not used.
   double command_mask_deg = 5.0;
+  // Carrier runaway (a weak channel's aided PLL off its signal: CarrierRunawayMonitor). Below runaway_below_dbhz
+  // (the channel's C/N0 estimate) the 1 s mean of replica carrier minus the filter's predicted Doppler is checked;
+  // above runaway_hz the channel's correlations are left out of the filter until a later 1 s mean is within it,
+  // its aiding steps once by minus that mean (its PLL back onto the prediction), and its carrier phase is reported
+  // with loss of lock. Why 5 Hz: 1 s means of the 16-18 dB-Hz threshold runs' channels that never ran away
+  // (13,702 channel-seconds, 27 runs, straight and circle): median 0.26 Hz, 99.9 % 3.41 Hz, largest 4.73 Hz;
+  // the 11 runaway channels reached 12-137 Hz (docs/validation.md). Strong channels are left alone: there the PLL
+  // follows the signal and the prediction, not the PLL, is what lags (10 g turn).
+  double runaway_below_dbhz = 30.0;
+  double runaway_average_s = 1.0;
+  double runaway_hz = 5.0;
+};
+
+// One channel's carrier against the filter's prediction: block means over average_s of (replica carrier - predicted
+// Doppler), Hz. add() returns true when a block completes; mean_hz() is then its mean, recent_hz() the mean of the
+// last kRecent epochs (where the PLL is now: a runaway PLL drifts by up to 10-25 Hz/s, so the 1 s mean lags the
+// carrier by several Hz, and a step by it left cn0_18_file_0's PRN 18 running away for 58 s; on a locked channel
+// at 18 dB-Hz one epoch's offset has a 0.46 Hz standard deviation: 9 channels, 26,456 epochs). reset() starts a new block
+// (after a step of the aiding, a re-lock, or a strong epoch), skipping the next `settle` epochs (a pipelined
+// command reaches the channel one period late).
+class CarrierRunawayMonitor {
+ public:
+  bool add(double offset_hz, double period_s, double average_s) {
+    if (!std::isfinite(offset_hz)) return false;
+    if (settle_ > 0) {
+      --settle_;
+      return false;
+    }
+    sum_ += offset_hz;
+    ++n_;
+    recent_[next_++ % kRecent] = offset_hz;
+    if (static_cast<double>(n_) * period_s < average_s - 1e-9) return false;
+    mean_hz_ = sum_ / n_;
+    sum_ = 0.0;
+    n_ = 0;
+    return true;
+  }
+  void reset(int settle = 0) {
+    sum_ = 0.0;
+    n_ = 0;
+    next_ = 0;
+    settle_ = settle;
+  }
+  double mean_hz() const { return mean_hz_; }
+  double recent_hz() const {
+    const int n = std::min(next_, kRecent);
+    double s = 0.0;
+    for (int k = 0; k < n; ++k) s += recent_[k];
+    return n > 0 ? s / n : mean_hz_;
+  }
+
+ private:
+  static constexpr int kRecent = 5;
+  double sum_ = 0.0, mean_hz_ = 0.0;
+  std::array<double, kRecent> recent_{};
+  int n_ = 0, settle_ = 0, next_ = 0;
 };
 
 // The I&Q model's signal power of one channel from the prompt taps: running means of I_P^2 + Q_P^2 on the raw
@@ -87,6 +144,12 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
     double aid_hz = NAN;  // the carrier aiding sent (changes by the INS propagation only)
     // The command sent last (vector): a pipelined loop's is still pending when the next inputs are taken.
     double sent_code_rate_chips_per_s = 0.0, sent_jump_chips = 0.0;
+    // Carrier runaway (ReceiveUltraTightOptions::runaway_hz): the monitor, whether the channel is judged off its
+    // signal now (left out of the filter, its phase flagged), and the aiding step still to send (Hz).
+    CarrierRunawayMonitor runaway;
+    bool runaway_off = false;
+    double pending_step_hz = 0.0;
+    double last_offset_hz = NAN;  // the latest epoch's replica minus predicted Doppler (ultratight.csv)
   };
   void start(const receiver::VectorEpochInput& epoch, double t_k);
   double imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const;
@@ -94,6 +157,8 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   void emit_nav();
   std::vector<fusion::ChannelCorrelation> correlations(const receiver::VectorEpochInput& epoch, double t_k);
   std::map<int, double> propagated_doppler_change();
+  double predicted_doppler_at(int prn, double t_s) const;
+  bool runaway_check(const receiver::VectorChannelInput& in, double t_mid_s);
   void command(const receiver::VectorEpochInput& epoch, double t_k, std::span<receiver::VectorChannelCommand> out,
                const std::map<int, double>& aid_change);
 
@@ -110,6 +175,7 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   std::size_t next_imu_ = 0;
   bool period_open_ = false;
   std::map<int, fusion::ReplicaCommand> period_replicas_;  // the open period's replicas by PRN
+  std::map<int, fusion::ReplicaCommand> previous_replicas_;  // the period's before it (predicted Doppler's slope)
   std::map<int, ChannelState> channels_;
   std::optional<double> first_integration_t_s_;
   std::optional<std::int64_t> last_sample_;
@@ -119,6 +185,7 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   std::int64_t handover_sample_ = 0;
   long long vector_epochs_ = 0, channel_epochs_ = 0, coasting_channel_epochs_ = 0, releases_ = 0, relocks_ = 0;
   long long measurements_ = 0, known_bits_ = 0, not_wiped_ = 0;
+  long long runaway_recentres_ = 0, runaway_left_out_ = 0;
 };
 
 }  // namespace ultratrack::tools
