@@ -222,13 +222,19 @@ bool ReceiveUltraTight::runaway_check(const receiver::VectorChannelInput& in, do
   if (!st.commanded || in.coasting || !(in.cn0_dbhz < ut_.runaway_below_dbhz)) {
     st.runaway.reset();
     st.runaway_off = false;
+    st.runaway_repeats = 0;
     st.pending_step_hz = 0.0;
     return false;
   }
   if (st.runaway.add(st.last_offset_hz, ut_.period_s, ut_.runaway_average_s)) {
     const double mean = st.runaway.mean_hz();
-    st.runaway_off = std::abs(mean) > ut_.runaway_hz;
-    if (st.runaway_off) {
+    const bool off = std::abs(mean) > ut_.runaway_hz;
+    st.runaway_repeats = off && st.runaway_off ? st.runaway_repeats + 1 : 0;
+    st.runaway_off = off;
+    if (st.runaway_repeats >= ut_.runaway_max_recentres) {
+      st.runaway_given_up = true;
+      ++runaway_releases_;
+    } else if (st.runaway_off) {
       st.pending_step_hz = -st.runaway.recent_hz();
       // The step reaches the PLL with the next command (a pipelined one a period later) and shows in the
       // measurement after that: 3 epochs are left out of the next mean.
@@ -322,7 +328,7 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
       const double prediction_m = r.pseudorange_m + r.range_rate_mps * dt - shift_m;
       jump = (replica_m - prediction_m) / kChip_m;  // replica too far away: advance it
       st.coast_s = in.coasting ? st.coast_s + ut_.period_s : 0.0;
-      vector = std::abs(jump) <= ut_.max_jump_chips && st.coast_s <= ut_.max_coast_s;
+      vector = std::abs(jump) <= ut_.max_jump_chips && st.coast_s <= ut_.max_coast_s && !st.runaway_given_up;
       if (vector) {
         commands[i].vector = true;
         commands[i].filter_driven = true;
@@ -355,7 +361,9 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
       }
     }
     if (st.commanded && !vector) ++releases_;
+    if (!in.synchronised) st.runaway_given_up = false;  // lost: a new track starts afresh
     if (!vector) {
+      st.runaway_repeats = 0;
       st.runaway.reset();
       st.runaway_off = false;
       st.pending_step_hz = 0.0;
@@ -453,10 +461,10 @@ std::string ReceiveUltraTight::summary_json() const {
                    "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
                    "\"releases\": {}, \"measurements\": {}, \"known_bits\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
                    "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}, \"aided_only_satellite_periods\": {}, "
-                   "\"carrier_recentres\": {}, \"runaway_left_out\": {}",
+                   "\"carrier_recentres\": {}, \"runaway_left_out\": {}, \"runaway_releases\": {}",
                    handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_,
                    coasting_channel_epochs_, relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates,
-                   k.accepted, k.rejected, k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_);
+                   k.accepted, k.rejected, k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_, runaway_releases_);
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
                    "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
                    o.sigma_pos_ned_m.x(), o.sigma_pos_ned_m.y(), o.sigma_pos_ned_m.z(), o.sigma_clock_bias_m,
@@ -471,11 +479,11 @@ std::string ReceiveUltraTight::report() const {
   for (const auto& [prn, st] : channels_) channels += st.ever;
   return fmt::format("receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
                      "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
-                     "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}",
+                     "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}",
                      fusion_.settings().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
                      fusion_.settings().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
                      handover_t_s_, channels, channel_epochs_, coasting_channel_epochs_, relocks_, releases_,
-                     k.accepted, k.rejected, k.aided_only, runaway_recentres_);
+                     k.accepted, k.rejected, k.aided_only, runaway_recentres_, runaway_releases_);
 }
 
 }  // namespace ultratrack::tools

@@ -6,7 +6,9 @@
 // epoch (E/P/L I&Q normalised to unit noise, data bit removed by the prompt's sign, the replica that actually ran
 // given explicitly), (3) predicts every satellite's replica and commands each channel's code (rate and phase jump)
 // and carrier aiding (predicted Doppler; the channel's Costas PLL stays closed, so carrier phase stays continuous).
-// A channel that loses lock coasts on the prediction and re-locks without acquisition. Logs: ultratight.csv
+// A channel that loses lock coasts on the prediction and re-locks without acquisition. A weak channel whose PLL
+// runs away from the predicted Doppler (CarrierRunawayMonitor) is left out of the filter, stepped back onto the
+// prediction and its carrier phase flagged as slipped; one that keeps running away is released. Logs: ultratight.csv
 // (per vector epoch and channel, keyed like tracking.csv by sample/time/prn) and nav.csv rows after the hand-over.
 // Time: the driver's t_s is IMU time (GPS time minus the IMU time origin); its clock bias is against the receiver
 // clock with the engine's clock jumps since the hand-over taken out. Units: s, m, m/s, Hz, chips.
@@ -50,6 +52,9 @@ struct ReceiveUltraTightOptions {
   double runaway_below_dbhz = 30.0;
   double runaway_average_s = 1.0;
   double runaway_hz = 5.0;
+  // A channel still beyond runaway_hz in the 1 s after each of this many re-centrings in a row is not locked (its
+  // PLL cannot hold the signal): the loop releases it (scalar, then lost) instead of keeping it "bit-synced".
+  int runaway_max_recentres = 3;
 };
 
 // One channel's carrier against the filter's prediction: block means over average_s of (replica carrier - predicted
@@ -149,6 +154,8 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
     CarrierRunawayMonitor runaway;
     bool runaway_off = false;
     double pending_step_hz = 0.0;
+    int runaway_repeats = 0;     // re-centrings in a row each followed by a 1 s mean still beyond runaway_hz
+    bool runaway_given_up = false;  // released for that; commanded again only after a new synchronisation
     double last_offset_hz = NAN;  // the latest epoch's replica minus predicted Doppler (ultratight.csv)
   };
   void start(const receiver::VectorEpochInput& epoch, double t_k);
@@ -185,7 +192,7 @@ class ReceiveUltraTight final : public receiver::VectorLoop {
   std::int64_t handover_sample_ = 0;
   long long vector_epochs_ = 0, channel_epochs_ = 0, coasting_channel_epochs_ = 0, releases_ = 0, relocks_ = 0;
   long long measurements_ = 0, known_bits_ = 0, not_wiped_ = 0;
-  long long runaway_recentres_ = 0, runaway_left_out_ = 0;
+  long long runaway_recentres_ = 0, runaway_left_out_ = 0, runaway_releases_ = 0;
 };
 
 }  // namespace ultratrack::tools

@@ -179,6 +179,7 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
               json_number(summary, "runaway_left_out"));
   EXPECT_EQ(json_number(summary, "carrier_recentres"), 0.0);
   EXPECT_EQ(json_number(summary, "runaway_left_out"), 0.0);
+  EXPECT_EQ(json_number(summary, "runaway_releases"), 0.0);
 
   const auto log = read_log(rx);
   // The channels commanded at the hand-over: at least 6 (the file's 10 satellites: 8 above 10 deg, the others
