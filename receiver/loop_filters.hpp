@@ -72,4 +72,16 @@ inline double dll_thermal_jitter_chips(double bn_hz, double spacing_chips, doubl
   return std::sqrt(bn_hz * spacing_chips / (2.0 * c) * (1.0 + 2.0 / (t_s * c * (2.0 - spacing_chips))));
 }
 
+// The code error of the first-order DLL above is not white: each update t_s keeps 1 - 4 Bn t_s of it, so readings
+// interval_s apart correlate by rho = (1 - 4 Bn t_s)^(interval_s / t_s) (0.66 for 1 Hz, 20 ms updates, 0.1 s
+// epochs). A filter that takes such readings as independent gains N readings' information where the mean of N
+// AR(1) samples has variance (sigma^2 / N) (1 + rho) / (1 - rho) (large N). This returns the factor on the
+// 1-sigma of a white sequence of the same information, sqrt((1 + rho) / (1 - rho)) (2.21 for the numbers above;
+// 1 when interval_s is long against the loop's time constant). Requires 0 < 4 Bn t_s < 1.
+inline double dll_white_equivalent_sigma_factor(double bn_hz, double t_s, double interval_s) {
+  const double keep = 1.0 - 4.0 * bn_hz * t_s;
+  const double rho = std::pow(keep, interval_s / t_s);
+  return std::sqrt((1.0 + rho) / (1.0 - rho));
+}
+
 }  // namespace ultratrack::receiver

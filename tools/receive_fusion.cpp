@@ -19,6 +19,7 @@
 #include "ins/imu_error_model.hpp"
 #include "ins/strapdown.hpp"
 #include "io/input_error.hpp"
+#include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
 #include "io/json_text.hpp"
@@ -32,6 +33,7 @@ constexpr double kG = 9.80665;
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kWeek_s = 604800.0;
 constexpr double kClockJumpDetect_s = 1e-7;  // receiver clock offsets change only by jumps (>= 1 ms in practice)
+constexpr double kDllUpdate_s = 0.020;  // the DLL's update interval after bit sync (the tight filter starts after frame sync)
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -236,7 +238,14 @@ struct ReceiveFusion::Impl {
     tight.elevation_mask_rad = ro.pvt.elevation_mask_rad;
     tight.ionosphere = ro.pvt.ionosphere;
     tight.troposphere = ro.pvt.troposphere;
-    tight.sigma_range_zenith_m = ro.pvt.sigma_zenith_m;
+    // The tight filter takes every epoch's pseudorange as independent, but the DLL's code error is correlated
+    // over its time constant 1 / (4 Bn) (0.25 s at 1 Hz against 0.1 s epochs): its 1-sigma per epoch is the
+    // PVT's, widened to the white sequence of the same information (receiver::dll_white_equivalent_sigma_factor,
+    // 2.21 at the defaults). Without it the tight filter, and the ultra-tight one it hands over to, stated a
+    // position 1-sigma ~1.7x too small (benchmarks/ultratight_consistency.sh, docs/validation.md).
+    tight.sigma_range_zenith_m =
+        ro.pvt.sigma_zenith_m * receiver::dll_white_equivalent_sigma_factor(ro.tracking.dll_bw_coherent_hz, kDllUpdate_s,
+                                                                            ro.observation_interval_s);
     tight.sigma_rate_zenith_mps = ro.pvt.sigma_doppler_mps;
   }
 

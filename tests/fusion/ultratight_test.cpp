@@ -333,6 +333,9 @@ double nees_monte_carlo(FilterKind f, int runs, double clock_bias_psd, const cha
     cfg.duration_s = std::getenv("ULTRATRACK_NEES_DURATION_S") ? std::atof(std::getenv("ULTRATRACK_NEES_DURATION_S")) : 4.0;
     cfg.seed = 100 + k;
     cfg.clock_bias_psd_m2_per_s = clock_bias_psd;
+    // Diagnostic (docs/validation.md, ultra-tight NEES at the receiver level): a closed PLL of this bandwidth with the
+    // carrier running on (correlation_sim pll_bw_hz), as the receiver's channels; not set by the tests.
+    if (const char* bw = std::getenv("ULTRATRACK_NEES_PLL_BW_HZ")) cfg.pll_bw_hz = std::atof(bw);
     const CorrelationRunResult r = run_correlation_simulation(cfg);
     sum += r.nees.back();
     cpu += r.cpu_s;

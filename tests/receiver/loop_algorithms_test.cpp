@@ -344,3 +344,37 @@ TEST(BitSync, EnergyTestDecidesOnTheRightEdgeWithinSeconds) {
                 mean_s, longest_s, c.predicted_s);
   }
 }
+
+// The first-order DLL's code error sampled at the receiver's epochs is an AR(1) sequence: the mean of N samples
+// has the variance of N white samples of 1-sigma dll_white_equivalent_sigma_factor times the error's own. Truth:
+// the loop closed with dll_rate_correction_chips_per_s on white discriminator noise (20 ms updates, 1 Hz and
+// 2 Hz, 0.1 s epochs), 2000 blocks of N = 400 epochs. The variance of the block means has a relative standard
+// error sqrt(2 / 2000) = 3.2 %; the large-N form leaves out 2 rho / (N (1 - rho) (1 + rho)) <= 0.6 % here: 10 %.
+TEST(DelayLockLoop, WhiteEquivalentSigmaFactorMatchesTheClosedLoopsBlockMeans) {
+  for (const double bn : {1.0, 2.0}) {
+    const double t = 0.020, interval = 0.1;
+    const int per_epoch = 5, n = 400, blocks = 2000;
+    std::mt19937_64 rng(41);
+    std::normal_distribution<double> noise(0.0, 0.01);  // chips per discriminator reading
+    double tau = 0.0, sum_means2 = 0.0, sum_tau2 = 0.0;
+    long long count = 0;
+    for (int k = 0; k < 200; ++k) tau -= dll_rate_correction_chips_per_s(tau + noise(rng), bn) * t;  // settle
+    for (int b = 0; b < blocks; ++b) {
+      double sum = 0.0;
+      for (int i = 0; i < n; ++i) {
+        for (int u = 0; u < per_epoch; ++u) tau -= dll_rate_correction_chips_per_s(tau + noise(rng), bn) * t;
+        sum += tau;
+        sum_tau2 += tau * tau;
+        ++count;
+      }
+      sum_means2 += (sum / n) * (sum / n);
+    }
+    const double var_tau = sum_tau2 / count, var_mean = sum_means2 / blocks;
+    const double measured = std::sqrt(var_mean * n / var_tau);
+    const double factor = dll_white_equivalent_sigma_factor(bn, t, interval);
+    std::printf("DLL %.0f Hz: white-equivalent sigma factor closed form %.3f, closed loop %.3f\n", bn, factor, measured);
+    EXPECT_NEAR(measured / factor, 1.0, 0.10) << bn;
+  }
+  EXPECT_NEAR(dll_white_equivalent_sigma_factor(1.0, 0.020, 0.1), 2.21, 0.01);  // rho = 0.92^5 = 0.659
+  EXPECT_NEAR(dll_white_equivalent_sigma_factor(1.0, 0.020, 10.0), 1.0, 1e-6);  // epochs far apart: white
+}
