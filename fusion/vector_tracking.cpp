@@ -365,12 +365,16 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     commands[i].code_phase_jump_chips = jump;
     if (opt_.carrier == VectorCarrier::kFll || opt_.carrier == VectorCarrier::kPll) {
       // The NCO holds one frequency over the epoch: the predicted Doppler at its middle (the Doppler moves up to
-      // ~100 Hz/s in a 2 g turn: 1 Hz over half an epoch). Not filter-driven: the FLL channel has its own C/N0
-      // lock test and differential bits, which the presence test and the known-bit pure PLL would contradict.
+      // ~100 Hz/s in a 2 g turn: 1 Hz over half an epoch). Filter-driven as the aided channels (opt_.filter_driven):
+      // the channel's loss test is the presence test (its 0.2 s C/N0 test, whose estimates dip under 25 dB-Hz for
+      // ~30 % of the time at 26 dB-Hz, made it coast with the signal there), its time tag is held, and its rows
+      // keep updating the filter below min_cn0_dbhz with the weak-signal weights. Its own carrier loop does not
+      // run (no long sums, no pure PLL): its bits stay differential (coherent while phase-locked, kPll).
       const double half_epoch_s = 0.5 * (ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02);
       commands[i].carrier_frequency_hz =
           predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
       commands[i].carrier_commanded = true;
+      commands[i].filter_driven = opt_.filter_driven;
       if (opt_.carrier == VectorCarrier::kPll) {
         const auto doppler_at = [&](std::int64_t sample) {
           const double d = static_cast<double>(sample - in.sample) / in.fs_hz;

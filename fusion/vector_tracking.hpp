@@ -96,7 +96,10 @@ ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorSt
 // aided by the predicted Doppler's changes (carrier_aiding); kFll, the filter closes it (a vector FLL): every
 // vector epoch each channel's carrier NCO is commanded to the predicted Doppler at the middle of its next epoch,
 // and the channel's frequency discriminator (receiver/vector_frequency_discriminator.hpp) is the pseudorange-rate
-// measurement that keeps the prediction honest; kPll, a vector PLL (fusion/vector_carrier_phase.hpp): as kFll, plus
+// measurement that keeps the prediction honest (filter-driven as kAidedPll's channels: their presence test judges
+// lock, and with the bits known (--nav) the discriminator has them wiped, which keeps it unbiased down to ~18
+// dB-Hz where the Costas form reads the prediction; 90 % tracking threshold 15.8 dB-Hz on the issue-7 files against
+// 25.6 for kAidedPll, docs/validation.md); kPll, a vector PLL (fusion/vector_carrier_phase.hpp): as kFll, plus
 // per-channel carrier states in the filter, updated by each channel's Costas discriminator, that add a phase jump
 // and a frequency residual to every command, so that the replica stays phase-locked with no loop in the channel
 // (the pseudorange-rate rows are then phase-locked delta ranges); a channel whose phase lock fails is commanded as
@@ -129,8 +132,10 @@ struct VectorTrackingOptions {
   double max_coast_sigma_chips = 0.5;
   // Channels in vector mode are filter-driven (receiver::VectorChannelCommand::filter_driven, as ultra-tight's):
   // the channel's scalar loss test (C/N0 below min_cn0_dbhz or PLI below 0.3 for 0.3 s) gives way to the presence
-  // test (1 s windows, 12 dB-Hz), its PLL sums N x 20 ms with the known bits wiped (pure PLL), its time tag is
-  // held, and its epochs reach the filter without the per-epoch fade gate below 30 dB-Hz. Such a channel's
+  // test (1 s windows, 12 dB-Hz), its PLL sums N x 20 ms with the known bits wiped (pure PLL; kFll / kPll: no
+  // channel PLL, the known bits wipe the frequency discriminator's epochs instead), its time tag is held, and its
+  // epochs reach the filter without the per-epoch fade gate below 30 dB-Hz. (kPll's phase arcs keep their own lock
+  // test: a weak filter-driven channel stays usable, and its arc ends when that test fails.) Such a channel's
   // discriminators keep updating the filter below min_cn0_dbhz (down to whatever the presence test keeps), with
   // their variances from the lower of the channel's 0.2 s C/N0 and its weak_cn0_average_s running mean (linear):
   // at 22 dB-Hz the 0.2 s estimates span 16-25 dB-Hz (threshold runs) and the DLL variance grows as 1 / C/N0^2

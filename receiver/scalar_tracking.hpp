@@ -214,7 +214,8 @@ class ScalarTracking final {
   // frequency is the external loop's (command_carrier), the channel's carrier loop does not run, long coherent
   // integration is off, bits are detected differentially (BitAssembler::set_differential: the replica's phase
   // wanders by the frequency error's integral), the loss test is the C/N0 alone (the PLI reads the wandering
-  // phase), and coasting ends as soon as the C/N0 is back (nothing to re-lock). Clearing it hands the carrier
+  // phase; filter-driven, as the vector FLL's channels are: the presence test), and coasting ends as soon as the
+  // C/N0 is back or the presence test finds the signal (nothing to re-lock). Clearing it hands the carrier
   // back to the PLL from the commanded frequency (its frequency-rate state cleared, the PLI restarted).
   // phase_locked (vector PLL, VectorChannelCommand::carrier_phase_locked): the external loop closes the phase too,
   // so the bits are detected coherently (Costas sign, polarity from the preamble) rather than differentially;

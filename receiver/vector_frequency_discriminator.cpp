@@ -21,6 +21,12 @@ double costas_phase_change_cycles(std::complex<float> first, std::complex<float>
   return d;
 }
 
+double wiped_phase_change_cycles(std::complex<float> first, std::complex<float> second, int sign_product) {
+  const std::complex<double> z = std::conj(std::complex<double>(first)) * std::complex<double>(second) *
+                                 static_cast<double>(sign_product < 0 ? -1 : 1);
+  return std::arg(z) / kTwoPi;
+}
+
 double phase_change_frequency_variance_hz2(double cn0_hz, double t_s, double dt_s) {
   return 2.0 * costas_phase_variance_cycles2(cn0_hz, t_s) / (dt_s * dt_s);
 }

@@ -48,11 +48,14 @@ struct VectorChannelInput {
   double replica_pseudorange_mid_m = 0.0;  // the replica's pseudorange at measurement_sample
   double measured_pseudorange_m = 0.0;   // replica - code error x chip length
   // Carrier Doppler over the two latest contiguous epochs (middle to middle): the replica's mean frequency plus
-  // the Costas phase change. Centred at doppler_sample; absent before two contiguous 20 ms epochs.
+  // the Costas phase change, or, for a filter-driven channel whose carrier the loop commands with both epochs'
+  // bits known, the phase change with the bits wiped (doppler_bits_wiped; wiped_phase_change_cycles: twice the
+  // range, no pull toward 0 below ~24 dB-Hz). Centred at doppler_sample; absent before two contiguous 20 ms epochs.
   bool has_doppler = false;
   double measured_doppler_hz = 0.0;
   std::int64_t doppler_sample = 0;
   double doppler_interval_s = 0.0;       // middle-to-middle time of the two epochs
+  bool doppler_bits_wiped = false;
   // The same correlation epoch for a loop that updates from correlations (ultra-tight): its first sample, the
   // replica carrier's mean frequency over it (Hz), and the early/prompt/late I and Q of the master antenna
   // normalised to unit noise variance per I or Q (by the noise tap's running mean power), data bit not removed.
@@ -107,8 +110,8 @@ struct VectorChannelCommand {
   // Vector FLL: carrier_frequency_hz (finite) is the carrier NCO's frequency from the next epoch start on, not an
   // aid; the channel runs no carrier loop of its own (ScalarTracking::set_carrier_commanded): the loop closes the
   // carrier through the channel's frequency discriminator (measured_doppler_hz), the channel's bits are detected
-  // differentially, its lock test is the C/N0 alone, and its carrier phase is reported with loss of lock (the
-  // NCO's accumulated Doppler, not a phase-locked observable).
+  // differentially, its lock test is the C/N0 alone (the presence test when filter_driven too), and its carrier
+  // phase is reported with loss of lock (the NCO's accumulated Doppler, not a phase-locked observable).
   bool carrier_commanded = false;
   // Vector PLL (with carrier_commanded): the loop also closes the carrier phase. carrier_phase_jump_cycles (positive
   // advances the replica carrier) is applied once at next_epoch_sample, on top of carrier_frequency_hz; the channel
@@ -123,7 +126,8 @@ struct VectorChannelCommand {
   bool carrier_slip = false;
   // The loop's filter drives the replica and judges lock (ultra-tight): the channel's scalar loss test gives way
   // to the presence test (ScalarTracking::set_filter_driven), its PLL sums N x 20 ms with the known bits wiped
-  // (pure PLL), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).
+  // (pure PLL; with carrier_commanded there is no PLL, and the known bits wipe the frequency discriminator's
+  // epochs instead), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).
   bool filter_driven = false;
 };
 

@@ -281,11 +281,12 @@ TEST(ReceiveVectorFll, RejectsAnUnknownCarrierModeAndOneWithoutVectorCoupling) {
 }
 
 // Coasting in FLL mode: the blockage scenario of ReceiveVector.ChannelsCoastThroughFadesAndReLockWithoutAcquisition
-// (every signal absent 14-17 s, PRN 24 alone 18.5-20.5 s). A faded FLL channel coasts on the filter's commanded
-// carrier and code; with nothing to re-lock it is bit-synced again once its C/N0 estimate reads 3 dB above the loss
-// threshold. Bounds as there (issue 7's): no satellite acquired twice or lost, each coasting window starting within
-// 1 s of the fade (the 0.2 s C/N0 window and the 0.3 s loss time) and ending within 1 s of the return, fixes
-// resuming, 2 m 3-D RMS.
+// (every signal absent 14-17 s, PRN 24 alone 18.5-20.5 s). FLL channels are filter-driven as the aided ones: a
+// faded channel is declared absent by its presence test (1 s windows: coasting from 1-2 s into the fade, not
+// before a window could end) and coasts on the filter's commanded carrier and code; with nothing to re-lock it is
+// bit-synced again once two presence windows, or its C/N0 estimate 3 dB above the loss threshold, find the signal.
+// Bounds as there (issue 7's): no satellite acquired twice or lost, each coasting window starting 1-3 s into the
+// blockage (PRN 24's within its 2 s fade) and ending within 1 s of the return, fixes resuming, 2 m 3-D RMS.
 TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
@@ -315,13 +316,13 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   double worst = 0.0;
   for (const auto& [prn, w] : windows) {
     ASSERT_EQ(w.size(), prn == kFaded ? 2u : 1u) << "PRN " << prn;
-    EXPECT_GT(w[0].first, kGapStart) << "PRN " << prn;
-    EXPECT_LT(w[0].first, kGapStart + 1.0) << "PRN " << prn;
+    EXPECT_GE(w[0].first, kGapStart + 1.0) << "PRN " << prn << " coasting before a presence window could end";
+    EXPECT_LT(w[0].first, kGapStart + 3.0) << "PRN " << prn << " noticed the blockage late";
     worst = std::max(worst, w[0].second + 0.02 - kGapEnd);  // a row is an epoch's start
     EXPECT_LE(w[0].second + 0.02, kGapEnd + 1.0) << "PRN " << prn;
     if (prn == kFaded) {
       EXPECT_GT(w[1].first, kFadeStart);
-      EXPECT_LT(w[1].first, kFadeStart + 1.0);
+      EXPECT_LT(w[1].first, kFadeEnd);  // the 2 s fade holds one whole 1 s window
       EXPECT_LE(w[1].second + 0.02, kFadeEnd + 1.0);
     }
   }
@@ -332,4 +333,87 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
               fixes.size(), v.rms_3d_m);
   EXPECT_GE(fixes.size(), 65u);
   EXPECT_LE(v.rms_3d_m, 2.0);
+}
+
+// Weak signal after the hand-over in FLL mode (issue 7's threshold protocol, short): the static receiver of the
+// first test with every satellite stepped down to kWeak = 20 dB-Hz at 15 s until the end at 25 s, 5 dB below the
+// scalar loops' 25.3 dB-Hz threshold (docs/validation.md). FLL channels are filter-driven: the presence test
+// judges their lock (a 60 s run at 20 dB-Hz is falsely lost with probability 6e-5: the scalar C/N0 test, whose 0.2 s
+// estimates dip under 25 dB-Hz, coasted them at 26 dB-Hz already), and with --nav their frequency discriminator
+// has the bits wiped (its Costas form reads 0.56 x a 3 Hz offset at 20 dB-Hz: the filter would see its own
+// prediction). Every channel handed over must stay in vector mode and bit-synced (never coasting or lost) to the
+// end. Against the simulator's truth: (1) each channel's mean C/N0 estimate over the weak part (linear mean, from
+// kStep + 2 s: after the 1 s presence window and 0.2 s estimates have followed the step) at least kWeak - 1 dB --
+// a replica off the signal by a fraction of a chip or by more than a few Hz reads less (a channel on noise reads
+// < 15 dB-Hz); the noise-tap estimator reads high at this level (means 19.9-21.4 dB-Hz here), so only the low
+// side says anything about the replica; (2) the commanded NCO
+// Doppler minus the true Doppler, RMS over the weak part within 3 Hz: the wiped discriminator gives 6.3 Hz
+// (1-sigma, closed form x 1.17) per 20 ms row at 20 dB-Hz, and the filter averages ~50 rows a second from ten
+// channels through a constant-velocity model; 3 Hz costs the 20 ms correlation 0.1 dB (sinc^2(3 Hz x 20 ms)) and
+// is an eighth of the +-25 Hz range; (3) the filter's position RMS over the weak part within 5 m (the threshold
+// runs at 20 dB-Hz: 0.7-2.4 m).
+TEST(ReceiveVectorFll, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
+  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 20.0;
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "weak.toml") << scenario(brdc, 100.0, kEnd,
+                                               "[[cn0_step]]\nstart_s = " + std::to_string(kStep) +
+                                                   "\ncn0_dbhz = " + std::to_string(kWeak) + "\n");
+  const auto sim = dir / "sim", fll = dir / "fll";
+  run("simulate", {"--scenario", (dir / "weak.toml").string(), "--out", sim.string()});
+  receive(sim, brdc, fll, "fll");
+  fs::remove(sim / "antenna0.i8.bin");
+
+  int satellites = 0;
+  EXPECT_EQ(total_losses(fll, &satellites), 0);
+  const auto kept = kept_in_vector_mode(fll / "vector.csv");
+  int handed = 0;
+  for (const auto& [prn, k] : kept) {
+    EXPECT_TRUE(k) << "PRN " << prn << " fell back to scalar";
+    handed += k;
+  }
+  EXPECT_GE(handed, 9);  // ten in view, one without its ephemeris at the start at most
+
+  // tracking.csv from the step: every record of the vector PRNs bit-synced; their C/N0 estimates from kStep + 2 s.
+  std::map<int, double> last, cn0_sum;
+  std::map<int, int> cn0_n;
+  {
+    std::ifstream in(fll / "tracking.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      const auto f = ultratrack::test::split_csv_line(line);
+      const int prn = std::stoi(f[0]);
+      const double t = std::stod(f[2]);
+      if (t < kStep || !kept.count(prn) || !kept.at(prn)) continue;
+      EXPECT_EQ(f[9], "bit-synced") << "PRN " << prn << " at " << t << " s";
+      last[prn] = t;
+      if (t >= kStep + 2.0 && f[6] != "nan") {
+        cn0_sum[prn] += std::pow(10.0, std::stod(f[6]) / 10.0);
+        ++cn0_n[prn];
+      }
+    }
+  }
+  double worst_cn0 = 100.0;
+  for (const auto& [prn, k] : kept) {
+    if (!k) continue;
+    EXPECT_GT(last[prn], kEnd - 0.2) << "PRN " << prn << " stopped early";
+    ASSERT_GT(cn0_n[prn], 300) << "PRN " << prn;
+    const double mean_dbhz = 10.0 * std::log10(cn0_sum[prn] / cn0_n[prn]);
+    worst_cn0 = std::min(worst_cn0, mean_dbhz);
+    EXPECT_GE(mean_dbhz, kWeak - 1.0) << "PRN " << prn;
+  }
+
+  const auto truth = read_truth(sim / "truth.csv");
+  const auto ephs = signals::read_rinex_nav(brdc).ephemerides;
+  const DopplerErrors d = doppler_errors(fll / "tracking.csv", truth, ephs, kStep + 2.0, kEnd);
+  const auto filter = ultratrack::test::static_filter_position_rms(fll / "vector_state.csv", sim / "truth.csv", kStep);
+  std::printf("FLL, step to %.0f dB-Hz at %.0f s: %d channels kept to the end, lowest mean C/N0 estimate %.2f dB-Hz; "
+              "NCO Doppler - truth RMS %.2f Hz, max %.2f Hz over %d epochs; filter position 3-D RMS %.2f m "
+              "over %d epochs\n", kWeak, kStep, handed, worst_cn0, d.rms_hz, d.max_hz, d.epochs, filter.rms_3d_m,
+              filter.epochs);
+  EXPECT_GE(d.epochs, 9 * 350);  // 8 s of 20 ms epochs, 9 or more channels
+  EXPECT_LE(d.rms_hz, 3.0);
+  ASSERT_GT(filter.epochs, 400);  // 10 s of 20 ms vector epochs, the filter never restarted
+  EXPECT_LE(filter.rms_3d_m, 5.0);
 }
