@@ -1,5 +1,6 @@
 // Readers of the receive outputs that several tools tests check against the truth: the coasting windows of
-// tracking.csv and the vector filter's position error (vector_state.csv) against a static truth.csv.
+// tracking.csv, the vector filter's position error (vector_state.csv) against a static truth.csv, and the loss of
+// lock indicators of observations.rnx's last epoch.
 #pragma once
 
 #include <cmath>
@@ -60,6 +61,24 @@ inline PositionErrorRms static_filter_position_rms(const std::filesystem::path& 
   }
   if (r.epochs > 0) r.rms_3d_m = std::sqrt(sum2 / r.epochs);
   return r;
+}
+
+// observations.rnx (RINEX 3, one row per satellite, C1C then L1C), its last epoch: each satellite's L1C loss of
+// lock indicator (the 15th character of the phase's 16-character field; the row's first field is the 3-character
+// satellite and C1C's 16).
+inline std::vector<char> last_epoch_lli(const std::filesystem::path& rinex) {
+  std::ifstream obs(rinex);
+  std::vector<char> lli;
+  bool header = true;
+  for (std::string line; std::getline(obs, line);) {
+    if (header)
+      header = line.find("END OF HEADER") == std::string::npos;
+    else if (line.rfind(">", 0) == 0)
+      lli.clear();
+    else if (line.size() >= 35)
+      lli.push_back(line[19 + 14]);
+  }
+  return lli;
 }
 
 }  // namespace ultratrack::test

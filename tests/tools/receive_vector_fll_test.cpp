@@ -201,24 +201,8 @@ TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth)
 
   // observations.rnx, its last epoch (all channels in vector mode): every L1C phase of the FLL run carries LLI 1
   // (the 15th character of its 16-character field; the satellite's first field is C1C), none of the aided PLL's.
-  const auto last_epoch_lli = [](const fs::path& rinex) {
-    std::ifstream obs(rinex);
-    std::string line;
-    std::vector<char> lli;
-    bool header = true;
-    while (std::getline(obs, line)) {
-      if (header) {
-        header = line.find("END OF HEADER") == std::string::npos;
-      } else if (line.rfind(">", 0) == 0) {
-        lli.clear();
-      } else if (line.size() >= 35) {
-        lli.push_back(line[19 + 14]);
-      }
-    }
-    return lli;
-  };
-  const auto fll_lli = last_epoch_lli(fll / "observations.rnx");
-  const auto pll_lli = last_epoch_lli(pll / "observations.rnx");
+  const auto fll_lli = ultratrack::test::last_epoch_lli(fll / "observations.rnx");
+  const auto pll_lli = ultratrack::test::last_epoch_lli(pll / "observations.rnx");
   EXPECT_EQ(static_cast<int>(fll_lli.size()), satellites);
   for (char c : fll_lli) EXPECT_EQ(c, '1');
   EXPECT_FALSE(pll_lli.empty());

@@ -20,6 +20,7 @@
 
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "receive_output_readers.hpp"
 #include "run_command.hpp"
 #include "scenario.hpp"
 #include "simulation.hpp"
@@ -234,14 +235,7 @@ TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitt
 
   // observations.rnx, its last epoch (every channel phase-locked by the filter): no L1C phase carries LLI (the
   // 15th character of its 16-character field; the satellite's first field is C1C), unlike the FLL's.
-  std::ifstream obs(dir / "pll" / "observations.rnx");
-  std::vector<char> lli;
-  bool header = true;
-  for (std::string line; std::getline(obs, line);) {
-    if (header) header = line.find("END OF HEADER") == std::string::npos;
-    else if (line.rfind(">", 0) == 0) lli.clear();
-    else if (line.size() >= 35) lli.push_back(line[19 + 14]);
-  }
+  const std::vector<char> lli = ultratrack::test::last_epoch_lli(dir / "pll" / "observations.rnx");
   EXPECT_EQ(static_cast<int>(lli.size()), arcs);
   for (char c : lli) EXPECT_EQ(c, ' ');
 }
@@ -315,14 +309,7 @@ TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
   std::printf("fades, vector PLL: %d satellites, %d phase arcs, %d phase losses\n", satellites, arcs, losses);
   EXPECT_EQ(losses, satellites + 1);
   EXPECT_EQ(arcs, satellites + losses);
-  std::ifstream obs(pll / "observations.rnx");
-  std::vector<char> lli;
-  bool header = true;
-  for (std::string line; std::getline(obs, line);) {
-    if (header) header = line.find("END OF HEADER") == std::string::npos;
-    else if (line.rfind(">", 0) == 0) lli.clear();
-    else if (line.size() >= 35) lli.push_back(line[19 + 14]);
-  }
+  const std::vector<char> lli = ultratrack::test::last_epoch_lli(pll / "observations.rnx");
   EXPECT_EQ(static_cast<int>(lli.size()), satellites);
   for (char c : lli) EXPECT_EQ(c, ' ');
 }
