@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "run_command.hpp"
+#include "vector_carrier_runs.hpp"
 #include "solution_compare.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
@@ -121,17 +122,6 @@ DopplerErrors doppler_errors(const fs::path& tracking, const std::vector<TruthRo
   return d;
 }
 
-int total_losses(const fs::path& out, int* satellites) {
-  const std::string summary = ultratrack::test::read_text_file(out / "summary.json");
-  int total = 0;
-  *satellites = 0;
-  for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1)) {
-    total += std::stoi(summary.substr(at + 10));
-    ++*satellites;
-  }
-  return total;
-}
-
 // Per PRN of vector.csv: in vector mode at some time and never back to scalar afterwards.
 std::map<int, bool> kept_in_vector_mode(const fs::path& vector_csv) {
   std::map<int, bool> in_vector, dropped;
@@ -149,19 +139,6 @@ std::map<int, bool> kept_in_vector_mode(const fs::path& vector_csv) {
   return kept;
 }
 
-std::string scenario(const fs::path& brdc, double height_m, double duration_s, const std::string& trajectory) {
-  return "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " + std::to_string(duration_s) +
-         "\ncn0_dbhz = 45.0\nseed = 4\n[time]\ngps_week = 2190\ntow_s = 518772.0\n[navigation]\nrinex = \"" +
-         brdc.generic_string() + "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, " + std::to_string(height_m) +
-         "]\n[atmosphere]\nionosphere = true\ntroposphere = false\n" + trajectory;
-}
-
-void receive(const fs::path& sim, const fs::path& brdc, const fs::path& out, const char* carrier) {
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--vector-carrier", carrier, "--out",
-                  out.string()});
-}
-
 }  // namespace
 
 // Static, 45 dB-Hz, 16 s hot (channels handed to the filter at ~12.6 s; checked from 13.5 s). The filter's
@@ -173,16 +150,16 @@ void receive(const fs::path& sim, const fs::path& brdc, const fs::path& out, con
 TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "static.toml") << scenario(brdc, 100.0, 16.0, "");
+  std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const auto sim = dir / "sim", fll = dir / "fll", pll = dir / "pll";
   run("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
-  receive(sim, brdc, fll, "fll");
-  receive(sim, brdc, pll, "aided-pll");
+  ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
+  ultratrack::test::receive_vector_carrier(sim, brdc, pll, "aided-pll");
   fs::remove(sim / "antenna0.i8.bin");
   EXPECT_NE(ultratrack::test::read_text_file(fll / "summary.json").find("\"carrier\": \"fll\""), std::string::npos);
 
   int satellites = 0;
-  EXPECT_EQ(total_losses(fll, &satellites), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(fll, &satellites), 0);
   EXPECT_GE(satellites, 10);
   const auto kept = kept_in_vector_mode(fll / "vector.csv");
   EXPECT_EQ(static_cast<int>(kept.size()), satellites);
@@ -221,18 +198,15 @@ TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth)
 TEST(ReceiveVectorFll, TwoGTurnKeepsEveryChannelWithTheCommandedDopplerOnTheTruth) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "turn.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
-                                     "15.0,0.0,0.0,0.0,0.0\n5.0,0.0,8.09,0.0,0.0\n";
-  std::ofstream(dir / "turn.toml") << scenario(brdc, 1000.0, 20.0,
-                                               "[trajectory]\nfile = \"turn.csv\"\nspeed_mps = 138.9\nheading_deg = 0.0\n");
+  const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc);
   const auto sim = dir / "sim", fll = dir / "fll", pll = dir / "pll";
-  run("simulate", {"--scenario", (dir / "turn.toml").string(), "--out", sim.string()});
-  receive(sim, brdc, fll, "fll");
-  receive(sim, brdc, pll, "aided-pll");
+  run("simulate", {"--scenario", turn.string(), "--out", sim.string()});
+  ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
+  ultratrack::test::receive_vector_carrier(sim, brdc, pll, "aided-pll");
   fs::remove(sim / "antenna0.i8.bin");
 
   int satellites = 0;
-  EXPECT_EQ(total_losses(fll, &satellites), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(fll, &satellites), 0);
   EXPECT_GE(satellites, 8);
   const auto kept = kept_in_vector_mode(fll / "vector.csv");
   EXPECT_EQ(static_cast<int>(kept.size()), satellites);
@@ -276,13 +250,13 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   const auto dir = ultratrack::test::scratch_dir();
   constexpr double kGapStart = 14.0, kGapEnd = 17.0, kFadeStart = 18.5, kFadeEnd = 20.5;
   constexpr int kFaded = 24;
-  std::ofstream(dir / "gap.toml") << scenario(brdc, 100.0, 22.0,
+  std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 22.0,
                                               "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
                                               "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
                                               "fade_s = 2.0\n");
   const auto sim = dir / "sim", fll = dir / "fll";
   run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});
-  receive(sim, brdc, fll, "fll");
+  ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
   fs::remove(sim / "antenna0.i8.bin");
   const std::string summary = ultratrack::test::read_text_file(fll / "summary.json");
   int satellites = 0;
@@ -293,7 +267,7 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   }
   EXPECT_GE(satellites, 8);
   int also = 0;
-  EXPECT_EQ(total_losses(fll, &also), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(fll, &also), 0);
 
   const auto windows = ultratrack::test::coasting_windows(fll / "tracking.csv");  // coasting runs per PRN
   EXPECT_EQ(static_cast<int>(windows.size()), satellites);
@@ -340,16 +314,16 @@ TEST(ReceiveVectorFll, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 20.0;
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "weak.toml") << scenario(brdc, 100.0, kEnd,
+  std::ofstream(dir / "weak.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, kEnd,
                                                "[[cn0_step]]\nstart_s = " + std::to_string(kStep) +
                                                    "\ncn0_dbhz = " + std::to_string(kWeak) + "\n");
   const auto sim = dir / "sim", fll = dir / "fll";
   run("simulate", {"--scenario", (dir / "weak.toml").string(), "--out", sim.string()});
-  receive(sim, brdc, fll, "fll");
+  ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
   fs::remove(sim / "antenna0.i8.bin");
 
   int satellites = 0;
-  EXPECT_EQ(total_losses(fll, &satellites), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(fll, &satellites), 0);
   const auto kept = kept_in_vector_mode(fll / "vector.csv");
   int handed = 0;
   for (const auto& [prn, k] : kept) {

@@ -22,6 +22,7 @@
 #include "ins/truth_interpolator.hpp"
 #include "receive_output_readers.hpp"
 #include "run_command.hpp"
+#include "vector_carrier_runs.hpp"
 #include "scenario.hpp"
 #include "simulation.hpp"
 #include "signals/if_synthesiser.hpp"
@@ -35,19 +36,6 @@ namespace {
 
 void run(const std::string& command, std::vector<std::string> args) {
   ultratrack::test_support::run_command(command, std::move(args));
-}
-
-std::string scenario(const fs::path& brdc, double height_m, double duration_s, const std::string& trajectory) {
-  return "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " + std::to_string(duration_s) +
-         "\ncn0_dbhz = 45.0\nseed = 4\n[time]\ngps_week = 2190\ntow_s = 518772.0\n[navigation]\nrinex = \"" +
-         brdc.generic_string() + "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, " + std::to_string(height_m) +
-         "]\n[atmosphere]\nionosphere = true\ntroposphere = false\n" + trajectory;
-}
-
-void receive(const fs::path& sim, const fs::path& brdc, const fs::path& out, const char* carrier) {
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--vector-carrier", carrier, "--out",
-                  out.string()});
 }
 
 constexpr double kFs = 2.0e6;
@@ -157,14 +145,6 @@ int summary_int(const fs::path& out, const std::string& key) {
   return at == std::string::npos ? -1 : std::stoi(s.substr(at + key.size() + 4));
 }
 
-int total_losses(const fs::path& out) {
-  const std::string summary = ultratrack::test::read_text_file(out / "summary.json");
-  int total = 0;
-  for (auto at = summary.find("\"losses\": "); at != std::string::npos; at = summary.find("\"losses\": ", at + 1))
-    total += std::stoi(summary.substr(at + 10));
-  return total;
-}
-
 struct Runs {
   PhaseErrors pll, aided;
   std::pair<double, double> d_pll, d_aided, d_fll;
@@ -173,7 +153,7 @@ struct Runs {
 Runs run_three(const fs::path& dir, const fs::path& brdc, const std::string& toml, double from_s, double to_s) {
   const auto sim = dir / "sim";
   run("simulate", {"--scenario", toml, "--out", sim.string()});
-  for (const char* m : {"pll", "aided-pll", "fll"}) receive(sim, brdc, dir / m, m);
+  for (const char* m : {"pll", "aided-pll", "fll"}) ultratrack::test::receive_vector_carrier(sim, brdc, dir / m, m);
   fs::remove(sim / "antenna0.i8.bin");
   const Scenario s = read_scenario(sim / "scenario.toml");
   const NavigationSource nav = load_navigation(s);
@@ -216,10 +196,10 @@ void print(const char* what, const Runs& r) {
 TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitter) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "static.toml") << scenario(brdc, 100.0, 16.0, "");
+  std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const Runs r = run_three(dir, brdc, (dir / "static.toml").string(), 13.5, 16.0);
   print("static 45 dB-Hz", r);
-  EXPECT_EQ(total_losses(dir / "pll"), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(dir / "pll"), 0);
   const int arcs = summary_int(dir / "pll", "phase_arcs");
   EXPECT_GE(static_cast<int>(r.pll.per_prn.size()), 10);
   EXPECT_EQ(arcs, static_cast<int>(r.pll.per_prn.size()));  // one hand-over each, never re-started
@@ -252,13 +232,10 @@ TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitt
 TEST(ReceiveVectorPll, TwoGTurnKeepsEveryPhaseArcWithoutSlips) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "turn.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
-                                     "15.0,0.0,0.0,0.0,0.0\n5.0,0.0,8.09,0.0,0.0\n";
-  std::ofstream(dir / "turn.toml") << scenario(brdc, 1000.0, 20.0,
-                                               "[trajectory]\nfile = \"turn.csv\"\nspeed_mps = 138.9\nheading_deg = 0.0\n");
-  const Runs r = run_three(dir, brdc, (dir / "turn.toml").string(), 14.0, 20.0);
+  const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc);
+  const Runs r = run_three(dir, brdc, turn.string(), 14.0, 20.0);
   print("2 g turn (14-20 s)", r);
-  EXPECT_EQ(total_losses(dir / "pll"), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(dir / "pll"), 0);
   EXPECT_EQ(summary_int(dir / "pll", "phase_losses"), 0);
   EXPECT_GE(static_cast<int>(r.pll.per_prn.size()), 8);
   EXPECT_EQ(r.pll.arcs, static_cast<int>(r.pll.per_prn.size()));
@@ -288,13 +265,13 @@ TEST(ReceiveVectorPll, RejectsAnUnknownCarrierMode) {
 TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "gap.toml") << scenario(brdc, 100.0, 22.0,
+  std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 22.0,
                                               "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
                                               "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
                                               "fade_s = 2.0\n");
   const auto sim = dir / "sim", pll = dir / "pll";
   run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});
-  receive(sim, brdc, pll, "pll");
+  ultratrack::test::receive_vector_carrier(sim, brdc, pll, "pll");
   fs::remove(sim / "antenna0.i8.bin");
   const std::string summary = ultratrack::test::read_text_file(pll / "summary.json");
   int satellites = 0;
@@ -304,7 +281,7 @@ TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
     ++satellites;
   }
   EXPECT_GE(satellites, 8);
-  EXPECT_EQ(total_losses(pll), 0);
+  EXPECT_EQ(ultratrack::test::total_losses(pll), 0);
   const int losses = summary_int(pll, "phase_losses"), arcs = summary_int(pll, "phase_arcs");
   std::printf("fades, vector PLL: %d satellites, %d phase arcs, %d phase losses\n", satellites, arcs, losses);
   EXPECT_EQ(losses, satellites + 1);
