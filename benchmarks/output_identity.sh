@@ -10,8 +10,9 @@
 # `receive --coupling vector`; the static 3-antenna scenario (scenarios/attitude_static.toml, 30 s) through
 # `attitude`; and the same IMU file through `fuse`-free `ins`. Simulated files are cached in the scratch folder
 # (${ULTRATRACK_IDENTITY_DIR:-/tmp/ultratrack_identity}), keyed by the job name: delete it after changing the
-# simulator. Lines that carry the wall time (summary.json's wall_time_s, realtime_factor, threads used) are left
-# out of the hash; every other byte of every output file counts.
+# simulator. Left out of the hash: lines that carry the wall time (summary.json's wall_time_s, realtime_factor,
+# threads used), RINEX headers' creation date, and the run folder's name inside JSON (replaced by RUNS); every
+# other byte of every output file counts.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=$here/build
@@ -54,7 +55,10 @@ hash_outputs() {  # job dir
   while IFS= read -r f; do
     rel=${f#"$dir"/}
     if [[ $f == *.json ]]; then
-      h=$(grep -v -E '"(wall_time_s|wall_s|realtime_factor|cpu_time_s|threads)"' "$f" | sha256sum | cut -c1-64)
+      h=$(grep -v -E '"(wall_time_s|wall_s|realtime_factor|cpu_time_s|threads)"' "$f" | sed "s|$runs|RUNS|g" |
+          sha256sum | cut -c1-64)
+    elif [[ $f == *.rnx ]]; then  # the header's creation date
+      h=$(grep -v 'PGM / RUN BY / DATE' "$f" | sha256sum | cut -c1-64)
     else
       h=$(sha256sum "$f" | cut -c1-64)
     fi
