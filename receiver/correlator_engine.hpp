@@ -7,8 +7,8 @@
 // multiply-accumulate loop (same chip indices as the portable copy; sums equal to float rounding).
 // An integer copy (correlate_i16) takes planar int16 samples: int16 carrier wipe-off against a Q15 rotation
 // table, +-1 chips from one index computation per group of taps a whole number of chips apart, pmaddwd-style
-// multiply-adds into int32, and the chunk's exact carrier phase applied to the sums afterwards (see the .cpp).
-// It has three copies (portable, AVX2, AVX-512 BW+VL+VNNI: 32 samples per instruction), bit-identical.
+// multiply-adds into int32, and the chunk's exact carrier phase applied to the sums afterwards (the derivation:
+// correlator_kernels.hpp). Three copies (portable, AVX2, AVX-512 BW+VL+VNNI: 32 samples per step), bit-identical.
 #pragma once
 
 #include <array>
@@ -27,7 +27,7 @@ inline constexpr int kMaxTaps = 6;
 // copies in one process; a level the CPU or the build lacks throws std::invalid_argument: see
 // correlator_isa_available()). kAvx512 is the integer kernel's AVX-512 BW+VL+VNNI copy (the float kernel has
 // no AVX-512 copy and runs its AVX2 one there). The environment variable ULTRATRACK_CORRELATOR_ISA = baseline,
-// avx2 or avx512 caps what kAuto picks (tests and benchmarks of every copy on one machine).
+// avx2 or avx512 caps what kAuto picks (tests and benchmarks of every copy on one machine; correlator_isa.cpp).
 enum class CorrelatorIsa { kAuto, kBaseline, kAvx2, kAvx512 };
 bool correlator_isa_available(CorrelatorIsa isa);
 bool correlator_avx2_available();

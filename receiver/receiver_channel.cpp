@@ -54,36 +54,39 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   if (vector_.vector && vector_.carrier_slip) carrier_slip_pending_ = true;
   if (vector_.vector && loop_.state() != TrackingState::kBitSynced && !loop_.coasting()) vector_ = {};
   // Only a channel whose replica the vector loop drives may coast; dropped from it while coasting, it is lost.
-  loop_.allow_coasting(vector_.vector);
-  loop_.set_filter_driven(vector_.vector && vector_.filter_driven);
+  ScalarTrackingControl control;
+  control.coasting_allowed = vector_.vector;
+  control.filter_driven = vector_.vector && vector_.filter_driven;
   // Vector FLL: the loop's frequency is the NCO's; the channel's own carrier loop stands still.
   const bool fll = vector_.vector && vector_.carrier_commanded && std::isfinite(vector_.carrier_frequency_hz);
-  loop_.set_carrier_commanded(fll, fll && vector_.carrier_phase_locked);
+  control.carrier_commanded = fll;
+  control.carrier_phase_locked = fll && vector_.carrier_phase_locked;
   if (fll) {
-    loop_.command_carrier(vector_.carrier_frequency_hz);
+    control.carrier_frequency_hz = vector_.carrier_frequency_hz;
     last_scalar_.carrier_frequency_hz = vector_.carrier_frequency_hz;
     previous_aid_hz_ = NAN;  // a later aided command starts aiding afresh
   }
-  // A filter-driven channel keeps its time tag too: its bits are known and its code-period count is the filter's
-  // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
-  nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
-  vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
-  vector_carrier_jump_pending_ = fll && vector_.carrier_phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
   // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
   // the command already computed for the next epoch (between epochs) gets it too.
   if (fll) {
   } else if (vector_.vector && std::isfinite(vector_.carrier_frequency_hz)) {
     if (std::isfinite(previous_aid_hz_)) {
-      const double delta = vector_.carrier_frequency_hz - previous_aid_hz_;
-      loop_.aid_frequency(delta);
-      last_scalar_.carrier_frequency_hz += delta;
+      control.aid = CarrierAid::kShift;
+      control.aid_delta_hz = vector_.carrier_frequency_hz - previous_aid_hz_;
+      last_scalar_.carrier_frequency_hz += control.aid_delta_hz;
     } else {
-      loop_.start_aiding();
+      control.aid = CarrierAid::kStart;
     }
     previous_aid_hz_ = vector_.carrier_frequency_hz;
   } else {
     previous_aid_hz_ = NAN;
   }
+  loop_.apply(control);
+  // A filter-driven channel keeps its time tag too: its bits are known and its code-period count is the filter's
+  // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
+  nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
+  vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
+  vector_carrier_jump_pending_ = fll && vector_.carrier_phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
   // Between epochs the next one starts at once: replace the command it would start with.
   if ((vector_.vector || was_vector) && channel_.next_epoch_sample() == channel_.next_sample())
     channel_.command(merged_command());

@@ -91,7 +91,9 @@ class ReceiverChannel {
         if (report.state != TrackingState::kBitSynced && report.state != TrackingState::kCoasting) {
           vector_ = {};
           previous_aid_hz_ = NAN;
-          loop_.set_carrier_commanded(false);
+          ScalarTrackingControl released = loop_.control();
+          released.carrier_commanded = false;
+          loop_.apply(released);
         }
         channel_.command(merged_command());
         if (report.set_coherent) channel_.set_coherent_periods(report.coherent_periods, report.aligned_period);

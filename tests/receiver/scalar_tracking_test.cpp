@@ -295,15 +295,17 @@ TEST(ScalarTracking, CoastsThroughAFadeAndReLocksFromTheAidedFrequency) {
     NcoCommand cmd = rep.command;
     const double next_t = static_cast<double>(e.first_sample + e.num_samples) / kFs;
     if (rep.state == TrackingState::kBitSynced || rep.state == TrackingState::kCoasting) {
-      loop.allow_coasting(true);
+      ScalarTrackingControl control;
+      control.coasting_allowed = true;
       if (!aiding) {
-        loop.start_aiding();
+        control.aid = CarrierAid::kStart;
         aiding = true;
       } else {
-        const double delta = true_doppler(next_t) - true_doppler(aided_at);
-        loop.aid_frequency(delta);
-        cmd.carrier_frequency_hz += delta;
+        control.aid = CarrierAid::kShift;
+        control.aid_delta_hz = true_doppler(next_t) - true_doppler(aided_at);
+        cmd.carrier_frequency_hz += control.aid_delta_hz;
       }
+      loop.apply(control);
       aided_at = next_t;
     }
     channel.command(cmd);
