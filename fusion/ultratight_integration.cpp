@@ -1,5 +1,7 @@
 #include "fusion/ultratight_integration.hpp"
 
+#include "fusion/ultratight_measurement_models.hpp"
+
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -15,113 +17,6 @@ namespace {
 
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kLambda_m = signals::kL1Wavelength_m;
-constexpr double kChip_m = kC / signals::kCaChipRate_hz;
-
-// The replica errors of a hypothesis dx over the period that ended at the update time: the nominal's errors
-// at that time (range e0, rate e1) seen over the period (mean range: a rate error e1 held over the period
-// moves the mean range by -e1 span / 2) plus the known offset of the replica that ran from the nominal
-// (period_replica_errors), so h(dx) describes the replica that really ran.
-Eigen::Matrix2d period_mixing(double span_s) {
-  Eigen::Matrix2d M = Eigen::Matrix2d::Identity();
-  M(0, 1) = -0.5 * span_s;
-  return M;
-}
-
-// One satellite's I&Q (6 rows) over the period with the replica actually held.
-class PeriodIqMeasurement {
- public:
-  static constexpr int kMeasurementSize = kIqRowsPerChannel;
-  using Vector6 = Eigen::Matrix<double, 6, 1>;
-  PeriodIqMeasurement(const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_b,
-                      const Eigen::Vector3d& w_ib_b, const IqSettings& s, const Eigen::Vector2d& offset,
-                      double span_s, const IqTaps& measured, double prior_code_sigma_chips, double rate_noise_var,
-                      double start_phase_rad, double start_phase_var)
-      : replica_(nominal, {sat}, lever_b, w_ib_b), s_(s), offset_(offset), M_(period_mixing(span_s)),
-        R_(iq_noise_covariance(s)),
-        code_sigma_(prior_code_sigma_chips), start_phase_(start_phase_rad) {
-    // Frequency noise of the receiver clock within the period (common to every satellite; see finish_period)
-    // enters the taps through their frequency derivative.
-    if (rate_noise_var > 0.0) {
-      const Eigen::Matrix<double, 6, 1> g = iq_jacobian(errors(StateVector<17>::Zero()), s_).col(1) / kLambda_m;
-      R_ += rate_noise_var * g * g.transpose();
-    }
-    // The replica's unknown phase error at the period's start (a closed PLL's residual) turns all six taps.
-    if (start_phase_var > 0.0) {
-      const Eigen::Matrix<double, 6, 1> g = iq_phase_derivative(errors(StateVector<17>::Zero()), s_);
-      R_ += start_phase_var * g * g.transpose();
-    }
-    for (int k = 0; k < 3; ++k) {
-      z_(k) = measured.i[k];
-      z_(3 + k) = measured.q[k];
-    }
-  }
-  const Vector6& z() const { return z_; }
-  Vector6 h(const StateVector<17>& dx) const {
-    const IqTaps t = expected_iq(errors(dx), s_);
-    Vector6 out;
-    for (int k = 0; k < 3; ++k) {
-      out(k) = t.i[k];
-      out(3 + k) = t.q[k];
-    }
-    return out;
-  }
-  MeasurementJacobian<17> H(const StateVector<17>& dx) const {
-    const TrackingErrors te = errors(dx);
-    Eigen::Matrix<double, 6, 2> J = iq_jacobian(te, s_);
-    // The prompt sits on the triangle's peak, where R = 1 - |tau| has a kink: its local slope (+-1) would
-    // claim to measure tau with the sign of the current guess. Statistical linearisation over the prior
-    // (tau ~ N(guess, sigma^2)): the expected slope is the local one times erf(|guess| / (sqrt 2 sigma)).
-    if (code_sigma_ > 0.0) {
-      const double w = std::erf(std::abs(te.code_chips) / (std::sqrt(2.0) * code_sigma_));
-      J(1, 0) *= w;
-      J(4, 0) *= w;
-    }
-    const Eigen::Matrix<double, 2, 2> D = Eigen::Vector2d(1.0 / kChip_m, 1.0 / kLambda_m).asDiagonal();
-    return J * D * M_ * replica_.jacobian();
-  }
-  const Eigen::Matrix<double, 6, 6>& R() const { return R_; }
-
- private:
-  TrackingErrors errors(const StateVector<17>& dx) const {
-    const Eigen::Vector2d e = M_ * replica_.errors(0, dx) + offset_;
-    TrackingErrors te = tracking_errors(e(0), e(1));
-    te.phase_rad = start_phase_;
-    return te;
-  }
-  ReplicaErrors17 replica_;
-  IqSettings s_;
-  Eigen::Vector2d offset_;
-  Eigen::Matrix2d M_;
-  Vector6 z_;
-  Eigen::Matrix<double, 6, 6> R_;
-  double code_sigma_ = 0.0;
-  double start_phase_ = 0.0;
-};
-
-// Discriminator form: range and rate errors of the replica that ran, h(dx) = replica errors + offset.
-class PeriodDiscriminatorMeasurement {
- public:
-  PeriodDiscriminatorMeasurement(const NominalState& nominal, const SatelliteObservable& sat,
-                                 const Eigen::Vector3d& lever_b, const Eigen::Vector3d& w_ib_b,
-                                 const Eigen::Vector2d& offset, double span_s, const Eigen::Vector2d& measured,
-                                 const DiscriminatorNoise& noise, double rate_noise_var, double start_phase_rate_var)
-      : replica_(nominal, {sat}, lever_b, w_ib_b), offset_(offset), M_(period_mixing(span_s)), z_(measured),
-        R_(Eigen::MatrixXd::Zero(2, 2)) {
-    R_(0, 0) = noise.range_sigma_m * noise.range_sigma_m;
-    R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps + rate_noise_var + start_phase_rate_var;
-  }
-  Eigen::VectorXd z() const { return z_; }
-  Eigen::VectorXd h(const StateVector<17>& dx) const { return M_ * replica_.errors(dx) + offset_; }
-  MeasurementJacobian<17> H(const StateVector<17>&) const { return M_ * replica_.jacobian(); }
-  Eigen::MatrixXd R() const { return R_; }
-
- private:
-  ReplicaErrors17 replica_;
-  Eigen::Vector2d offset_;
-  Eigen::Matrix2d M_;
-  Eigen::VectorXd z_;
-  Eigen::MatrixXd R_;
-};
 
 void check_options(const UltraTightOptions& o) {
   auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
@@ -327,14 +222,11 @@ class UltraTightCore final : public UltraTightCoreBase {
       const double rr_now = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
       // The replica's period [t0, t0 + T] may end before this update (a receiver channel's epoch): the signal's
       // rate is carried back along the slope of the command's two predictions.
-      const double back_end = nominal_.nav.t_s - (r.t_start_s + T_);
       const double command_span = nominal_.nav.t_s - command.t_start_s;
       const double rate_slope = command_span > 0.0 ? (s->range_rate_mps - command.range_rate_mps) / command_span : 0.0;
-      const double rate_end = rr_now - rate_slope * back_end;
-      const double range_end = pr_now - 0.5 * (rate_end + rr_now) * back_end;
-      const Eigen::Vector2d offset = period_replica_errors(r.pseudorange_m, r.range_rate_mps, range_end,
-                                                           rate_end - rate_slope * T_, rate_end, T_);
-      const double span = 2.0 * (nominal_.nav.t_s - r.t_start_s) - T_;  // the mean range sits span / 2 back
+      const Eigen::Vector2d offset = period_signal_offset(r.pseudorange_m, r.range_rate_mps, r.t_start_s, T_,
+                                                          nominal_.nav.t_s, pr_now, rr_now, rate_slope);
+      const double span = period_span_s(nominal_.nav.t_s, r.t_start_s, T_);
       const double clock_rate_var = 0.0;  // the common clock term is in P for this period (above)
       IqSettings is;
       is.cn0_dbhz = c->cn0_dbhz;
@@ -351,18 +243,20 @@ class UltraTightCore final : public UltraTightCoreBase {
       const StateVector<17> dx_before = period_dx_;
       bool ok = false;
       if (opt_.form == UltraTightForm::Iq) {
-        const MeasurementJacobian<17> J = rep.jacobian();
-        const Eigen::Matrix<double, 1, 17> h_range = J.row(0) - 0.5 * span * J.row(1);
-        const double sigma_code = std::sqrt(std::max(0.0, (h_range * filter_.P() * h_range.transpose())(0, 0))) / kChip_m;
-        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, offset, span, c->taps, sigma_code,
-                                         clock_rate_var, start_phase, start_phase_var));
+        IqPeriodOptions period;
+        period.offset = offset;
+        period.span_s = span;
+        period.prior_code_sigma_chips = prior_code_sigma_chips(rep, filter_.P(), span);
+        period.clock_rate_var_m2ps2 = clock_rate_var;
+        period.start_phase_rad = start_phase;
+        period.start_phase_var_rad2 = start_phase_var;
+        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, c->taps, period));
       } else {
         // The frequency discriminator reads the mean phase, start phase + pi T f(T / 3): the start phase comes off.
-        const double f_hz = frequency_discriminator_hz(c->taps, is) - start_phase / (M_PI * T_);
-        const Eigen::Vector2d z(code_discriminator_chips(c->taps, is) * kChip_m, f_hz * kLambda_m);
-        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span, z,
+        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span,
+                                                   period_discriminator_errors(c->taps, is, start_phase),
                                                    discriminator_noise(is), clock_rate_var,
-                                                   start_phase_var * std::pow(kLambda_m / (M_PI * T_), 2)));
+                                                   start_phase_rate_variance(start_phase_var, T_)));
       }
       if (c->continuous_carrier) {
         // This epoch's end phase (after the period's last update, below): its measured mean phase (data wiped:
