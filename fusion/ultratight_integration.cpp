@@ -1,7 +1,5 @@
 #include "fusion/ultratight_integration.hpp"
 
-#include "fusion/ultratight_measurement_models.hpp"
-
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
@@ -9,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "fusion/ultratight_measurement_models.hpp"
 #include "ins/earth_model.hpp"
 #include "signals/gps_constants.hpp"
 
