@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "fusion/ultratight_measurement_models.hpp"
 #include "ins/earth_model.hpp"
 #include "signals/gps_constants.hpp"
 

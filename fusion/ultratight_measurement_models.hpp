@@ -12,8 +12,11 @@
 //            the replica that ran minus the nominal's signal (period_signal_offset);
 //   taps   = expected_iq(code = p0 / chip length (293.05 m), frequency = p1 / L1 wavelength (0.1903 m) Hz,
 //            start phase rad).
-// Both forms' H are that chain's derivatives with J_rep in place of de/ddx (J_rep leaves out the tight model's
-// terms of order |v| / R_earth per metre of position error: tight_measurements.hpp).
+// Both forms' H are that chain's derivatives with J_rep (taken at dx = 0) in place of de/ddx. J_rep leaves out the
+// tight model's small terms (tight_measurements.hpp): the antenna velocity turning with position, |v| / R_earth
+// (m/s) per metre, and the receiver's share of the travel-time rate, a fraction (|v_sat| + w_e |r_sat|) / c
+// (< 2e-5) of the rate entries; away from dx = 0 also the cross terms (attitude with gyro bias in the lever-arm
+// velocity, attitude with position). tests/fusion/ultratight_measurement_models_test.cpp bounds each.
 #pragma once
 
 #include <Eigen/Core>
