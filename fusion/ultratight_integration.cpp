@@ -1,7 +1,5 @@
 #include "fusion/ultratight_integration.hpp"
 
-#include "fusion/ultratight_measurement_models.hpp"
-
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
