@@ -1,7 +1,10 @@
 # ultratrack_layer(NAME DEPS...) builds the static library ultratrack_<NAME> from every .cpp in the
 # layer's folder. Headers are included as "<layer>/<file>.hpp". Each layer gets a private include root
 # in the build tree that holds only a link to its own folder, so a layer can include exactly the layers
-# it links: the dependency rule is enforced by the compiler, not by discipline.
+# it links: the dependency rule is enforced by the compiler, not by discipline. Installed, the headers are
+# include/ultratrack/<layer>/*.hpp under one include root, and the library is Ultratrack::<layer> of the
+# exported package (every layer is listed in the global property ULTRATRACK_LAYERS, which
+# cmake/UltratrackInstall.cmake installs).
 function(ultratrack_layer name)
   cmake_parse_arguments(ARG "" "" "DEPS;EXTERNAL" ${ARGN})
   set(include_root "${CMAKE_BINARY_DIR}/layer_include/${name}")
@@ -11,17 +14,21 @@ function(ultratrack_layer name)
   endif()
   file(GLOB sources CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.cpp")
   file(GLOB headers CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/*.hpp")
+  set(include_dirs "$<BUILD_INTERFACE:${include_root}>" "$<INSTALL_INTERFACE:include/ultratrack>")
   if(sources)
     add_library(ultratrack_${name} STATIC ${sources} ${headers})
-    target_include_directories(ultratrack_${name} PUBLIC "${include_root}")
+    target_include_directories(ultratrack_${name} PUBLIC ${include_dirs})
     target_compile_options(ultratrack_${name} PRIVATE -Wall -Wextra -Wpedantic)
     target_link_libraries(ultratrack_${name} PUBLIC ${ARG_DEPS} ${ARG_EXTERNAL})
   else()  # a layer that has only headers so far
     add_library(ultratrack_${name} INTERFACE)
-    target_include_directories(ultratrack_${name} INTERFACE "${include_root}")
+    target_include_directories(ultratrack_${name} INTERFACE ${include_dirs})
     target_link_libraries(ultratrack_${name} INTERFACE ${ARG_DEPS} ${ARG_EXTERNAL})
   endif()
+  set_target_properties(ultratrack_${name} PROPERTIES EXPORT_NAME ${name})
   add_library(ultratrack::${name} ALIAS ultratrack_${name})
+  set_property(GLOBAL APPEND PROPERTY ULTRATRACK_LAYERS ${name})
+  set_property(GLOBAL PROPERTY ULTRATRACK_LAYER_HEADERS_${name} "${headers}")
 endfunction()
 
 # ultratrack_test(NAME SOURCES... LIBS...) one GoogleTest executable per test folder.

@@ -22,8 +22,8 @@
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
-#include "scenario.hpp"
-#include "simulation.hpp"
+#include "scenario_toml.hpp"
+#include "simulation_run.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -37,7 +37,7 @@ struct DemoArgs {
 };
 
 // Acquires the first 10 ms of the simulated file and compares every satellite with satellites.csv.
-void acquire_and_compare(const fs::path& samples, const Scenario& scenario, const SimulationResult& sim) {
+void acquire_and_compare(const fs::path& samples, const sim::Scenario& scenario, const sim::SimulationResult& sim) {
   receiver::SampleSourceOptions source_options;
   source_options.fs_hz = scenario.sample_rate_hz;
   source_options.if_hz = scenario.if_hz;
@@ -79,7 +79,7 @@ void acquire_and_compare(const fs::path& samples, const Scenario& scenario, cons
 
 // Receives the simulated file with the receiver's defaults for this scenario and compares the fixes with the
 // scenario's static position.
-void receive_and_compare(const fs::path& samples, const Scenario& scenario, const fs::path& out) {
+void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario, const fs::path& out) {
   receiver::SampleSourceOptions source_options;
   source_options.fs_hz = scenario.sample_rate_hz;
   source_options.if_hz = scenario.if_hz;
@@ -128,7 +128,7 @@ void receive_and_compare(const fs::path& samples, const Scenario& scenario, cons
 }
 
 void run_demo(const DemoArgs& args) {
-  Scenario scenario = parse_scenario(kDemoScenarioToml, "built-in demo scenario (scenarios/default.toml)");
+  sim::Scenario scenario = parse_scenario(kDemoScenarioToml, "built-in demo scenario (scenarios/default.toml)");
   if (args.duration_s > 0.0) scenario.duration_s = args.duration_s;
   const fs::path out(args.out_dir);
   fs::create_directories(out);
@@ -139,7 +139,9 @@ void run_demo(const DemoArgs& args) {
              scenario.cn0_dbhz);
 
   fmt::print("\n1. simulate -> {}\n", (out / "simulation").string());
-  const SimulationResult sim = run_simulation(scenario, out / "simulation", isatty(fileno(stderr)) ? stderr : nullptr);
+  const SigintStop interrupt;  // the SIGINT guard to swap for tools/interrupt_guard.hpp
+  const sim::SimulationResult sim =
+      run_simulation(scenario, out / "simulation", isatty(fileno(stderr)) ? stderr : nullptr, interrupt.token());
   fmt::print("  {:.1f} s of signal in {:.1f} s ({:.1f}x real time), {} satellites in view\n", sim.signal_s, sim.wall_s,
              sim.signal_s / std::max(sim.wall_s, 1e-9), sim.satellites.size());
 

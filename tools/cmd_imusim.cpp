@@ -10,13 +10,16 @@
 #include <string>
 
 #include "commands.hpp"
-#include "imu_simulation.hpp"
+#include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
+#include "ins/odometer.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "io/atomic_file.hpp"
+#include "sim/imu_simulation.hpp"
+#include "sim/simulation_files.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -62,22 +65,29 @@ void run_imusim(const ImuSimOptions& o) {
 
   fs::create_directories(o.out_dir);
   ins::NavCsvWriter truth_out(fs::path(o.out_dir) / "truth.csv");
+  ins::ImuCsvWriter imu_out(fs::path(o.out_dir) / "imu.csv");
   std::vector<ins::TruthSample> truth_for_odometer;
-  const ImuSimulationResult r = simulate_imu(
-      spec, o.rate_hz, error_spec, o.seed, fs::path(o.out_dir) / "imu.csv",
-      [&](const ins::TruthSample& t) {
-        truth_out.write(t.nav());
-        if (o.odometer) truth_for_odometer.push_back(t);
-      },
-      "imusim");
+  sim::ImuSimulationCallbacks callbacks;
+  callbacks.on_imu = [&](const ins::ImuIncrement& inc) { imu_out.write(inc); };
+  callbacks.on_truth = [&](const ins::TruthSample& t) {
+    truth_out.write(t.nav());
+    if (o.odometer) truth_for_odometer.push_back(t);
+  };
+  callbacks.on_progress = [](int percent) { fmt::print(stderr, "imusim: IMU {}%\n", percent); };
+  const sim::ImuSimulationResult r = sim::simulate_imu(spec, o.rate_hz, error_spec, o.seed, callbacks);
+  imu_out.commit();
   truth_out.commit();
-  if (o.odometer) write_odometer_csv(fs::path(o.out_dir) / "odometer.csv", truth_for_odometer, o.odometer_sf);
+  if (o.odometer) {
+    ins::OdometerOptions odometer;
+    odometer.scale_factor_error = o.odometer_sf;
+    sim::write_odometer_csv(fs::path(o.out_dir) / "odometer.csv", ins::simulate_odometer(truth_for_odometer, odometer));
+  }
   const std::size_t rows = r.imu_rows;
   std::string json = "{\n";
   json += fmt::format("  \"trajectory\": \"{}\",\n  \"duration_s\": {},\n  \"imu_rate_hz\": {},\n  \"imu_rows\": {},\n",
                       o.profile.empty() ? o.segments_file : o.profile, spec.duration_s(), o.rate_hz, rows);
   json += fmt::format("  \"preset\": \"{}\",\n  \"seed\": {},\n", o.preset, o.seed);
-  json += turn_on_bias_json(r.turn_on);
+  json += sim::turn_on_bias_json(r.turn_on);
   json += fmt::format("  \"distance_m\": {:.3f}\n}}\n", r.distance_m);
   io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);

@@ -1,5 +1,6 @@
 // `ultratrack simulate --scenario S.toml --out DIR`: synthesise IF samples and truth from a scenario
-// (tools/scenario.hpp for the keys, tools/simulation.hpp for the outputs).
+// (tools/scenario_toml.hpp for the keys, sim/simulation_files.hpp for the outputs). Ctrl-C stops the run
+// early and still finishes the files.
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
@@ -8,8 +9,8 @@
 #include <string>
 
 #include "commands.hpp"
-#include "scenario.hpp"
-#include "simulation.hpp"
+#include "scenario_toml.hpp"
+#include "simulation_run.hpp"
 
 namespace ultratrack::tools {
 
@@ -22,8 +23,9 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--out", *out_dir, "Output folder (created when missing)")->required();
   cmd->add_flag("--quiet", *quiet, "No progress lines");
   cmd->callback([scenario_path, out_dir, quiet] {
-    const Scenario scenario = read_scenario(*scenario_path);
-    const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr);
+    const sim::Scenario scenario = read_scenario(*scenario_path);
+    const SigintStop interrupt;  // the SIGINT guard to swap for tools/interrupt_guard.hpp
+    const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr, interrupt.token());
     const std::string inertial =
         scenario.trajectory_enabled()
             ? fmt::format("imu.csv ({} rows at {} Hz, preset {}), {}", r.imu_rows, scenario.imu_rate_hz,

@@ -17,11 +17,13 @@
 
 #include "receiver/multi_sample_source.hpp"
 #include "receiver/receiver_engine.hpp"
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/input_error.hpp"
-#include "simulation.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -36,8 +38,8 @@ struct Collector final : receiver::ReceiverObserver {
 
 constexpr double kDeg = M_PI / 180.0;
 
-tools::Scenario attitude_scenario() {
-  tools::Scenario s;
+sim::Scenario attitude_scenario() {
+  sim::Scenario s;
   s.sample_rate_hz = 2.6e6;
   s.format = signals::SampleFormat::i8;
   s.duration_s = 15.0;
@@ -56,7 +58,7 @@ tools::Scenario attitude_scenario() {
 }
 
 // The engine over the simulated files with `threads` threads: every antenna-phase epoch and tracking record.
-Collector receive(const tools::Scenario& s, const std::vector<fs::path>& files, const tools::NavigationSource& nav,
+Collector receive(const sim::Scenario& s, const std::vector<fs::path>& files, const sim::NavigationSource& nav,
                   int threads) {
   receiver::ReceiverOptions options;
   options.fs_hz = s.sample_rate_hz;
@@ -105,12 +107,12 @@ bool same_epoch(const receiver::AntennaPhaseEpoch& a, const receiver::AntennaPha
 }  // namespace
 
 TEST(AttitudeReceive, BetweenAntennaPhasesMatchTheGeometryAndFlagTheEvents) {
-  tools::Scenario s = attitude_scenario();
-  const tools::NavigationSource nav = tools::load_navigation(s);
+  sim::Scenario s = attitude_scenario();
+  const sim::NavigationSource nav = sim::load_navigation(s);
   // The slip goes on the highest satellite (sure to be tracked).
   int slip_prn = 0;
   {
-    signals::IfSynthesiser probe(tools::synthesiser_options(s, nav), nav.ephemerides, tools::make_motion(s));
+    signals::IfSynthesiser probe(sim::synthesiser_options(s, nav), nav.ephemerides, sim::make_motion(s));
     double best = -1.0;
     for (const auto& v : probe.visible_satellites(0))
       if (v.elevation_rad > best) best = v.elevation_rad, slip_prn = v.prn;
@@ -119,7 +121,7 @@ TEST(AttitudeReceive, BetweenAntennaPhasesMatchTheGeometryAndFlagTheEvents) {
   s.cycle_slips = {{1, slip_prn, 12.0, 3.0, 0.1}};
   s.blockages = {{2, 13.0, 0.5}};
   const fs::path dir = test::scratch_dir() / "attitude_receive";
-  const tools::SimulationResult sim = tools::run_simulation(s, dir);
+  const sim::SimulationResult sim = tools::run_simulation(s, dir);
   ASSERT_EQ(sim.sample_files.size(), 3u);
   ASSERT_TRUE(fs::exists(dir / "antenna_events.csv"));
 
@@ -128,7 +130,7 @@ TEST(AttitudeReceive, BetweenAntennaPhasesMatchTheGeometryAndFlagTheEvents) {
                                           << (collector.epochs.empty() ? -1.0 : collector.epochs.front().receive_time.tow_s);
 
   // Baselines in ECEF from the scenario's ENU offsets (exact: a static receiver).
-  const auto motion = tools::make_motion(s);
+  const auto motion = sim::make_motion(s);
   const Eigen::Vector3d r0 = motion->antenna_state(0, 0.0).r_e_m;
   std::array<Eigen::Vector3d, 3> b;
   for (int k = 0; k < 3; ++k) b[k] = motion->antenna_state(k, 0.0).r_e_m - r0;
@@ -196,16 +198,16 @@ TEST(AttitudeReceive, BetweenAntennaPhasesMatchTheGeometryAndFlagTheEvents) {
 // The multi-antenna path gives the same bits with 1, 2 and 3 threads: every antenna is correlated inside its
 // channel's job, and everything shared is done in channel order on the caller's thread.
 TEST(AttitudeReceive, AntennaPhasesAreIdenticalForAnyNumberOfThreads) {
-  tools::Scenario s = attitude_scenario();
+  sim::Scenario s = attitude_scenario();
   s.duration_s = 12.0;
-  const tools::NavigationSource nav = tools::load_navigation(s);
+  const sim::NavigationSource nav = sim::load_navigation(s);
   {
-    signals::IfSynthesiser probe(tools::synthesiser_options(s, nav), nav.ephemerides, tools::make_motion(s));
+    signals::IfSynthesiser probe(sim::synthesiser_options(s, nav), nav.ephemerides, sim::make_motion(s));
     s.cycle_slips = {{1, probe.visible_satellites(0).front().prn, 11.0, 3.0, 0.1}};
   }
   s.blockages = {{2, 11.3, 0.3}};
   const fs::path dir = test::scratch_dir() / "attitude_receive_threads";
-  const tools::SimulationResult sim = tools::run_simulation(s, dir);
+  const sim::SimulationResult sim = tools::run_simulation(s, dir);
   const Collector one = receive(s, sim.sample_files, nav, 1);
   ASSERT_GT(one.epochs.size(), 10u);
   for (int threads = 2; threads <= 3; ++threads) {

@@ -19,7 +19,7 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/input_error.hpp"
 #include "signals/nominal_constellation.hpp"
 #include "signals/rinex_nav.hpp"

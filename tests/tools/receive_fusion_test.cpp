@@ -20,9 +20,11 @@
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
 #include "run_command.hpp"
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/rinex_nav.hpp"
-#include "simulation.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "solution_compare.hpp"
 #include "support/test_data.hpp"
 
@@ -41,7 +43,7 @@ struct Sim {
   std::vector<int> prns_by_elevation;  // highest first
 };
 
-Sim& sim() {
+Sim& simulated() {
   static Sim s = [] {
     Sim r;
     r.dir = test::scratch_dir();
@@ -56,7 +58,7 @@ Sim& sim() {
            "[imu]\npreset = \"hg1700ae\"\nseed = 7\n[atmosphere]\nionosphere = true\ntroposphere = true\n";
     test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
     // The scenario's own broadcast data as a RINEX file: the receiver's hot start.
-    const tools::NavigationSource nav = tools::load_navigation(tools::read_scenario(r.dir / "circle.toml"));
+    const sim::NavigationSource nav = sim::load_navigation(tools::read_scenario(r.dir / "circle.toml"));
     signals::RinexNavData data;
     data.ephemerides = nav.ephemerides;
     data.klobuchar = nav.klobuchar;
@@ -122,7 +124,7 @@ struct Rms {
 
 // Fused (nav.csv) and PVT (solution.csv) 3-D position errors at the fixes made after the fused start.
 Rms compare(const fs::path& rx) {
-  const auto& s = sim();
+  const auto& s = simulated();
   const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
   const auto fixes = tools::read_solution_csv(rx / "solution.csv");
   Rms r;
@@ -150,13 +152,13 @@ Rms compare(const fs::path& rx) {
 }
 
 std::vector<std::string> receive_args(const fs::path& rx) {
-  const auto& s = sim();
+  const auto& s = simulated();
   return {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string(),
           "--imu", (s.sim / "imu.csv").string(), "--out", rx.string()};
 }
 
 fs::path motion_config() {
-  const auto file = sim().dir / "motion.toml";
+  const auto file = simulated().dir / "motion.toml";
   std::ofstream(file) << "[alignment]\nmotion_window_s = 1.0\n";
   return file;
 }
@@ -169,7 +171,7 @@ fs::path motion_config() {
 // beat them; its honest bound is the running-mean bound of the fixes themselves (Rms above). A time-tag error
 // of 0.1 s (0.8 m along the track) or a wrong measurement covariance breaks it. (60 s figures: validation.md.)
 TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
-  const auto rx = sim().dir / "rx_loose";
+  const auto rx = simulated().dir / "rx_loose";
   auto args = receive_args(rx);
   args.insert(args.end(), {"--coupling", "loose", "--filter", "ekf", "--align", "motion", "--fusion-config",
                            motion_config().string()});
@@ -190,7 +192,7 @@ TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
 // fused position must beat the PVT fixes at the same epochs, with the EKF and with the UKF.
 TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
   for (const std::string filter : {"ekf", "ukf"}) {
-    const auto rx = sim().dir / ("rx_tight_" + filter);
+    const auto rx = simulated().dir / ("rx_tight_" + filter);
     auto args = receive_args(rx);
     args.insert(args.end(), {"--coupling", "tight", "--filter", filter, "--align", "motion", "--fusion-config",
                              motion_config().string()});
@@ -213,7 +215,7 @@ TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
 // from the configuration at t = 0 and taken the first epoch. The jump must be taken out of the pseudoranges and
 // epoch times (without that, 2280 km steps: the gate rejects nearly every later update).
 TEST(ReceiveFusion, TightCouplingCarriesItsClockThroughAReceiverClockJump) {
-  const auto& s = sim();
+  const auto& s = simulated();
   const auto rx_config = s.dir / "jump.toml";
   std::ofstream(rx_config) << "[receiver]\nclock_jump_threshold_s = 1e-5\ninitial_travel_time_s = 0.075\n";
   const auto config = s.dir / "start.toml";
@@ -240,7 +242,7 @@ TEST(ReceiveFusion, TightCouplingCarriesItsClockThroughAReceiverClockJump) {
 // three pseudoranges and rates must then pull the horizontal error to the noise (what stays unobservable with
 // three satellites is one position/clock combination, here mostly vertical: its sigma grows, as it must).
 TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCannotFix) {
-  const auto& s = sim();
+  const auto& s = simulated();
   ASSERT_GE(s.prns_by_elevation.size(), 3u);
   const auto config = s.dir / "three.toml";
   std::ofstream(config) << "[initial]\nattitude_deg = [0, 0, 0]\n"
@@ -282,7 +284,7 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
 
 // Bad IMU input: one InputError naming the IMU file, and no outputs under their final names.
 TEST(ReceiveFusion, BadImuInputIsOneInputErrorNamingTheFileAndLeavesNoOutputs) {
-  const auto& s = sim();
+  const auto& s = simulated();
   auto expect_error = [&](const std::string& name, const fs::path& imu, std::vector<std::string> extra,
                           const std::string& words) {
     const auto rx = s.dir / ("bad_" + name);

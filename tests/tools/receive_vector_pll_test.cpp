@@ -23,14 +23,17 @@
 #include "receive_output_readers.hpp"
 #include "run_command.hpp"
 #include "vector_carrier_runs.hpp"
-#include "scenario.hpp"
-#include "simulation.hpp"
+#include "scenario_toml.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
 namespace signals = ultratrack::signals;
 using namespace ultratrack::tools;
+using namespace ultratrack::sim;
 
 namespace {
 

@@ -1,6 +1,6 @@
 // Scenario files: the issue's keys parse to the stated values; unknown keys, wrong types and conflicting
 // keys are InputErrors naming the file, the key and the line; the echo (to_toml) reads back the same.
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,8 @@
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 const char* kIssueExample = R"(
 [signal]
@@ -130,6 +132,8 @@ troposphere = true
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 const char* kAttitudeScenario = R"(
 [signal]

@@ -15,15 +15,19 @@
 #include "ins/strapdown.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/input_error.hpp"
 #include "signals/satellite_state.hpp"
-#include "simulation.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kLat = 35.274016, kLon = 137.013759, kH = 100.0;

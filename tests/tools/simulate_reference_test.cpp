@@ -28,14 +28,18 @@
 
 #include "brute_force_fine_search.hpp"
 #include "commands.hpp"
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/sample_reader.hpp"
-#include "simulation.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 struct GpsSdrSimSatellite {
   int prn;

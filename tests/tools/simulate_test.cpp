@@ -9,15 +9,19 @@
 #include <set>
 #include <sstream>
 
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/input_error.hpp"
 #include "signals/sample_reader.hpp"
-#include "simulation.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "support/brute_force_acquisition.hpp"
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 using signals::test_support::BruteForceAcquisition;
 
@@ -201,6 +205,8 @@ TEST(Simulate, TrajectoryFileDrivesTheReceiver) {
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 // [[cn0_step]]: parsed, echoed, checked, and written to cn0_steps.csv with the sample-exact first sample
 // (ceil(start_s fs): 0.0123456 s at 1 MHz is sample 12346); satellites.csv gives the level at sample 0.

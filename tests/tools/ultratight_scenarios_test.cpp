@@ -15,13 +15,17 @@
 #include <string>
 #include <vector>
 
-#include "scenario.hpp"
+#include "scenario_toml.hpp"
 #include "signals/input_error.hpp"
-#include "simulation.hpp"
+#include "sim/navigation_source.hpp"
+#include "sim/scenario_models.hpp"
+#include "simulation_run.hpp"
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
 namespace {
+
+using namespace ultratrack::sim;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kG0 = 9.80665;

@@ -1,6 +1,6 @@
-// Simulation scenarios: the TOML file that `ultratrack simulate` runs (and other tools write to drive it),
-// parsed strictly with toml++: every key known and of the right type, or an InputError naming the file,
-// the line and the key. Units as in the key names; relative paths resolve against the scenario's folder.
+// Scenario files: sim::Scenario as TOML, parsed strictly with toml++: every key known and of the right type, or
+// an io::InputError naming the file, the line and the key. Units as in the key names; relative paths resolve
+// against the scenario's folder (sim::resolve_path).
 //
 //   [signal]      sample_rate_hz = 2.6e6  if_hz = 0.0  format = "i8"  duration_s = 60.0  cn0_dbhz = 45.0
 //                 seed = 1  cn0_dbhz_by_prn = { 5 = 40.0 }  nav_data = true  noise = true
@@ -45,104 +45,21 @@
 // without it only the IMU and truth files are written. [[antenna]] and attitude_deg need [trajectory].
 #pragma once
 
-#include <array>
-#include <cstdint>
 #include <filesystem>
-#include <map>
-#include <optional>
 #include <string>
 #include <string_view>
-#include <vector>
 
-#include "signals/if_synthesiser.hpp"
-#include "signals/sample_format.hpp"
+#include "sim/scenario.hpp"
 
 namespace ultratrack::tools {
 
-struct Scenario {
-  std::filesystem::path source;  // the scenario file ("" for a built-in one); relative paths resolve against it
-
-  // [signal]
-  double sample_rate_hz = 2.6e6;
-  double if_hz = 0.0;
-  signals::SampleFormat format = signals::SampleFormat::i8;
-  signals::TwoBitLayout two_bit;  // r2/i2 only
-  double duration_s = 60.0;
-  double cn0_dbhz = 45.0;
-  std::uint64_t seed = 1;
-  std::map<int, double> cn0_dbhz_by_prn;
-  bool nav_data = true;
-  bool noise = true;
-
-  // [time]
-  int gps_week = 2190;
-  double tow_s = 518400.0;
-
-  // [navigation]: exactly one of rinex / constellation ("nominal" when neither is given)
-  std::string rinex;
-  std::string constellation = "nominal";
-  double elevation_mask_deg = 5.0;
-  bool include_unhealthy = false;
-
-  // [receiver]: a static position (with optional extra antennas) or a trajectory file
-  std::array<double, 3> llh_deg_m = {35.274016, 137.013759, 100.0};
-  std::string trajectory;
-  std::vector<std::array<double, 3>> antenna_offsets_enu_m = {{0.0, 0.0, 0.0}};
-  double clock_bias_m = 0.0;
-  double clock_drift_mps = 0.0;
-  double clock_bias_noise_m_per_sqrt_s = 0.0;
-  double clock_drift_noise_mps_per_sqrt_s = 0.0;
-
-  // [atmosphere]
-  bool ionosphere = true;
-  bool troposphere = false;
-
-  // [output]
-  double truth_rate_hz = 10.0;
-
-  // Whether IF samples are synthesised: [signal] present, or no [trajectory] (the classic scenario).
-  bool signal = true;
-
-  // [trajectory]: exactly one of profile / file when the section is present (trajectory_enabled())
-  std::string trajectory_profile;
-  std::string trajectory_file;
-  double trajectory_duration_s = 0.0;  // profiles only
-  double imu_rate_hz = 100.0;
-  double start_speed_mps = 0.0;    // segment files only
-  double start_heading_deg = 0.0;  // segment files only
-  bool coordinated_turns = false;  // segment files only: bank into turns (aircraft)
-  double ramp_s = 1.0;             // segment files only: command blend time at segment starts
-  bool odometer = false;
-  double odometer_scale_factor_error = 0.0;
-
-  // [imu]
-  std::string imu_preset = "ideal";
-  std::uint64_t imu_seed = 1;
-  std::optional<double> gyro_bias_dph, accel_bias_mg, gyro_arw_dpsh, accel_vrw_mpspsh;
-
-  // [[antenna]] and [receiver] attitude_deg (inertial scenarios)
-  std::vector<std::array<double, 3>> lever_arms_body_m = {{0.0, 0.0, 0.0}};
-  std::array<double, 3> attitude_deg = {0.0, 0.0, 0.0};
-  // [[antenna]] line_bias_cycles / phase_noise_m (one entry per [[antenna]] table when given), [[cycle_slip]],
-  // [[blockage]]
-  std::vector<signals::AntennaImpairment> antenna_impairments;
-  std::vector<signals::CycleSlipEvent> cycle_slips;
-  std::vector<signals::BlockageEvent> blockages;
-  std::vector<signals::Cn0StepEvent> cn0_steps;  // [[cn0_step]]
-
-  bool trajectory_enabled() const { return !trajectory_profile.empty() || !trajectory_file.empty(); }
-};
-
 // Parses scenario text; `source` names it in errors and anchors relative paths. Throws InputError.
-Scenario parse_scenario(std::string_view text, const std::filesystem::path& source);
+sim::Scenario parse_scenario(std::string_view text, const std::filesystem::path& source);
 // Reads and parses a scenario file. Throws InputError (missing file, syntax, unknown key, wrong type, range).
-Scenario read_scenario(const std::filesystem::path& path);
+sim::Scenario read_scenario(const std::filesystem::path& path);
 
 // The scenario as TOML with every key written (defaults filled in, paths made absolute): reading it back
 // gives the same scenario.
-std::string to_toml(const Scenario& scenario);
-
-// A path from the scenario, resolved against the scenario file's folder when relative.
-std::filesystem::path resolve_path(const Scenario& scenario, const std::string& path);
+std::string to_toml(const sim::Scenario& scenario);
 
 }  // namespace ultratrack::tools

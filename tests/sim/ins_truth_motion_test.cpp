@@ -2,7 +2,7 @@
 // 500 km/h with two antennas 1.2 m apart, the carrier phase difference between the antennas equals the
 // baseline projected on the line of sight over the wavelength (the attitude receiver's observable), and the
 // code timing of each antenna follows its own position.
-#include "ins_motion.hpp"
+#include "sim/ins_truth_motion.hpp"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@
 #include "signals/nominal_constellation.hpp"
 #include "signals/satellite_state.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::sim {
 namespace {
 
 TEST(InsTruthMotion, CarrierPhaseDifferenceBetweenAntennasIsBaselineOnLineOfSight) {
@@ -61,4 +61,4 @@ TEST(InsTruthMotion, CarrierPhaseDifferenceBetweenAntennasIsBaselineOnLineOfSigh
 }
 
 }  // namespace
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::sim

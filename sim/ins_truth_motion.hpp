@@ -10,7 +10,7 @@
 #include "ins/truth_interpolator.hpp"
 #include "signals/receiver_motion.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::sim {
 
 class InsTruthMotion final : public signals::ReceiverMotion {
  public:
@@ -30,4 +30,4 @@ class InsTruthMotion final : public signals::ReceiverMotion {
   double t0_s_;
 };
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::sim
