@@ -378,7 +378,7 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       const double half_epoch_s = 0.5 * (ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02);
       commands[i].carrier_frequency_hz =
           predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
-      commands[i].carrier_commanded = true;
+      commands[i].carrier = receiver::CarrierControl::kFrequency;
       commands[i].filter_driven = opt_.filter_driven;
       if (opt_.carrier == VectorCarrier::kPll) {
         const auto doppler_at = [&](std::int64_t sample) {
@@ -472,7 +472,7 @@ void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
       ++phase_arcs_;
     }
   }
-  if (!ph.active()) return;  // the FLL's command (carrier_phase_locked false)
+  if (!ph.active()) return;  // the FLL's command (CarrierControl::kFrequency)
   // The replica's phase at its next epoch start: the carrier states' phase there; the frequency over that epoch:
   // the prediction at its middle plus the residual.
   const std::int64_t next = ch.next_epoch_sample;
@@ -488,7 +488,7 @@ void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
     return;
   }
   ph.record_command(next, command.carrier_frequency_hz);
-  command.carrier_phase_locked = true;
+  command.carrier = receiver::CarrierControl::kFrequencyAndPhase;
   command.carrier_phase_jump_cycles = jump;
   command.carrier_frequency_hz += ph.nu_hz();
   log.phase_tracking = true;

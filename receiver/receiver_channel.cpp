@@ -57,8 +57,10 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   loop_.allow_coasting(vector_.vector);
   loop_.set_filter_driven(vector_.vector && vector_.filter_driven);
   // Vector FLL: the loop's frequency is the NCO's; the channel's own carrier loop stands still.
-  const bool fll = vector_.vector && vector_.carrier_commanded && std::isfinite(vector_.carrier_frequency_hz);
-  loop_.set_carrier_commanded(fll, fll && vector_.carrier_phase_locked);
+  const bool fll =
+      vector_.vector && vector_.carrier != CarrierControl::kAided && std::isfinite(vector_.carrier_frequency_hz);
+  const bool phase_locked = fll && vector_.carrier == CarrierControl::kFrequencyAndPhase;
+  loop_.set_carrier_commanded(fll, phase_locked);
   if (fll) {
     loop_.command_carrier(vector_.carrier_frequency_hz);
     last_scalar_.carrier_frequency_hz = vector_.carrier_frequency_hz;
@@ -68,7 +70,7 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
   nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
-  vector_carrier_jump_pending_ = fll && vector_.carrier_phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
+  vector_carrier_jump_pending_ = phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
   // Carrier aiding: the predicted Doppler's change since the previous command goes into the PLL's integrator;
   // the command already computed for the next epoch (between epochs) gets it too.
   if (fll) {
@@ -158,7 +160,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
     // Costas phases are bit-insensitive, within +-1/4 cycle: their change is taken within +-1/4 cycle. A channel
     // whose carrier a filter commands and drives, with both bits known, has them wiped: the full phase change
     // (+-1/2 cycle), which at 20-22 dB-Hz stays unbiased where the Costas change reads 0.56-0.78 of the offset.
-    const bool wipe = vector_.vector && vector_.filter_driven && vector_.carrier_commanded && e.bit_sign != 0 &&
+    const bool wipe = vector_.vector && vector_.filter_driven && vector_.carrier != CarrierControl::kAided && e.bit_sign != 0 &&
                       p.bit_sign != 0;
     const double dphi = wipe ? wiped_phase_change_cycles(p.prompt, e.prompt, e.bit_sign * p.bit_sign)
                              : costas_phase_change_cycles(p.prompt, e.prompt);

@@ -15,6 +15,7 @@
 
 #include "support/test_data.hpp"
 #include "tools/run_command.hpp"
+#include "tools/vector_carrier_runs.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack;
@@ -57,13 +58,7 @@ pipelines::ReceiveOptions options(pipelines::Coupling coupling) {
 TEST(ReceiverPipeline, VectorEpochsReachTheSinkAndTheSummaryCountsThem) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "static.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 16.0\n"
-                                        "cn0_dbhz = 45.0\nseed = 4\n"
-                                        "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
-                                        "[navigation]\nrinex = \""
-                                     << brdc.generic_string()
-                                     << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
-                                        "[atmosphere]\nionosphere = true\ntroposphere = false\n";
+  std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const auto sim = dir / "sim";
   test_support::run_command("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
   const signals::RinexNavData nav = signals::read_rinex_nav(brdc);
