@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "fuse_run.hpp"
+#include "pipelines/fuse.hpp"
 #include "gnss_fix_simulation.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory.hpp"
@@ -51,7 +51,7 @@ std::vector<ins::ImuIncrement> corrupt(const Scenario& s, const std::string& pre
   return out;
 }
 
-tools::FuseResult run_once(const Scenario& s, const ins::TruthInterpolator& truth, const std::string& preset,
+pipelines::FuseResult run_once(const Scenario& s, const ins::TruthInterpolator& truth, const std::string& preset,
                            std::uint64_t seed, fusion::FilterKind filter, std::vector<std::pair<double, double>> outages,
                            double gnss_rate_hz) {
   tools::GnssFixSimulationOptions g;
@@ -59,19 +59,19 @@ tools::FuseResult run_once(const Scenario& s, const ins::TruthInterpolator& trut
   g.first_time_s = 0.0;
   g.seed = seed + 1000;
   const auto fixes = tools::simulate_gnss_fixes(truth, g);
-  tools::FuseSettings settings;
+  pipelines::FuseSettings settings;
   settings.filter = filter;
-  settings.align = tools::AlignMode::Motion;
+  settings.align = pipelines::AlignMode::Motion;
   settings.config.imu_preset = preset;
   settings.config.velocity_sigma_mps = 0.05;
   settings.outages = std::move(outages);
-  return tools::fuse(corrupt(s, preset, seed), fixes, s.truth, settings);
+  return pipelines::fuse(corrupt(s, preset, seed), fixes, tools::truth_samples_from_nav(s.truth), settings);
 }
 
 void BM_LooseRms(benchmark::State& state, std::string profile, fusion::FilterKind filter) {
   const Scenario s = make_scenario(profile, 300.0, 100.0);
   const ins::TruthInterpolator truth(s.truth_samples);
-  tools::FuseResult r;
+  pipelines::FuseResult r;
   for (auto _ : state) r = run_once(s, truth, "hg1700ae", 21, filter, {}, 1.0);
   if (!r.rms_all || !r.gnss_rms) {
     state.SkipWithError("no truth comparison");
@@ -79,7 +79,7 @@ void BM_LooseRms(benchmark::State& state, std::string profile, fusion::FilterKin
   }
   // After convergence (heading 1-sigma < 1 deg) when it happens; the straight run from rest never separates
   // heading from the east accelerometer bias (constant specific force), so all rows after alignment count there.
-  const tools::ErrorRms& e = r.rms_converged ? *r.rms_converged : *r.rms_all;
+  const pipelines::ErrorRms& e = r.rms_converged ? *r.rms_converged : *r.rms_all;
   state.counters["fused_h_rms_m"] = e.horizontal_m;
   state.counters["fused_3d_rms_m"] = e.position_3d_m;
   state.counters["gnss_h_rms_m"] = r.gnss_rms->horizontal_m;

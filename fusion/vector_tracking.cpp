@@ -140,6 +140,13 @@ ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorSt
 VectorTrackingFilter::VectorTrackingFilter(const VectorTrackingOptions& options) : opt_(options) {
   model_.noise = opt_.process;
   phase_.fill(VectorCarrierPhase(opt_.pll));
+  prn_.fill(fresh_prn_state());
+}
+
+VectorTrackingFilter::PrnState VectorTrackingFilter::fresh_prn_state() const {
+  PrnState s;
+  s.doppler_bias = FalseLockMonitor(FalseLockMonitor::Averaging::kRunning, opt_.doppler_bias_average_s);
+  return s;
 }
 
 std::optional<SatelliteObservable> VectorTrackingFilter::observable(const receiver::VectorEpochInput& in, int prn,
@@ -188,7 +195,7 @@ bool VectorTrackingFilter::initialise(const receiver::VectorEpochInput& in) {
   sample_ = in.sample;
   clock_corrections_s_ = in.clock_corrections_s;
   starved_s_ = 0.0;
-  prn_.fill({});
+  prn_.fill(fresh_prn_state());
   phase_.fill(VectorCarrierPhase(opt_.pll));
   ++initialisations_;
   return true;
@@ -289,13 +296,11 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       // ~2-5 m/s that a 3.9-sigma gate passes at 20-30 dB-Hz; they would drag the velocity, and with it every
       // replica. Its rows are left out while the mean is off by more than doppler_bias_hz (see the commands).
       const double off_hz = (m.z() - m.h(ekf_->x()))(0) / -signals::kL1Wavelength_m;
-      const double a = std::min(1.0, (step_s > 0.0 ? step_s : 0.02) / opt_.doppler_bias_average_s);
-      st.doppler_bias_hz += a * (off_hz - st.doppler_bias_hz);
-      ++st.doppler_epochs;
+      st.doppler_bias.add(off_hz, step_s > 0.0 ? step_s : 0.02);
       // (An FLL or vector-PLL channel has no PLL of its own to lock falsely: its offset is the filter's own lag,
       // which its rows correct.)
       const bool weak = opt_.carrier == VectorCarrier::kAidedPll && cn0 < ratio_hz(opt_.false_lock_below_dbhz);
-      if (!(weak && std::abs(st.doppler_bias_hz) > opt_.doppler_bias_hz)) {
+      if (!(weak && std::abs(st.doppler_bias.mean_hz()) > opt_.doppler_bias_hz)) {
         const UpdateResult rr = ekf_->update(m);
         log.rate_innovation_mps = rr.innovation.size() ? rr.innovation(0) : NAN;
         log.rate_used = rr.accepted;
@@ -373,7 +378,7 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       const double half_epoch_s = 0.5 * (ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02);
       commands[i].carrier_frequency_hz =
           predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
-      commands[i].carrier_commanded = true;
+      commands[i].carrier = receiver::CarrierControl::kFrequency;
       commands[i].filter_driven = opt_.filter_driven;
       if (opt_.carrier == VectorCarrier::kPll) {
         const auto doppler_at = [&](std::int64_t sample) {
@@ -398,11 +403,10 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       const double low_cn0 =
           std::isfinite(ch.cn0_dbhz) ? std::min(ratio_hz(ch.cn0_dbhz), st.cn0_mean_hz) : st.cn0_mean_hz;
       if (opt_.carrier_aiding && low_cn0 < ratio_hz(opt_.false_lock_below_dbhz) &&
-          std::abs(st.doppler_bias_hz) > opt_.false_lock_hz &&
-          st.doppler_epochs * step_s >= opt_.doppler_bias_average_s) {
-        st.aid_offset_hz -= st.doppler_bias_hz;
-        st.doppler_bias_hz = 0.0;
-        st.doppler_epochs = 0;
+          std::abs(st.doppler_bias.mean_hz()) > opt_.false_lock_hz &&
+          st.doppler_bias.epochs() * step_s >= opt_.doppler_bias_average_s) {
+        st.aid_offset_hz -= st.doppler_bias.mean_hz();
+        st.doppler_bias.reset();
         ++frequency_resets_;
       }
       if (opt_.carrier_aiding) commands[i].carrier_frequency_hz = p.doppler_hz + st.aid_offset_hz;
@@ -468,7 +472,7 @@ void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
       ++phase_arcs_;
     }
   }
-  if (!ph.active()) return;  // the FLL's command (carrier_phase_locked false)
+  if (!ph.active()) return;  // the FLL's command (CarrierControl::kFrequency)
   // The replica's phase at its next epoch start: the carrier states' phase there; the frequency over that epoch:
   // the prediction at its middle plus the residual.
   const std::int64_t next = ch.next_epoch_sample;
@@ -484,7 +488,7 @@ void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
     return;
   }
   ph.record_command(next, command.carrier_frequency_hz);
-  command.carrier_phase_locked = true;
+  command.carrier = receiver::CarrierControl::kFrequencyAndPhase;
   command.carrier_phase_jump_cycles = jump;
   command.carrier_frequency_hz += ph.nu_hz();
   log.phase_tracking = true;

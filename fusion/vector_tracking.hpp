@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fusion/ekf.hpp"
+#include "fusion/false_lock_monitor.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "fusion/vector_carrier_phase.hpp"
 #include "receiver/vector_loop.hpp"
@@ -144,7 +145,7 @@ struct VectorTrackingOptions {
   bool filter_driven = true;
   double weak_cn0_average_s = 1.0;
   // False PLL lock of a weak channel (running mean C/N0 below false_lock_below_dbhz): the mean over
-  // doppler_bias_average_s of its measured minus predicted Doppler. Above doppler_bias_hz its Doppler rows are left
+  // doppler_bias_average_s of its measured minus predicted Doppler (fusion/false_lock_monitor.hpp, kRunning). Above doppler_bias_hz its Doppler rows are left
   // out; above false_lock_hz (after at least one averaging time) its carrier aiding steps once by that mean,
   // putting the PLL back on the predicted frequency. Locked channels of the threshold runs kept 15 s means within
   // 2 Hz (the PLL's own noise averaged, and the prediction's error); false locks sat at 20-25 Hz. Strong channels are left
@@ -216,12 +217,14 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
     int rejections = 0;   // consecutive rejections
     double coast_s = 0.0;  // commanded without a usable measurement (faded, coasting) this long
     double cn0_mean_hz = NAN;  // running mean of the channel's C/N0 estimates (ratio-Hz), while synchronised
-    double doppler_bias_hz = 0.0;  // running mean of measured minus predicted Doppler
-    int doppler_epochs = 0;        // Doppler measurements in that mean
+    // Running mean of measured minus predicted Doppler over doppler_bias_average_s (its epochs: Doppler
+    // measurements since the last aiding step).
+    FalseLockMonitor doppler_bias{FalseLockMonitor::Averaging::kRunning, 0.5};
     double aid_offset_hz = 0.0;    // steps given to the carrier aiding (false-lock resets)
   };
   // Whether a channel's measurements may update the filter and keep it commanded as tracked (not faded).
   bool usable(const receiver::VectorChannelInput& ch, const PrnState& st) const;
+  PrnState fresh_prn_state() const;  // with the false-lock monitor of opt_
   std::optional<SatelliteObservable> observable(const receiver::VectorEpochInput& in, int prn, std::int64_t sample,
                                                 double pseudorange_m) const;
   bool initialise(const receiver::VectorEpochInput& in);

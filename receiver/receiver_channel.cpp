@@ -58,9 +58,11 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   control.coasting_allowed = vector_.vector;
   control.filter_driven = vector_.vector && vector_.filter_driven;
   // Vector FLL: the loop's frequency is the NCO's; the channel's own carrier loop stands still.
-  const bool fll = vector_.vector && vector_.carrier_commanded && std::isfinite(vector_.carrier_frequency_hz);
+  const bool fll =
+      vector_.vector && vector_.carrier != CarrierControl::kAided && std::isfinite(vector_.carrier_frequency_hz);
+  const bool phase_locked = fll && vector_.carrier == CarrierControl::kFrequencyAndPhase;
   control.carrier_commanded = fll;
-  control.carrier_phase_locked = fll && vector_.carrier_phase_locked;
+  control.carrier_phase_locked = phase_locked;
   if (fll) {
     control.carrier_frequency_hz = vector_.carrier_frequency_hz;
     last_scalar_.carrier_frequency_hz = vector_.carrier_frequency_hz;
@@ -86,7 +88,7 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   // (bit errors at ~20 dB-Hz, 5 % at 18, fail subframes and would drop the frame lock, hence the tag).
   nav_.hold_time_tag(loop_.coasting() || (vector_.vector && vector_.filter_driven));
   vector_jump_pending_ = vector_.vector && vector_.code_phase_jump_chips != 0.0;
-  vector_carrier_jump_pending_ = fll && vector_.carrier_phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
+  vector_carrier_jump_pending_ = phase_locked && vector_.carrier_phase_jump_cycles != 0.0;
   // Between epochs the next one starts at once: replace the command it would start with.
   if ((vector_.vector || was_vector) && channel_.next_epoch_sample() == channel_.next_sample())
     channel_.command(merged_command());
@@ -161,7 +163,7 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
     // Costas phases are bit-insensitive, within +-1/4 cycle: their change is taken within +-1/4 cycle. A channel
     // whose carrier a filter commands and drives, with both bits known, has them wiped: the full phase change
     // (+-1/2 cycle), which at 20-22 dB-Hz stays unbiased where the Costas change reads 0.56-0.78 of the offset.
-    const bool wipe = vector_.vector && vector_.filter_driven && vector_.carrier_commanded && e.bit_sign != 0 &&
+    const bool wipe = vector_.vector && vector_.filter_driven && vector_.carrier != CarrierControl::kAided && e.bit_sign != 0 &&
                       p.bit_sign != 0;
     const double dphi = wipe ? wiped_phase_change_cycles(p.prompt, e.prompt, e.bit_sign * p.bit_sign)
                              : costas_phase_change_cycles(p.prompt, e.prompt);

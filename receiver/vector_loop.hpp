@@ -2,9 +2,9 @@
 // a VectorLoop every channel's latest correlation results, as pseudorange and Doppler measurements on the
 // receiver's clock, and the replica's state; the loop answers one VectorChannelCommand per channel, which the
 // channel applies through its NcoCommand at the start of its next epoch (code rate and a code phase jump; the
-// carrier either stays with the channel's Costas PLL, aided by the loop's predicted Doppler, or, with
-// carrier_commanded, is the loop's: a vector FLL, or with carrier_phase_locked too, a vector PLL whose phase the
-// loop closes through carrier_phase_jump_cycles). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
+// carrier either stays with the channel's Costas PLL, aided by the loop's predicted Doppler (CarrierControl::kAided),
+// or is the loop's: a vector FLL (kFrequency), or a vector PLL whose phase the loop closes through
+// carrier_phase_jump_cycles (kFrequencyAndPhase)). Units: metres, m/s, Hz, chips, samples; C/N0 in dB-Hz.
 #pragma once
 
 #include <array>
@@ -99,34 +99,41 @@ struct VectorEpochInput {
   std::int64_t command_sample = 0;
 };
 
-// What the loop tells one channel. vector false: the channel's own DLL closes its code loop (scalar).
-struct VectorChannelCommand {
-  bool vector = false;
-  double code_rate_chips_per_s = 0.0;  // including code Doppler
-  double code_phase_jump_chips = 0.0;  // applied once at next_epoch_sample; positive advances the replica
-  // Carrier aiding: the predicted carrier Doppler at next_epoch_sample, Hz; its change from one command to the
-  // next is added to the channel's PLL (ScalarTracking::aid_frequency). NaN: no aiding.
-  double carrier_frequency_hz = NAN;
+// Who closes a vector channel's carrier (VectorChannelCommand::carrier).
+enum class CarrierControl {
+  // The channel's Costas PLL; carrier_frequency_hz aids it (its change from one command to the next is added to the
+  // PLL, ScalarTracking::aid_frequency).
+  kAided,
   // Vector FLL: carrier_frequency_hz (finite) is the carrier NCO's frequency from the next epoch start on, not an
   // aid; the channel runs no carrier loop of its own (ScalarTracking::set_carrier_commanded): the loop closes the
   // carrier through the channel's frequency discriminator (measured_doppler_hz), the channel's bits are detected
   // differentially, its lock test is the C/N0 alone (the presence test when filter_driven too), and its carrier
   // phase is reported with loss of lock (the NCO's accumulated Doppler, not a phase-locked observable).
-  bool carrier_commanded = false;
-  // Vector PLL (with carrier_commanded): the loop also closes the carrier phase. carrier_phase_jump_cycles (positive
+  kFrequency,
+  // Vector PLL: as kFrequency, and the loop also closes the carrier phase: carrier_phase_jump_cycles (positive
   // advances the replica carrier) is applied once at next_epoch_sample, on top of carrier_frequency_hz; the channel
   // detects its bits coherently (Costas: polarity from the preamble) and reports its carrier phase as locked (no
-  // RINEX loss-of-lock flag, except on the first epoch after unlocked ones). carrier_phase_locked false with
-  // carrier_commanded: the FLL above (the jump is ignored).
-  bool carrier_phase_locked = false;
-  double carrier_phase_jump_cycles = 0.0;
+  // RINEX loss-of-lock flag, except on the first epoch after unlocked ones).
+  kFrequencyAndPhase,
+};
+
+// What the loop tells one channel. vector false: the channel's own DLL closes its code loop (scalar).
+struct VectorChannelCommand {
+  bool vector = false;
+  double code_rate_chips_per_s = 0.0;  // including code Doppler
+  double code_phase_jump_chips = 0.0;  // applied once at next_epoch_sample; positive advances the replica
+  // The predicted carrier Doppler at next_epoch_sample, Hz: an aid to the channel's PLL (kAided) or the carrier
+  // NCO's frequency (kFrequency, kFrequencyAndPhase). NaN: no aiding (and with kFrequency*: the channel's own loop).
+  double carrier_frequency_hz = NAN;
+  CarrierControl carrier = CarrierControl::kAided;
+  double carrier_phase_jump_cycles = 0.0;  // kFrequencyAndPhase only
   // The loop judges the channel's carrier phase not to follow the signal now (an aided PLL run away from the
-  // predicted Doppler, or just stepped back onto it: tools/receive_ultratight.hpp, CarrierRunawayMonitor): the
+  // predicted Doppler, or just stepped back onto it: pipelines/ultratight_loop.hpp, fusion/false_lock_monitor.hpp): the
   // channel's next measurement carries the loss-of-lock flag (RINEX LLI, Hatch smoother restart), as a cycle slip.
   bool carrier_slip = false;
   // The loop's filter drives the replica and judges lock (ultra-tight): the channel's scalar loss test gives way
   // to the presence test (ScalarTracking::set_filter_driven), its PLL sums N x 20 ms with the known bits wiped
-  // (pure PLL; with carrier_commanded there is no PLL, and the known bits wipe the frequency discriminator's
+  // (pure PLL; with a commanded carrier there is no PLL, and the known bits wipe the frequency discriminator's
   // epochs instead), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).
   bool filter_driven = false;
 };

@@ -8,20 +8,11 @@
 #include <filesystem>
 #include <vector>
 
-#include "ins/attitude.hpp"
-#include "signals/gps_time.hpp"
+#include "pipelines/fuse_inputs.hpp"
 
 namespace ultratrack::tools {
 
-struct AttitudeCsvRow {
-  int line = 0;  // in the file, for messages
-  signals::GpsTime time;
-  ins::EulerAngles euler;                                      // rad (nan when not fixed)
-  double sigma_roll_rad = 0.0, sigma_pitch_rad = 0.0, sigma_yaw_rad = 0.0;
-  int num_sats = 0;
-  bool fixed = false;
-  double ratio = 0.0;
-};
+using AttitudeCsvRow = pipelines::GpsAttitudeRow;  // the row (pipelines/fuse_inputs.hpp); this file reads it
 
 std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file);
 

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 
+#include "signals/gps_time.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {
@@ -49,6 +50,22 @@ std::vector<int> parse_prn_list_option(const std::string& option, const std::str
     start = comma + 1;
   }
   return prns;
+}
+
+bool parse_on_off_option(const std::string& option, const std::string& value, const char* on, const char* off) {
+  if (value == on) return true;
+  if (value == off) return false;
+  throw signals::InputError("command line", option + ": '" + value + "' is neither " + on + " nor " + off);
+}
+
+int build_gps_week() {
+  static const char* months = "JanFebMarAprMayJunJulAugSepOctNovDec";
+  const std::string date = __DATE__;  // "Mmm dd yyyy"
+  signals::CalendarTime c;
+  c.month = static_cast<int>(std::string(months).find(date.substr(0, 3)) / 3) + 1;
+  c.day = std::stoi(date.substr(4, 2));
+  c.year = std::stoi(date.substr(7, 4));
+  return signals::gps_time_from_calendar(c).week;
 }
 
 }  // namespace ultratrack::tools

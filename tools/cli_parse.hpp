@@ -1,5 +1,5 @@
 // Command-line values parsed as text so that a malformed one is an InputError (exit 2) like any other bad
-// input: numbers, integers and PRN lists ("1-32", "3,7,12-15").
+// input: numbers, integers, PRN lists ("1-32", "3,7,12-15") and two-valued switches; the build date's GPS week.
 #pragma once
 
 #include <string>
@@ -10,5 +10,9 @@ namespace ultratrack::tools {
 double parse_double_option(const std::string& option, const std::string& text);
 int parse_int_option(const std::string& option, const std::string& text);
 std::vector<int> parse_prn_list_option(const std::string& option, const std::string& text);
+// true for the value `on`, false for `off`.
+bool parse_on_off_option(const std::string& option, const std::string& value, const char* on, const char* off);
+// The GPS week of the build date: a reference within +-512 weeks of any recording made near it.
+int build_gps_week();
 
 }  // namespace ultratrack::tools

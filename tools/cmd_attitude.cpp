@@ -10,7 +10,6 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <memory>
 #include <string>
 #include <vector>
@@ -20,6 +19,7 @@
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "interrupt_guard.hpp"
 #include "receiver/multi_sample_source.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_summary.hpp"
@@ -28,15 +28,6 @@
 
 namespace ultratrack::tools {
 namespace {
-
-volatile std::sig_atomic_t g_attitude_interrupted = 0;
-void stop_attitude(int) { g_attitude_interrupted = 1; }
-
-struct SigintGuard {
-  SigintGuard() : previous(std::signal(SIGINT, stop_attitude)) { g_attitude_interrupted = 0; }
-  ~SigintGuard() { std::signal(SIGINT, previous); }
-  void (*previous)(int);
-};
 
 struct AttitudeArgs {
   std::vector<std::string> inputs;
@@ -87,7 +78,7 @@ void run_attitude(const AttitudeArgs& args) {
   receiver::ReceiverEngine engine(options, outputs);
   if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
 
-  SigintGuard sigint;
+  InterruptGuard interrupt;  // Ctrl-C ends the loop; the outputs are still finished
   const auto block_size = static_cast<std::size_t>(std::max<std::int64_t>(1, std::llround(0.05 * options.fs_hz)));
   std::vector<std::vector<std::complex<float>>> blocks(n_ant, std::vector<std::complex<float>>(block_size));
   std::vector<std::span<std::complex<float>>> out(n_ant);
@@ -95,7 +86,7 @@ void run_attitude(const AttitudeArgs& args) {
   const auto wall_start = std::chrono::steady_clock::now();
   std::int64_t done = 0;
   double next_progress_s = 10.0;
-  while (done < to_process && !g_attitude_interrupted) {
+  while (done < to_process && !interrupt.interrupted()) {
     const auto want = static_cast<std::size_t>(std::min<std::int64_t>(block_size, to_process - done));
     for (std::size_t a = 0; a < n_ant; ++a) out[a] = std::span(blocks[a].data(), want);
     const receiver::SampleBlock got = source.read(out);
@@ -119,7 +110,7 @@ void run_attitude(const AttitudeArgs& args) {
   run.fs_hz = options.fs_hz;
   run.if_hz = source_options.if_hz;
   run.wall_time_s = wall_s;
-  run.interrupted = g_attitude_interrupted != 0;
+  run.interrupted = interrupt.interrupted();
   outputs.finish(engine, run, args.inputs);
 
   const double t = receiver::processed_seconds(engine);

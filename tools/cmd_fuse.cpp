@@ -13,10 +13,14 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "fuse_run.hpp"
-#include "fused_nav_csv.hpp"
 #include "attitude_csv.hpp"
+#include "fuse_config.hpp"
 #include "gnss_csv.hpp"
+#include "gnss_fix_simulation.hpp"
+#include "interrupt_guard.hpp"
+#include "pipelines/fuse.hpp"
+#include "pipelines/fuse_summary.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "ins/imu_csv.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
@@ -26,6 +30,7 @@ namespace ultratrack::tools {
 namespace {
 
 namespace fs = std::filesystem;
+using pipelines::AlignMode;
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct FuseCommandOptions {
@@ -42,7 +47,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
     throw io::InputError("command line", "--coupling " + o.coupling +
                                              ": fuse takes external position/velocity fixes, only 'loose' applies "
                                              "(tight coupling runs from observables: ultratrack receive --imu)");
-  FuseSettings s;
+  pipelines::FuseSettings s;
   if (o.filter == "ekf") {
     s.filter = fusion::FilterKind::Ekf;
   } else if (o.filter == "ukf") {
@@ -89,21 +94,23 @@ void run_fuse_command(const FuseCommandOptions& o) {
                o.align);
 
   fs::create_directories(o.out_dir);
-  FusedNavCsvWriter nav(fs::path(o.out_dir) / "nav.csv");
+  pipelines::FusedNavCsvWriter nav(fs::path(o.out_dir) / "nav.csv");
   long long rows = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  const FuseResult r = fuse(
-      imu, gnss, truth, s,
-      [&](const ins::NavState& state, const NavSigma& sigma) {
+  InterruptGuard interrupt;  // Ctrl-C ends the run early; nav.csv and summary.json cover it so far
+  const pipelines::FuseResult r = pipelines::fuse(
+      imu, gnss, truth_samples_from_nav(truth), s,
+      [&](const ins::NavState& state, const pipelines::NavSigma& sigma) {
         if (rows++ % o.decimate == 0) nav.write(state, sigma);
       },
       [&](double fraction) {
         if (!o.quiet) fmt::print("fuse: {:3.0f} %\n", 100.0 * fraction);
-      });
+      },
+      interrupt.token());
   nav.commit();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   io::write_file_atomically(fs::path(o.out_dir) / "summary.json",
-                            fuse_summary_json(r, s, o.imu_file, o.gnss_file, o.truth_file));
+                            pipelines::fuse_summary_json(r, s, o.imu_file, o.gnss_file, o.truth_file));
 
   const auto& e = r.initial_attitude;
   fmt::print("fuse: aligned {}: roll {:.3f} pitch {:.3f} yaw {:.3f} deg\n", r.alignment_note, e.roll_rad / kDeg,
@@ -130,7 +137,8 @@ void run_fuse_command(const FuseCommandOptions& o) {
   for (const auto& oo : r.outages)
     fmt::print("fuse: outage {:.1f}-{:.1f} s: horizontal error at its end {:.3f} m (1-sigma {:.3f} m)\n", oo.start_s,
                oo.end_s, oo.horizontal_error_m, oo.sigma_horizontal_m);
-  fmt::print("fuse: wrote {}/nav.csv and summary.json\n", o.out_dir);
+  fmt::print("fuse: wrote {}/nav.csv and summary.json{}\n", o.out_dir,
+             interrupt.interrupted() ? " (interrupted)" : "");
 }
 
 }  // namespace

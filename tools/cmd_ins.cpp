@@ -21,6 +21,7 @@
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
 #include "ins/strapdown.hpp"
+#include "interrupt_guard.hpp"
 #include "io/atomic_file.hpp"
 #include "truth_csv.hpp"
 
@@ -127,7 +128,8 @@ void run_ins(const InsOptions& o) {
   const double nominal_dt = imu.size() > first + 1 ? imu[first + 1].t_s - imu[first].t_s : 0.0;
   const auto t_start = std::chrono::steady_clock::now();
   std::size_t steps = 0;
-  for (std::size_t k = first; k < imu.size(); ++k) {
+  InterruptGuard interrupt;  // Ctrl-C ends the run; nav.csv and summary.json cover it so far
+  for (std::size_t k = first; k < imu.size() && !interrupt.interrupted(); ++k) {
     const double dt = imu[k].t_s - nav.state().t_s;
     if (nominal_dt > 0.0 && dt > 3.0 * nominal_dt) nav.reset_history();  // data gap: no coning history across it
     nav.step(imu[k]);
@@ -159,6 +161,7 @@ void run_ins(const InsOptions& o) {
         cmp.matched, cmp.max_horizontal_m, cmp.max_vertical_m, cmp.max_velocity_mps, cmp.max_attitude_deg,
         cmp.final_horizontal_m, cmp.final_vertical_m, cmp.final_attitude_deg);
   }
+  if (interrupt.interrupted()) json += "  \"interrupted\": true,\n";
   json += fmt::format("  \"steps_per_second\": {:.0f}\n}}\n", wall_s > 0 ? steps / wall_s : 0.0);
   io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);

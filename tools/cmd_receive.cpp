@@ -1,27 +1,22 @@
-// `ultratrack receive`: the scalar receiver end to end on a recording (receiver/receiver_engine.hpp fed by
+// `ultratrack receive`: the receiver end to end on a recording (pipelines/receiver_pipeline.hpp fed by
 // receiver/sample_source.hpp), writing solution.csv, NMEA, KML, RINEX 3.04 obs + nav, tracking.csv and
-// summary.json into --out (receiver/receiver_outputs.hpp). Options: command-line flags over --config (TOML,
-// tools/receive_config.hpp) over the defaults. A progress bar on a terminal, plain lines otherwise.
+// summary.json into --out (receiver/receiver_outputs.hpp) and the coupling's logs (pipelines/receive_csv_files.hpp).
+// Options: command-line flags over --config (TOML, tools/receive_config.hpp) over the defaults; the coupling's in
+// tools/receive_fusion_options.hpp. A progress bar on a terminal, plain lines otherwise.
 // Exit: 0 with a fix; 2 (InputError) for bad input, including a file in which no satellite is found (no
 // outputs then); 3 when satellites were tracked but the file ended before a fix (outputs written, summary
 // says "fix": false). SIGINT stops the loop and still finishes every output.
-// --coupling vector: one vector filter closes the channels' code loops (tools/receive_vector.hpp).
-// --imu F --coupling loose|tight: GNSS/INS integration on the way (tools/receive_fusion.hpp): nav.csv and a "fusion"
-// object in summary.json; exit 3 also when the integration never started, 0 with a fused solution but no PVT fix.
-// --imu F --coupling ultra-tight: tight pull-in, then the ultra-tight loop drives the channels
-// (tools/receive_ultratight.hpp): ultratight.csv and an "ultratight" object in summary.json.
+// --coupling vector: one vector filter closes the channels' code loops: vector.csv, vector_state.csv.
+// --imu F --coupling loose|tight: GNSS/INS integration on the way: nav.csv and a "fusion" object in summary.json;
+// exit 3 also when the integration never started, 0 with a fused solution but no PVT fix.
+// --imu F --coupling ultra-tight: tight pull-in, then the ultra-tight loop drives the channels: ultratight.csv and
+// an "ultratight" object in summary.json.
 #include <fmt/core.h>
-#include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
-#include <cstdio>
-#include <ctime>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,15 +24,14 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "format_options.hpp"
+#include "interrupt_guard.hpp"
+#include "pipelines/receive_csv_files.hpp"
+#include "pipelines/receiver_pipeline.hpp"
 #include "receive_config.hpp"
-#include "receive_fusion.hpp"
-#include "receive_ultratight.hpp"
-#include "receive_vector.hpp"
-#include "receiver/receiver_engine.hpp"
+#include "receive_fusion_options.hpp"
+#include "receive_progress.hpp"
 #include "receiver/receiver_outputs.hpp"
-#include "receiver/sample_prefetcher.hpp"
 #include "receiver/sample_source.hpp"
-#include "signals/gps_time.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
 #include "signals/sample_format.hpp"
@@ -46,77 +40,12 @@ namespace ultratrack::tools {
 
 namespace {
 
-volatile std::sig_atomic_t g_interrupted = 0;
-void stop_receiving(int) { g_interrupted = 1; }  // C++ linkage: no clash with other commands' handlers
-
-// Restores the previous SIGINT handler when the command leaves, however it leaves.
-struct SigintGuard {
-  SigintGuard() : previous(std::signal(SIGINT, stop_receiving)) { g_interrupted = 0; }
-  ~SigintGuard() { std::signal(SIGINT, previous); }
-  void (*previous)(int);
-};
-
 struct ReceiveArgs {
   std::string input, fs, if_hz = "0", config, nav, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
-  std::string vector_carrier;  // --vector-carrier aided-pll|fll|pll (with --coupling vector)
   FormatArgs format;
   ReceiveFusionArgs fusion;
   bool iq_swap = false, q_negate = false, quiet = false;
-};
-
-// The GPS week of the build date: a reference within +-512 weeks of any recording made near it.
-int build_week() {
-  static const char* months = "JanFebMarAprMayJunJulAugSepOctNovDec";
-  const std::string date = __DATE__;  // "Mmm dd yyyy"
-  signals::CalendarTime c;
-  c.month = static_cast<int>(std::string(months).find(date.substr(0, 3)) / 3) + 1;
-  c.day = std::stoi(date.substr(4, 2));
-  c.year = std::stoi(date.substr(7, 4));
-  return signals::gps_time_from_calendar(c).week;
-}
-
-bool on_off(const std::string& option, const std::string& value, const char* on, const char* off) {
-  if (value == on) return true;
-  if (value == off) return false;
-  throw signals::InputError("command line", option + ": '" + value + "' is neither " + on + " nor " + off);
-}
-
-class Progress {
- public:
-  Progress(bool quiet, double total_s) : quiet_(quiet), tty_(isatty(fileno(stderr)) != 0), total_s_(total_s) {}
-  void update(const receiver::ReceiverEngine& engine, bool final = false) {
-    if (quiet_) return;
-    const double t = receiver::processed_seconds(engine);
-    const auto now = std::chrono::steady_clock::now();
-    if (!final) {
-      if (tty_ && now - last_ < std::chrono::milliseconds(250)) return;
-      if (!tty_ && t < next_line_s_) return;
-    }
-    last_ = now;
-    next_line_s_ = t + 10.0;
-    const auto& fix = engine.last_fix();
-    const std::string status = fix ? fmt::format("fix {:.6f} {:.6f} {:.1f} m ({} sats)", fix->lat_rad * 57.29577951308232,
-                                                 fix->lon_rad * 57.29577951308232, fix->height_m, fix->used_prns.size())
-                                   : "no fix";
-    const int tracked = engine.channels_in_use(), synced = engine.channels_synchronised();
-    if (tty_) {
-      const double fraction = total_s_ > 0.0 ? std::min(1.0, t / total_s_) : 0.0;
-      const int width = 30, filled = static_cast<int>(fraction * width);
-      fmt::print(stderr, "\r[{}{}] {:6.1f}/{:.1f} s  tracking {:2d} (synced {:2d})  {}   ", std::string(filled, '#'),
-                 std::string(width - filled, '.'), t, total_s_, tracked, synced, status);
-      if (final) fmt::print(stderr, "\n");
-    } else {
-      fmt::print(stderr, "receive: {:.1f}/{:.1f} s, tracking {} (synced {}), {}\n", t, total_s_, tracked, synced,
-                 status);
-    }
-  }
-
- private:
-  bool quiet_, tty_;
-  double total_s_;
-  double next_line_s_ = 0.0;
-  std::chrono::steady_clock::time_point last_{};
 };
 
 void run_receive(const ReceiveArgs& args) {
@@ -131,13 +60,14 @@ void run_receive(const ReceiveArgs& args) {
   if (skip_s < 0.0) throw signals::InputError("command line", "--skip: must not be negative");
   source_options.start_sample = std::llround(skip_s * source_options.fs_hz);
 
-  receiver::ReceiverOptions options;
+  pipelines::ReceiveOptions pipeline;
+  receiver::ReceiverOptions& options = pipeline.receiver;
   options.fs_hz = source_options.fs_hz;
   if (!args.config.empty()) apply_receive_config(args.config, options);
   if (!args.elevation_mask.empty())
     options.pvt.elevation_mask_rad = parse_double_option("--elevation-mask-deg", args.elevation_mask) * M_PI / 180.0;
-  if (!args.troposphere.empty()) options.pvt.troposphere = on_off("--troposphere", args.troposphere, "on", "off");
-  if (!args.ionosphere.empty()) options.pvt.ionosphere = on_off("--ionosphere", args.ionosphere, "broadcast", "off");
+  if (!args.troposphere.empty()) options.pvt.troposphere = parse_on_off_option("--troposphere", args.troposphere, "on", "off");
+  if (!args.ionosphere.empty()) options.pvt.ionosphere = parse_on_off_option("--ionosphere", args.ionosphere, "broadcast", "off");
   if (!args.channels.empty()) options.channels = parse_int_option("--channels", args.channels);
   if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
@@ -148,7 +78,7 @@ void run_receive(const ReceiveArgs& args) {
     options.reference_week_is_signal_week = true;
   } else if (options.reference_week == 0) {
     // A nav file dates the recording; the build date only bounds it (+-512 weeks for the 10-bit WN).
-    options.reference_week = nav.ephemerides.empty() ? build_week() : nav.ephemerides.front().week;
+    options.reference_week = nav.ephemerides.empty() ? build_gps_week() : nav.ephemerides.front().week;
     options.reference_week_is_signal_week = !nav.ephemerides.empty();
   }
   const double duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
@@ -171,53 +101,26 @@ void run_receive(const ReceiveArgs& args) {
                                                       "acquisition needs ({} x {} ms)",
                                                       to_process, needed, acq.noncoherent, acq.coherent_ms));
 
-  // GNSS/INS integration (--coupling): settings and the IMU file checked before any output exists.
-  const auto fusion_settings = parse_receive_fusion(args.fusion);
+  apply_receive_coupling_args(args.fusion, pipeline);
+  if (std::string why; !pipeline.IsValid(&why)) throw signals::InputError("command line", why);
   std::vector<ins::ImuIncrement> imu;
-  if (fusion_settings) imu = read_receive_imu(*fusion_settings);
+  if (pipelines::uses_imu(pipeline.coupling)) imu = read_receive_imu(args.fusion.imu);
 
   receiver::ReceiverOutputs outputs(args.out, options.fs_hz, options.observation_interval_s);
-  std::optional<ReceiveFusion> fusion;
-  if (fusion_settings) fusion.emplace(*fusion_settings, std::move(imu), outputs, args.out, options, nav.ephemerides);
-  receiver::ReceiverEngine engine(options, fusion ? static_cast<receiver::ReceiverObserver&>(*fusion) : outputs);
-  if (fusion) fusion->attach(engine);
-  if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
-  const ReceiveCoupling coupling = parse_receive_coupling(args.fusion.coupling);
-  if (!args.vector_carrier.empty() && coupling != ReceiveCoupling::Vector)
-    throw signals::InputError("command line", "--vector-carrier needs --coupling vector");
-  const fusion::VectorCarrier vector_carrier =
-      args.vector_carrier.empty() ? fusion::VectorCarrier::kAidedPll : parse_vector_carrier(args.vector_carrier);
-  std::unique_ptr<ReceiveVector> vector;  // --coupling vector: the vector tracking filter closes the code loops
-  if (coupling == ReceiveCoupling::Vector)
-    (vector = std::make_unique<ReceiveVector>(options, args.out, vector_carrier))->attach(engine);
-  std::unique_ptr<ReceiveUltraTight> ultratight;  // --coupling ultra-tight: the INS-predicted replica drives them
-  if (coupling == ReceiveCoupling::UltraTight)
-    (ultratight = std::make_unique<ReceiveUltraTight>(*fusion, options, args.out))->attach(engine);
-
-  SigintGuard sigint;
-  Progress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
-  const auto block_size = static_cast<std::size_t>(std::max<std::int64_t>(1, std::llround(0.05 * options.fs_hz)));
+  pipelines::ReceiveCsvFiles logs(args.out, pipeline.coupling, options.fs_hz);
+  pipelines::Receiver receiver(pipeline, std::move(imu), nav, outputs, logs);
+  ReceiveProgress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
   const auto wall_start = std::chrono::steady_clock::now();
-  // With more than one thread the next block is read (and converted to int16) while this one is processed.
-  receiver::SamplePrefetcher reader(source, block_size, to_process, engine.threads() > 1);
-  while (!g_interrupted) {
-    const receiver::PrefetchedBlock got = reader.next();
-    if (got.where.count == 0) break;
-    engine.process(got.samples, got.where.first_sample, {got.re, got.im}, got.i16_gain);
-    reader.set_i16_gain(engine.i16_gain());
-    progress.update(engine);
-  }
-  engine.finish_vector_loop();  // a pipelined loop's last update
+  InterruptGuard interrupt;  // Ctrl-C ends the loop; every output is still finished
+  receiver.run(source, to_process, interrupt.token(),
+               [&](const receiver::ReceiverEngine& engine) { progress.update(engine); });
+  const pipelines::ReceiveSummary summary = receiver.finish();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  progress.update(engine, true);
-
-  const auto& stats = engine.stats();
-  bool acquired = false;
-  for (int prn = 1; prn <= 32; ++prn) acquired = acquired || stats.satellites[static_cast<std::size_t>(prn)].acquisitions > 0;
-  if (!acquired && !g_interrupted)
+  progress.update(receiver.engine(), true);
+  if (!summary.satellites_found && !summary.interrupted)
     throw signals::InputError(args.input, fmt::format("no GPS L1 C/A satellite found in {:.1f} s of signal: check "
                                                       "--format, --fs, --if, --iq-swap/--q-negate",
-                                                      receiver::processed_seconds(engine)));
+                                                      summary.processed_s));
 
   receiver::RunDescription run;
   run.input = args.input;
@@ -229,51 +132,29 @@ void run_receive(const ReceiveArgs& args) {
   run.if_hz = source_options.if_hz;
   run.skip_s = skip_s;
   run.wall_time_s = wall_s;
-  run.interrupted = g_interrupted != 0;
-  run.coupling = to_string(coupling);
-  if (fusion) {
-    fusion->finish(engine.stats().first_sample + engine.stats().samples_processed);
-    run.extra_json = fusion->summary_json();
-  }
-  if (ultratight) {
-    ultratight->finish(engine.stats().first_sample + engine.stats().samples_processed);
-    run.extra_json += ",\n  " + ultratight->summary_json();
-  }
-  if (vector) {
-    vector->finish();
-    run.extra_json = vector->summary_json();
-  }
-  outputs.finish(engine, run);
-  if (fusion) fusion->commit();
-  if (vector)
-    fmt::print("receive: vector tracking: {} epochs with channels in vector mode ({} channel-epochs), filter started "
-               "{} times, reset {} times; {} channel-epochs coasting\n", vector->vector_epochs(), vector->vector_channel_epochs(),
-               vector->filter().initialisations(), vector->filter().resets(), vector->coasting_channel_epochs());
+  run.interrupted = summary.interrupted;
+  run.coupling = pipelines::to_string(pipeline.coupling);
+  run.extra_json = summary.summary_json;
+  outputs.finish(receiver.engine(), run);
+  logs.commit();
 
-  const double t = receiver::processed_seconds(engine);
+  const double t = summary.processed_s;
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
-             wall_s > 0 ? t / wall_s : 0.0, engine.threads(), run.interrupted ? ", interrupted" : "");
-  int used = 0, tracked = 0;
-  for (int prn = 1; prn <= 32; ++prn) {
-    used += stats.satellites[static_cast<std::size_t>(prn)].used_in_fixes > 0;
-    tracked += engine.tracked_time_s(prn) > 0.0;
-  }
-  fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", tracked, used, stats.fixes,
-             engine.decoded_ephemerides().size());
-  if (fusion) fmt::print("{}\n", fusion->report());
-  if (ultratight) fmt::print("{}\n", ultratight->report());
-  if (fusion && !fusion->started())
+             wall_s > 0 ? t / wall_s : 0.0, summary.threads, run.interrupted ? ", interrupted" : "");
+  fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", summary.satellites_tracked,
+             summary.satellites_used, summary.fixes, summary.ephemerides_decoded);
+  for (const std::string& line : summary.report) fmt::print("{}\n", line);
+  const bool fused = pipelines::uses_imu(pipeline.coupling);
+  if (fused && !summary.navigation_started)
     throw CommandExit(3, fmt::format("{}: no fused solution ({}); outputs up to the end are in {}", args.input,
-                                     fusion->not_started_reason(), args.out));
-  if (stats.fixes == 0 && !(fusion && fusion->started()))
+                                     summary.navigation_not_started, args.out));
+  if (summary.fixes == 0 && !(fused && summary.navigation_started))
     throw CommandExit(3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} "
                                      "ephemerides decoded; --nav gives a hot start); outputs up to the end are in {}",
-                                     args.input, t, tracked, engine.decoded_ephemerides().size(), args.out));
-  if (stats.fixes == 0) return;  // a fused solution without any PVT fix (tight coupling)
-  const auto& s = stats;
+                                     args.input, t, summary.satellites_tracked, summary.ephemerides_decoded, args.out));
+  if (summary.fixes == 0) return;  // a fused solution without any PVT fix (tight coupling)
   fmt::print("receive: first fix after {:.2f} s; mean position {:.7f} deg, {:.7f} deg, {:.2f} m; outputs in {}\n",
-             receiver::ttff_seconds(engine), s.sum_lat_rad / s.fixes * 180.0 / M_PI,
-             s.sum_lon_rad / s.fixes * 180.0 / M_PI, s.sum_height_m / s.fixes, args.out);
+             summary.ttff_s, summary.mean_lat_deg, summary.mean_lon_deg, summary.mean_height_m, args.out);
 }
 
 }  // namespace
@@ -298,10 +179,6 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--skip", args->skip, "seconds of signal to skip at the start");
   cmd->add_option("--reference-week", args->reference_week,
                   "full GPS week near the recording, for the 10-bit week (default: nav file or build date)");
-  cmd->add_option("--vector-carrier", args->vector_carrier,
-                  "with --coupling vector: aided-pll (default: each channel's PLL, aided), fll (the filter "
-                  "commands the carrier NCOs: vector FLL) or pll (the filter commands the carrier NCOs' frequency "
-                  "and phase from per-channel carrier states its Costas discriminators update: vector PLL)");
   cmd->add_flag("--iq-swap", args->iq_swap, "exchange I and Q (complex formats)");
   cmd->add_flag("--q-negate", args->q_negate, "negate Q (complex) / invert the spectrum (real IF)");
   add_receive_fusion_options(cmd, args->fusion);

@@ -20,41 +20,13 @@
 // Unknown sections or keys and wrong value types are InputErrors naming the file and line.
 #pragma once
 
-#include <Eigen/Core>
 #include <filesystem>
-#include <optional>
-#include <string>
 
-#include "fusion/clock_model.hpp"
-#include "fusion/gnss_ins_integration.hpp"
-#include "signals/gps_time.hpp"
+#include "pipelines/fuse_config.hpp"
 
 namespace ultratrack::tools {
 
-struct FuseConfig {
-  std::string imu_preset = "hg1700ae";
-  std::optional<Eigen::Vector3d> attitude_deg;    // roll, pitch, yaw
-  std::optional<Eigen::Vector3d> position_deg_m;  // lat_deg, lon_deg, height_m
-  std::optional<Eigen::Vector3d> velocity_ned_mps;  // --align config without GNSS velocity (receive --imu)
-  std::optional<Eigen::Vector3d> sigma_position_m, sigma_velocity_mps, sigma_attitude_deg;
-  double static_duration_s = 60.0;
-  double motion_min_speed_mps = 5.0;
-  double motion_window_s = 2.0;
-  double velocity_sigma_mps = 0.1;
-  bool use_velocity = true;
-  Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();
-  fusion::UkfParameters ukf;
-  fusion::GateOptions gate;
-  double propagation_interval_s = 0.05;
-  double convergence_heading_sigma_deg = 1.0;
-  std::optional<signals::GpsTime> attitude_gps_time_at_imu_zero;
-  Eigen::Vector3d attitude_misalignment_deg = Eigen::Vector3d::Zero();  // roll, pitch, yaw of array -> IMU body
-  double attitude_max_pitch_deg = 80.0;
-  std::string clock_oscillator = "tcxo";
-  fusion::OscillatorAllan clock_allan = *fusion::oscillator_preset("tcxo");  // preset, then h0 / h_minus2
-  std::optional<double> clock_allan_h0, clock_allan_hm2;  // as given in the file
-  fusion::HeightAidingOptions height_aiding;
-};
+using pipelines::FuseConfig;  // the plain struct (pipelines/fuse_config.hpp); this file reads it from TOML
 
 // Reads the file over the defaults; throws io::InputError.
 FuseConfig read_fuse_config(const std::filesystem::path& path);

@@ -5,20 +5,15 @@
 // malformed, non-finite, out of range or not strictly increasing in time is an InputError with file and line.
 #pragma once
 
-#include <Eigen/Core>
 #include <filesystem>
 #include <span>
 #include <vector>
 
+#include "pipelines/fuse_inputs.hpp"
+
 namespace ultratrack::tools {
 
-struct GnssCsvRow {
-  double t_s = 0.0;
-  double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
-  bool has_velocity = false;
-  Eigen::Vector3d v_n = Eigen::Vector3d::Zero();          // m/s, valid when has_velocity
-  Eigen::Vector3d sigma_ned_m = Eigen::Vector3d::Ones();  // 1-sigma north, east, down position error
-};
+using GnssCsvRow = pipelines::GnssFixRow;  // the row (pipelines/fuse_inputs.hpp); this file reads and writes it
 
 std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file);
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "fused_nav_csv.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "gnss_csv.hpp"
 #include "io/input_error.hpp"
 #include "support/test_data.hpp"
@@ -102,7 +102,7 @@ TEST(FuseCommand, ForeignRatesAndTimesAlignInMotionAndConverge) {
   const double t0 = json_number(summary, "t_s", "alignment");
   EXPECT_GT(t0, 10.0);
   EXPECT_NEAR(std::remainder(t0 - 0.137, 0.2), 0.0, 1e-9);
-  const auto rows = ultratrack::tools::read_fused_nav_csv(dir / "fuse/nav.csv");
+  const auto rows = ultratrack::pipelines::read_fused_nav_csv(dir / "fuse/nav.csv");
   ASSERT_GT(rows.size(), 40000u);
   EXPECT_EQ(rows.front().nav.t_s, t0);  // starts exactly at the alignment time, between IMU samples
   EXPECT_NEAR(rows.back().nav.t_s, 240.0, 1e-9);

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "fused_nav_csv.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "gnss_csv.hpp"
 #include "gnss_fix_simulation.hpp"
 #include "ins/earth_model.hpp"
@@ -115,15 +115,15 @@ TEST(FuseNavCsv, RoundTripKeepsStateAndSigmas) {
   s.height_m = 321.5;
   s.v_n = {10, -3, 0.25};
   s.q_nb = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
-  ultratrack::tools::NavSigma g{{1, 2, 3}, {0.1, 0.2, 0.3}, {0.001, 0.002, 0.01}};
+  ultratrack::pipelines::NavSigma g{{1, 2, 3}, {0.1, 0.2, 0.3}, {0.001, 0.002, 0.01}};
   {
-    ultratrack::tools::FusedNavCsvWriter w(f);
+    ultratrack::pipelines::FusedNavCsvWriter w(f);
     w.write(s, g);
     s.t_s += 0.005;
     w.write(s, g);
     w.commit();
   }
-  const auto rows = ultratrack::tools::read_fused_nav_csv(f);
+  const auto rows = ultratrack::pipelines::read_fused_nav_csv(f);
   ASSERT_EQ(rows.size(), 2u);
   EXPECT_EQ(rows[1].nav.t_s, s.t_s);
   EXPECT_NEAR(rows[1].nav.lat_rad, s.lat_rad, 1e-15);

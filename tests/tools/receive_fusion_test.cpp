@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "command_exit.hpp"
-#include "fused_nav_csv.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
 #include "run_command.hpp"
@@ -97,10 +97,10 @@ Eigen::Vector3d truth_at(const std::vector<tools::TruthPoint>& truth, double tow
   return a.r_e_m + w * (b.r_e_m - a.r_e_m);
 }
 
-Eigen::Vector3d nav_at(const std::vector<tools::FusedNavRow>& nav, double t_s) {
+Eigen::Vector3d nav_at(const std::vector<pipelines::FusedNavRow>& nav, double t_s) {
   auto it = std::lower_bound(nav.begin(), nav.end(), t_s,
-                             [](const tools::FusedNavRow& r, double t) { return r.nav.t_s < t; });
-  auto pos = [](const tools::FusedNavRow& r) {
+                             [](const pipelines::FusedNavRow& r, double t) { return r.nav.t_s < t; });
+  auto pos = [](const pipelines::FusedNavRow& r) {
     return ins::ecef_from_geodetic(r.nav.lat_rad, r.nav.lon_rad, r.nav.height_m);
   };
   if (it == nav.begin()) return pos(*it);
@@ -125,7 +125,7 @@ struct Rms {
 // Fused (nav.csv) and PVT (solution.csv) 3-D position errors at the fixes made after the fused start.
 Rms compare(const fs::path& rx) {
   const auto& s = simulated();
-  const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
+  const auto nav = pipelines::read_fused_nav_csv(rx / "nav.csv");
   const auto fixes = tools::read_solution_csv(rx / "solution.csv");
   Rms r;
   double f2 = 0.0, g2 = 0.0, since_start = 0.0, bound2 = 0.0;
@@ -259,7 +259,7 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
   const std::string solution = test::read_text_file(rx / "solution.csv");
   EXPECT_EQ(std::count(solution.begin(), solution.end(), '\n'), 1) << "solution.csv: header only";
   EXPECT_GE(json_number(summary, "epochs_fewer_than_4_satellites"), 50.0);
-  const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
+  const auto nav = pipelines::read_fused_nav_csv(rx / "nav.csv");
   ASSERT_FALSE(nav.empty());
   EXPECT_NEAR(nav.back().nav.t_s, kDuration_s, 0.02);
   double worst_late_m = 0.0;

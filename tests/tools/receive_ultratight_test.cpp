@@ -17,16 +17,15 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
-#include <random>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "fused_nav_csv.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
-#include "receive_ultratight.hpp"
+#include "pipelines/ultratight_loop.hpp"
 #include "run_command.hpp"
 #include "solution_compare.hpp"
 #include "support/test_data.hpp"
@@ -92,7 +91,7 @@ struct NavError {
 };
 NavError nav_error(const fs::path& rx, double t0) {
   const auto truth = tools::read_simulation_truth_csv(sim().sim / "truth.csv");
-  const auto nav = tools::read_fused_nav_csv(rx / "nav.csv");
+  const auto nav = pipelines::read_fused_nav_csv(rx / "nav.csv");
   NavError e;
   double s2 = 0.0, g2 = 0.0;
   for (const auto& r : nav) {
@@ -400,96 +399,4 @@ TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
                "--ut-measurement must be iq or discriminator");
   expect_error("bad_coupling", {"--coupling", "ultratight"}, "ultra-tight");
   expect_error("missing_imu_file", {"--imu", (s.dir / "none.csv").string(), "--coupling", "ultra-tight"}, "not found");
-}
-
-// The I&Q model's amplitude estimate on simulated prompt taps (I ~ N(A, 1), Q ~ N(0, 1) in unit noise, raw scale
-// 1 / 7: scale2 = 49), against the truth A^2 = 2 C/N0 T and the closed-form spread of a running mean of weight w,
-// sqrt((4 + 4 A^2) w / (2 - w)). Between 14 and 20 dB-Hz the estimate must be unbiased (mean within 4 standard
-// errors; ~N w / 2 independent samples for N epochs) and its spread that of the ~1 s mean, not the 0.2 s one's
-// (2.3 x larger): within 15 % of the closed form (the restarts from the fast mean add ~6 % at 16 dB-Hz). A 14 dB-Hz
-// gate on it then passes >= 90 % of the 16 dB-Hz epochs without raising their mean A^2 by more than 5 % (the
-// 0.2 s mean under the old 18 dB-Hz gate: 11 % passed, at 1.9 x). After a step 45 -> 16 dB-Hz it follows the
-// 0.2 s mean.
-TEST(PromptPowerAverage, UnbiasedOneSecondMeanOfSimulatedTapsAndFollowsAStep) {
-  constexpr double kT = 0.020, kScale2 = 49.0, kW = 0.02;
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> n01;
-  auto raw_power = [&](double a) {
-    const double i = a + n01(rng), q = n01(rng);
-    return (i * i + q * q) / kScale2;
-  };
-  for (const double cn0 : {14.0, 16.0, 18.0, 20.0}) {
-    const double a2 = 2.0 * std::pow(10.0, cn0 / 10.0) * kT;
-    tools::PromptPowerAverage avg;
-    constexpr int kWarm = 500, kN = 100000;
-    double sum = 0.0, sum2 = 0.0, passed = 0.0, passed_sum = 0.0;
-    const double gate_a2 = 2.0 * std::pow(10.0, 1.4) * kT;  // 14 dB-Hz
-    for (int k = 0; k < kWarm + kN; ++k) {
-      const double e = avg.update(raw_power(std::sqrt(a2)), kScale2);
-      if (k < kWarm) continue;
-      sum += e;
-      sum2 += e * e;
-      if (e >= gate_a2) {
-        ++passed;
-        passed_sum += e;
-      }
-    }
-    const double mean = sum / kN, sd = std::sqrt(sum2 / kN - mean * mean);
-    const double closed = std::sqrt((4.0 + 4.0 * a2) * kW / (2.0 - kW));
-    EXPECT_NEAR(mean, a2, 4.0 * closed / std::sqrt(kN * kW / 2.0)) << cn0 << " dB-Hz";
-    EXPECT_NEAR(sd / closed, 1.0, 0.15) << cn0 << " dB-Hz";
-    if (cn0 == 16.0) {
-      EXPECT_GE(passed / kN, 0.90);
-      EXPECT_LT(passed_sum / passed / a2, 1.05);
-    }
-  }
-  // Step: 45 dB-Hz for 2 s, then 16 dB-Hz: after 2 s (100 epochs) the estimate is within 3 closed-form sigmas of
-  // the 0.2 s mean at 16 dB-Hz (the 0.2 s mean has decayed by 0.9^100 from A^2 = 1265; the 1 s mean alone would
-  // still read 1265 x 0.98^100 = 168).
-  tools::PromptPowerAverage avg;
-  const double strong = std::sqrt(2.0 * std::pow(10.0, 4.5) * kT), weak2 = 2.0 * std::pow(10.0, 1.6) * kT;
-  for (int k = 0; k < 100; ++k) avg.update(raw_power(strong), kScale2);
-  double e = 0.0;
-  for (int k = 0; k < 100; ++k) e = avg.update(raw_power(std::sqrt(weak2)), kScale2);
-  EXPECT_NEAR(e, weak2, 3.0 * std::sqrt((4.0 + 4.0 * weak2) * 0.1 / 1.9));
-}
-
-// The carrier-runaway monitor against closed forms. A locked channel: per-epoch offsets with the 0.46 Hz standard
-// deviation measured at 18 dB-Hz (cn0_18_file_0, 9 locked channels) and a 0.3 Hz bias: every 1 s block mean lies
-// within the bias +- 5 sigma of a 50-epoch mean (0.33 Hz; white, so a bound, not a sampling estimate), far inside
-// the 5 Hz threshold. A runaway: offsets ramping at 8 Hz/s from 0 (runaways seen drift 3-25 Hz/s): a block's mean
-// is the ramp at its middle (4 Hz for the first, 12 Hz for the second, which is caught), and recent_hz the ramp at
-// the middle of the last 5 epochs.
-TEST(CarrierRunawayMonitor, BlockMeansOfLockedNoiseStayNearTheBiasAndARampIsCaughtWithItsCurrentOffset) {
-  constexpr double kT = 0.020, kAverage = 1.0, kSigma = 0.46, kBias = 0.3;
-  std::mt19937 rng(11);
-  std::normal_distribution<double> noise(0.0, kSigma);
-  tools::CarrierRunawayMonitor locked;
-  int blocks = 0;
-  double worst = 0.0;
-  for (int k = 0; k < 50 * 600; ++k)
-    if (locked.add(kBias + noise(rng), kT, kAverage)) {
-      ++blocks;
-      worst = std::max(worst, std::abs(locked.mean_hz() - kBias));
-    }
-  EXPECT_EQ(blocks, 600);
-  EXPECT_LT(worst, 5.0 * kSigma / std::sqrt(50.0));
-
-  // A ramp of 8 Hz/s sampled at the epochs' middles (k + 0.5) T: block b (epochs 50 b .. 50 b + 49) has the mean
-  // 8 (b + 0.5) Hz; recent_hz at its end is the ramp at epoch 50 b + 47 (the middle of the last 5: k - 2).
-  tools::CarrierRunawayMonitor ramp;
-  int caught = -1;
-  for (int k = 0; k < 500 && caught < 0; ++k)
-    if (ramp.add(8.0 * (k + 0.5) * kT, kT, kAverage) && std::abs(ramp.mean_hz()) > 5.0) {
-      caught = k;
-      EXPECT_NEAR(ramp.mean_hz(), 8.0 * (k / 50 + 0.5), 1e-9);
-      EXPECT_NEAR(ramp.recent_hz(), 8.0 * (k - 2.0 + 0.5) * kT, 1e-9);
-    }
-  EXPECT_EQ(caught, 99);  // the second block (mean 12 Hz; 15.6 Hz now)
-  // After a reset with settle 3, the next 3 offsets are not counted: a block needs 53 more epochs.
-  ramp.reset(3);
-  int n = 0;
-  while (!ramp.add(1.0, kT, kAverage)) ++n;
-  EXPECT_EQ(n, 52);
-  EXPECT_NEAR(ramp.mean_hz(), 1.0, 1e-12);
 }

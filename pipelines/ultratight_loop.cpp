@@ -1,12 +1,9 @@
-#include "receive_ultratight.hpp"
+#include "pipelines/ultratight_loop.hpp"
 
 #include <fmt/core.h>
-#include <fmt/format.h>
-#include <fmt/ostream.h>
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
 
 #include "fusion/clock_model.hpp"
 #include "fusion/ins_error_model.hpp"
@@ -18,7 +15,7 @@
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kC = signals::kSpeedOfLight_mps;
@@ -28,23 +25,22 @@ constexpr double kEpochChips = 20.0 * 1023.0;  // a 20 ms channel epoch of C/A c
 
 }  // namespace
 
-ReceiveUltraTight::ReceiveUltraTight(ReceiveFusion& fusion, const receiver::ReceiverOptions& options,
-                                     const std::filesystem::path& dir, ReceiveUltraTightOptions ut)
-    : fusion_(fusion), options_(options), ut_(ut), log_(dir / "ultratight.csv") {
-  log_.stream() << "sample,time_s,prn,synchronised,ultratight,coasting,coast_s,cn0_dbhz,measured_pseudorange_m,"
-                   "predicted_pseudorange_m,measured_doppler_hz,predicted_doppler_hz,replica_carrier_hz,"
-                   "replica_code_rate_chips_per_s,predicted_code_rate_chips_per_s,code_jump_chips,updated,accepted,"
-                   "nis,innovation_1,innovation_2,innovation_3,innovation_4,innovation_5,innovation_6,carrier_offset_hz,"
-                   "carrier_runaway\n";
+UltraTightLoop::UltraTightLoop(GnssInsCoupler& fusion, ReceiveSink& sink, UltraTightLoopOptions ut)
+    : fusion_(fusion), sink_(sink), options_(fusion.options().receiver), ut_(ut) {}
+
+UltraTightLoop::ChannelState& UltraTightLoop::channel(int prn) {
+  auto [it, made] = channels_.try_emplace(prn);
+  if (made) it->second.runaway = fusion::FalseLockMonitor(fusion::FalseLockMonitor::Averaging::kBlock, ut_.runaway_average_s);
+  return it->second;
 }
 
-void ReceiveUltraTight::attach(receiver::ReceiverEngine& engine) {
-  engine.set_vector_loop(this, ut_.period_s, fusion_.settings().ut_pipelined);
+void UltraTightLoop::attach(receiver::ReceiverEngine& engine) {
+  engine.set_vector_loop(this, ut_.period_s, fusion_.options().ut_pipelined);
 }
 
 // IMU time of a receiver sample: the receive time on the clock continuous since the hand-over, less the
 // driver's clock bias (carried to that time by its drift).
-double ReceiveUltraTight::imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const {
+double UltraTightLoop::imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const {
   const signals::GpsTime rx = signals::add_seconds(
       epoch.receive_time,
       (epoch.clock_corrections_s - corrections_at_start_s_) + static_cast<double>(sample - epoch.sample) / epoch.fs_hz);
@@ -54,18 +50,18 @@ double ReceiveUltraTight::imu_time(const receiver::VectorEpochInput& epoch, std:
   return t_rx - bias_m / kC;
 }
 
-void ReceiveUltraTight::emit_nav() {
+void UltraTightLoop::emit_nav() {
   const auto& o = driver_->output();
   fusion_.write_nav(o.nav, o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
 }
 
 // IMU rows are split where a vector epoch falls inside one (constant rates over a row); a nav row at each row end.
-void ReceiveUltraTight::feed_imu_to(double t) {
+void UltraTightLoop::feed_imu_to(double t) {
   const auto& imu = fusion_.imu();
   while (t_ins_ < t - 1e-9) {
     while (next_imu_ < imu.size() && imu[next_imu_].t_s <= t_ins_ + 1e-9) ++next_imu_;
     if (next_imu_ == 0 || next_imu_ >= imu.size())
-      throw io::InputError(fusion_.settings().imu_file,
+      throw io::InputError(fusion_.options().imu_name,
                            fmt::format("does not cover the signal: the ultra-tight loop needs IMU time {:.3f} s, the "
                                        "rows span {:.3f}-{:.3f} s",
                                        t, imu.front().t_s, imu.back().t_s));
@@ -79,10 +75,10 @@ void ReceiveUltraTight::feed_imu_to(double t) {
   }
 }
 
-void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_k) {
+void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) {
   const fusion::IntegrationOutput& out = fusion_.integration()->output();
-  const ReceiveFusionSettings& s = fusion_.settings();
-  const FuseConfig& c = s.config;
+  const ReceiveOptions& s = fusion_.options();
+  const FuseConfig& c = s.navigation;
   fusion::UltraTightOptions o;
   o.filter = s.filter;
   o.form = s.ut_form;
@@ -132,7 +128,7 @@ void ReceiveUltraTight::start(const receiver::VectorEpochInput& epoch, double t_
   fusion_.hand_over();
 }
 
-std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const receiver::VectorEpochInput& epoch,
+std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const receiver::VectorEpochInput& epoch,
                                                                         double t_k) {
   std::vector<fusion::ChannelCorrelation> out;
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
@@ -160,7 +156,7 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
     // normalised power does not follow (I_P innovation variance 3.3 instead of 1: docs/validation.md). The
     // average of the epochs before this one: with this epoch's prompt in it (weight 0.1) the I_P innovation
     // would lose a tenth of its noise (variance 0.81).
-    ChannelState& st = channels_[in.prn];
+    ChannelState& st = channel(in.prn);
     const double scale2 = in.iq_scale * in.iq_scale;
     const double p2 = (in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2;
     // PromptPowerAverage: the ~1 s mean while the C/N0 holds (the 0.2 s mean's spread made the gate below,
@@ -202,7 +198,7 @@ std::vector<fusion::ChannelCorrelation> ReceiveUltraTight::correlations(const re
 
 // The filter's predicted Doppler of a satellite at IMU time t_s: linear through the starts of the open period's
 // replica and the one before (the measured epoch of a pipelined loop may start in the period before). NaN: none.
-double ReceiveUltraTight::predicted_doppler_at(int prn, double t_s) const {
+double UltraTightLoop::predicted_doppler_at(int prn, double t_s) const {
   const auto cur = period_replicas_.find(prn);
   if (cur == period_replicas_.end()) return NAN;
   const double f1 = cur->second.nco.carrier_frequency_hz, t1 = cur->second.t_start_s;
@@ -216,8 +212,8 @@ double ReceiveUltraTight::predicted_doppler_at(int prn, double t_s) const {
 // channel is judged off its signal (its correlations are then not used). Only a commanded, not coasting channel
 // below runaway_below_dbhz is checked; anything else starts the monitor afresh. A 1 s mean beyond runaway_hz sets
 // the aiding step (sent with the next command) and keeps the channel off until a later 1 s mean is within it.
-bool ReceiveUltraTight::runaway_check(const receiver::VectorChannelInput& in, double t_mid_s) {
-  ChannelState& st = channels_[in.prn];
+bool UltraTightLoop::runaway_check(const receiver::VectorChannelInput& in, double t_mid_s) {
+  ChannelState& st = channel(in.prn);
   st.last_offset_hz = in.replica_carrier_frequency_hz - predicted_doppler_at(in.prn, t_mid_s);
   if (!st.commanded || in.coasting || !(in.cn0_dbhz < ut_.runaway_below_dbhz)) {
     st.runaway.reset();
@@ -226,7 +222,7 @@ bool ReceiveUltraTight::runaway_check(const receiver::VectorChannelInput& in, do
     st.pending_step_hz = 0.0;
     return false;
   }
-  if (st.runaway.add(st.last_offset_hz, ut_.period_s, ut_.runaway_average_s)) {
+  if (st.runaway.add(st.last_offset_hz, ut_.period_s)) {
     const double mean = st.runaway.mean_hz();
     const bool off = std::abs(mean) > ut_.runaway_hz;
     st.runaway_repeats = off && st.runaway_off ? st.runaway_repeats + 1 : 0;
@@ -249,7 +245,7 @@ bool ReceiveUltraTight::runaway_check(const receiver::VectorChannelInput& in, do
 // only this as aiding: the filter's corrections would reach them as frequency steps, and the PLL's residual
 // phase, which the I&Q / discriminator measurement reads as a frequency error, would then be fed back into it
 // (a loop inside the loop: it diverged within a second in the 500 km/h circle).
-std::map<int, double> ReceiveUltraTight::propagated_doppler_change() {
+std::map<int, double> UltraTightLoop::propagated_doppler_change() {
   std::map<int, double> out;
   const fusion::NominalState n = driver_->nominal();
   const auto& o = driver_->options();
@@ -274,7 +270,7 @@ std::map<int, double> ReceiveUltraTight::propagated_doppler_change() {
   return out;
 }
 
-void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double t_k,
+void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k,
                                 std::span<receiver::VectorChannelCommand> commands,
                                 const std::map<int, double>& aid_change) {
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
@@ -285,12 +281,12 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
   previous_replicas_ = previous;
   for (const auto& r : driver_->replicas()) period_replicas_[r.prn] = r;
   int commanded = 0;
-  // The epoch's ultratight.csv rows, formatted into one buffer and written at once (fmt::print on the stream
-  // formats each call into a temporary string first).
-  fmt::memory_buffer rows;
+  log_.sample = epoch.sample;
+  log_.time_s = static_cast<double>(epoch.sample) / epoch.fs_hz;
+  log_.channels.clear();
   for (std::size_t i = 0; i < epoch.channels.size(); ++i) {
     const receiver::VectorChannelInput& in = epoch.channels[i];
-    ChannelState& st = channels_[in.prn];
+    ChannelState& st = channel(in.prn);
     const auto rep = period_replicas_.find(in.prn);
     double jump = NAN, predicted_m = NAN, measured_m = NAN, predicted_doppler = NAN;
     if (in.has_measurement) {
@@ -372,23 +368,34 @@ void ReceiveUltraTight::command(const receiver::VectorEpochInput& epoch, double 
     st.commanded = vector;
     const auto u = updates.find(in.prn);
     const fusion::UltraTightSatelliteUpdate* up = u == updates.end() ? nullptr : u->second;
-    fmt::format_to(std::back_inserter(rows), "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
-               epoch.sample, static_cast<double>(epoch.sample) / epoch.fs_hz, in.prn, in.synchronised, vector,
-               in.coasting, st.coast_s, in.cn0_dbhz, measured_m, predicted_m,
-               in.has_doppler ? in.measured_doppler_hz : NAN, predicted_doppler,
-               in.has_measurement ? in.replica_carrier_frequency_hz : NAN, in.code_rate_chips_per_s,
-               vector ? commands[i].code_rate_chips_per_s : NAN, jump, up != nullptr, up && up->accepted,
-               up ? up->nis : NAN);
+    UltraTightChannelLog& l = log_.channels.emplace_back();
+    l.prn = in.prn;
+    l.synchronised = in.synchronised;
+    l.ultratight = vector;
+    l.coasting = in.coasting;
+    l.coast_s = st.coast_s;
+    l.cn0_dbhz = in.cn0_dbhz;
+    l.measured_pseudorange_m = measured_m;
+    l.predicted_pseudorange_m = predicted_m;
+    l.measured_doppler_hz = in.has_doppler ? in.measured_doppler_hz : NAN;
+    l.predicted_doppler_hz = predicted_doppler;
+    l.replica_carrier_hz = in.has_measurement ? in.replica_carrier_frequency_hz : NAN;
+    l.replica_code_rate_chips_per_s = in.code_rate_chips_per_s;
+    l.predicted_code_rate_chips_per_s = vector ? commands[i].code_rate_chips_per_s : NAN;
+    l.code_jump_chips = jump;
+    l.updated = up != nullptr;
+    l.accepted = up && up->accepted;
+    l.nis = up ? up->nis : NAN;
     for (int k = 0; k < 6; ++k)
-      fmt::format_to(std::back_inserter(rows), ",{:.4f}", up && k < up->innovation.size() ? up->innovation(k) : NAN);
-    fmt::format_to(std::back_inserter(rows), ",{:.3f},{:d}\n", in.has_measurement ? st.last_offset_hz : NAN,
-                   vector && st.runaway_off);
+      l.innovation[static_cast<std::size_t>(k)] = up && k < up->innovation.size() ? up->innovation(k) : NAN;
+    l.carrier_offset_hz = in.has_measurement ? st.last_offset_hz : NAN;
+    l.carrier_runaway = vector && st.runaway_off;
   }
-  log_.stream().write(rows.data(), static_cast<std::streamsize>(rows.size()));
+  sink_.on_ultratight_epoch(log_);
   if (commanded > 0) ++vector_epochs_;
 }
 
-void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
+void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
                                std::span<receiver::VectorChannelCommand> commands) {
   if (!driver_) {
     if (fusion_.handed_over() || !fusion_.integration() || !epoch.ephemerides) return;
@@ -428,7 +435,7 @@ void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
   driver_->start_period(ut_.period_s);
   period_open_ = true;
   for (const auto& in : epoch.channels) {
-    ChannelState& st = channels_[in.prn];
+    ChannelState& st = channel(in.prn);
     if (st.was_coasting && !in.coasting && in.vector_mode) ++relocks_;
     st.was_coasting = in.coasting;
   }
@@ -437,16 +444,15 @@ void ReceiveUltraTight::update(const receiver::VectorEpochInput& epoch,
   command(epoch, t_k, commands, aid_change);
 }
 
-void ReceiveUltraTight::finish(std::int64_t end_sample) {
+void UltraTightLoop::finish(std::int64_t end_sample) {
   if (driver_ && last_sample_) {
     const double t_end = last_t_s_ + static_cast<double>(end_sample - *last_sample_) / options_.fs_hz;
     feed_imu_to(std::min(t_end, fusion_.imu().back().t_s));
   }
-  log_.commit();
 }
 
-std::string ReceiveUltraTight::summary_json() const {
-  const ReceiveFusionSettings& s = fusion_.settings();
+std::string UltraTightLoop::summary_json() const {
+  const ReceiveOptions& s = fusion_.options();
   std::string j = fmt::format(
       "\"ultratight\": {{\"filter\": \"{}\", \"measurement\": \"{}\", \"handed_over\": {}, \"loop\": \"{}\"",
       s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf",
@@ -472,7 +478,7 @@ std::string ReceiveUltraTight::summary_json() const {
   return j;
 }
 
-std::string ReceiveUltraTight::report() const {
+std::string UltraTightLoop::report() const {
   if (!driver_) return "receive: ultra-tight: never handed over (the tight integration did not start or ran too briefly)";
   const auto& k = driver_->counters();
   long long channels = 0;
@@ -480,10 +486,10 @@ std::string ReceiveUltraTight::report() const {
   return fmt::format("receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
                      "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
                      "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}",
-                     fusion_.settings().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
-                     fusion_.settings().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
+                     fusion_.options().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
+                     fusion_.options().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
                      handover_t_s_, channels, channel_epochs_, coasting_channel_epochs_, relocks_, releases_,
                      k.accepted, k.rejected, k.aided_only, runaway_recentres_, runaway_releases_);
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -1,4 +1,4 @@
-// nav.csv of `ultratrack fuse`: the INS nav.csv columns (ins/nav_csv.hpp) followed by the filter's 1-sigma
+// nav.csv of `ultratrack fuse` and `receive --coupling loose|tight|ultra-tight`: the INS nav.csv columns (ins/nav_csv.hpp) followed by the filter's 1-sigma
 // `sigma_n_m,sigma_e_m,sigma_d_m,sigma_vn_mps,sigma_ve_mps,sigma_vd_mps,sigma_att_n_deg,sigma_att_e_deg,
 // sigma_att_d_deg` (NED position and velocity; attitude as the psi-angle about north, east, down: tilts and
 // heading). Written atomically with round-trip precision; the reader is strict (tests, post-processing).
@@ -10,18 +10,13 @@
 #include <vector>
 
 #include "ins/nav_state.hpp"
+#include "pipelines/nav_sigma.hpp"
 
 namespace ultratrack::io {
 class AtomicFile;
 }
 
-namespace ultratrack::tools {
-
-struct NavSigma {
-  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
-  Eigen::Vector3d velocity_ned_mps = Eigen::Vector3d::Zero();
-  Eigen::Vector3d attitude_ned_rad = Eigen::Vector3d::Zero();
-};
+namespace ultratrack::pipelines {
 
 struct FusedNavRow {
   ins::NavState nav;
@@ -41,4 +36,4 @@ class FusedNavCsvWriter {
 
 std::vector<FusedNavRow> read_fused_nav_csv(const std::filesystem::path& file);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

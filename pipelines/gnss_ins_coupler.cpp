@@ -1,4 +1,4 @@
-#include "receive_fusion.hpp"
+#include "pipelines/gnss_ins_coupler.hpp"
 
 #include <fmt/core.h>
 
@@ -7,32 +7,24 @@
 #include <numbers>
 #include <span>
 
-#include "cli_parse.hpp"
-#include "fused_nav_csv.hpp"
 #include "fusion/clock_model.hpp"
-#include "fusion/fuse_motion_alignment.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "ins/attitude.hpp"
-#include "ins/coarse_alignment.hpp"
 #include "ins/earth_model.hpp"
-#include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/strapdown.hpp"
 #include "io/input_error.hpp"
+#include "io/json_text.hpp"
+#include "pipelines/navigation_initialisation.hpp"
 #include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
-#include "io/json_text.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
-namespace fs = std::filesystem;
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kG = 9.80665;
 constexpr double kC = signals::kSpeedOfLight_mps;
-constexpr double kWeek_s = 604800.0;
-constexpr double kClockJumpDetect_s = 1e-7;  // receiver clock offsets change only by jumps (>= 1 ms in practice)
 constexpr double kDllUpdate_s = 0.020;  // the DLL's update interval after bit sync (the tight filter starts after frame sync)
 
 double median(std::vector<double> v) {
@@ -64,145 +56,20 @@ fusion::GnssFix fix_measurement(const receiver::PvtSolution& f, double t_s) {
 
 }  // namespace
 
-ReceiveCoupling parse_receive_coupling(const std::string& text) {
-  if (text == "scalar" || text == "none") return ReceiveCoupling::Scalar;
-  if (text == "vector") return ReceiveCoupling::Vector;
-  if (text == "loose") return ReceiveCoupling::Loose;
-  if (text == "tight") return ReceiveCoupling::Tight;
-  if (text == "ultra-tight") return ReceiveCoupling::UltraTight;
-  throw io::InputError("command line",
-                       "--coupling must be scalar, vector, loose, tight or ultra-tight, got '" + text + "'");
-}
-
-std::string to_string(ReceiveCoupling coupling) {
-  switch (coupling) {
-    case ReceiveCoupling::Scalar: return "scalar";
-    case ReceiveCoupling::Vector: return "vector";
-    case ReceiveCoupling::Loose: return "loose";
-    case ReceiveCoupling::Tight: return "tight";
-    case ReceiveCoupling::UltraTight: return "ultra-tight";
-  }
-  return "?";
-}
-
-void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
-  cmd->add_option("--imu", a.imu, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps) for GNSS/INS integration (--coupling)");
-  cmd->add_option("--coupling", a.coupling,
-                  "scalar (default: per-channel loops), vector (one vector filter closes the code loops), or "
-                  "GNSS/INS integration with --imu: loose (PVT fixes), tight (pseudoranges and rates) or "
-                  "ultra-tight (the INS-predicted replica drives the channels, the filter updates from correlations)");
-  cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
-  cmd->add_option("--align", a.align, "with --coupling: static, motion (default) or config");
-  cmd->add_option("--fusion-config", a.config,
-                  "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
-  cmd->add_option("--imu-time-origin", a.time_origin,
-                  "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
-                  "the GPS time of week) or a GPS time of week in seconds");
-  cmd->add_option("--ut-measurement", a.ut_measurement,
-                  "with --coupling ultra-tight: iq (default: the E/P/L I&Q, seed 001 eqs. 11-17) or discriminator");
-  cmd->add_flag("--ut-serial", a.ut_serial,
-                "with --coupling ultra-tight: run the loop between blocks, its commands at once (by default it runs "
-                "beside the correlation of the next block, its commands reaching the channels one 20 ms loop "
-                "period later: faster with 2 or more threads; either way the same output for any --threads)");
-  a.ut_pipelined_option =
-      cmd->add_flag("--ut-pipelined", a.ut_pipelined,
-                    "with --coupling ultra-tight: the pipelined loop, which is the default (kept for older command "
-                    "lines; --ut-pipelined=false is --ut-serial)");
-}
-
-std::optional<ReceiveFusionSettings> parse_receive_fusion(const ReceiveFusionArgs& a) {
-  ReceiveFusionSettings s;
-  const bool pipelined_given = a.ut_pipelined_option && a.ut_pipelined_option->count() > 0;
-  s.coupling = parse_receive_coupling(a.coupling);
-  if (s.coupling == ReceiveCoupling::Scalar || s.coupling == ReceiveCoupling::Vector) {
-    if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
-      throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
-                                           "--coupling loose, tight or ultra-tight");
-    if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
-    if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
-    if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
-    return std::nullopt;
-  }
-  if (!a.ut_measurement.empty() && s.coupling != ReceiveCoupling::UltraTight)
-    throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
-  if (a.ut_serial && s.coupling != ReceiveCoupling::UltraTight)
-    throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
-  if (pipelined_given && s.coupling != ReceiveCoupling::UltraTight)
-    throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
-  if (a.ut_serial && pipelined_given && a.ut_pipelined)
-    throw io::InputError("command line", "--ut-serial and --ut-pipelined exclude each other");
-  s.ut_pipelined = a.ut_pipelined && !a.ut_serial;
-  if (a.ut_measurement.empty() || a.ut_measurement == "iq") {
-    s.ut_form = fusion::UltraTightForm::Iq;
-  } else if (a.ut_measurement == "discriminator") {
-    s.ut_form = fusion::UltraTightForm::Discriminator;
-  } else {
-    throw io::InputError("command line", "--ut-measurement must be iq or discriminator, got '" + a.ut_measurement + "'");
-  }
-  if (a.imu.empty()) throw io::InputError("command line", "--coupling " + a.coupling + " needs --imu FILE");
-  s.imu_file = a.imu;
-  const std::string filter = a.filter.empty() ? "ekf" : a.filter;
-  if (filter == "ekf") {
-    s.filter = fusion::FilterKind::Ekf;
-  } else if (filter == "ukf") {
-    s.filter = fusion::FilterKind::Ukf;
-  } else {
-    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + filter + "'");
-  }
-  const std::string align = a.align.empty() ? "motion" : a.align;
-  if (align == "static") {
-    s.align = AlignMode::Static;
-  } else if (align == "motion") {
-    s.align = AlignMode::Motion;
-  } else if (align == "config") {
-    s.align = AlignMode::Config;
-  } else {
-    throw io::InputError("command line", "--align must be static, motion or config, got '" + align + "'");
-  }
-  if (!a.config.empty()) s.config = read_fuse_config(a.config);
-  (void)ins::imu_preset(s.config.imu_preset);  // an unknown preset fails here, before any output
-  if (s.align == AlignMode::Config && !s.config.attitude_deg)
-    throw io::InputError(a.config.empty() ? "command line" : a.config,
-                         "--align config needs [initial] attitude_deg in --fusion-config");
-  if (a.time_origin.empty() || a.time_origin == "sample0") {
-    s.time_origin.kind = ImuTimeOrigin::Kind::Sample0;
-  } else if (a.time_origin == "tow") {
-    s.time_origin.kind = ImuTimeOrigin::Kind::WeekStart;
-  } else {
-    s.time_origin.kind = ImuTimeOrigin::Kind::Tow;
-    s.time_origin.tow_s = parse_double_option("--imu-time-origin", a.time_origin);
-    if (!(s.time_origin.tow_s >= 0.0 && s.time_origin.tow_s < kWeek_s))
-      throw io::InputError("command line", "--imu-time-origin: a GPS time of week lies in [0, 604800) s");
-  }
-  return s;
-}
-
-std::vector<ins::ImuIncrement> read_receive_imu(const ReceiveFusionSettings& s) {
-  std::error_code ec;
-  if (!fs::is_regular_file(s.imu_file, ec)) throw io::InputError(s.imu_file, "IMU file not found");
-  auto imu = ins::read_imu_csv(s.imu_file);
-  if (imu.size() < 2) throw io::InputError(s.imu_file, "the IMU file needs at least two rows");
-  return imu;
-}
-
-// ---------------------------------------------------------------------------------------------------------
-
-struct ReceiveFusion::Impl {
-  ReceiveFusionSettings settings;
+struct GnssInsCoupler::Impl {
+  ReceiveOptions settings;
   std::vector<ins::ImuIncrement> imu;
   receiver::ReceiverObserver* downstream = nullptr;
+  ReceiveSink* sink = nullptr;
   const receiver::ReceiverEngine* engine = nullptr;
   double fs_hz = 0.0;
   fusion::TightOptions tight;
   std::vector<signals::Ephemeris> nav_ephemerides, all_ephemerides;
   std::size_t decoded_seen = 0;
-  FusedNavCsvWriter nav;
 
   // Time line.
   std::optional<signals::GpsTime> origin;  // GPS time of IMU t_s = 0
-  std::optional<signals::GpsTime> clock_ref;
-  double clock_base_offset_s = 0.0, clock_jump_s = 0.0;
-  int clock_jumps = 0;
+  ReceiverClockJumps clock;
   double last_epoch_t_s = 0.0;
   std::int64_t last_epoch_sample = 0;
   bool have_epoch_time = false;
@@ -231,10 +98,11 @@ struct ReceiveFusion::Impl {
   double last_row_t_s = 0.0;  // tight epochs applied with 1-3 satellites with ephemeris
   NavSigma final_sigma;
 
-  Impl(const ReceiveFusionSettings& s, std::vector<ins::ImuIncrement> i, receiver::ReceiverObserver& d,
-       const fs::path& out_dir, const receiver::ReceiverOptions& ro, std::vector<signals::Ephemeris> eph)
-      : settings(s), imu(std::move(i)), downstream(&d), fs_hz(ro.fs_hz), nav_ephemerides(std::move(eph)),
-        all_ephemerides(nav_ephemerides), nav(out_dir / "nav.csv") {
+  Impl(const ReceiveOptions& s, std::vector<ins::ImuIncrement> i, receiver::ReceiverObserver& d, ReceiveSink& k,
+       std::vector<signals::Ephemeris> eph)
+      : settings(s), imu(std::move(i)), downstream(&d), sink(&k), fs_hz(s.receiver.fs_hz),
+        nav_ephemerides(std::move(eph)), all_ephemerides(nav_ephemerides), clock(s.receiver.fs_hz) {
+    const receiver::ReceiverOptions& ro = s.receiver;
     tight.elevation_mask_rad = ro.pvt.elevation_mask_rad;
     tight.ionosphere = ro.pvt.ionosphere;
     tight.troposphere = ro.pvt.troposphere;
@@ -250,9 +118,7 @@ struct ReceiveFusion::Impl {
   }
 
   // Ultra-tight pulls in with the tight integration until the hand-over.
-  bool is_tight() const {
-    return settings.coupling == ReceiveCoupling::Tight || settings.coupling == ReceiveCoupling::UltraTight;
-  }
+  bool is_tight() const { return pipelines::is_tight(settings.coupling); }
   bool handed_over = false;
 
   const std::vector<signals::Ephemeris>& ephemerides() {
@@ -264,23 +130,6 @@ struct ReceiveFusion::Impl {
     return all_ephemerides;
   }
   signals::KlobucharParameters iono() const { return engine ? engine->klobuchar() : signals::KlobucharParameters{}; }
-
-  // The epoch with receiver clock jumps undone (receive time and pseudoranges continuous).
-  receiver::ObservationEpoch continuous(const receiver::ObservationEpoch& e) {
-    if (!clock_ref) {
-      clock_ref = e.receive_time;
-      clock_base_offset_s = -static_cast<double>(e.sample_index) / fs_hz;
-    }
-    const double offset =
-        signals::seconds_between(e.receive_time, *clock_ref) - static_cast<double>(e.sample_index) / fs_hz;
-    const double jump = offset - clock_base_offset_s;  // -(sum of the corrections applied so far)
-    if (std::abs(jump - clock_jump_s) > kClockJumpDetect_s) ++clock_jumps;
-    clock_jump_s = jump;
-    receiver::ObservationEpoch out = e;
-    out.receive_time = signals::add_seconds(e.receive_time, -jump);
-    for (auto& o : out.observations) o.pseudorange_m -= kC * jump;
-    return out;
-  }
 
   // Ephemerides of the epoch's satellites at its time (one set per PRN).
   std::vector<signals::Ephemeris> epoch_ephemerides(const receiver::ObservationEpoch& e) {
@@ -305,36 +154,12 @@ struct ReceiveFusion::Impl {
     return std::make_pair(median(b), d.empty() ? 0.0 : median(d));
   }
 
-  void set_origin(const signals::GpsTime& g, std::int64_t sample) {
-    switch (settings.time_origin.kind) {
-      case ImuTimeOrigin::Kind::Sample0: origin = signals::add_seconds(g, -static_cast<double>(sample) / fs_hz); break;
-      case ImuTimeOrigin::Kind::WeekStart: origin = signals::GpsTime{g.week, 0.0}; break;
-      case ImuTimeOrigin::Kind::Tow: {
-        signals::GpsTime o{g.week, settings.time_origin.tow_s};
-        const double d = signals::seconds_between(g, o);
-        if (d < -0.5 * kWeek_s) o.week -= 1;
-        if (d > 0.5 * kWeek_s) o.week += 1;
-        origin = o;
-        break;
-      }
-    }
-  }
-
-  std::string origin_text() const {
-    switch (settings.time_origin.kind) {
-      case ImuTimeOrigin::Kind::Sample0: return "sample0";
-      case ImuTimeOrigin::Kind::WeekStart: return "tow";
-      case ImuTimeOrigin::Kind::Tow: return fmt::format("{}", settings.time_origin.tow_s);
-    }
-    return "?";
-  }
-
   void check_covered(double t, const signals::GpsTime& g) const {
     if (t >= imu.front().t_s && t <= imu.back().t_s + 1e-6) return;
-    throw io::InputError(settings.imu_file,
+    throw io::InputError(settings.imu_name,
                          fmt::format("does not cover the signal: the epoch at GPS week {} tow {:.3f} s is IMU time "
                                      "{:.3f} s (--imu-time-origin {}), the IMU rows span {:.3f}-{:.3f} s",
-                                     g.week, g.tow_s, t, origin_text(), imu.front().t_s, imu.back().t_s));
+                                     g.week, g.tow_s, t, to_string(settings.imu_time_origin), imu.front().t_s, imu.back().t_s));
   }
 
   void emit() {
@@ -342,7 +167,7 @@ struct ReceiveFusion::Impl {
     final_sigma = NavSigma{out.sigma_pos_ned_m, out.sigma_vel_n_mps, out.sigma_att_rad};
     if (nav_rows > 0 && !(out.nav.t_s > last_row_t_s)) return;  // an increment too short to step
     last_row_t_s = out.nav.t_s;
-    nav.write(out.nav, final_sigma);
+    sink->on_navigation(out.nav, final_sigma);
     ++nav_rows;
   }
 
@@ -371,10 +196,9 @@ struct ReceiveFusion::Impl {
 
   // Tries to start the INS + filter at this epoch (time t; fix = this epoch's, if any).
   bool try_start(double t, const receiver::ObservationEpoch& e, const std::optional<fusion::GnssFix>& fix) {
-    const FuseConfig& c = settings.config;
+    const FuseConfig& c = settings.navigation;
     const ins::ImuErrorSpec preset = ins::imu_preset(c.imu_preset);
-    ins::NavState init;
-    Eigen::Vector3d sigma_att, sigma_vel = Eigen::Vector3d::Constant(1.0);
+    AttitudeStart start;
     const fusion::GnssFix* pos_fix = nullptr;
     if (settings.align == AlignMode::Config) {
       if (!c.position_deg_m && !fix) {
@@ -383,21 +207,12 @@ struct ReceiveFusion::Impl {
       }
       // A configured position is the vehicle's at the IMU's first sample: the INS starts there (and runs alone
       // until the first epoch); without one, at this epoch's fix.
-      init.t_s = c.position_deg_m ? imu.front().t_s - (imu[1].t_s - imu.front().t_s) : t;
-      init.q_nb = ins::quaternion_from_euler(
-          {c.attitude_deg->x() * kDeg, c.attitude_deg->y() * kDeg, c.attitude_deg->z() * kDeg});
-      sigma_att = Eigen::Vector3d(1.0, 1.0, 5.0) * kDeg;
-      if (fix && fix->has_velocity) init.v_n = fix->v_n_mps;
-      if (c.velocity_ned_mps) init.v_n = *c.velocity_ned_mps;
+      start = align_from_config(c.position_deg_m ? imu.front().t_s - (imu[1].t_s - imu.front().t_s) : t, c);
+      if (fix && fix->has_velocity) start.v_n = fix->v_n_mps;
+      if (c.velocity_ned_mps) start.v_n = *c.velocity_ned_mps;
       if (fix) pos_fix = &*fix;
-      alignment_note = "attitude from the configuration";
     } else if (settings.align == AlignMode::Static) {
-      const double t0 = imu.front().t_s;
-      std::size_t end = 0;
-      while (end < imu.size() && imu[end].t_s <= t0 + c.static_duration_s + 1e-9) ++end;
-      if (end < 2 || end == imu.size())
-        throw io::InputError(settings.imu_file, fmt::format("the static alignment span ({} s) needs IMU data beyond it",
-                                                            c.static_duration_s));
+      const std::size_t end = static_span_end(imu, imu.front().t_s, c, settings.imu_name);
       pos_fix = fix_near(imu[end - 1].t_s);  // at rest over the span: any fix is the position there
       if (!pos_fix && !c.position_deg_m) {
         not_started = "--align static: waiting for a fix";
@@ -408,61 +223,25 @@ struct ReceiveFusion::Impl {
         return false;
       }
       const double lat = pos_fix ? pos_fix->lat_rad : c.position_deg_m->x() * kDeg;
-      // As `fuse` (tools/fuse_run.cpp): levelling + gyrocompassing, residual-bias error margins (seed 002).
-      const ins::AlignmentResult a = ins::coarse_align(std::span(imu).first(end), t0, lat);
-      init.t_s = imu[end - 1].t_s;
-      init.q_nb = a.q_nb;
-      sigma_vel = Eigen::Vector3d::Constant(0.1);
-      const Eigen::Vector3d noise = ins::alignment_noise_sigma(preset, a.duration_s, lat, kG);
-      const double tilt = std::hypot(preset.accel.bias_sigma / kG, noise.x());
-      const double heading = std::hypot(preset.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(lat)), noise.z());
-      sigma_att = {std::max(2.0 * tilt, 0.05 * kDeg), std::max(2.0 * tilt, 0.05 * kDeg),
-                   std::clamp(2.0 * heading, 0.5 * kDeg, 60.0 * kDeg)};
-      alignment_note = fmt::format("static over {:.1f} s", a.duration_s);
+      start = align_static(std::span(imu).first(end), imu.front().t_s, lat, preset);
     } else {
-      const auto a = fusion::align_in_motion(imu, velocities, {c.motion_min_speed_mps, c.motion_window_s});
+      const auto a = align_moving(imu, velocities, c, c.motion_window_s, false);
       if (!a) {
         not_started = fmt::format("--align motion: the fixes never showed {} m/s for {} s", c.motion_min_speed_mps,
                                   c.motion_window_s);
         return false;
       }
-      init.t_s = a->t_s;
-      init.q_nb = a->q_nb;
-      init.v_n = a->v_n;
-      sigma_vel = Eigen::Vector3d::Constant(c.velocity_sigma_mps * 2.0);
-      sigma_att = Eigen::Vector3d(1.0, 1.0, 3.0) * kDeg;
+      start = *a;
       pos_fix = fix_near(a->t_s);
-      alignment_note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
     }
-    Eigen::Vector3d sigma_pos = Eigen::Vector3d::Constant(10.0);
-    if (c.position_deg_m) {
-      init.lat_rad = c.position_deg_m->x() * kDeg;
-      init.lon_rad = c.position_deg_m->y() * kDeg;
-      init.height_m = c.position_deg_m->z();
-    } else {
-      // the fix is the antenna's: move to the IMU by the lever arm
-      const Eigen::Vector3d l_n = init.q_nb * c.lever_arm_b;
-      const ins::Radii r = ins::radii_of_curvature(pos_fix->lat_rad);
-      init.lat_rad = pos_fix->lat_rad - l_n.x() / (r.meridian_m + pos_fix->height_m);
-      init.lon_rad = pos_fix->lon_rad - l_n.y() / ((r.transverse_m + pos_fix->height_m) * std::cos(pos_fix->lat_rad));
-      init.height_m = pos_fix->height_m + l_n.z();
-      sigma_pos = pos_fix->sigma_pos_ned_m;
-    }
-    if (c.sigma_position_m) sigma_pos = *c.sigma_position_m;
-    if (c.sigma_velocity_mps) sigma_vel = *c.sigma_velocity_mps;
-    if (c.sigma_attitude_deg) sigma_att = *c.sigma_attitude_deg * kDeg;
-
-    fusion::IntegrationOptions o;
-    o.coupling = is_tight() ? fusion::Coupling::Tight : fusion::Coupling::Loose;
-    o.filter = settings.filter;
-    o.model = fusion::error_model_from_preset(preset);
-    o.lever_arm_b = c.lever_arm_b;
-    o.sigma_pos_ned_m = sigma_pos;
-    o.sigma_vel_n_mps = sigma_vel;
-    o.sigma_att_rad = sigma_att;
-    o.gate = c.gate;
-    o.ukf = c.ukf;
-    o.propagation_interval_s = c.propagation_interval_s;
+    alignment_note = start.note;
+    GnssPosition position;
+    if (pos_fix) position = {pos_fix->lat_rad, pos_fix->lon_rad, pos_fix->height_m, pos_fix->sigma_pos_ned_m};
+    const NavigationStart n =
+        initialise_navigation(start, pos_fix ? &position : nullptr, c, Eigen::Vector3d::Constant(10.0));
+    const ins::NavState& init = n.nav;
+    fusion::IntegrationOptions o =
+        integration_options(n, c, is_tight() ? fusion::Coupling::Tight : fusion::Coupling::Loose, settings.filter);
     if (is_tight()) {
       // Clock from this epoch at the INS antenna position and velocity there (the INS alone from the start to
       // the epoch), carried back to the start.
@@ -485,8 +264,8 @@ struct ReceiveFusion::Impl {
       o.initial_clock_drift_mps = clock->second;
       o.initial_clock_bias_m = clock->first - clock->second * (t - init.t_s);
       // The fit's error follows the position and velocity errors (a few metres, m/s), not the receiver's ms.
-      o.model.clock.bias_sigma_m = 3.0 * sigma_pos.norm() + 10.0;
-      o.model.clock.drift_sigma_mps = 3.0 * sigma_vel.norm() + 1.0;
+      o.model.clock.bias_sigma_m = 3.0 * n.sigma_pos_ned_m.norm() + 10.0;
+      o.model.clock.drift_sigma_mps = 3.0 * n.sigma_vel_n_mps.norm() + 1.0;
       o.model.clock = fusion::clock_noise_from_allan(c.clock_allan, o.model.clock);
       o.height_aiding = c.height_aiding;
     }
@@ -507,18 +286,18 @@ struct ReceiveFusion::Impl {
     ++epochs_seen;
     if (fix) ++fixes_seen;
     if (handed_over) return;
-    const receiver::ObservationEpoch e = continuous(raw);
+    const receiver::ObservationEpoch e = clock.continuous(raw);
     std::optional<signals::GpsTime> g;
     if (fix) {
       g = fix->time;
       // The fix's clock on the continuous receiver clock, for the epochs without a fix (loose).
-      last_fix_clock = FixClock{e.receive_time, fix->clock_bias_m - kC * clock_jump_s, fix->clock_drift_mps};
+      last_fix_clock = FixClock{e.receive_time, fix->clock_bias_m - kC * clock.jump_s(), fix->clock_drift_mps};
     } else if (integration && is_tight()) {
       g = signals::add_seconds(e.receive_time, -integration->nominal().clock_bias_m / kC);
-    } else if (is_tight() && settings.align == AlignMode::Config && settings.config.position_deg_m) {
+    } else if (is_tight() && settings.align == AlignMode::Config && settings.navigation.position_deg_m) {
       // No fix (fewer than four satellites): the clock from the configured position (only to map this epoch's
       // time: an error of tens of metres there is tens of nanoseconds).
-      const FuseConfig& c = settings.config;
+      const FuseConfig& c = settings.navigation;
       const Eigen::Vector3d r_e =
           ins::ecef_from_geodetic(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg, c.position_deg_m->z());
       const Eigen::Vector3d v_e = ins::C_en(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg) *
@@ -534,7 +313,7 @@ struct ReceiveFusion::Impl {
       ++(integration ? unused : before_start);
       return;
     }
-    if (!origin) set_origin(*g, e.sample_index);
+    if (!origin) origin = imu_time_origin_gps(settings.imu_time_origin, *g, e.sample_index, fs_hz);
     const double t = signals::seconds_between(*g, *origin);
     check_covered(t, *g);
     last_epoch_t_s = t;
@@ -582,30 +361,28 @@ struct ReceiveFusion::Impl {
   }
 };
 
-ReceiveFusion::ReceiveFusion(const ReceiveFusionSettings& settings, std::vector<ins::ImuIncrement> imu,
-                             receiver::ReceiverObserver& downstream, const std::filesystem::path& out_dir,
-                             const receiver::ReceiverOptions& receiver_options,
-                             std::vector<signals::Ephemeris> nav_ephemerides)
-    : impl_(std::make_unique<Impl>(settings, std::move(imu), downstream, out_dir, receiver_options,
-                                   std::move(nav_ephemerides))) {}
+GnssInsCoupler::GnssInsCoupler(const ReceiveOptions& options, std::vector<ins::ImuIncrement> imu,
+                               receiver::ReceiverObserver& downstream, ReceiveSink& sink,
+                               std::vector<signals::Ephemeris> nav_ephemerides)
+    : impl_(std::make_unique<Impl>(options, std::move(imu), downstream, sink, std::move(nav_ephemerides))) {}
 
-ReceiveFusion::~ReceiveFusion() = default;
+GnssInsCoupler::~GnssInsCoupler() = default;
 
-void ReceiveFusion::attach(const receiver::ReceiverEngine& engine) { impl_->engine = &engine; }
+void GnssInsCoupler::attach(const receiver::ReceiverEngine& engine) { impl_->engine = &engine; }
 
-void ReceiveFusion::on_tracking(const receiver::TrackingRecord& r) { impl_->downstream->on_tracking(r); }
-void ReceiveFusion::on_acquisition(std::int64_t first, const std::vector<receiver::AcquisitionResult>& r) {
+void GnssInsCoupler::on_tracking(const receiver::TrackingRecord& r) { impl_->downstream->on_tracking(r); }
+void GnssInsCoupler::on_acquisition(std::int64_t first, const std::vector<receiver::AcquisitionResult>& r) {
   impl_->downstream->on_acquisition(first, r);
 }
-void ReceiveFusion::on_antenna_phases(const receiver::AntennaPhaseEpoch& e) { impl_->downstream->on_antenna_phases(e); }
+void GnssInsCoupler::on_antenna_phases(const receiver::AntennaPhaseEpoch& e) { impl_->downstream->on_antenna_phases(e); }
 
-void ReceiveFusion::on_observations(const receiver::ObservationEpoch& epoch) {
+void GnssInsCoupler::on_observations(const receiver::ObservationEpoch& epoch) {
   impl_->downstream->on_observations(epoch);
   impl_->flush();  // the previous epoch had no fix
   impl_->held = epoch;
 }
 
-void ReceiveFusion::on_fix(const receiver::PvtSolution& fix, const receiver::ObservationEpoch& epoch) {
+void GnssInsCoupler::on_fix(const receiver::PvtSolution& fix, const receiver::ObservationEpoch& epoch) {
   impl_->downstream->on_fix(fix, epoch);
   if (impl_->held && impl_->held->sample_index == epoch.sample_index) {
     const receiver::ObservationEpoch e = std::move(*impl_->held);
@@ -617,7 +394,7 @@ void ReceiveFusion::on_fix(const receiver::PvtSolution& fix, const receiver::Obs
   }
 }
 
-void ReceiveFusion::finish(std::int64_t end_sample) {
+void GnssInsCoupler::finish(std::int64_t end_sample) {
   Impl& m = *impl_;
   m.flush();
   if (m.integration && m.have_epoch_time && !m.handed_over) {
@@ -626,52 +403,51 @@ void ReceiveFusion::finish(std::int64_t end_sample) {
   }
 }
 
-bool ReceiveFusion::started() const { return impl_->integration.has_value(); }
-std::string ReceiveFusion::not_started_reason() const { return impl_->not_started; }
-void ReceiveFusion::commit() { impl_->nav.commit(); }
+bool GnssInsCoupler::started() const { return impl_->integration.has_value(); }
+std::string GnssInsCoupler::not_started_reason() const { return impl_->not_started; }
+long long GnssInsCoupler::nav_rows() const { return impl_->nav_rows; }
+NavSigma GnssInsCoupler::final_sigma() const { return impl_->final_sigma; }
 
-const fusion::GnssInsIntegration* ReceiveFusion::integration() const {
+const fusion::GnssInsIntegration* GnssInsCoupler::integration() const {
   return impl_->integration ? &*impl_->integration : nullptr;
 }
-const std::vector<ins::ImuIncrement>& ReceiveFusion::imu() const { return impl_->imu; }
-const ReceiveFusionSettings& ReceiveFusion::settings() const { return impl_->settings; }
-std::optional<signals::GpsTime> ReceiveFusion::imu_time_origin() const { return impl_->origin; }
-std::optional<std::pair<std::int64_t, double>> ReceiveFusion::last_epoch_time() const {
+const std::vector<ins::ImuIncrement>& GnssInsCoupler::imu() const { return impl_->imu; }
+const ReceiveOptions& GnssInsCoupler::options() const { return impl_->settings; }
+std::optional<signals::GpsTime> GnssInsCoupler::imu_time_origin() const { return impl_->origin; }
+std::optional<std::pair<std::int64_t, double>> GnssInsCoupler::last_epoch_time() const {
   if (!impl_->have_epoch_time) return std::nullopt;
   return std::make_pair(impl_->last_epoch_sample, impl_->last_epoch_t_s);
 }
-void ReceiveFusion::hand_over() { impl_->handed_over = true; }
-bool ReceiveFusion::handed_over() const { return impl_->handed_over; }
-void ReceiveFusion::write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
+void GnssInsCoupler::hand_over() { impl_->handed_over = true; }
+bool GnssInsCoupler::handed_over() const { return impl_->handed_over; }
+void GnssInsCoupler::write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
                               const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad) {
   Impl& m = *impl_;
   m.final_sigma = NavSigma{sigma_pos_ned_m, sigma_vel_n_mps, sigma_att_rad};
   if (m.nav_rows > 0 && !(nav.t_s > m.last_row_t_s)) return;
   m.last_row_t_s = nav.t_s;
-  m.nav.write(nav, m.final_sigma);
+  m.sink->on_navigation(nav, m.final_sigma);
   ++m.nav_rows;
 }
 
-std::string ReceiveFusion::summary_json() const {
+std::string GnssInsCoupler::summary_json() const {
   const Impl& m = *impl_;
-  const char* align = m.settings.align == AlignMode::Static   ? "static"
-                      : m.settings.align == AlignMode::Motion ? "motion"
-                                                              : "config";
+  const char* align = to_string(m.settings.align);
   std::string j = "\"fusion\": {";
   j += fmt::format("\"coupling\": \"{}\", \"filter\": \"{}\", \"align\": \"{}\", \"imu_file\": \"{}\", "
                    "\"imu_time_origin\": \"{}\", \"imu_preset\": \"{}\", \"started\": {}",
                    to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align,
-                   io::json_escape(m.settings.imu_file), m.origin_text(), io::json_escape(m.settings.config.imu_preset),
+                   io::json_escape(m.settings.imu_name), to_string(m.settings.imu_time_origin), io::json_escape(m.settings.navigation.imu_preset),
                    m.integration.has_value());
   if (m.origin)
     j += fmt::format(", \"imu_time_origin_gps\": {{\"week\": {}, \"tow_s\": {:.9f}}}", m.origin->week, m.origin->tow_s);
   j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
                    "\"epochs_unused\": {}",
                    m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
-  if (m.settings.coupling == ReceiveCoupling::UltraTight)
+  if (m.settings.coupling == Coupling::kUltraTight)
     j += fmt::format(", \"handed_over\": {}", m.handed_over);
   if (m.is_tight()) j += fmt::format(", \"epochs_fewer_than_4_satellites\": {}", m.epochs_below_4);
-  j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock_jumps, m.nav_rows);
+  j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock.jumps(), m.nav_rows);
   if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", io::json_escape(m.not_started));
   const auto& k = m.integration->counters();
   const auto& e = m.initial_attitude;
@@ -686,8 +462,8 @@ std::string ReceiveFusion::summary_json() const {
     j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
                      "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "
                      "\"rejected\": {}}}",
-                     m.settings.config.clock_oscillator, m.settings.config.clock_allan.h0,
-                     m.settings.config.clock_allan.h_minus2, m.settings.config.height_aiding.enabled ? "auto" : "off",
+                     m.settings.navigation.clock_oscillator, m.settings.navigation.clock_allan.h0,
+                     m.settings.navigation.clock_allan.h_minus2, m.settings.navigation.height_aiding.enabled ? "auto" : "off",
                      k.epochs_few_satellites, k.height_accepted, k.height_rejected);
   const NavSigma& g = m.final_sigma;
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
@@ -697,7 +473,7 @@ std::string ReceiveFusion::summary_json() const {
   return j;
 }
 
-std::string ReceiveFusion::report() const {
+std::string GnssInsCoupler::report() const {
   const Impl& m = *impl_;
   if (!m.integration)
     return fmt::format("receive: {} integration not started: {}", to_string(m.settings.coupling), m.not_started);
@@ -710,4 +486,4 @@ std::string ReceiveFusion::report() const {
       m.final_sigma.position_ned_m.z(), m.nav_rows);
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -1,4 +1,4 @@
-#include "fuse_run.hpp"
+#include "pipelines/fuse.hpp"
 
 #include <fmt/core.h>
 
@@ -8,19 +8,15 @@
 #include <span>
 
 #include "fusion/fuse_motion_alignment.hpp"
-#include "gnss_fix_simulation.hpp"
-#include "ins/coarse_alignment.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
-#include "io/json_text.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kG = 9.80665;
 
 // GNSS position/velocity linearly interpolated at t (clamped to the fixes' span).
 struct GnssState {
@@ -30,14 +26,14 @@ struct GnssState {
   Eigen::Vector3d sigma_ned_m = Eigen::Vector3d::Ones();
 };
 
-GnssState gnss_at(const std::vector<GnssCsvRow>& g, double t) {
-  auto from = [](const GnssCsvRow& r) {
+GnssState gnss_at(const std::vector<GnssFixRow>& g, double t) {
+  auto from = [](const GnssFixRow& r) {
     return GnssState{r.lat_rad, r.lon_rad, r.height_m, r.has_velocity, r.v_n, r.sigma_ned_m};
   };
   if (t <= g.front().t_s) return from(g.front());
   if (t >= g.back().t_s) return from(g.back());
-  const auto it = std::upper_bound(g.begin(), g.end(), t, [](double x, const GnssCsvRow& r) { return x < r.t_s; });
-  const GnssCsvRow &b = *it, &a = *(it - 1);
+  const auto it = std::upper_bound(g.begin(), g.end(), t, [](double x, const GnssFixRow& r) { return x < r.t_s; });
+  const GnssFixRow &b = *it, &a = *(it - 1);
   const double w = (t - a.t_s) / (b.t_s - a.t_s);
   GnssState s;
   s.lat_rad = a.lat_rad + w * (b.lat_rad - a.lat_rad);
@@ -60,7 +56,7 @@ Eigen::Vector3d ned_difference(double lat_a, double lon_a, double h_a, double la
 // second at 5 Hz and fake motion while parked).
 constexpr double kPositionDifferenceSpan_s = 5.0;
 
-std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssCsvRow>& g) {
+std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFixRow>& g) {
   std::vector<fusion::GnssVelocitySample> out;
   std::size_t lo = 0, hi = 0;
   for (std::size_t i = 0; i < g.size(); ++i) {
@@ -163,10 +159,10 @@ std::vector<TimedAttitude> timed_attitudes(const FuseSettings& s, double imu_sta
 
 }  // namespace
 
-FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssCsvRow>& gnss,
-                const std::vector<ins::NavState>& truth, const FuseSettings& s,
+FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssFixRow>& gnss,
+                const std::vector<ins::TruthSample>& truth, const FuseSettings& s,
                 const std::function<void(const ins::NavState&, const NavSigma&)>& on_row,
-                const std::function<void(double)>& on_progress) {
+                const std::function<void(double)>& on_progress, std::stop_token stop) {
   const FuseConfig& c = s.config;
   if (imu.size() < 2) throw io::InputError("IMU file", "fewer than 2 IMU rows");
   if (gnss.empty()) throw io::InputError("GNSS file", "no fixes");
@@ -178,50 +174,26 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   const fusion::AttitudeAidingOptions attitude_options = attitude_aiding_options(c);
   const std::vector<TimedAttitude> attitude = timed_attitudes(s, imu_start, imu.back().t_s);
 
-  // --- initial state ---
+  // --- initial state (pipelines/navigation_initialisation.hpp) ---
   FuseResult result;
-  ins::NavState init;
-  Eigen::Vector3d sigma_att;
-  Eigen::Vector3d sigma_vel = Eigen::Vector3d::Constant(0.5);
+  AttitudeStart start;
   const double lat_hint = c.position_deg_m ? c.position_deg_m->x() * kDeg : gnss.front().lat_rad;
   if (s.align == AlignMode::Static) {
-    std::size_t end = 0;
-    while (end < imu.size() && imu[end].t_s <= imu_start + c.static_duration_s + 1e-9) ++end;
-    if (end < 2 || end == imu.size())
-      throw io::InputError("IMU file", fmt::format("the static alignment span ({} s) needs IMU data beyond it",
-                                                   c.static_duration_s));
-    const ins::AlignmentResult a = ins::coarse_align(std::span(imu).first(end), imu_start, lat_hint);
-    init.t_s = imu[end - 1].t_s;
-    init.q_nb = a.q_nb;
-    init.v_n.setZero();
-    sigma_vel = Eigen::Vector3d::Constant(0.1);
-    // residual-bias alignment errors (seed 002): tilt = b_a / g, heading = b_g / (W cos L), twice for margin
-    const Eigen::Vector3d noise = ins::alignment_noise_sigma(preset, a.duration_s, lat_hint, kG);
-    const double tilt = std::hypot(preset.accel.bias_sigma / kG, noise.x());
-    const double heading =
-        std::hypot(preset.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(lat_hint)), noise.z());
-    sigma_att = {std::max(2.0 * tilt, 0.05 * kDeg), std::max(2.0 * tilt, 0.05 * kDeg),
-                 std::clamp(2.0 * heading, 0.5 * kDeg, 60.0 * kDeg)};
-    result.alignment_note = fmt::format("static over {:.1f} s", a.duration_s);
-    if (heading > 10.0 * kDeg)
-      result.alignment_note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
-                                           heading / kDeg);
+    const std::size_t end = static_span_end(imu, imu_start, c, "IMU file");
+    start = align_static(std::span(imu).first(end), imu_start, lat_hint, preset);
+    if (start.heading_sigma_rad > 10.0 * kDeg)
+      start.note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
+                                start.heading_sigma_rad / kDeg);
   } else if (s.align == AlignMode::Motion) {
     // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
-    const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssCsvRow& r) { return r.has_velocity; });
+    const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
     const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
-    const auto a = fusion::align_in_motion(imu, gnss_velocities(gnss), {c.motion_min_speed_mps, window});
+    const auto a = align_moving(imu, gnss_velocities(gnss), c, window, position_only);
     if (!a)
       throw io::InputError("GNSS file", fmt::format("no in-motion alignment: the fixes never show {} m/s for {} s "
                                                     "within the IMU data",
                                                     c.motion_min_speed_mps, c.motion_window_s));
-    init.t_s = a->t_s;
-    init.q_nb = a->q_nb;
-    init.v_n = a->v_n;
-    sigma_vel = Eigen::Vector3d::Constant(position_only ? 1.0 : c.velocity_sigma_mps * 2.0);
-    sigma_att = position_only ? Eigen::Vector3d(3.0 * kDeg, 3.0 * kDeg, 5.0 * kDeg)
-                              : Eigen::Vector3d(1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg);
-    result.alignment_note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
+    start = *a;
   } else if (s.align == AlignMode::Attitude) {
     if (attitude.empty()) throw io::InputError("command line", "--align attitude needs --attitude FILE");
     const double from = std::max(imu_start, gnss.front().t_s);
@@ -232,63 +204,36 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       throw io::InputError(s.attitude_file, fmt::format("--align attitude: no fixed attitude within the IMU and GNSS "
                                                         "data ({:.3f}-{:.3f} s)",
                                                         from, imu.back().t_s));
-    init.t_s = it->t_s;
-    init.q_nb = fusion::measured_q_nb(it->attitude, attitude_options.q_ba);
+    start.t_s = it->t_s;
+    start.q_nb = fusion::measured_q_nb(it->attitude, attitude_options.q_ba);
     // One GPS attitude's accuracy: its Euler sigmas as NED rotation sigmas (fusion/attitude_measurement.hpp).
     const Eigen::Matrix3d M = fusion::euler_rate_to_rotation_n(it->attitude.euler_a);
     const Eigen::Matrix3d R = M * it->attitude.sigma_euler_rad.cwiseAbs2().asDiagonal() * M.transpose();
-    sigma_att = R.diagonal().cwiseSqrt().cwiseMax(0.01 * kDeg);
-    sigma_vel = Eigen::Vector3d::Constant(1.0);
-    result.alignment_note = fmt::format("GPS attitude at {:.3f} s (line {})", it->t_s, it->line);
+    start.sigma_att_rad = R.diagonal().cwiseSqrt().cwiseMax(0.01 * kDeg);
+    start.sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
+    start.note = fmt::format("GPS attitude at {:.3f} s (line {})", it->t_s, it->line);
   } else {
     if (!c.attitude_deg) throw io::InputError("configuration", "--align config needs [initial] attitude_deg");
-    auto it = std::find_if(gnss.begin(), gnss.end(), [&](const GnssCsvRow& r) { return r.t_s >= imu_start; });
-    init.t_s = it->t_s;
-    init.q_nb = ins::quaternion_from_euler({c.attitude_deg->x() * kDeg, c.attitude_deg->y() * kDeg,
-                                            c.attitude_deg->z() * kDeg});
-    sigma_att = Eigen::Vector3d(1.0, 1.0, 5.0) * kDeg;
-    sigma_vel = Eigen::Vector3d::Constant(1.0);
-    result.alignment_note = "attitude from the configuration";
+    auto it = std::find_if(gnss.begin(), gnss.end(), [&](const GnssFixRow& r) { return r.t_s >= imu_start; });
+    start = align_from_config(it->t_s, c);
   }
-  const GnssState g0 = gnss_at(gnss, init.t_s);
-  if ((s.align == AlignMode::Config || s.align == AlignMode::Attitude) && g0.has_velocity) init.v_n = g0.v_n;
-  if (s.align == AlignMode::Config && c.velocity_ned_mps) init.v_n = *c.velocity_ned_mps;
-  Eigen::Vector3d sigma_pos = g0.sigma_ned_m;
-  if (c.position_deg_m) {
-    init.lat_rad = c.position_deg_m->x() * kDeg;
-    init.lon_rad = c.position_deg_m->y() * kDeg;
-    init.height_m = c.position_deg_m->z();
-  } else {
-    // the fix is the antenna's: move to the IMU by the lever arm
-    const Eigen::Vector3d l_n = init.q_nb * c.lever_arm_b;
-    const ins::Radii r = ins::radii_of_curvature(g0.lat_rad);
-    init.lat_rad = g0.lat_rad - l_n.x() / (r.meridian_m + g0.height_m);
-    init.lon_rad = g0.lon_rad - l_n.y() / ((r.transverse_m + g0.height_m) * std::cos(g0.lat_rad));
-    init.height_m = g0.height_m + l_n.z();
-  }
-  if (c.sigma_position_m) sigma_pos = *c.sigma_position_m;
-  if (c.sigma_velocity_mps) sigma_vel = *c.sigma_velocity_mps;
-  if (c.sigma_attitude_deg) sigma_att = *c.sigma_attitude_deg * kDeg;
+  result.alignment_note = start.note;
+  const GnssState g0 = gnss_at(gnss, start.t_s);
+  if ((s.align == AlignMode::Config || s.align == AlignMode::Attitude) && g0.has_velocity) start.v_n = g0.v_n;
+  if (s.align == AlignMode::Config && c.velocity_ned_mps) start.v_n = *c.velocity_ned_mps;
+  const GnssPosition position{g0.lat_rad, g0.lon_rad, g0.height_m, g0.sigma_ned_m};
+  const NavigationStart n = initialise_navigation(start, &position, c, g0.sigma_ned_m);
+  const ins::NavState& init = n.nav;
   result.initial_attitude = ins::euler_from_quaternion(init.q_nb);
   result.start_s = init.t_s;
 
-  fusion::IntegrationOptions o;
-  o.coupling = fusion::Coupling::Loose;
-  o.filter = s.filter;
-  o.model = fusion::error_model_from_preset(preset);
-  o.lever_arm_b = c.lever_arm_b;
-  o.sigma_pos_ned_m = sigma_pos;
-  o.sigma_vel_n_mps = sigma_vel;
-  o.sigma_att_rad = sigma_att;
-  o.gate = c.gate;
-  o.ukf = c.ukf;
-  o.propagation_interval_s = c.propagation_interval_s;
+  fusion::IntegrationOptions o = integration_options(n, c, fusion::Coupling::Loose, s.filter);
   o.attitude = attitude_options;
   fusion::GnssInsIntegration integration(init, o);
 
   // --- run ---
   std::optional<ins::TruthInterpolator> truth_at;
-  if (truth.size() >= 2) truth_at.emplace(truth_samples_from_nav(truth));
+  if (truth.size() >= 2) truth_at.emplace(truth);
   std::vector<RowError> errors;
   std::optional<double> converged_since;
   std::size_t g = 0;
@@ -332,9 +277,9 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     result.final_nav = out.nav;
   };
   emit(integration.output());
-  for (; k < imu.size(); ++k) {
+  for (; k < imu.size() && !stop.stop_requested(); ++k) {
     while (g < gnss.size() && gnss[g].t_s <= imu[k].t_s) {
-      const GnssCsvRow& r = gnss[g++];
+      const GnssFixRow& r = gnss[g++];
       if (in_outage(s, r.t_s)) {
         ++result.fixes_in_outage;
         continue;
@@ -404,66 +349,4 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   return result;
 }
 
-std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
-                              const std::string& gnss_file, const std::string& truth_file) {
-  auto rms_json = [](const ErrorRms& e) {
-    return fmt::format(
-        "{{\"rows\": {}, \"horizontal_m\": {:.6g}, \"vertical_m\": {:.6g}, \"position_3d_m\": {:.6g}, "
-        "\"velocity_mps\": {:.6g}, \"attitude_deg\": {:.6g}, \"heading_deg\": {:.6g}, \"within_3sigma\": {:.4f}}}",
-        e.rows, e.horizontal_m, e.vertical_m, e.position_3d_m, e.velocity_mps, e.attitude_deg, e.heading_deg,
-        e.within_3sigma);
-  };
-  const char* align = s.align == AlignMode::Static   ? "static"
-                      : s.align == AlignMode::Motion ? "motion"
-                      : s.align == AlignMode::Config ? "config"
-                                                     : "attitude";
-  std::string j = "{\n";
-  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", io::json_escape(imu_file), io::json_escape(gnss_file));
-  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", io::json_escape(truth_file));
-  j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
-                   s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
-  j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
-                   "\"yaw_deg\": {:.6f}}},\n",
-                   io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
-                   r.initial_attitude.pitch_rad / kDeg, r.initial_attitude.yaw_rad / kDeg);
-  j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
-  j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
-                   r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
-  j += fmt::format("  \"updates_accepted\": {},\n  \"updates_rejected\": {},\n  \"fixes_late\": {},\n",
-                   r.counters.accepted, r.counters.rejected, r.counters.late);
-  j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
-                   r.counters.fix_rejected);
-  if (!s.attitude.empty()) {
-    const AttitudeUse& a = r.attitude;
-    const auto& n = r.counters;
-    const Eigen::Vector3d& m = s.config.attitude_misalignment_deg;
-    j += fmt::format("  \"attitude\": {{\"file\": \"{}\", \"rows\": {}, \"fixed_rows\": {}, \"unfixed_skipped\": {}, "
-                     "\"before_start\": {}, \"after_end\": {}, \"in_outage\": {}, \"used\": {}, \"updates\": {}, "
-                     "\"updates_accepted\": {}, \"updates_rejected\": {}, \"rejected_near_vertical\": {}, \"late\": {}, "
-                     "\"fallback_fixes\": {}, \"misalignment_deg\": [{}, {}, {}], \"max_pitch_deg\": {}}},\n",
-                     io::json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start,
-                     a.after_end, a.in_outage, a.used, n.attitude_epochs, n.attitude_accepted, n.attitude_rejected,
-                     n.attitude_unusable, n.attitude_late, n.fixes_without_attitude, m.x(), m.y(), m.z(),
-                     s.config.attitude_max_pitch_deg);
-  }
-  j += fmt::format("  \"converged\": {},\n  \"converged_at_s\": {},\n", r.converged_at_s.has_value(),
-                   r.converged_at_s ? fmt::format("{}", *r.converged_at_s) : std::string("null"));
-  j += fmt::format("  \"convergence_heading_sigma_deg\": {},\n", s.config.convergence_heading_sigma_deg);
-  const NavSigma& g = r.final_sigma;
-  j += fmt::format("  \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, \"vel_mps\": {:.6g}, "
-                   "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
-                   g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
-                   g.attitude_ned_rad.x() / kDeg, g.attitude_ned_rad.y() / kDeg, g.attitude_ned_rad.z() / kDeg);
-  if (r.rms_all) j += "  \"rms_all\": " + rms_json(*r.rms_all) + ",\n";
-  if (r.rms_converged) j += "  \"rms_converged\": " + rms_json(*r.rms_converged) + ",\n";
-  if (r.gnss_rms) j += "  \"gnss_only_rms\": " + rms_json(*r.gnss_rms) + ",\n";
-  j += "  \"outages\": [";
-  for (std::size_t i = 0; i < r.outages.size(); ++i)
-    j += fmt::format("{}{{\"start_s\": {}, \"end_s\": {}, \"horizontal_error_m\": {:.6g}, \"sigma_horizontal_m\": {:.6g}}}",
-                     i ? ", " : "", r.outages[i].start_s, r.outages[i].end_s, r.outages[i].horizontal_error_m,
-                     r.outages[i].sigma_horizontal_m);
-  j += "]\n}\n";
-  return j;
-}
-
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

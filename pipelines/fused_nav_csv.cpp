@@ -1,4 +1,4 @@
-#include "fused_nav_csv.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 
 #include <fmt/core.h>
 
@@ -11,7 +11,7 @@
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -71,4 +71,4 @@ std::vector<FusedNavRow> read_fused_nav_csv(const std::filesystem::path& file) {
   return rows;
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -13,21 +13,21 @@
 #include <Eigen/Core>
 #include <functional>
 #include <optional>
+#include <stop_token>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "attitude_csv.hpp"
-#include "fuse_config.hpp"
-#include "fused_nav_csv.hpp"
 #include "fusion/gnss_ins_integration.hpp"
-#include "gnss_csv.hpp"
 #include "ins/attitude.hpp"
 #include "ins/nav_state.hpp"
+#include "ins/truth_interpolator.hpp"
+#include "pipelines/fuse_config.hpp"
+#include "pipelines/fuse_inputs.hpp"
+#include "pipelines/nav_sigma.hpp"
+#include "pipelines/navigation_initialisation.hpp"
 
-namespace ultratrack::tools {
-
-enum class AlignMode { Static, Motion, Config, Attitude };
+namespace ultratrack::pipelines {
 
 struct FuseSettings {
   fusion::FilterKind filter = fusion::FilterKind::Ekf;
@@ -35,7 +35,7 @@ struct FuseSettings {
   FuseConfig config;
   std::vector<std::pair<double, double>> outages;  // [start, start + duration): GNSS fixes dropped
   // GPS attitude (empty: none). attitude_file names it in messages and the summary.
-  std::vector<AttitudeCsvRow> attitude;
+  std::vector<GpsAttitudeRow> attitude;
   std::string attitude_file;
 };
 
@@ -77,15 +77,13 @@ struct FuseResult {
   AttitudeUse attitude;
 };
 
-// Every solution row (after each IMU interval) goes to on_row. Throws io::InputError for inputs that do not
-// fit together (no overlap in time, no alignment window, unknown preset, ...).
-FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssCsvRow>& gnss,
-                const std::vector<ins::NavState>& truth, const FuseSettings& settings,
+// Every solution row (after each IMU interval) goes to on_row. truth: a trajectory on the IMU time line for the
+// RMS statistics (empty: none). A stop request ends the run after the current IMU interval (the result then covers
+// the rows so far). Throws io::InputError for inputs that do not fit together (no overlap in time, no alignment
+// window, unknown preset, ...).
+FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssFixRow>& gnss,
+                const std::vector<ins::TruthSample>& truth, const FuseSettings& settings,
                 const std::function<void(const ins::NavState&, const NavSigma&)>& on_row = {},
-                const std::function<void(double fraction)>& on_progress = {});
+                const std::function<void(double fraction)>& on_progress = {}, std::stop_token stop = {});
 
-// summary.json text of a run.
-std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
-                              const std::string& gnss_file, const std::string& truth_file);
-
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -1,0 +1,75 @@
+#include "pipelines/fuse_summary.hpp"
+
+#include <fmt/core.h>
+
+#include <numbers>
+
+#include "io/json_text.hpp"
+
+namespace ultratrack::pipelines {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+}  // namespace
+
+std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
+                              const std::string& gnss_file, const std::string& truth_file) {
+  auto rms_json = [](const ErrorRms& e) {
+    return fmt::format(
+        "{{\"rows\": {}, \"horizontal_m\": {:.6g}, \"vertical_m\": {:.6g}, \"position_3d_m\": {:.6g}, "
+        "\"velocity_mps\": {:.6g}, \"attitude_deg\": {:.6g}, \"heading_deg\": {:.6g}, \"within_3sigma\": {:.4f}}}",
+        e.rows, e.horizontal_m, e.vertical_m, e.position_3d_m, e.velocity_mps, e.attitude_deg, e.heading_deg,
+        e.within_3sigma);
+  };
+  const char* align = to_string(s.align);
+  std::string j = "{\n";
+  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", io::json_escape(imu_file), io::json_escape(gnss_file));
+  if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", io::json_escape(truth_file));
+  j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
+                   s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
+  j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
+                   "\"yaw_deg\": {:.6f}}},\n",
+                   io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
+                   r.initial_attitude.pitch_rad / kDeg, r.initial_attitude.yaw_rad / kDeg);
+  j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
+  j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
+                   r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
+  j += fmt::format("  \"updates_accepted\": {},\n  \"updates_rejected\": {},\n  \"fixes_late\": {},\n",
+                   r.counters.accepted, r.counters.rejected, r.counters.late);
+  j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
+                   r.counters.fix_rejected);
+  if (!s.attitude.empty()) {
+    const AttitudeUse& a = r.attitude;
+    const auto& n = r.counters;
+    const Eigen::Vector3d& m = s.config.attitude_misalignment_deg;
+    j += fmt::format("  \"attitude\": {{\"file\": \"{}\", \"rows\": {}, \"fixed_rows\": {}, \"unfixed_skipped\": {}, "
+                     "\"before_start\": {}, \"after_end\": {}, \"in_outage\": {}, \"used\": {}, \"updates\": {}, "
+                     "\"updates_accepted\": {}, \"updates_rejected\": {}, \"rejected_near_vertical\": {}, \"late\": {}, "
+                     "\"fallback_fixes\": {}, \"misalignment_deg\": [{}, {}, {}], \"max_pitch_deg\": {}}},\n",
+                     io::json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start,
+                     a.after_end, a.in_outage, a.used, n.attitude_epochs, n.attitude_accepted, n.attitude_rejected,
+                     n.attitude_unusable, n.attitude_late, n.fixes_without_attitude, m.x(), m.y(), m.z(),
+                     s.config.attitude_max_pitch_deg);
+  }
+  j += fmt::format("  \"converged\": {},\n  \"converged_at_s\": {},\n", r.converged_at_s.has_value(),
+                   r.converged_at_s ? fmt::format("{}", *r.converged_at_s) : std::string("null"));
+  j += fmt::format("  \"convergence_heading_sigma_deg\": {},\n", s.config.convergence_heading_sigma_deg);
+  const NavSigma& g = r.final_sigma;
+  j += fmt::format("  \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, \"vel_mps\": {:.6g}, "
+                   "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
+                   g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
+                   g.attitude_ned_rad.x() / kDeg, g.attitude_ned_rad.y() / kDeg, g.attitude_ned_rad.z() / kDeg);
+  if (r.rms_all) j += "  \"rms_all\": " + rms_json(*r.rms_all) + ",\n";
+  if (r.rms_converged) j += "  \"rms_converged\": " + rms_json(*r.rms_converged) + ",\n";
+  if (r.gnss_rms) j += "  \"gnss_only_rms\": " + rms_json(*r.gnss_rms) + ",\n";
+  j += "  \"outages\": [";
+  for (std::size_t i = 0; i < r.outages.size(); ++i)
+    j += fmt::format("{}{{\"start_s\": {}, \"end_s\": {}, \"horizontal_error_m\": {:.6g}, \"sigma_horizontal_m\": {:.6g}}}",
+                     i ? ", " : "", r.outages[i].start_s, r.outages[i].end_s, r.outages[i].horizontal_error_m,
+                     r.outages[i].sigma_horizontal_m);
+  j += "]\n}\n";
+  return j;
+}
+
+}  // namespace ultratrack::pipelines

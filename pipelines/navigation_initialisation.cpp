@@ -1,0 +1,130 @@
+#include "pipelines/navigation_initialisation.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "fusion/ins_error_model.hpp"
+#include "ins/attitude.hpp"
+#include "ins/coarse_alignment.hpp"
+#include "ins/earth_model.hpp"
+#include "io/input_error.hpp"
+
+namespace ultratrack::pipelines {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kG = 9.80665;
+
+}  // namespace
+
+const char* to_string(AlignMode mode) {
+  switch (mode) {
+    case AlignMode::Static: return "static";
+    case AlignMode::Motion: return "motion";
+    case AlignMode::Config: return "config";
+    case AlignMode::Attitude: return "attitude";
+  }
+  return "?";
+}
+
+std::size_t static_span_end(std::span<const ins::ImuIncrement> imu, double t0_s, const FuseConfig& config,
+                            const std::string& imu_name) {
+  std::size_t end = 0;
+  while (end < imu.size() && imu[end].t_s <= t0_s + config.static_duration_s + 1e-9) ++end;
+  if (end < 2 || end == imu.size())
+    throw io::InputError(imu_name, fmt::format("the static alignment span ({} s) needs IMU data beyond it",
+                                               config.static_duration_s));
+  return end;
+}
+
+AttitudeStart align_static(std::span<const ins::ImuIncrement> span, double t0_s, double lat_rad,
+                           const ins::ImuErrorSpec& preset) {
+  const ins::AlignmentResult a = ins::coarse_align(span, t0_s, lat_rad);
+  AttitudeStart s;
+  s.t_s = span.back().t_s;
+  s.q_nb = a.q_nb;
+  s.sigma_vel_n_mps = Eigen::Vector3d::Constant(0.1);
+  const Eigen::Vector3d noise = ins::alignment_noise_sigma(preset, a.duration_s, lat_rad, kG);
+  const double tilt = std::hypot(preset.accel.bias_sigma / kG, noise.x());
+  s.heading_sigma_rad = std::hypot(preset.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(lat_rad)), noise.z());
+  s.sigma_att_rad = {std::max(2.0 * tilt, 0.05 * kDeg), std::max(2.0 * tilt, 0.05 * kDeg),
+                     std::clamp(2.0 * s.heading_sigma_rad, 0.5 * kDeg, 60.0 * kDeg)};
+  s.note = fmt::format("static over {:.1f} s", a.duration_s);
+  return s;
+}
+
+std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu,
+                                          std::span<const fusion::GnssVelocitySample> velocities,
+                                          const FuseConfig& config, double window_s, bool position_only) {
+  const auto a = fusion::align_in_motion(imu, velocities, {config.motion_min_speed_mps, window_s});
+  if (!a) return std::nullopt;
+  AttitudeStart s;
+  s.t_s = a->t_s;
+  s.q_nb = a->q_nb;
+  s.v_n = a->v_n;
+  s.sigma_vel_n_mps = Eigen::Vector3d::Constant(position_only ? 1.0 : config.velocity_sigma_mps * 2.0);
+  s.sigma_att_rad = position_only ? Eigen::Vector3d(3.0 * kDeg, 3.0 * kDeg, 5.0 * kDeg)
+                                  : Eigen::Vector3d(1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg);
+  s.note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
+  return s;
+}
+
+AttitudeStart align_from_config(double t_s, const FuseConfig& config) {
+  AttitudeStart s;
+  s.t_s = t_s;
+  const Eigen::Vector3d& e = *config.attitude_deg;
+  s.q_nb = ins::quaternion_from_euler({e.x() * kDeg, e.y() * kDeg, e.z() * kDeg});
+  s.sigma_att_rad = Eigen::Vector3d(1.0, 1.0, 5.0) * kDeg;
+  s.sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
+  s.note = "attitude from the configuration";
+  return s;
+}
+
+NavigationStart initialise_navigation(const AttitudeStart& a, const GnssPosition* fix, const FuseConfig& c,
+                                      const Eigen::Vector3d& sigma_configured_position_m) {
+  NavigationStart s;
+  s.nav.t_s = a.t_s;
+  s.nav.q_nb = a.q_nb;
+  s.nav.v_n = a.v_n;
+  s.sigma_vel_n_mps = a.sigma_vel_n_mps;
+  s.sigma_att_rad = a.sigma_att_rad;
+  if (c.position_deg_m) {
+    s.nav.lat_rad = c.position_deg_m->x() * kDeg;
+    s.nav.lon_rad = c.position_deg_m->y() * kDeg;
+    s.nav.height_m = c.position_deg_m->z();
+    s.sigma_pos_ned_m = sigma_configured_position_m;
+  } else {
+    // the fix is the antenna's: move to the IMU by the lever arm
+    const Eigen::Vector3d l_n = a.q_nb * c.lever_arm_b;
+    const ins::Radii r = ins::radii_of_curvature(fix->lat_rad);
+    s.nav.lat_rad = fix->lat_rad - l_n.x() / (r.meridian_m + fix->height_m);
+    s.nav.lon_rad = fix->lon_rad - l_n.y() / ((r.transverse_m + fix->height_m) * std::cos(fix->lat_rad));
+    s.nav.height_m = fix->height_m + l_n.z();
+    s.sigma_pos_ned_m = fix->sigma_ned_m;
+  }
+  if (c.sigma_position_m) s.sigma_pos_ned_m = *c.sigma_position_m;
+  if (c.sigma_velocity_mps) s.sigma_vel_n_mps = *c.sigma_velocity_mps;
+  if (c.sigma_attitude_deg) s.sigma_att_rad = *c.sigma_attitude_deg * kDeg;
+  return s;
+}
+
+fusion::IntegrationOptions integration_options(const NavigationStart& start, const FuseConfig& c,
+                                               fusion::Coupling coupling, fusion::FilterKind filter) {
+  fusion::IntegrationOptions o;
+  o.coupling = coupling;
+  o.filter = filter;
+  o.model = fusion::error_model_from_preset(ins::imu_preset(c.imu_preset));
+  o.lever_arm_b = c.lever_arm_b;
+  o.sigma_pos_ned_m = start.sigma_pos_ned_m;
+  o.sigma_vel_n_mps = start.sigma_vel_n_mps;
+  o.sigma_att_rad = start.sigma_att_rad;
+  o.gate = c.gate;
+  o.ukf = c.ukf;
+  o.propagation_interval_s = c.propagation_interval_s;
+  return o;
+}
+
+}  // namespace ultratrack::pipelines

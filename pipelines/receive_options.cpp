@@ -1,0 +1,31 @@
+#include "pipelines/receive_options.hpp"
+
+#include <algorithm>
+
+#include "ins/imu_error_model.hpp"
+
+namespace ultratrack::pipelines {
+
+
+bool ReceiveOptions::IsValid(std::string* error) const {
+  auto fail = [&](std::string why) {
+    if (error) *error = std::move(why);
+    return false;
+  };
+  if (std::string why = receiver.validate(); !why.empty()) return fail(why);
+  if (coupling != Coupling::kVector && vector_carrier != fusion::VectorCarrier::kAidedPll)
+    return fail("--vector-carrier needs --coupling vector");
+  if (!uses_imu(coupling)) return true;
+  const auto& names = ins::imu_preset_names();
+  if (std::find(names.begin(), names.end(), navigation.imu_preset) == names.end())
+    return fail("unknown IMU preset '" + navigation.imu_preset + "'");
+  if (align == AlignMode::Attitude) return fail("--align attitude is `fuse`'s (GPS attitude rows)");
+  if (align == AlignMode::Config && !navigation.attitude_deg)
+    return fail("--align config needs [initial] attitude_deg in --fusion-config");
+  if (imu_time_origin.kind == ImuTimeOrigin::Kind::Tow &&
+      !(imu_time_origin.tow_s >= 0.0 && imu_time_origin.tow_s < 604800.0))
+    return fail("--imu-time-origin: a GPS time of week lies in [0, 604800) s");
+  return true;
+}
+
+}  // namespace ultratrack::pipelines

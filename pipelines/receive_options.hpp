@@ -1,0 +1,45 @@
+// Everything a receive pipeline (pipelines/receiver_pipeline.hpp) needs to know before the first sample: the
+// receiver's options, the coupling, the vector filter's carrier mode, and for the GNSS/INS couplings the filter,
+// the alignment, the navigation settings and the IMU's time origin; for ultra-tight the measurement form and
+// whether the loop runs pipelined. Validated once with IsValid (as ceres' Options).
+#pragma once
+
+#include <string>
+
+#include "fusion/gnss_ins_integration.hpp"
+#include "fusion/ultratight_integration.hpp"
+#include "fusion/vector_tracking.hpp"
+#include "pipelines/coupling.hpp"
+#include "pipelines/fuse_config.hpp"
+#include "pipelines/imu_time_line.hpp"
+#include "pipelines/navigation_initialisation.hpp"
+#include "receiver/receiver_options.hpp"
+
+namespace ultratrack::pipelines {
+
+struct ReceiveOptions {
+  receiver::ReceiverOptions receiver;
+  Coupling coupling = Coupling::kScalar;
+  // kVector: how the vector filter closes the carrier (aided-pll, fll, pll).
+  fusion::VectorCarrier vector_carrier = fusion::VectorCarrier::kAidedPll;
+
+  // kLoose, kTight, kUltraTight.
+  fusion::FilterKind filter = fusion::FilterKind::Ekf;
+  AlignMode align = AlignMode::Motion;  // Static, Motion or Config (Attitude is `fuse`'s)
+  FuseConfig navigation;                // `fuse`'s configuration keys
+  ImuTimeOrigin imu_time_origin;
+  std::string imu_name = "IMU data";  // names the IMU data in errors and summary.json (the file's path)
+
+  // kUltraTight. Pipelined (the default): the loop runs beside the next block's correlation
+  // (receiver::ReceiverEngine::set_vector_loop), its commands one 20 ms vector epoch later, as a real-time
+  // receiver runs its navigation filter concurrently with the correlators. false: the loop runs on the caller
+  // between blocks, its commands at the epoch that produced them (slower with 2 or more threads).
+  fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;
+  bool ut_pipelined = true;
+
+  // True when the options fit together; otherwise false and *error (when given) says why, naming the setting as
+  // the configuration file or the command line calls it.
+  bool IsValid(std::string* error) const;
+};
+
+}  // namespace ultratrack::pipelines

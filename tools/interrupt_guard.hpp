@@ -1,0 +1,27 @@
+// The one SIGINT handler of the program: while an InterruptGuard lives, Ctrl-C requests a stop on its
+// std::stop_token instead of killing the process, so that a command's loop (a pipeline's, the simulator's) can end
+// early and still finish every output. Guards may nest (a command run inside another): a Ctrl-C stops them all.
+// The previous handler is restored when the last guard goes.
+#pragma once
+
+#include <stop_token>
+
+namespace ultratrack::tools {
+
+class InterruptGuard {
+ public:
+  InterruptGuard();
+  ~InterruptGuard();
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+  // Stop requested by SIGINT (or by request_stop()).
+  std::stop_token token() const { return source_.get_token(); }
+  bool interrupted() const { return source_.stop_requested(); }
+  void request_stop() { source_.request_stop(); }
+
+ private:
+  std::stop_source source_;
+};
+
+}  // namespace ultratrack::tools

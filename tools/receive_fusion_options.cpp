@@ -1,0 +1,137 @@
+#include "receive_fusion_options.hpp"
+
+#include <filesystem>
+
+#include "cli_parse.hpp"
+#include "fuse_config.hpp"
+#include "ins/imu_csv.hpp"
+#include "ins/imu_error_model.hpp"
+#include "io/input_error.hpp"
+
+namespace ultratrack::tools {
+namespace {
+
+using pipelines::Coupling;
+constexpr double kWeek_s = 604800.0;
+
+}  // namespace
+
+void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
+  cmd->add_option("--imu", a.imu, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps) for GNSS/INS integration (--coupling)");
+  cmd->add_option("--coupling", a.coupling,
+                  "scalar (default: per-channel loops), vector (one vector filter closes the code loops), or "
+                  "GNSS/INS integration with --imu: loose (PVT fixes), tight (pseudoranges and rates) or "
+                  "ultra-tight (the INS-predicted replica drives the channels, the filter updates from correlations)");
+  cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
+  cmd->add_option("--align", a.align, "with --coupling: static, motion (default) or config");
+  cmd->add_option("--fusion-config", a.config,
+                  "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
+  cmd->add_option("--imu-time-origin", a.time_origin,
+                  "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
+                  "the GPS time of week) or a GPS time of week in seconds");
+  cmd->add_option("--ut-measurement", a.ut_measurement,
+                  "with --coupling ultra-tight: iq (default: the E/P/L I&Q, seed 001 eqs. 11-17) or discriminator");
+  cmd->add_flag("--ut-serial", a.ut_serial,
+                "with --coupling ultra-tight: run the loop between blocks, its commands at once (by default it runs "
+                "beside the correlation of the next block, its commands reaching the channels one 20 ms loop "
+                "period later: faster with 2 or more threads; either way the same output for any --threads)");
+  a.ut_pipelined_option =
+      cmd->add_flag("--ut-pipelined", a.ut_pipelined,
+                    "with --coupling ultra-tight: the pipelined loop, which is the default (kept for older command "
+                    "lines; --ut-pipelined=false is --ut-serial)");
+  cmd->add_option("--vector-carrier", a.vector_carrier,
+                  "with --coupling vector: aided-pll (default: each channel's PLL, aided), fll (the filter "
+                  "commands the carrier NCOs: vector FLL) or pll (the filter commands the carrier NCOs' frequency "
+                  "and phase from per-channel carrier states its Costas discriminators update: vector PLL)");
+}
+
+void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveOptions& s) {
+  const bool pipelined_given = a.ut_pipelined_option && a.ut_pipelined_option->count() > 0;
+  const auto coupling = pipelines::coupling_from_string(a.coupling);
+  if (!coupling)
+    throw io::InputError("command line",
+                         "--coupling must be scalar, vector, loose, tight or ultra-tight, got '" + a.coupling + "'");
+  s.coupling = *coupling;
+  if (!a.vector_carrier.empty()) {
+    if (s.coupling != Coupling::kVector) throw io::InputError("command line", "--vector-carrier needs --coupling vector");
+    if (a.vector_carrier == "aided-pll") {
+      s.vector_carrier = fusion::VectorCarrier::kAidedPll;
+    } else if (a.vector_carrier == "fll") {
+      s.vector_carrier = fusion::VectorCarrier::kFll;
+    } else if (a.vector_carrier == "pll") {
+      s.vector_carrier = fusion::VectorCarrier::kPll;
+    } else {
+      throw io::InputError("command line", "--vector-carrier must be aided-pll, fll or pll, got '" + a.vector_carrier + "'");
+    }
+  }
+  if (!pipelines::uses_imu(s.coupling)) {
+    if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
+      throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
+                                           "--coupling loose, tight or ultra-tight");
+    if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
+    if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
+    if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
+    return;
+  }
+  if (!a.ut_measurement.empty() && s.coupling != Coupling::kUltraTight)
+    throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
+  if (a.ut_serial && s.coupling != Coupling::kUltraTight)
+    throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
+  if (pipelined_given && s.coupling != Coupling::kUltraTight)
+    throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
+  if (a.ut_serial && pipelined_given && a.ut_pipelined)
+    throw io::InputError("command line", "--ut-serial and --ut-pipelined exclude each other");
+  s.ut_pipelined = a.ut_pipelined && !a.ut_serial;
+  if (a.ut_measurement.empty() || a.ut_measurement == "iq") {
+    s.ut_form = fusion::UltraTightForm::Iq;
+  } else if (a.ut_measurement == "discriminator") {
+    s.ut_form = fusion::UltraTightForm::Discriminator;
+  } else {
+    throw io::InputError("command line", "--ut-measurement must be iq or discriminator, got '" + a.ut_measurement + "'");
+  }
+  if (a.imu.empty()) throw io::InputError("command line", "--coupling " + a.coupling + " needs --imu FILE");
+  s.imu_name = a.imu;
+  const std::string filter = a.filter.empty() ? "ekf" : a.filter;
+  if (filter == "ekf") {
+    s.filter = fusion::FilterKind::Ekf;
+  } else if (filter == "ukf") {
+    s.filter = fusion::FilterKind::Ukf;
+  } else {
+    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + filter + "'");
+  }
+  const std::string align = a.align.empty() ? "motion" : a.align;
+  if (align == "static") {
+    s.align = pipelines::AlignMode::Static;
+  } else if (align == "motion") {
+    s.align = pipelines::AlignMode::Motion;
+  } else if (align == "config") {
+    s.align = pipelines::AlignMode::Config;
+  } else {
+    throw io::InputError("command line", "--align must be static, motion or config, got '" + align + "'");
+  }
+  if (!a.config.empty()) s.navigation = read_fuse_config(a.config);
+  (void)ins::imu_preset(s.navigation.imu_preset);  // an unknown preset fails here, before any output
+  if (s.align == pipelines::AlignMode::Config && !s.navigation.attitude_deg)
+    throw io::InputError(a.config.empty() ? "command line" : a.config,
+                         "--align config needs [initial] attitude_deg in --fusion-config");
+  if (a.time_origin.empty() || a.time_origin == "sample0") {
+    s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::Sample0;
+  } else if (a.time_origin == "tow") {
+    s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::WeekStart;
+  } else {
+    s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::Tow;
+    s.imu_time_origin.tow_s = parse_double_option("--imu-time-origin", a.time_origin);
+    if (!(s.imu_time_origin.tow_s >= 0.0 && s.imu_time_origin.tow_s < kWeek_s))
+      throw io::InputError("command line", "--imu-time-origin: a GPS time of week lies in [0, 604800) s");
+  }
+}
+
+std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw io::InputError(file, "IMU file not found");
+  auto imu = ins::read_imu_csv(file);
+  if (imu.size() < 2) throw io::InputError(file, "the IMU file needs at least two rows");
+  return imu;
+}
+
+}  // namespace ultratrack::tools

@@ -1,0 +1,23 @@
+// `receive`'s progress display on stderr: a bar redrawn every 250 ms on a terminal, a plain line every 10 s of
+// signal otherwise; nothing with --quiet.
+#pragma once
+
+#include <chrono>
+
+#include "receiver/receiver_engine.hpp"
+
+namespace ultratrack::tools {
+
+class ReceiveProgress {
+ public:
+  ReceiveProgress(bool quiet, double total_s);
+  void update(const receiver::ReceiverEngine& engine, bool final = false);
+
+ private:
+  bool quiet_, tty_;
+  double total_s_;
+  double next_line_s_ = 0.0;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+}  // namespace ultratrack::tools
