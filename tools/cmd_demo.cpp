@@ -23,6 +23,7 @@
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
 #include "scenario_toml.hpp"
+#include "interrupt_guard.hpp"
 #include "simulation_run.hpp"
 
 namespace ultratrack::tools {
@@ -139,7 +140,7 @@ void run_demo(const DemoArgs& args) {
              scenario.cn0_dbhz);
 
   fmt::print("\n1. simulate -> {}\n", (out / "simulation").string());
-  const SigintStop interrupt;  // the SIGINT guard to swap for tools/interrupt_guard.hpp
+  const InterruptGuard interrupt;
   const sim::SimulationResult sim =
       run_simulation(scenario, out / "simulation", isatty(fileno(stderr)) ? stderr : nullptr, interrupt.token());
   fmt::print("  {:.1f} s of signal in {:.1f} s ({:.1f}x real time), {} satellites in view\n", sim.signal_s, sim.wall_s,

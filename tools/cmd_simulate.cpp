@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "scenario_toml.hpp"
+#include "interrupt_guard.hpp"
 #include "simulation_run.hpp"
 
 namespace ultratrack::tools {
@@ -24,7 +25,7 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_flag("--quiet", *quiet, "No progress lines");
   cmd->callback([scenario_path, out_dir, quiet] {
     const sim::Scenario scenario = read_scenario(*scenario_path);
-    const SigintStop interrupt;  // the SIGINT guard to swap for tools/interrupt_guard.hpp
+    const InterruptGuard interrupt;
     const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr, interrupt.token());
     const std::string inertial =
         scenario.trajectory_enabled()
