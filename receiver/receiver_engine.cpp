@@ -64,7 +64,7 @@ ReceiverEngine::~ReceiverEngine() {
 void ReceiverEngine::add_navigation(const std::vector<signals::Ephemeris>& ephemerides,
                                     const signals::KlobucharParameters& iono, const signals::UtcParameters& utc) {
   ephemerides_.insert(ephemerides_.end(), ephemerides.begin(), ephemerides.end());
-  if (iono.valid) iono_ = iono;
+  ionosphere_.set(iono, IonosphereSource::kNavigationFile, std::nullopt);
   if (utc.valid) utc_ = utc;
   supplied_navigation_ = std::make_shared<const SuppliedNavigation>(SuppliedNavigation{ephemerides_, iono, utc});
 }
@@ -351,7 +351,7 @@ void ReceiverEngine::collect_navigation(ReceiverChannel& channel) {
     if (a && (!mine || mine->week != a->week || mine->toa_s != a->toa_s)) mine = a;
   }
   if (!nav.take_new_ephemeris()) return;
-  if (decoder.klobuchar().valid) iono_ = decoder.klobuchar();
+  ionosphere_.set(decoder.klobuchar(), IonosphereSource::kBroadcast, view_.first_sample + view_.num_samples);
   if (decoder.utc().valid) utc_ = decoder.utc();
   if (!decoder.ephemeris()) return;
   const signals::Ephemeris& eph = *decoder.ephemeris();
@@ -545,9 +545,8 @@ void ReceiverEngine::solve(const ObservationEpoch& epoch) {
   }
   if (pvt_input_.size() < 4) return;
   PvtOptions pvt = options_.pvt;
-  pvt.ionosphere = pvt.ionosphere && iono_.valid;
   const Eigen::Vector3d initial = last_fix_ ? last_fix_->r_e_m : Eigen::Vector3d::Zero();
-  PvtSolution fix = solve_pvt(pvt_input_, epoch.receive_time, iono_, pvt, initial);
+  PvtSolution fix = solve_pvt(pvt_input_, epoch.receive_time, ionosphere_.parameters(), pvt, initial);
   if (!fix.valid) return;
   if (!stats_.first_fix_sample) stats_.first_fix_sample = epoch.sample_index;
   ++stats_.fixes;
@@ -619,7 +618,7 @@ void ReceiverEngine::vector_epoch(std::int64_t sample) {
     PipelinedVector& p = pipelined_;
     collect_vector_inputs(sample, p.in, p.epoch);
     p.ephemerides = ephemerides_;
-    p.iono = iono_;
+    p.iono = ionosphere_.parameters();
     p.last_fix = last_fix_;
     p.epoch.ephemerides = &p.ephemerides;
     p.epoch.iono = &p.iono;
@@ -633,7 +632,7 @@ void ReceiverEngine::vector_epoch(std::int64_t sample) {
   collect_vector_inputs(sample, vector_in_, epoch);
   vector_out_.assign(vector_in_.size(), VectorChannelCommand{});
   epoch.ephemerides = &ephemerides_;
-  epoch.iono = &iono_;
+  epoch.iono = &ionosphere_.parameters();
   epoch.last_fix = last_fix_ ? &*last_fix_ : nullptr;
   epoch.channels = vector_in_;
   if (clock_) vector_loop_->update(epoch, vector_out_);

@@ -25,6 +25,7 @@
 #include "receiver/acquisition.hpp"
 #include "receiver/antenna_phase.hpp"
 #include "receiver/carrier_smoothing.hpp"
+#include "receiver/ionosphere_model.hpp"
 #include "receiver/observables.hpp"
 #include "receiver/pvt.hpp"
 #include "receiver/receiver_channel.hpp"
@@ -119,7 +120,10 @@ class ReceiverEngine {
   float i16_gain() const { return i16_gain_; }
   // Ephemerides decoded from the signal (each new set once), and the broadcast Klobuchar/UTC parameters.
   const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return decoded_; }
-  const signals::KlobucharParameters& klobuchar() const { return iono_; }
+  // The Klobuchar parameters in use: a default set until the nav file's or the broadcast ones are known
+  // (receiver/ionosphere_model.hpp); ionosphere() also tells which, since when, and the known ones alone.
+  const signals::KlobucharParameters& klobuchar() const { return ionosphere_.parameters(); }
+  const IonosphereModel& ionosphere() const { return ionosphere_; }
   const signals::UtcParameters& utc() const { return utc_; }
   // The latest almanac decoded from any channel, per PRN (index = PRN).
   const std::array<std::optional<signals::Almanac>, 33>& almanacs() const { return almanacs_; }
@@ -196,7 +200,7 @@ class ReceiverEngine {
   std::vector<signals::Ephemeris> ephemerides_;  // all known: supplied + decoded
   std::vector<signals::Ephemeris> decoded_;
   std::array<std::optional<signals::Almanac>, 33> almanacs_{};
-  signals::KlobucharParameters iono_;
+  IonosphereModel ionosphere_;  // Klobuchar in use (default, nav file, broadcast)
   std::shared_ptr<const SuppliedNavigation> supplied_navigation_;  // the nav file's sets: known bits (issue 7)
   signals::UtcParameters utc_;
   std::optional<PvtSolution> last_fix_;
@@ -227,7 +231,7 @@ class ReceiverEngine {
   double fix_clock_corrections_s_ = 0.0;  // clock_corrections_s_ when last_fix_ was solved
   std::vector<VectorChannelInput> vector_in_;
   std::vector<VectorChannelCommand> vector_out_;
-  // Pipelined loop: one epoch's inputs, copied (the engine changes ephemerides_, iono_, last_fix_ and the channels
+  // Pipelined loop: one epoch's inputs, copied (the engine changes ephemerides_, ionosphere_, last_fix_ and the channels
   // while the loop runs), and its commands until the next vector epoch applies them.
   struct PipelinedVector {
     bool queued = false;    // inputs captured, update not yet run
