@@ -7,14 +7,15 @@
 # (+-0.3 ms) and drift (+-0.5 ppm), sample format in turn i8 at 2.6 MHz, r2 (2-bit real) at 20 MHz with a 4.1 MHz
 # IF, i16 at 4 MHz. Truth: the scenario's start position and time (the snapshot's first sample).
 # Prints one row per case and the table per class: cases, fixes within 10 m (3-D), fixes flagged by the
-# quality check (quality != pass, or no fix), wrong fixes (> 10 m) not flagged, median and 95th-percentile error.
+# quality check (quality != pass, or no fix), wrong fixes (> 10 m) not flagged, median and 95th-percentile error,
+# and the fixes within their own 95 % error bound (snapshot.json error_bound_3d_95_m).
 #
 #   benchmarks/snapshot_mc.sh [--cases 7] [--seed0 1] [--time-error 10] [--out DIR] [--ultratrack build/tools/ultratrack]
-#       [--nav FILE] [--keep]
+#       [--nav FILE] [--keep] [--snapshot-args "..."]   (more options for every `snapshot`)
 # Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3. CPU: a few seconds per case.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-cases=7 seed0=1 time_error=10 out="" keep=0
+cases=7 seed0=1 time_error=10 out="" keep=0 snapshot_args=""
 ut="$here/../build/tools/ultratrack"
 nav="$here/../../shared/data/brdc0010.22n"
 while [[ $# -gt 0 ]]; do
@@ -26,6 +27,7 @@ while [[ $# -gt 0 ]]; do
     --ultratrack) ut="$2"; shift 2 ;;
     --nav) nav="$2"; shift 2 ;;
     --keep) keep=1; shift ;;
+    --snapshot-args) snapshot_args="$2"; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -35,10 +37,11 @@ done
 mkdir -p "$out"
 nav="$(cd "$(dirname "$nav")" && pwd)/$(basename "$nav")"
 
-python3 - "$ut" "$nav" "$out" "$cases" "$seed0" "$time_error" "$keep" <<'EOF'
+python3 - "$ut" "$nav" "$out" "$cases" "$seed0" "$time_error" "$keep" "$snapshot_args" <<'EOF'
 import json, math, os, random, shutil, statistics, subprocess, sys
 
 ut, nav, out, cases, seed0, time_error, keep = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]), float(sys.argv[6]), sys.argv[7] == "1"
+extra = sys.argv[8].split()
 
 def ecef(lat, lon, h):
     a, f = 6378137.0, 1 / 298.257223563
@@ -104,10 +107,10 @@ imu_rate_hz = 100.0
                 approx = tow + err
                 args = [ut, "snapshot", "--input", os.path.join(case, "sim", f"antenna0.{fmt_name}.bin"), "--format", fmt_name,
                         "--fs", str(fs), "--if", str(if_hz), "--nav", nav, "--time", f"2190:{approx:.6f}", "--time-sigma-s", "10",
-                        "--ms", str(ms), "--doppler-max", "8000", "--out", os.path.join(case, "snap")]
+                        "--ms", str(ms), "--doppler-max", "8000", "--out", os.path.join(case, "snap")] + extra
                 snap = subprocess.run(args, capture_output=True, text=True)
                 result = {"seed": seed, "cn0": cn0, "motion": motion, "ms": ms, "format": fmt_name, "exit": snap.returncode,
-                          "error_m": float("nan"), "quality": "none", "time_error_s": float("nan"), "used": 0}
+                          "error_m": float("nan"), "quality": "none", "time_error_s": float("nan"), "used": 0, "bound_m": float("nan")}
                 path = os.path.join(case, "snap", "snapshot.json")
                 if os.path.exists(path):
                     j = json.load(open(path))
@@ -116,12 +119,13 @@ imu_rate_hz = 100.0
                         truth = ecef(lat, lon, h)
                         result["error_m"] = math.dist(truth, j["ecef_m"])
                         result["quality"] = j["quality"]
+                        result["bound_m"] = j["error_bound_3d_95_m"]
                         result["time_error_s"] = (approx + j["time_correction_s"]) - tow
                     else:
                         result["quality"] = "no fix"
                 rows.append(result)
                 print(f"{seed:5d} {cn0:4.0f} {motion:7s} {ms:4d} {fmt_name:4s} exit {snap.returncode} used {result['used']:2d} "
-                      f"err {result['error_m']:10.2f} m  time err {result['time_error_s']*1e3:9.3f} ms  {result['quality']}", flush=True)
+                      f"err {result['error_m']:10.2f} m (95 % bound {result['bound_m']:6.1f})  time err {result['time_error_s']*1e3:9.3f} ms  {result['quality']}", flush=True)
                 if not keep:
                     shutil.rmtree(os.path.join(case, "sim"), ignore_errors=True)
 
@@ -135,7 +139,7 @@ def pct(values, p):
     return v[min(len(v) - 1, int(math.ceil(p * len(v))) - 1)]
 
 print()
-print(f"{'C/N0':>5} {'motion':>7} {'ms':>4} {'cases':>5} {'<=10 m':>7} {'rate':>6} {'flagged':>7} {'wrong unflagged':>15} {'median m':>9} {'p95 m':>9}")
+print(f"{'C/N0':>5} {'motion':>7} {'ms':>4} {'cases':>5} {'<=10 m':>7} {'rate':>6} {'flagged':>7} {'wrong unflagged':>15} {'median m':>9} {'p95 m':>9} {'in bound':>8}")
 total = good = 0
 for cn0 in (45.0, 35.0):
     for motion in ("static", "250mps"):
@@ -147,9 +151,10 @@ for cn0 in (45.0, 35.0):
             flagged = sum(1 for r in sel if r["quality"] != "pass")
             wrong_unflagged = sum(1 for r in sel if r["quality"] == "pass" and not (r["error_m"] <= 10.0))
             errs = [r["error_m"] for r in sel if not math.isnan(r["error_m"])]
+            in_bound = sum(1 for r in sel if r["error_m"] <= r["bound_m"])
             total += len(sel)
             good += ok
             print(f"{cn0:5.0f} {motion:>7} {ms:4d} {len(sel):5d} {ok:7d} {ok / len(sel):6.0%} {flagged:7d} {wrong_unflagged:15d} "
-                  f"{statistics.median(errs) if errs else float('nan'):9.2f} {pct(errs, 0.95):9.2f}")
+                  f"{statistics.median(errs) if errs else float('nan'):9.2f} {pct(errs, 0.95):9.2f} {in_bound:8d}")
 print(f"all: {good} of {total} within 10 m ({good / max(total, 1):.1%})")
 EOF

@@ -45,10 +45,10 @@ double ionosphere_change_seconds(const IonosphereModelChange& change, std::int64
 
 std::vector<std::string> ionosphere_comment_lines(const IonosphereModel& model, std::int64_t first_sample, double fs_hz,
                                                   bool applied) {
-  if (!applied) return {"IONOSPHERE: no correction applied (--ionosphere off)"};
+  if (!applied) return {"IONO none applied (--ionosphere off)"};
   std::vector<std::string> lines;
   for (const IonosphereModelChange& c : model.history())
-    lines.push_back(fmt::format("IONOSPHERE: {} Klobuchar{} from {:.3f} s", ionosphere_source_name(c.source),
+    lines.push_back(fmt::format("IONO {} Klobuchar{} from {:.3f} s", ionosphere_source_name(c.source),
                                 c.source == IonosphereSource::kDefault ? " (RTKLIB ion_default)" : "",
                                 ionosphere_change_seconds(c, first_sample, fs_hz)));
   return lines;

@@ -58,9 +58,9 @@ class IonosphereModel {
 // Seconds of signal from first_sample (the first processed sample) to the change; 0 for one from the start.
 double ionosphere_change_seconds(const IonosphereModelChange& change, std::int64_t first_sample, double fs_hz);
 
-// The history as RINEX header COMMENT texts (<= 60 characters each), e.g. "IONOSPHERE: default Klobuchar
-// (RTKLIB ion_default) from 0.000 s", then "IONOSPHERE: broadcast Klobuchar from 41.000 s"; applied = false
-// (the PVT's correction switched off) gives one line saying so.
+// The history as RINEX header COMMENT texts (<= 60 characters each), e.g. "IONO default Klobuchar (RTKLIB
+// ion_default) from 0.000 s", then "IONO broadcast Klobuchar from 41.000 s"; applied = false (the PVT's
+// correction switched off) gives one line saying so.
 std::vector<std::string> ionosphere_comment_lines(const IonosphereModel& model, std::int64_t first_sample, double fs_hz,
                                                   bool applied);
 

@@ -110,7 +110,7 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
     auto amplitude = [&](double phase) { return std::sqrt(std::max(power(phase) - noise, 0.0)); };
     // The search's code phase is at its first (decimated) sample, (decimation - 1) / 2 input samples in.
     double phase = r.code_phase_chips - 0.5 * (decimation - 1) * chips_per_sample;
-    for (int iteration = 0; iteration < 3; ++iteration) {
+    for (int iteration = 0; iteration < 5; ++iteration) {
       const double early = amplitude(phase - d / 2.0), late = amplitude(phase + d / 2.0);
       if (early + late <= 0.0) break;
       // The received code phase at sample 0 is later than the replica's when late > early.

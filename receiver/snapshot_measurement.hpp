@@ -8,7 +8,8 @@
 // 2. Fine code phase by a non-coherent early-minus-late loop over the whole snapshot, run to convergence: per
 //    coherent block the early and late correlations (spacing d chips) at the acquisition Doppler, the replica's
 //    code rate scaled by that Doppler; amplitudes with the noise power (a lag half a code period away)
-//    removed; tau += (1 - d / 2) (E - L) / (E + L), three times. The code phase at the first sample is the result.
+//    removed; tau += (1 - d / 2) (L - E) / (E + L), five times (a front end's filter rounds the peak and
+//    lowers the gain near it: the repetitions converge anyway). The code phase at the first sample is the result.
 // 1-sigma of the code phase: the non-coherent early-late discriminator's thermal noise (Kaplan & Hegarty,
 // 3rd ed., eq. 8.48 without band limiting), sigma^2 = d / (4 C/N0 T) (1 + 2 / ((2 - d) C/N0 T_coh)), with
 // T the snapshot length; of the Doppler: the acquisition's fine-search resolution, step / 8, with a floor from
@@ -27,7 +28,7 @@ struct SnapshotSearchOptions {
   double doppler_max_hz = 5000.0;  // search +-, receiver oscillator offset included
   double pfa = 1e-3;               // per PRN search
   int coherent_ms = 0;             // 0: 10 ms, or 5 ms for snapshots shorter than 40 ms
-  double spacing_chips = 1.0;      // early-late spacing d of the fine code loop, (0, 1.5]
+  double spacing_chips = 0.5;      // early-late spacing d of the fine code loop, (0, 1.5]
 
   bool IsValid(std::string* error) const;
 };

@@ -40,7 +40,7 @@ constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 struct SnapshotArgs {
   std::string input, fs, if_hz = "0", nav, time, time_sigma = "10", approx_llh, ms = "100", out;
-  std::string prns = "1-32", doppler_max = "5000", pfa = "1e-3", skip = "0";
+  std::string prns = "1-32", doppler_max = "5000", pfa = "1e-3", skip = "0", spacing = "0.5";
   FormatArgs format;
   bool iq_swap = false, q_negate = false, quiet = false;
 };
@@ -106,6 +106,8 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotArgs& 
                "  \"sigma\": {{\"east_m\": {:.3f}, \"north_m\": {:.3f}, \"up_m\": {:.3f}, \"clock_m\": {:.3f}, "
                "\"time_s\": {:.9f}}},\n",
                s.sigma_enu_m.x(), s.sigma_enu_m.y(), s.sigma_enu_m.z(), s.sigma_clock_m, s.sigma_time_s);
+    // 95 % of a 3-D Gaussian error lies within sqrt(7.81) = 2.8 times the root of the summed variances.
+    fmt::print(out, "  \"error_bound_3d_95_m\": {:.3f},\n", 2.8 * s.sigma_enu_m.norm());
     fmt::print(out,
                "  \"residual_test\": {{\"statistic\": {:.3f}, \"threshold\": {}, \"residual_rms_m\": {:.3f}, "
                "\"doppler_statistic\": {:.3f}}},\n",
@@ -171,6 +173,7 @@ void run_snapshot(const SnapshotArgs& args) {
   search.fs_hz = source_options.fs_hz;
   search.doppler_max_hz = parse_double_option("--doppler-max", args.doppler_max);
   search.pfa = parse_double_option("--pfa", args.pfa);
+  search.spacing_chips = parse_double_option("--spacing-chips", args.spacing);
   const std::vector<int> prns = parse_prn_list_option("--prn", args.prns);
   std::string why;
   if (!search.IsValid(&why)) throw signals::InputError("command line", why);
@@ -272,6 +275,8 @@ void add_snapshot_command(CLI::App& app) {
   cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15")->capture_default_str();
   cmd->add_option("--doppler-max", args->doppler_max, "Doppler search range +-, Hz")->capture_default_str();
   cmd->add_option("--pfa", args->pfa, "false-alarm probability per PRN")->capture_default_str();
+  cmd->add_option("--spacing-chips", args->spacing, "early-late spacing of the fine code phase, chips (0, 1.5]")
+      ->capture_default_str();
   cmd->add_flag("--iq-swap", args->iq_swap, "exchange I and Q (complex formats)");
   cmd->add_flag("--q-negate", args->q_negate, "negate Q (complex) / invert the spectrum (real IF)");
   cmd->add_option("--out", args->out, "output folder (snapshot.json, solution.csv)")->required();
