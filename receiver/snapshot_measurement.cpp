@@ -1,6 +1,7 @@
 #include "receiver/snapshot_measurement.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -20,29 +21,36 @@ int coherent_ms_for(const SnapshotSearchOptions& o, std::size_t samples) {
   return length_ms >= 40.0 ? 10 : 5;
 }
 
-// Non-coherent power of the correlation with the replica started at code phase `phase_chips` at sample 0,
-// summed over the coherent blocks of `block` samples.
-double correlation_power(std::span<const std::complex<float>> samples, const signals::CaCodeChips& code,
-                         double phase_chips, double chips_per_sample, double doppler_hz, double fs_hz,
-                         std::size_t block) {
+// Non-coherent powers of the correlations with replicas started at code phases phases_chips[j] at sample 0,
+// summed over the coherent blocks of `block` samples (one carrier wipe-off for all of them).
+template <std::size_t N>
+std::array<double, N> correlation_powers(std::span<const std::complex<float>> samples, const signals::CaCodeChips& code,
+                                         const std::array<double, N>& phases_chips, double chips_per_sample,
+                                         double doppler_hz, double fs_hz, std::size_t block) {
   const std::size_t blocks = samples.size() / block;
   const double carrier_step = -2.0 * kPi * doppler_hz / fs_hz;
-  double power = 0.0;
+  std::array<double, N> power{};
   for (std::size_t b = 0; b < blocks; ++b) {
-    std::complex<double> sum = 0.0;
+    std::array<std::complex<double>, N> sum{};
     const std::size_t first = b * block;
-    // Carrier phasor recomputed per block (exact phase), advanced by rotation inside it.
+    // Carrier phasor and code phases recomputed exactly at each block start, advanced incrementally inside it.
     std::complex<double> phasor = std::polar(1.0, carrier_step * static_cast<double>(first));
     const std::complex<double> rotate = std::polar(1.0, carrier_step);
+    std::array<double, N> chip{};
+    for (std::size_t j = 0; j < N; ++j) {
+      chip[j] = std::fmod(phases_chips[j] + static_cast<double>(first) * chips_per_sample, kCodeLength);
+      if (chip[j] < 0.0) chip[j] += kCodeLength;
+    }
     for (std::size_t k = 0; k < block; ++k) {
-      const std::size_t n = first + k;
-      double chip = std::fmod(phase_chips + static_cast<double>(n) * chips_per_sample, kCodeLength);
-      if (chip < 0.0) chip += kCodeLength;
-      const int c = code[static_cast<std::size_t>(chip) % signals::kCaCodeLength_chips];
-      sum += static_cast<double>(c) * std::complex<double>(samples[n]) * phasor;
+      const std::complex<double> wiped = std::complex<double>(samples[first + k]) * phasor;
+      for (std::size_t j = 0; j < N; ++j) {
+        sum[j] += static_cast<double>(code[static_cast<std::size_t>(chip[j])]) * wiped;
+        chip[j] += chips_per_sample;
+        if (chip[j] >= kCodeLength) chip[j] -= kCodeLength;
+      }
       phasor *= rotate;
     }
-    power += std::norm(sum);
+    for (std::size_t j = 0; j < N; ++j) power[j] += std::norm(sum[j]);
   }
   return power;
 }
@@ -59,6 +67,7 @@ bool SnapshotSearchOptions::IsValid(std::string* error) const {
   if (!(pfa > 0.0 && pfa <= 0.5)) return fail("pfa must be in (0, 0.5]");
   if (coherent_ms < 0 || coherent_ms > 10) return fail("coherent time must be 0 (automatic) or 1..10 ms");
   if (!(spacing_chips > 0.0 && spacing_chips <= 1.5)) return fail("early-late spacing must be in (0, 1.5] chips");
+  if (!(min_metric_ratio >= 1.0)) return fail("minimum metric ratio must be >= 1");
   return true;
 }
 
@@ -99,19 +108,19 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
   const double d = options.spacing_chips;
   std::vector<SnapshotDetection> out;
   for (const AcquisitionResult& r : found) {
-    if (!r.detected) continue;
+    if (!r.detected || r.metric < options.min_metric_ratio * r.threshold) continue;
     const signals::CaCodeChips& code = signals::ca_code(r.prn);
     const double chips_per_sample = signals::kCaChipRate_hz * (1.0 + r.doppler_hz / signals::kL1Frequency_hz) /
                                     options.fs_hz;
-    auto power = [&](double phase) {
-      return correlation_power(used, code, phase, chips_per_sample, r.doppler_hz, options.fs_hz, block);
-    };
-    const double noise = power(r.code_phase_chips + kCodeLength / 2.0);  // far from the peak: noise alone
-    auto amplitude = [&](double phase) { return std::sqrt(std::max(power(phase) - noise, 0.0)); };
+    // Noise alone: a replica half a code period away from the peak.
+    const double noise = correlation_powers<1>(used, code, {r.code_phase_chips + kCodeLength / 2.0}, chips_per_sample,
+                                               r.doppler_hz, options.fs_hz, block)[0];
     // The search's code phase is at its first (decimated) sample, (decimation - 1) / 2 input samples in.
     double phase = r.code_phase_chips - 0.5 * (decimation - 1) * chips_per_sample;
     for (int iteration = 0; iteration < 5; ++iteration) {
-      const double early = amplitude(phase - d / 2.0), late = amplitude(phase + d / 2.0);
+      const auto p = correlation_powers<2>(used, code, {phase - d / 2.0, phase + d / 2.0}, chips_per_sample,
+                                           r.doppler_hz, options.fs_hz, block);
+      const double early = std::sqrt(std::max(p[0] - noise, 0.0)), late = std::sqrt(std::max(p[1] - noise, 0.0));
       if (early + late <= 0.0) break;
       // The received code phase at sample 0 is later than the replica's when late > early.
       phase += std::clamp((1.0 - d / 2.0) * (late - early) / (early + late), -0.5, 0.5);

@@ -394,6 +394,7 @@ SnapshotSolution solve_snapshot(const std::vector<SnapshotMeasurement>& meas, co
   }
   const std::optional<Eigen::Vector3d> seed = doppler_position(meas, t0);
   std::vector<Eigen::Vector3d> candidates;
+  std::vector<double> distances;  // from the Doppler fix (grid around it only)
   if (seed) {
     // Rings of a-priori positions around the Doppler fix, nearest first, on the sphere through the seed's foot.
     const Geodetic g = geodetic(*seed);
@@ -411,7 +412,10 @@ SnapshotSolution solve_snapshot(const std::vector<SnapshotMeasurement>& meas, co
         ring.emplace_back(d, p * (foot.norm() / p.norm()));
       }
     std::stable_sort(ring.begin(), ring.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [d, p] : ring) candidates.push_back(p);
+    for (const auto& [d, p] : ring) {
+      candidates.push_back(p);
+      distances.push_back(d);
+    }
   } else {
     // No Doppler fix: a global grid of a-priori positions under the satellites (every 2 degrees ~ 220 km is
     // too coarse for the integers; 1 degree of latitude, longitude spaced to keep ~110 km).
@@ -422,14 +426,24 @@ SnapshotSolution solve_snapshot(const std::vector<SnapshotMeasurement>& meas, co
         candidates.emplace_back(x, y, z);
       }
   }
-  // Pass 1: every candidate without fault exclusion; keep distinct converged solutions that fit to < 1 km.
+  // Pass 1: candidates without fault exclusion, nearest the Doppler fix first; keep distinct converged solutions
+  // that fit to < 1 km. Once one passes both residual tests with 2+ degrees of freedom, the search goes on only
+  // to kStopMargin_m beyond the candidate that found it (other solutions that fit come from a-priori positions
+  // near it: a wrong millisecond set is hundreds of km away, and the Doppler residuals reject it there).
+  constexpr double kStopMargin_m = 3.0e5;
   SnapshotOptions quick = opt;
   quick.max_exclusions = 0;
   std::vector<SnapshotSolution> found;
   int tried = 0;
-  for (const Eigen::Vector3d& c : candidates) {
+  double stop_beyond_m = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    const Eigen::Vector3d& c = candidates[k];
+    if (k < distances.size() && distances[k] > stop_beyond_m) break;
     ++tried;
     SnapshotSolution s = solve_snapshot_from(meas, t0, c, quick);
+    const bool strong = s.valid && s.used >= 7 && s.test_statistic <= s.test_threshold &&
+                        s.doppler_statistic <= chi_square_upper_quantile(s.used - 4, opt.false_alarm_probability);
+    if (strong && k < distances.size()) stop_beyond_m = std::min(stop_beyond_m, distances[k] + kStopMargin_m);
     if (s.used < 5 || !(s.residual_rms_m < 1000.0) || std::fabs(s.height_m) > opt.max_height_m) continue;
     if (std::fabs(s.time_correction_s) > 3.0 * opt.time_sigma_s) continue;
     const bool known = std::any_of(found.begin(), found.end(),

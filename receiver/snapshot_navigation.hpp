@@ -18,7 +18,8 @@
 //     one degree of freedom). The quality flag says whether the fix passed with redundancy.
 // Without an a-priori position: a Doppler-only fix (position and clock drift from the Doppler of a static
 // receiver, good to tens or hundreds of km) seeds a grid of a-priori positions (100 km apart, outwards to
-// grid_radius_m); each runs steps 1-3 and the passing solutions are ranked by their pseudorange cost plus
+// grid_radius_m, nearest first, ending 300 km past the first that passes both residual tests with 2+ degrees of
+// freedom); each runs steps 1-3 and the passing solutions are ranked by their pseudorange cost plus
 // the cost of their Doppler residuals after a velocity + drift solve (a wrong position leaves Doppler
 // residuals of ~1.4e-4 m/s per metre). Units: metres, seconds, Hz; ECEF WGS-84.
 #pragma once
