@@ -11,11 +11,11 @@
 # and the fixes within their own 95 % error bound (snapshot.json error_bound_3d_95_m).
 #
 #   benchmarks/snapshot_mc.sh [--cases 7] [--seed0 1] [--time-error 10] [--out DIR] [--ultratrack build/tools/ultratrack]
-#       [--nav FILE] [--keep] [--snapshot-args "..."]   (more options for every `snapshot`)
+#       [--nav FILE] [--keep] [--snapshot-args "..."] [--cn0 "45 35"]   (more options for every `snapshot`; levels)
 # Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3. CPU: a few seconds per case.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
-cases=7 seed0=1 time_error=10 out="" keep=0 snapshot_args=""
+cases=7 seed0=1 time_error=10 out="" keep=0 snapshot_args="" levels="45 35"
 ut="$here/../build/tools/ultratrack"
 nav="$here/../../shared/data/brdc0010.22n"
 while [[ $# -gt 0 ]]; do
@@ -28,6 +28,7 @@ while [[ $# -gt 0 ]]; do
     --nav) nav="$2"; shift 2 ;;
     --keep) keep=1; shift ;;
     --snapshot-args) snapshot_args="$2"; shift 2 ;;
+    --cn0) levels="$2"; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -37,11 +38,12 @@ done
 mkdir -p "$out"
 nav="$(cd "$(dirname "$nav")" && pwd)/$(basename "$nav")"
 
-python3 - "$ut" "$nav" "$out" "$cases" "$seed0" "$time_error" "$keep" "$snapshot_args" <<'EOF'
+python3 - "$ut" "$nav" "$out" "$cases" "$seed0" "$time_error" "$keep" "$snapshot_args" "$levels" <<'EOF'
 import json, math, os, random, shutil, statistics, subprocess, sys
 
 ut, nav, out, cases, seed0, time_error, keep = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]), float(sys.argv[6]), sys.argv[7] == "1"
 extra = sys.argv[8].split()
+levels = [float(x) for x in sys.argv[9].split()]
 
 def ecef(lat, lon, h):
     a, f = 6378137.0, 1 / 298.257223563
@@ -53,7 +55,7 @@ def ecef(lat, lon, h):
 formats = [("i8", 2.6e6, 0.0), ("r2", 20e6, 4.092e6), ("i16", 4e6, 0.0)]
 rows = []
 index = 0
-for cn0 in (45.0, 35.0):
+for cn0 in levels:
     for motion in ("static", "250mps"):
         for ms in (20, 100):
             for k in range(cases):
@@ -141,7 +143,7 @@ def pct(values, p):
 print()
 print(f"{'C/N0':>5} {'motion':>7} {'ms':>4} {'cases':>5} {'<=10 m':>7} {'rate':>6} {'flagged':>7} {'wrong unflagged':>15} {'median m':>9} {'p95 m':>9} {'in bound':>8}")
 total = good = 0
-for cn0 in (45.0, 35.0):
+for cn0 in levels:
     for motion in ("static", "250mps"):
         for ms in (20, 100):
             sel = [r for r in rows if r["cn0"] == cn0 and r["motion"] == motion and r["ms"] == ms]

@@ -107,8 +107,13 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
   const auto used = samples.first(blocks * block);
   const double d = options.spacing_chips;
   std::vector<SnapshotDetection> out;
+  double strongest_dbhz = -1e9;
+  for (const AcquisitionResult& r : found)
+    if (r.detected) strongest_dbhz = std::max(strongest_dbhz, r.cn0_dbhz);
   for (const AcquisitionResult& r : found) {
-    if (!r.detected || r.metric < options.min_metric_ratio * r.threshold) continue;
+    const bool strong = r.metric >= options.min_metric_ratio * r.threshold;
+    const bool near_strongest = r.cn0_dbhz >= strongest_dbhz - options.cross_correlation_margin_db;
+    if (!r.detected || (!strong && !near_strongest)) continue;
     const signals::CaCodeChips& code = signals::ca_code(r.prn);
     const double chips_per_sample = signals::kCaChipRate_hz * (1.0 + r.doppler_hz / signals::kL1Frequency_hz) /
                                     options.fs_hz;

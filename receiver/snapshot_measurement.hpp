@@ -29,10 +29,13 @@ struct SnapshotSearchOptions {
   double pfa = 1e-3;               // per PRN search
   int coherent_ms = 0;             // 0: 10 ms, or 5 ms for snapshots shorter than 40 ms
   double spacing_chips = 0.5;      // early-late spacing d of the fine code loop, (0, 1.5]
-  // A detection is kept only when its metric is at least this times the threshold: a snapshot fix depends on
-  // every measurement, and on real recordings detections just over the threshold are mostly spurs and
-  // cross-correlations (pocketsdr_L1_12MHz: 17 of them at 1.0-1.7 x). 2 costs ~3 dB of sensitivity.
+  // A detection is kept when its metric is at least min_metric_ratio times the threshold, or its C/N0 within
+  // cross_correlation_margin_db of the strongest detection's: a snapshot fix depends on every measurement, and on
+  // real recordings detections just over the threshold and far below the strongest are mostly spurs and
+  // cross-correlations (pocketsdr_L1_12MHz: 17 of them at 1.0-1.7 x, 16-20 dB below the strongest; Gold-code
+  // cross-correlations are 21-24 dB down).
   double min_metric_ratio = 2.0;
+  double cross_correlation_margin_db = 10.0;
 
   bool IsValid(std::string* error) const;
 };

@@ -153,12 +153,8 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotArgs& 
 void run_snapshot(const SnapshotArgs& args) {
   const auto started = std::chrono::steady_clock::now();
   const auto format = parse_format(args.format);
-  receiver::SampleSourceOptions source_options;
-  source_options.two_bit = parse_two_bit_layout(args.format);
-  source_options.fs_hz = parse_double_option("--fs", args.fs);
-  source_options.if_hz = parse_double_option("--if", args.if_hz);
-  source_options.iq_swap = args.iq_swap;
-  source_options.q_negate = args.q_negate;
+  receiver::SampleSourceOptions source_options =
+      parse_sample_source_options(args.format, args.fs, args.if_hz, args.iq_swap, args.q_negate);
   const double skip_s = parse_double_option("--skip", args.skip);
   if (!(skip_s >= 0.0)) throw signals::InputError("command line", "--skip must be >= 0");
   source_options.start_sample = std::llround(skip_s * source_options.fs_hz);
