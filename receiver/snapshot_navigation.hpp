@@ -53,7 +53,7 @@ struct SnapshotOptions {
   double time_sigma_s = 10.0;            // a-priori time uncertainty; |time correction| > 3 sigma is a failure
   double false_alarm_probability = 1e-3; // of the residual test
   int max_exclusions = 2;
-  double grid_radius_m = 2.5e6;          // a-priori grid around the Doppler fix (no approximate position)
+  double grid_radius_m = 5.0e6;          // a-priori grid around the Doppler fix (no approximate position)
   double grid_step_m = 1.0e5;
   double max_height_m = 1.0e5;           // |height| beyond this is not a receiver on or above the earth
   int max_iterations = 20;
