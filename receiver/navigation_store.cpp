@@ -18,12 +18,12 @@ bool same_set(const signals::Ephemeris& a, const signals::Ephemeris& b) {
 void NavigationStore::add_supplied(const std::vector<signals::Ephemeris>& ephemerides,
                                    const signals::KlobucharParameters& iono, const signals::UtcParameters& utc) {
   ephemerides_.insert(ephemerides_.end(), ephemerides.begin(), ephemerides.end());
-  if (iono.valid) iono_ = iono;
+  ionosphere_.set(iono, IonosphereSource::kNavigationFile, std::nullopt);
   if (utc.valid) utc_ = utc;
   supplied_navigation_ = std::make_shared<const SuppliedNavigation>(SuppliedNavigation{ephemerides_, iono, utc});
 }
 
-void NavigationStore::collect(NavigationDataChannel& nav, SatelliteStats& stats) {
+void NavigationStore::collect(NavigationDataChannel& nav, SatelliteStats& stats, std::int64_t sample) {
   if (nav.synchronised()) stats.frame_synced = true;
   const auto& decoder = nav.decoder();
   // Almanacs of every PRN, from any channel (a page every 30 s); the latest reference time wins.
@@ -33,7 +33,7 @@ void NavigationStore::collect(NavigationDataChannel& nav, SatelliteStats& stats)
     if (a && (!mine || mine->week != a->week || mine->toa_s != a->toa_s)) mine = a;
   }
   if (!nav.take_new_ephemeris()) return;
-  if (decoder.klobuchar().valid) iono_ = decoder.klobuchar();
+  ionosphere_.set(decoder.klobuchar(), IonosphereSource::kBroadcast, sample);
   if (decoder.utc().valid) utc_ = decoder.utc();
   if (!decoder.ephemeris()) return;
   const signals::Ephemeris& eph = *decoder.ephemeris();

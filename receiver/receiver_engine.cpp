@@ -138,7 +138,8 @@ void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples,
       observer_.on_tracking(r);
     }
     ReceiverChannel& channel = *channels_[slot];
-    navigation_.collect(channel.navigation(), stats_.satellites[static_cast<std::size_t>(channel.prn())]);
+    navigation_.collect(channel.navigation(), stats_.satellites[static_cast<std::size_t>(channel.prn())],
+                        view_.first_sample + view_.num_samples);
   }
 }
 

@@ -86,7 +86,10 @@ class ReceiverEngine {
   float i16_gain() const { return i16_gain_; }
   // Ephemerides decoded from the signal (each new set once), and the broadcast Klobuchar/UTC parameters.
   const std::vector<signals::Ephemeris>& decoded_ephemerides() const { return navigation_.decoded(); }
+  // The Klobuchar parameters in use: a default set until the nav file's or the broadcast ones are known
+  // (receiver/ionosphere_model.hpp); ionosphere() also tells which, since when, and the known ones alone.
   const signals::KlobucharParameters& klobuchar() const { return navigation_.klobuchar(); }
+  const IonosphereModel& ionosphere() const { return navigation_.ionosphere(); }
   const signals::UtcParameters& utc() const { return navigation_.utc(); }
   // The latest almanac decoded from any channel, per PRN (index = PRN).
   const std::array<std::optional<signals::Almanac>, 33>& almanacs() const { return navigation_.almanacs(); }

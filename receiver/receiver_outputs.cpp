@@ -59,10 +59,12 @@ void ReceiverOutputs::on_fix(const PvtSolution& fix, const ObservationEpoch&) {
 
 void ReceiverOutputs::finish(const ReceiverEngine& engine, const RunDescription& run) {
   if (!nmea_) nmea_.emplace(dir_ / "solution.nmea", 18);  // no fix: an empty NMEA file
+  obs_.set_comments(ionosphere_comment_lines(engine.ionosphere(), engine.stats().first_sample, fs_hz_,
+                                              engine.options().pvt.ionosphere));
   obs_.finish(fixes_ > 0 ? Eigen::Vector3d(sum_r_e_m_ / fixes_) : Eigen::Vector3d::Zero());
   signals::RinexNavData nav;
   nav.ephemerides = engine.decoded_ephemerides();
-  nav.klobuchar = engine.klobuchar();
+  nav.klobuchar = engine.ionosphere().known();
   nav.utc = engine.utc();
   nav.has_leap_seconds = engine.utc().valid;
   write_rinex_nav_304(dir_ / "navigation.rnx", nav);

@@ -65,6 +65,13 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
     fmt::print(out, "  \"mean_llh\": null,\n  \"mean_ecef_m\": null,\n");
   }
   fmt::print(out, "  \"ephemerides_decoded\": {},\n", engine.decoded_ephemerides().size());
+  fmt::print(out, "  \"ionosphere\": {{\"applied\": {}, \"models\": [", engine.options().pvt.ionosphere);
+  const auto& iono = engine.ionosphere().history();
+  for (std::size_t i = 0; i < iono.size(); ++i)
+    fmt::print(out, "{}{{\"model\": \"{} Klobuchar\", \"from_s\": {:.3f}}}", i ? ", " : "",
+               ionosphere_source_name(iono[i].source),
+               ionosphere_change_seconds(iono[i], s.first_sample, engine.options().fs_hz));
+  fmt::print(out, "]}},\n");
   fmt::print(out, "  \"per_satellite\": [");
   bool first = true;
   for (int prn = 1; prn <= 32; ++prn) {

@@ -56,6 +56,7 @@ void RinexObsWriter::finish(const Eigen::Vector3d& approx_r_e_m) {
   out << header_line(fmt::format("{:>9}{:11}{:<20}{:<20}", "3.04", "", "OBSERVATION DATA", "G (GPS)"),
                      "RINEX VERSION / TYPE");
   out << header_line(fmt::format("{:<20}{:<20}{:<20}", "ultratrack", "", ""), "PGM / RUN BY / DATE");
+  for (const std::string& c : comments_) out << header_line(c, "COMMENT");
   out << header_line(info_.marker_name, "MARKER NAME");
   out << header_line("NON_GEODETIC", "MARKER TYPE");
   out << header_line(fmt::format("{:<20}{:<40}", "", ""), "OBSERVER / AGENCY");

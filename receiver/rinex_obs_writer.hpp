@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "receiver/observables.hpp"
 #include "io/atomic_file.hpp"
@@ -24,6 +26,8 @@ class RinexObsWriter {
  public:
   RinexObsWriter(const std::filesystem::path& path, RinexObsHeaderInfo info);
   void write(const ObservationEpoch& epoch);
+  // COMMENT lines of the header (each cut to 60 characters), e.g. which ionosphere model was used from when.
+  void set_comments(std::vector<std::string> lines) { comments_ = std::move(lines); }
   // approx_r_e_m: the mean fix, written into APPROX POSITION XYZ (zeros when unknown).
   void finish(const Eigen::Vector3d& approx_r_e_m);
   int epochs_written() const { return epochs_; }
@@ -34,6 +38,7 @@ class RinexObsWriter {
   io::AtomicFile body_;
   std::optional<signals::GpsTime> first_epoch_;
   int epochs_ = 0;
+  std::vector<std::string> comments_;
 };
 
 }  // namespace ultratrack::receiver

@@ -33,12 +33,8 @@ struct AcquireArgs {
 
 void run_acquire(const AcquireArgs& args) {
   const auto format = parse_format(args.format);
-  receiver::SampleSourceOptions source_options;
-  source_options.two_bit = parse_two_bit_layout(args.format);
-  source_options.fs_hz = parse_double_option("--fs", args.fs);
-  source_options.if_hz = parse_double_option("--if", args.if_hz);
-  source_options.iq_swap = args.iq_swap;
-  source_options.q_negate = args.q_negate;
+  receiver::SampleSourceOptions source_options =
+      parse_sample_source_options(args.format, args.fs, args.if_hz, args.iq_swap, args.q_negate);
 
   receiver::AcquisitionOptions options;
   options.fs_hz = source_options.fs_hz;

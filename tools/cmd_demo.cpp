@@ -123,9 +123,9 @@ void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario,
   const Eigen::Vector3d mean = stats.sum_r_e_m / stats.fixes;
   fmt::print("  first fix after {:.2f} s of signal; mean fix {:.2f} m from the true position (3-D)\n",
              receiver::ttff_seconds(engine), (mean - truth).norm());
-  if (scenario.ionosphere && !engine.klobuchar().valid)
-    fmt::print("  (the simulated ionosphere stays uncorrected: its Klobuchar parameters are broadcast only every\n"
-               "   12.5 min, in subframe 4 page 18; give them with `receive --nav` to correct it)\n");
+  if (scenario.ionosphere && !engine.ionosphere().known().valid)
+    fmt::print("  (the simulated ionosphere is corrected with a default Klobuchar set: the broadcast parameters come\n"
+               "   only every 12.5 min, in subframe 4 page 18; give them with `receive --nav`)\n");
 }
 
 void run_demo(const DemoArgs& args) {

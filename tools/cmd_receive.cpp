@@ -171,7 +171,7 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--nav", args->nav, "RINEX navigation file: ephemerides known from the start (hot start)");
   cmd->add_option("--elevation-mask-deg", args->elevation_mask, "PVT elevation mask, degrees (default 10)");
   cmd->add_option("--troposphere", args->troposphere, "on|off (default on)");
-  cmd->add_option("--ionosphere", args->ionosphere, "broadcast|off (default broadcast)");
+  cmd->add_option("--ionosphere", args->ionosphere, "broadcast|off (default broadcast: a default Klobuchar set until the nav file's or the broadcast one is known)");
   cmd->add_option("--channels", args->channels, "tracking channels (default 12)");
   cmd->add_option("--threads", args->threads, "worker threads including the main one (default: all cores)");
   cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15 (default all)");

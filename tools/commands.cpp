@@ -8,6 +8,7 @@ void add_all_commands(CLI::App& app) {
   add_demo_command(app);
   add_acquire_command(app);
   add_receive_command(app);
+  add_snapshot_command(app);
   add_ins_command(app);
   add_imusim_command(app);
   add_fuse_command(app);

@@ -1,5 +1,7 @@
 #include "format_options.hpp"
 
+#include "cli_parse.hpp"
+
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {
@@ -46,6 +48,17 @@ signals::TwoBitLayout parse_two_bit_layout(const FormatArgs& args) {
   layout.coding = *coding;
   layout.order = *order;
   return layout;
+}
+
+receiver::SampleSourceOptions parse_sample_source_options(const FormatArgs& format, const std::string& fs,
+                                                          const std::string& if_hz, bool iq_swap, bool q_negate) {
+  receiver::SampleSourceOptions o;
+  o.two_bit = parse_two_bit_layout(format);
+  o.fs_hz = parse_double_option("--fs", fs);
+  o.if_hz = parse_double_option("--if", if_hz);
+  o.iq_swap = iq_swap;
+  o.q_negate = q_negate;
+  return o;
 }
 
 }  // namespace ultratrack::tools

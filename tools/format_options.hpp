@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
+#include "receiver/sample_source.hpp"
 #include "signals/sample_format.hpp"
 
 namespace ultratrack::tools {
@@ -18,5 +19,9 @@ void add_format_options(CLI::App* cmd, FormatArgs& args);
 // Parsed values; an unknown name is an InputError("command line", ...) that lists the known ones.
 signals::SampleFormat parse_format(const FormatArgs& args);
 signals::TwoBitLayout parse_two_bit_layout(const FormatArgs& args);
+// The sample source options of a command's --fs, --if (text, parsed as InputErrors), --iq-swap, --q-negate and
+// the 2-bit layout; start_sample and int16_gain stay at their defaults.
+receiver::SampleSourceOptions parse_sample_source_options(const FormatArgs& format, const std::string& fs,
+                                                          const std::string& if_hz, bool iq_swap, bool q_negate);
 
 }  // namespace ultratrack::tools
