@@ -66,7 +66,7 @@ template <class Filter>
 void update(Filter& filter, const CovarianceAnalysisOptions& o, const NominalState& nominal,
             const std::vector<SatelliteObservable>& sats, const Eigen::Vector3d& w_ib_b) {
   const Eigen::Vector3d lever = Eigen::Vector3d::Zero();
-  if (o.coupling == CovarianceCoupling::Tight) {
+  if (o.coupling == Coupling::kTight) {
     filter.update(EpochMeasurement17(nominal, sats, lever, w_ib_b, o.use_range_rate));
     return;
   }
@@ -156,7 +156,7 @@ CovarianceAnalysisOptions seed001_covariance_options(const std::string& trajecto
 
 CovarianceAnalysisOptions seed001_ultratight_options(const std::string& trajectory, FilterKind filter, IqForm form) {
   CovarianceAnalysisOptions o = seed001_covariance_options(trajectory, filter);
-  o.coupling = CovarianceCoupling::UltraTight;
+  o.coupling = Coupling::kUltraTight;
   o.iq_form = form;
   o.update_interval_s = o.iq.integration_time_s;
   o.propagation_interval_s = o.iq.integration_time_s;
@@ -171,6 +171,8 @@ CovarianceSample CovarianceAnalysisResult::at(double t_s) const {
 }
 
 CovarianceAnalysisResult run_covariance_analysis(const CovarianceAnalysisOptions& o) {
+  if (o.coupling != Coupling::kTight && o.coupling != Coupling::kUltraTight)
+    throw io::InputError("covariance analysis", "the coupling must be tight or ultra-tight");
   if (!(o.duration_s > 0.0) || !(o.propagation_interval_s > 0.0) || !(o.update_interval_s > 0.0))
     throw io::InputError("covariance analysis", "durations and intervals must be positive");
   if (!(o.sigma_range_m > 0.0) || !(o.sigma_rate_mps > 0.0))

@@ -12,6 +12,8 @@
 // Units SI; NED; times in seconds from the trajectory start.
 #pragma once
 
+#include "fusion/coupling.hpp"
+
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -25,14 +27,13 @@
 
 namespace ultratrack::fusion {
 
-enum class CovarianceCoupling { Tight, UltraTight };  // (gnss_ins_integration.hpp has the run-time Coupling)
 enum class IqForm {
   Iq,             // the correlator taps themselves (seed 001 eqs. 11-17)
   Discriminator,  // pre-filtered: code / frequency discriminators as range / range-rate errors
 };
 
 struct CovarianceAnalysisOptions {
-  CovarianceCoupling coupling = CovarianceCoupling::Tight;
+  Coupling coupling = Coupling::kTight;  // kTight or kUltraTight
   std::string trajectory = "straight";  // ins::profile_spec names: straight, circle, s, spiral (also land)
   FilterKind filter = FilterKind::Ekf;
   double duration_s = 150.0;

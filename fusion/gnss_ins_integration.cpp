@@ -47,6 +47,8 @@ bool finite(const Pending& p) {
 }
 
 void check_options(const IntegrationOptions& o) {
+  if (o.coupling != Coupling::kLoose && o.coupling != Coupling::kTight)
+    throw std::invalid_argument("integration: the coupling must be loose or tight");
   auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
   if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
     throw std::invalid_argument("integration: initial sigmas must be positive");
@@ -352,7 +354,7 @@ GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const Integ
     : impl_(std::make_unique<Impl>()) {
   check_options(options);
   impl_->options = options;
-  if (options.coupling == Coupling::Loose)
+  if (options.coupling == Coupling::kLoose)
     impl_->core = make_core<15>(initial, options);
   else if (options.height_aiding.enabled)
     impl_->core = make_core<18>(initial, options);
@@ -365,14 +367,14 @@ GnssInsIntegration::GnssInsIntegration(GnssInsIntegration&&) noexcept = default;
 GnssInsIntegration& GnssInsIntegration::operator=(GnssInsIntegration&&) noexcept = default;
 
 void GnssInsIntegration::add_fix(const GnssFix& fix) {
-  if (impl_->options.coupling != Coupling::Loose) throw std::logic_error("add_fix: integration is tightly coupled");
+  if (impl_->options.coupling != Coupling::kLoose) throw std::logic_error("add_fix: integration is tightly coupled");
   impl_->core->add_pending(fix.t_s, PendingFix{fix});
 }
 
 void GnssInsIntegration::add_observations(const receiver::ObservationEpoch& epoch,
                                           const std::vector<signals::Ephemeris>& ephemerides,
                                           const signals::KlobucharParameters& iono) {
-  if (impl_->options.coupling != Coupling::Tight)
+  if (impl_->options.coupling != Coupling::kTight)
     throw std::logic_error("add_observations: integration is loosely coupled");
   const double t_s = signals::seconds_between(epoch.receive_time, impl_->options.gps_time_origin) -
                      impl_->core->nominal().clock_bias_m / signals::kSpeedOfLight_mps;

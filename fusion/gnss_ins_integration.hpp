@@ -22,6 +22,7 @@
 #include "fusion/ekf.hpp"
 #include "fusion/height_aiding.hpp"
 #include "fusion/ins_error_model.hpp"
+#include "fusion/coupling.hpp"
 #include "fusion/ins_error_state.hpp"
 #include "fusion/loose_measurements.hpp"
 #include "fusion/tight_measurements.hpp"
@@ -34,11 +35,10 @@
 
 namespace ultratrack::fusion {
 
-enum class Coupling { Loose, Tight };
 enum class FilterKind { Ekf, Ukf };
 
 struct IntegrationOptions {
-  Coupling coupling = Coupling::Loose;
+  Coupling coupling = Coupling::kLoose;  // kLoose or kTight
   FilterKind filter = FilterKind::Ekf;
   InsErrorModelOptions model;                    // error_model_from_preset(...) is a good start
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // IMU -> antenna, body axes [m]

@@ -1,27 +1,15 @@
-// How a receive run closes its tracking loops: the one coupling enum of the tree.
-//   kScalar      every channel its own DLL/PLL (receiver/scalar_tracking.hpp)
-//   kVector      one vector filter closes the channels' code loops (pipelines/vector_loop_driver.hpp)
-//   kLoose       GNSS/INS integration on the PVT fixes (pipelines/gnss_ins_coupler.hpp)
-//   kTight       GNSS/INS integration on pseudoranges and rates (pipelines/gnss_ins_coupler.hpp)
-//   kUltraTight  tight pull-in, then the INS-predicted replica drives the channels (pipelines/ultratight_loop.hpp)
-// Text names: "scalar" (also "none"), "vector", "loose", "tight", "ultra-tight".
+// The coupling of a receive run: fusion::Coupling (fusion/coupling.hpp, the one coupling enum of the tree), named
+// here as the pipelines use it.
 #pragma once
 
-#include <optional>
-#include <string>
-#include <string_view>
+#include "fusion/coupling.hpp"
 
 namespace ultratrack::pipelines {
 
-enum class Coupling { kScalar, kVector, kLoose, kTight, kUltraTight };
-
-// Nothing for an unknown name.
-std::optional<Coupling> coupling_from_string(std::string_view text);
-std::string to_string(Coupling coupling);
-
-// Couplings that run an INS (need an IMU file): loose, tight, ultra-tight.
-constexpr bool uses_imu(Coupling c) { return c == Coupling::kLoose || c == Coupling::kTight || c == Coupling::kUltraTight; }
-// Couplings whose GNSS/INS filter takes raw observations (ultra-tight pulls in with the tight filter).
-constexpr bool is_tight(Coupling c) { return c == Coupling::kTight || c == Coupling::kUltraTight; }
+using fusion::Coupling;
+using fusion::coupling_from_string;
+using fusion::is_tight;
+using fusion::to_string;
+using fusion::uses_imu;
 
 }  // namespace ultratrack::pipelines

@@ -227,7 +227,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   result.initial_attitude = ins::euler_from_quaternion(init.q_nb);
   result.start_s = init.t_s;
 
-  fusion::IntegrationOptions o = integration_options(n, c, fusion::Coupling::Loose, s.filter);
+  fusion::IntegrationOptions o = integration_options(n, c, fusion::Coupling::kLoose, s.filter);
   o.attitude = attitude_options;
   fusion::GnssInsIntegration integration(init, o);
 

@@ -241,7 +241,7 @@ struct GnssInsCoupler::Impl {
         initialise_navigation(start, pos_fix ? &position : nullptr, c, Eigen::Vector3d::Constant(10.0));
     const ins::NavState& init = n.nav;
     fusion::IntegrationOptions o =
-        integration_options(n, c, is_tight() ? fusion::Coupling::Tight : fusion::Coupling::Loose, settings.filter);
+        integration_options(n, c, is_tight() ? fusion::Coupling::kTight : fusion::Coupling::kLoose, settings.filter);
     if (is_tight()) {
       // Clock from this epoch at the INS antenna position and velocity there (the INS alone from the start to
       // the epoch), carried back to the start.

@@ -391,7 +391,7 @@ TEST(AttitudeAiding, TightCouplingTakesAttitudeToo) {
   const ins::TrajectorySpec spec = ins::profile_spec("static", 20.0, 0.6, 2.1, 50.0);
   const ins::SimulatedRun run = ins::simulate(spec, 100.0);
   IntegrationOptions opt;
-  opt.coupling = Coupling::Tight;
+  opt.coupling = Coupling::kTight;
   opt.sigma_att_rad = Eigen::Vector3d(0.01, 0.01, 0.05);
   ins::NavState init = run.truth[0].nav();
   ins::correct_attitude(init, Eigen::Vector3d(0.0, 0.0, 2.0 * kDeg));

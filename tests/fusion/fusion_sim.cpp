@@ -116,7 +116,7 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
 }
 
 RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion::FilterKind filter) {
-  const bool tight = coupling == fusion::Coupling::Tight;
+  const bool tight = coupling == fusion::Coupling::kTight;
   const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s, 37.0 * kDeg, 127.0 * kDeg, 100.0);
   const ins::SimulatedRun run = ins::simulate(spec, cfg.imu_rate_hz);
   const ins::TruthInterpolator interp(run.truth);

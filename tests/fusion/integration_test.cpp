@@ -29,7 +29,7 @@ int mc_runs() {
 
 
 const char* name(Coupling c, FilterKind f) {
-  if (c == Coupling::Loose) return f == FilterKind::Ekf ? "loose EKF" : "loose UKF";
+  if (c == Coupling::kLoose) return f == FilterKind::Ekf ? "loose EKF" : "loose UKF";
   return f == FilterKind::Ekf ? "tight EKF" : "tight UKF";
 }
 
@@ -63,10 +63,10 @@ void check_accuracy_and_consistency(Coupling coupling, FilterKind filter) {
   EXPECT_LT(nees, 2.0 * n_state);
 }
 
-TEST(LooseIntegration, EkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::Loose, FilterKind::Ekf); }
-TEST(LooseIntegration, UkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::Loose, FilterKind::Ukf); }
-TEST(TightIntegration, EkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::Tight, FilterKind::Ekf); }
-TEST(TightIntegration, UkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::Tight, FilterKind::Ukf); }
+TEST(LooseIntegration, EkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::kLoose, FilterKind::Ekf); }
+TEST(LooseIntegration, UkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::kLoose, FilterKind::Ukf); }
+TEST(TightIntegration, EkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::kTight, FilterKind::Ekf); }
+TEST(TightIntegration, UkfBeatsGnssAndIsConsistent) { check_accuracy_and_consistency(Coupling::kTight, FilterKind::Ukf); }
 
 // 60 s outage after 200 s of convergence: horizontal drift RMS over the Monte Carlo runs.
 double outage_drift_rms(const std::string& preset, FilterKind filter, int runs, double& sigma_rms) {
@@ -86,7 +86,7 @@ double outage_drift_rms(const std::string& preset, FilterKind filter, int runs, 
       cfg.sigma_pos_ned_m = Eigen::Vector3d(0.05, 0.05, 0.1);
       cfg.sigma_vel_n_mps = Eigen::Vector3d(0.01, 0.01, 0.02);
     }
-    const RunResult res = test::run_simulation(cfg, Coupling::Loose, filter);
+    const RunResult res = test::run_simulation(cfg, Coupling::kLoose, filter);
     s2 += res.outage_drift_h_m * res.outage_drift_h_m;
     q2 += res.outage_sigma_h_m * res.outage_sigma_h_m;
   }
@@ -122,12 +122,12 @@ TEST(TightIntegration, BoundedWithThreeSatellites) {
     cfg.duration_s = 301.0;
     cfg.max_satellites = 3;
     cfg.reduce_after_s = 120.0;
-    const RunResult with3 = test::run_simulation(cfg, Coupling::Tight, f);
+    const RunResult with3 = test::run_simulation(cfg, Coupling::kTight, f);
     SimConfig free = cfg;  // the same run with no GNSS at all from 120 s: the free INS
     free.max_satellites = 0;
     free.outage_start_s = 119.9;
     free.outage_length_s = 180.0;
-    const RunResult none = test::run_simulation(free, Coupling::Tight, f);
+    const RunResult none = test::run_simulation(free, Coupling::kTight, f);
     double max_after = 0.0;
     for (std::size_t i = 0; i < with3.t_s.size(); ++i)
       if (with3.t_s[i] > 120.0) max_after = std::max(max_after, with3.pos_err_m[i].head<2>().norm());
@@ -193,7 +193,7 @@ TEST(LooseIntegration, FallsBackToWhatIsPresent) {
   cfg.seed = 9;
   cfg.duration_s = 150.0;
   cfg.velocity = false;  // position only
-  const RunResult pos_only = test::run_simulation(cfg, Coupling::Loose, FilterKind::Ekf);
+  const RunResult pos_only = test::run_simulation(cfg, Coupling::kLoose, FilterKind::Ekf);
   EXPECT_LT(test::rms3(pos_only.pos_err_m, 60), test::rms(pos_only.gnss_err_3d_m, 60));
   EXPECT_GT(pos_only.accepted, 140);
   // Velocity-only fixes through the public API: position error cannot be observed, but velocity is.

@@ -123,7 +123,7 @@ std::vector<int> best_triple(std::uint64_t seed) {
   SimConfig cfg = three_satellites(seed, "tcxo", false);
   cfg.max_satellites = 0;
   cfg.duration_s = kReduce_s + 2.0;
-  const RunResult r = test::run_simulation(cfg, Coupling::Tight, FilterKind::Ekf);
+  const RunResult r = test::run_simulation(cfg, Coupling::kTight, FilterKind::Ekf);
   std::size_t k = 0;
   while (k + 1 < r.t_s.size() && r.t_s[k] < kReduce_s) ++k;
   const auto& los = r.los_ned[k];
@@ -169,7 +169,7 @@ void print_geometry(const char* what, const RunResult& r) {
 TEST(ThreeSatellites, ClosedFormGeometryOfTheHighestAndTheBestTriple) {
   SimConfig high_cfg = three_satellites(77, "tcxo", true);
   high_cfg.duration_s = 301.0;  // the same 3 satellites stay the highest until then
-  const RunResult high = test::run_simulation(high_cfg, Coupling::Tight, FilterKind::Ekf);
+  const RunResult high = test::run_simulation(high_cfg, Coupling::kTight, FilterKind::Ekf);
   print_geometry("highest 3", high);
   for (std::size_t i = 0; i < high.t_s.size(); ++i) {
     if (high.t_s[i] < kReduce_s + 1.0) continue;
@@ -179,7 +179,7 @@ TEST(ThreeSatellites, ClosedFormGeometryOfTheHighestAndTheBestTriple) {
   }
   const std::vector<int> best = best_triple(77);
   ASSERT_EQ(best.size(), 3u);
-  const RunResult good = test::run_simulation(three_satellites(77, "tcxo", true, best), Coupling::Tight, FilterKind::Ekf);
+  const RunResult good = test::run_simulation(three_satellites(77, "tcxo", true, best), Coupling::kTight, FilterKind::Ekf);
   print_geometry("best 3", good);
   for (std::size_t i = 0; i < good.t_s.size(); ++i) {
     if (good.t_s[i] < kReduce_s + 1.0) continue;
@@ -199,7 +199,7 @@ TEST(ThreeSatellites, TightWithTerrainHeightStaysBoundedLooseCannotFix) {
   };
   for (const Case c : {Case{"tcxo", FilterKind::Ekf}, Case{"ocxo", FilterKind::Ekf}, Case{"tcxo", FilterKind::Ukf}}) {
     const SimConfig cfg = three_satellites(77, c.oscillator, true, best);
-    const RunResult r = test::run_simulation(cfg, Coupling::Tight, c.filter);
+    const RunResult r = test::run_simulation(cfg, Coupling::kTight, c.filter);
     const Stats s = stats(r, bound_height_sigma(cfg));
     std::printf("best 3, %s %s ", c.oscillator, c.filter == FilterKind::Ekf ? "EKF" : "UKF");
     print("aided", s, r);
@@ -222,7 +222,7 @@ TEST(ThreeSatellites, TightWithTerrainHeightStaysBoundedLooseCannotFix) {
 TEST(ThreeSatellites, WithoutAidingOrInAPoorGeometryTheOneSigmaGrows) {
   const std::vector<int> best = best_triple(77);
   for (const char* osc : {"tcxo", "ocxo"}) {
-    const RunResult r = test::run_simulation(three_satellites(77, osc, false, best), Coupling::Tight, FilterKind::Ekf);
+    const RunResult r = test::run_simulation(three_satellites(77, osc, false, best), Coupling::kTight, FilterKind::Ekf);
     const Stats s = stats(r, 0.0);
     std::printf("best 3, %s EKF ", osc);
     print("no aiding", s, r);
@@ -234,7 +234,7 @@ TEST(ThreeSatellites, WithoutAidingOrInAPoorGeometryTheOneSigmaGrows) {
   }
   SimConfig cfg = three_satellites(77, "tcxo", true);
   cfg.duration_s = 301.0;  // the same 3 satellites stay the highest until then
-  const RunResult r = test::run_simulation(cfg, Coupling::Tight, FilterKind::Ekf);
+  const RunResult r = test::run_simulation(cfg, Coupling::kTight, FilterKind::Ekf);
   const Stats s = stats(r, bound_height_sigma(cfg));
   print("highest 3, tcxo EKF aided", s, r);
   EXPECT_EQ(r.pvt_fixes_reduced, 0);

@@ -19,7 +19,7 @@ TEST(UltraTightCovariance, DiscriminatorFormWithPseudorangeNoiseEqualsTight) {
   auto tight = seed001_covariance_options("circle", FilterKind::Ekf);
   tight.duration_s = 20.0;
   auto ultra = tight;
-  ultra.coupling = CovarianceCoupling::UltraTight;
+  ultra.coupling = Coupling::kUltraTight;
   ultra.iq_form = IqForm::Discriminator;
   ultra.discriminator_sigma_range_m = 5.0;
   ultra.discriminator_use_rate = false;

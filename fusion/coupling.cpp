@@ -1,6 +1,6 @@
-#include "pipelines/coupling.hpp"
+#include "fusion/coupling.hpp"
 
-namespace ultratrack::pipelines {
+namespace ultratrack::fusion {
 
 std::optional<Coupling> coupling_from_string(std::string_view text) {
   if (text == "scalar" || text == "none") return Coupling::kScalar;
@@ -22,4 +22,4 @@ std::string to_string(Coupling coupling) {
   return "?";
 }
 
-}  // namespace ultratrack::pipelines
+}  // namespace ultratrack::fusion
