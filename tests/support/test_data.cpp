@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,13 @@ std::filesystem::path scenarios_dir() {
 
 namespace {
 
+// A number as hexadecimal digits (a folder name).
+std::string to_hex(std::size_t v) {
+  std::ostringstream out;
+  out << std::hex << v;
+  return out.str();
+}
+
 // Folders made for a whole test suite (SetUpTestSuite) are private to this process: ctest runs each test in its
 // own process, in parallel, and two processes of one suite must not share (and delete) each other's files.
 // They are removed when the process ends.
@@ -50,7 +58,11 @@ void remove_suite_dirs() {
 std::filesystem::path scratch_dir() {
   auto* unit = ::testing::UnitTest::GetInstance();
   const auto* info = unit->current_test_info();
-  const auto root = std::filesystem::temp_directory_path() / "ultratrack_tests";
+  // One root per checkout: two checkouts' suites running at once on one machine (CI beside a developer, two
+  // worktrees) must not share a test's folder; runs of one checkout still reuse (and first clear) theirs.
+  const std::string checkout = ULTRATRACK_SCENARIOS_DIR;
+  const auto root = std::filesystem::temp_directory_path() / "ultratrack_tests" /
+                    to_hex(std::hash<std::string>{}(checkout));
   std::filesystem::path dir;
   if (info) {
     dir = root / (std::string(info->test_suite_name()) + "." + info->name());
