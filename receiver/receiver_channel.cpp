@@ -61,8 +61,7 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   const bool fll =
       vector_.vector && vector_.carrier != CarrierControl::kAided && std::isfinite(vector_.carrier_frequency_hz);
   const bool phase_locked = fll && vector_.carrier == CarrierControl::kFrequencyAndPhase;
-  control.carrier_commanded = fll;
-  control.carrier_phase_locked = phase_locked;
+  control.carrier = fll ? vector_.carrier : CarrierControl::kAided;
   if (fll) {
     control.carrier_frequency_hz = vector_.carrier_frequency_hz;
     last_scalar_.carrier_frequency_hz = vector_.carrier_frequency_hz;

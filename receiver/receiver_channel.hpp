@@ -92,7 +92,7 @@ class ReceiverChannel {
           vector_ = {};
           previous_aid_hz_ = NAN;
           ScalarTrackingControl released = loop_.control();
-          released.carrier_commanded = false;
+          released.carrier = CarrierControl::kAided;
           loop_.apply(released);
         }
         channel_.command(merged_command());

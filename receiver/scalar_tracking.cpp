@@ -60,8 +60,9 @@ ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCo
 void ScalarTracking::apply(const ScalarTrackingControl& c) {
   allow_coasting(c.coasting_allowed);
   set_filter_driven(c.filter_driven);
-  set_carrier_commanded(c.carrier_commanded, c.carrier_phase_locked);
-  if (c.carrier_commanded) {
+  const bool commanded = c.carrier != CarrierControl::kAided;
+  set_carrier_commanded(commanded, c.carrier == CarrierControl::kFrequencyAndPhase);
+  if (commanded) {
     command_carrier(c.carrier_frequency_hz);
   } else if (c.aid == CarrierAid::kStart) {
     start_aiding();
@@ -74,8 +75,9 @@ ScalarTrackingControl ScalarTracking::control() const {
   ScalarTrackingControl c;
   c.coasting_allowed = coasting_allowed_;
   c.filter_driven = filter_driven_;
-  c.carrier_commanded = carrier_commanded_;
-  c.carrier_phase_locked = carrier_phase_locked_;
+  c.carrier = !carrier_commanded_      ? CarrierControl::kAided
+              : carrier_phase_locked_ ? CarrierControl::kFrequencyAndPhase
+                                      : CarrierControl::kFrequency;
   return c;
 }
 

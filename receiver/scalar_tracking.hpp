@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "receiver/carrier_control.hpp"
 #include "receiver/bit_sync.hpp"
 #include "receiver/correlation_epoch.hpp"
 #include "receiver/discriminators.hpp"
@@ -84,22 +85,20 @@ struct ScalarTrackingControl {
   // Filter-driven (ultra-tight): while set and bit-synced, lock is judged by the presence test alone and long
   // coherent sums use a pure PLL (see ScalarTrackingOptions::presence_window_s). Off: the scalar loss test.
   bool filter_driven = false;
-  // Vector FLL (VectorChannelCommand::carrier_commanded): while set and bit-synced or coasting, the carrier NCO's
-  // frequency is the external loop's (carrier_frequency_hz), the channel's carrier loop does not run, long
-  // coherent integration is off, bits are detected differentially (BitAssembler::set_differential: the
-  // replica's phase wanders by the frequency error's integral), the loss test is the C/N0 alone (the PLI reads
-  // the wandering phase; filter-driven, as the vector FLL's channels are: the presence test), and coasting ends
-  // as soon as the C/N0 is back or the presence test finds the signal (nothing to re-lock). Clearing it hands the
-  // carrier back to the PLL from the commanded frequency (its frequency-rate state cleared, the PLI restarted).
-  bool carrier_commanded = false;
-  // Vector PLL (with carrier_commanded; VectorChannelCommand::carrier_phase_locked): the external loop closes the
-  // phase too, so the bits are detected coherently (Costas sign, polarity from the preamble) rather than
-  // differentially; everything else as the FLL. Changing it alone switches the bit detection.
-  bool carrier_phase_locked = false;
-  // The commanded carrier frequency (Hz) for the next command, with carrier_commanded; ignored unless bit-synced
+  // kFrequency (vector FLL): while bit-synced or coasting, the carrier NCO's frequency is the external loop's
+  // (carrier_frequency_hz), the channel's carrier loop does not run, long coherent integration is off, bits are
+  // detected differentially (BitAssembler::set_differential: the replica's phase wanders by the frequency error's
+  // integral), the loss test is the C/N0 alone (the PLI reads the wandering phase; filter-driven, as the vector
+  // FLL's channels are: the presence test), and coasting ends as soon as the C/N0 is back or the presence test finds
+  // the signal (nothing to re-lock). Back to kAided hands the carrier to the PLL from the commanded frequency (its
+  // frequency-rate state cleared, the PLI restarted).
+  // kFrequencyAndPhase (vector PLL): the external loop closes the phase too, so the bits are detected coherently
+  // (Costas sign, polarity from the preamble) rather than differentially; everything else as kFrequency.
+  CarrierControl carrier = CarrierControl::kAided;
+  // The commanded carrier frequency (Hz) for the next command, with kFrequency or kFrequencyAndPhase; ignored unless bit-synced
   // or coasting, or when not finite.
   double carrier_frequency_hz = NAN;
-  // Carrier aiding (vector tracking, without carrier_commanded): only while bit-synced (kShift: or coasting);
+  // Carrier aiding (vector tracking, with kAided): only while bit-synced (kShift: or coasting);
   // ignored otherwise. aid_delta_hz (kShift) not finite: ignored.
   CarrierAid aid = CarrierAid::kNone;
   double aid_delta_hz = 0.0;

@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "receiver/carrier_control.hpp"
 #include "receiver/pvt.hpp"
 #include "signals/ephemeris.hpp"
 #include "signals/gps_time.hpp"
@@ -97,24 +98,6 @@ struct VectorEpochInput {
   // epoch start at or after command_sample, one channel epoch after next_epoch_sample, where the command of the
   // previous vector epoch takes effect first.
   std::int64_t command_sample = 0;
-};
-
-// Who closes a vector channel's carrier (VectorChannelCommand::carrier).
-enum class CarrierControl {
-  // The channel's Costas PLL; carrier_frequency_hz aids it (its change from one command to the next is added to the
-  // PLL, ScalarTracking::aid_frequency).
-  kAided,
-  // Vector FLL: carrier_frequency_hz (finite) is the carrier NCO's frequency from the next epoch start on, not an
-  // aid; the channel runs no carrier loop of its own (ScalarTracking::set_carrier_commanded): the loop closes the
-  // carrier through the channel's frequency discriminator (measured_doppler_hz), the channel's bits are detected
-  // differentially, its lock test is the C/N0 alone (the presence test when filter_driven too), and its carrier
-  // phase is reported with loss of lock (the NCO's accumulated Doppler, not a phase-locked observable).
-  kFrequency,
-  // Vector PLL: as kFrequency, and the loop also closes the carrier phase: carrier_phase_jump_cycles (positive
-  // advances the replica carrier) is applied once at next_epoch_sample, on top of carrier_frequency_hz; the channel
-  // detects its bits coherently (Costas: polarity from the preamble) and reports its carrier phase as locked (no
-  // RINEX loss-of-lock flag, except on the first epoch after unlocked ones).
-  kFrequencyAndPhase,
 };
 
 // What the loop tells one channel. vector false: the channel's own DLL closes its code loop (scalar).
