@@ -1,5 +1,5 @@
 // The navigation settings shared by `fuse` and `receive --coupling loose|tight|ultra-tight` (the TOML keys of
-// tools/fuse_config.hpp fill it): the IMU error preset, the initial state and its 1-sigmas, the alignment spans,
+// config/fuse_config_toml.hpp fill it): the IMU error preset, the initial state and its 1-sigmas, the alignment spans,
 // the GNSS fix weights and lever arm, the filter's UKF and gate parameters, the receiver clock's oscillator and
 // height aiding (tight), and GPS attitude's time origin and misalignment. Units: SI except where the name says deg.
 #pragma once

@@ -1,6 +1,6 @@
 // The simulation scenario: plain data that says what `simulate` makes (signal, time, navigation data, receiver,
 // atmosphere, truth rate, and for inertial scenarios the trajectory, IMU and antennas on the body). SI units and
-// degrees at the edges as the names say; relative paths resolve against `source`'s folder. tools/scenario_toml.hpp
+// degrees at the edges as the names say; relative paths resolve against `source`'s folder. config/scenario_toml.hpp
 // reads and writes it as TOML (the keys are the field names there).
 //
 // Static scenarios: antennas at `llh_deg_m` plus ENU offsets, or a trajectory CSV (signals/receiver_motion.hpp).

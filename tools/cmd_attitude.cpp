@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "antenna_config.hpp"
+#include "config/antenna_config_toml.hpp"
 #include "attitude_outputs.hpp"
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
@@ -38,7 +38,7 @@ struct AttitudeArgs {
 void run_attitude(const AttitudeArgs& args) {
   const auto format = signals::parse_sample_format(args.format);
   if (!format) throw signals::InputError("command line", "--format: unknown sample format '" + args.format + "' (i8, i16, f32, r8, r16)");
-  const AntennaConfig antennas = read_antenna_config(args.antennas);
+  const config::AntennaConfig antennas = config::read_antenna_config(args.antennas);
   const auto n_ant = antennas.solver.array.lever_arm_body_m.size();
   if (args.inputs.size() != n_ant)
     throw signals::InputError("command line", fmt::format("--input: {} files for the {} antennas of {}",

@@ -22,7 +22,7 @@
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "interrupt_guard.hpp"
 #include "simulation_run.hpp"
 
@@ -129,7 +129,7 @@ void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario,
 }
 
 void run_demo(const DemoArgs& args) {
-  sim::Scenario scenario = parse_scenario(kDemoScenarioToml, "built-in demo scenario (scenarios/default.toml)");
+  sim::Scenario scenario = config::parse_scenario(kDemoScenarioToml, "built-in demo scenario (scenarios/default.toml)");
   if (args.duration_s > 0.0) scenario.duration_s = args.duration_s;
   const fs::path out(args.out_dir);
   fs::create_directories(out);

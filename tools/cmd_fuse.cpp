@@ -14,7 +14,7 @@
 
 #include "commands.hpp"
 #include "attitude_csv.hpp"
-#include "fuse_config.hpp"
+#include "config/fuse_config_toml.hpp"
 #include "gnss_csv.hpp"
 #include "gnss_fix_simulation.hpp"
 #include "interrupt_guard.hpp"
@@ -72,7 +72,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
     if (!(o.outage[i + 1] > 0.0)) throw io::InputError("command line", "--outage duration must be positive");
     s.outages.emplace_back(o.outage[i], o.outage[i + 1]);
   }
-  if (!o.config_file.empty()) s.config = read_fuse_config(o.config_file);
+  if (!o.config_file.empty()) s.config = config::read_fuse_config(o.config_file);
   if (!o.attitude_origin.empty()) {
     const double week = o.attitude_origin[0], tow = o.attitude_origin[1];
     if (week < 0.0 || week != std::floor(week) || !(tow >= 0.0 && tow < 604800.0))

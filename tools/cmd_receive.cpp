@@ -1,7 +1,7 @@
 // `ultratrack receive`: the receiver end to end on a recording (pipelines/receiver_pipeline.hpp fed by
 // receiver/sample_source.hpp), writing solution.csv, NMEA, KML, RINEX 3.04 obs + nav, tracking.csv and
 // summary.json into --out (receiver/receiver_outputs.hpp) and the coupling's logs (pipelines/receive_csv_files.hpp).
-// Options: command-line flags over --config (TOML, tools/receive_config.hpp) over the defaults; the coupling's in
+// Options: command-line flags over --config (TOML, config/receive_config_toml.hpp) over the defaults; the coupling's in
 // tools/receive_fusion_options.hpp. A progress bar on a terminal, plain lines otherwise.
 // Exit: 0 with a fix; 2 (InputError) for bad input, including a file in which no satellite is found (no
 // outputs then); 3 when satellites were tracked but the file ended before a fix (outputs written, summary
@@ -27,7 +27,7 @@
 #include "interrupt_guard.hpp"
 #include "pipelines/receive_csv_files.hpp"
 #include "pipelines/receiver_pipeline.hpp"
-#include "receive_config.hpp"
+#include "config/receive_config_toml.hpp"
 #include "receive_fusion_options.hpp"
 #include "receive_progress.hpp"
 #include "receiver/receiver_outputs.hpp"
@@ -63,7 +63,7 @@ void run_receive(const ReceiveArgs& args) {
   pipelines::ReceiveOptions pipeline;
   receiver::ReceiverOptions& options = pipeline.receiver;
   options.fs_hz = source_options.fs_hz;
-  if (!args.config.empty()) apply_receive_config(args.config, options);
+  if (!args.config.empty()) config::apply_receive_config(args.config, options);
   if (!args.elevation_mask.empty())
     options.pvt.elevation_mask_rad = parse_double_option("--elevation-mask-deg", args.elevation_mask) * M_PI / 180.0;
   if (!args.troposphere.empty()) options.pvt.troposphere = parse_on_off_option("--troposphere", args.troposphere, "on", "off");

@@ -1,5 +1,5 @@
 // `ultratrack simulate --scenario S.toml --out DIR`: synthesise IF samples and truth from a scenario
-// (tools/scenario_toml.hpp for the keys, sim/simulation_files.hpp for the outputs). Ctrl-C stops the run
+// (config/scenario_toml.hpp for the keys, sim/simulation_files.hpp for the outputs). Ctrl-C stops the run
 // early and still finishes the files.
 #include <fmt/core.h>
 
@@ -9,7 +9,7 @@
 #include <string>
 
 #include "commands.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "interrupt_guard.hpp"
 #include "simulation_run.hpp"
 
@@ -24,7 +24,7 @@ void add_simulate_command(CLI::App& app) {
   cmd->add_option("--out", *out_dir, "Output folder (created when missing)")->required();
   cmd->add_flag("--quiet", *quiet, "No progress lines");
   cmd->callback([scenario_path, out_dir, quiet] {
-    const sim::Scenario scenario = read_scenario(*scenario_path);
+    const sim::Scenario scenario = config::read_scenario(*scenario_path);
     const InterruptGuard interrupt;
     const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr, interrupt.token());
     const std::string inertial =

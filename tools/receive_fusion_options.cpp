@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "cli_parse.hpp"
-#include "fuse_config.hpp"
+#include "config/fuse_config_toml.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
 #include "io/input_error.hpp"
@@ -109,7 +109,7 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   } else {
     throw io::InputError("command line", "--align must be static, motion or config, got '" + align + "'");
   }
-  if (!a.config.empty()) s.navigation = read_fuse_config(a.config);
+  if (!a.config.empty()) s.navigation = config::read_fuse_config(a.config);
   (void)ins::imu_preset(s.navigation.imu_preset);  // an unknown preset fails here, before any output
   if (s.align == pipelines::AlignMode::Config && !s.navigation.attitude_deg)
     throw io::InputError(a.config.empty() ? "command line" : a.config,

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "sim/simulation_files.hpp"
 
 namespace ultratrack::tools {
@@ -20,7 +20,7 @@ sim::SimulationResult run_simulation(const sim::Scenario& scenario, const std::f
                p.percent, p.done_s / std::max(p.wall_s, 1e-9));
     std::fflush(progress);
   };
-  return sim::simulate_to_folder(scenario, out_dir, to_toml(scenario), std::move(stop), print);
+  return sim::simulate_to_folder(scenario, out_dir, config::to_toml(scenario), std::move(stop), print);
 }
 
 }  // namespace ultratrack::tools

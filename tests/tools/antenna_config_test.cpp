@@ -1,6 +1,6 @@
 // The antenna file of `ultratrack attitude`: the [solver] switches reach the solver's options, a wrong type is an
 // InputError naming the key.
-#include "antenna_config.hpp"
+#include "config/antenna_config_toml.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,6 +11,7 @@
 #include "support/test_data.hpp"
 
 using namespace ultratrack;
+using namespace ultratrack::config;
 
 namespace {
 
@@ -25,16 +26,16 @@ std::filesystem::path write_antennas(const std::string& name, const std::string&
 }  // namespace
 
 TEST(AntennaConfig, SolverSwitchesReachTheSolverOptions) {
-  const auto defaults = tools::read_antenna_config(write_antennas("antennas_default.toml", ""));
+  const auto defaults = config::read_antenna_config(write_antennas("antennas_default.toml", ""));
   EXPECT_TRUE(defaults.solver.multi_epoch);
   EXPECT_TRUE(defaults.solver.use_length_constraint);
   EXPECT_EQ(defaults.solver.array.lever_arm_body_m.size(), 3u);
-  const auto off = tools::read_antenna_config(
+  const auto off = config::read_antenna_config(
       write_antennas("antennas_off.toml", "multi_epoch = false\nuse_length_constraint = false\n"));
   EXPECT_FALSE(off.solver.multi_epoch);
   EXPECT_FALSE(off.solver.use_length_constraint);
   try {
-    tools::read_antenna_config(write_antennas("antennas_bad.toml", "multi_epoch = 3\n"));
+    config::read_antenna_config(write_antennas("antennas_bad.toml", "multi_epoch = 3\n"));
     FAIL() << "no InputError";
   } catch (const signals::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("solver.multi_epoch"), std::string::npos) << e.what();

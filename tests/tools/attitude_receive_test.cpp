@@ -17,7 +17,7 @@
 
 #include "receiver/multi_sample_source.hpp"
 #include "receiver/receiver_engine.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/input_error.hpp"

@@ -15,7 +15,7 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
-#include "receive_config.hpp"
+#include "config/receive_config_toml.hpp"
 #include "signals/input_error.hpp"
 #include "support/test_data.hpp"
 
@@ -111,7 +111,7 @@ TEST(ReceiveConfig, UnknownKeysAndBadTypesNameTheFileAndKey) {
   const auto good = dir / "good.toml";
   std::ofstream(good) << "[receiver]\nchannels = 8\nprns = [1, 5, 9]\n[acquisition]\nnoncoherent = 4\n"
                          "[tracking]\npll_bw_hz = 12.5\n[pvt]\nelevation_mask_deg = 15.0\ntroposphere = false\n";
-  ultratrack::tools::apply_receive_config(good, o);
+  ultratrack::config::apply_receive_config(good, o);
   EXPECT_EQ(o.channels, 8);
   EXPECT_EQ(o.prns, (std::vector<int>{1, 5, 9}));
   EXPECT_EQ(o.acquisition.noncoherent, 4);
@@ -122,7 +122,7 @@ TEST(ReceiveConfig, UnknownKeysAndBadTypesNameTheFileAndKey) {
   const auto bad_key = dir / "bad_key.toml";
   std::ofstream(bad_key) << "[tracking]\npll_bandwidth = 10.0\n";
   try {
-    ultratrack::tools::apply_receive_config(bad_key, o);
+    ultratrack::config::apply_receive_config(bad_key, o);
     FAIL() << "unknown key accepted";
   } catch (const InputError& e) {
     const std::string what = e.what();
@@ -131,10 +131,10 @@ TEST(ReceiveConfig, UnknownKeysAndBadTypesNameTheFileAndKey) {
   }
   const auto bad_type = dir / "bad_type.toml";
   std::ofstream(bad_type) << "[receiver]\nchannels = \"twelve\"\n";
-  EXPECT_THROW(ultratrack::tools::apply_receive_config(bad_type, o), InputError);
+  EXPECT_THROW(ultratrack::config::apply_receive_config(bad_type, o), InputError);
   const auto bad_section = dir / "bad_section.toml";
   std::ofstream(bad_section) << "[receivr]\nchannels = 4\n";
-  EXPECT_THROW(ultratrack::tools::apply_receive_config(bad_section, o), InputError);
+  EXPECT_THROW(ultratrack::config::apply_receive_config(bad_section, o), InputError);
 }
 
 namespace {

@@ -19,7 +19,7 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/input_error.hpp"
 #include "signals/nominal_constellation.hpp"
 #include "signals/rinex_nav.hpp"
@@ -179,7 +179,7 @@ TEST(FormatsMatrix, TwoBitFileFixesWithAHotStart) {
 // The scenario keys of the 2-bit packing: parsed, echoed by to_toml (so that scenario.toml re-runs the same
 // file), and an unknown name is an InputError naming the key.
 TEST(FormatsMatrix, ScenarioTwoBitKeysParseAndEcho) {
-  using ultratrack::tools::parse_scenario;
+  using ultratrack::config::parse_scenario;
   const auto s = parse_scenario(
       "[signal]\nformat = \"r2\"\nif_hz = 4.092e6\nsample_rate_hz = 16.368e6\n"
       "two_bit_coding = \"offset-binary\"\ntwo_bit_order = \"msb-first\"\n",
@@ -187,7 +187,7 @@ TEST(FormatsMatrix, ScenarioTwoBitKeysParseAndEcho) {
   EXPECT_EQ(s.format, ultratrack::signals::SampleFormat::r2);
   EXPECT_EQ(s.two_bit.coding, ultratrack::signals::TwoBitCoding::offset_binary);
   EXPECT_EQ(s.two_bit.order, ultratrack::signals::BitOrder::msb_first);
-  const auto back = parse_scenario(ultratrack::tools::to_toml(s), "/tmp/b/echo.toml");
+  const auto back = parse_scenario(ultratrack::config::to_toml(s), "/tmp/b/echo.toml");
   EXPECT_EQ(back.two_bit.coding, s.two_bit.coding);
   EXPECT_EQ(back.two_bit.order, s.two_bit.order);
   try {

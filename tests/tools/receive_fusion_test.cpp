@@ -20,7 +20,7 @@
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
 #include "run_command.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/rinex_nav.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
@@ -58,7 +58,7 @@ Sim& simulated() {
            "[imu]\npreset = \"hg1700ae\"\nseed = 7\n[atmosphere]\nionosphere = true\ntroposphere = true\n";
     test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
     // The scenario's own broadcast data as a RINEX file: the receiver's hot start.
-    const sim::NavigationSource nav = sim::load_navigation(tools::read_scenario(r.dir / "circle.toml"));
+    const sim::NavigationSource nav = sim::load_navigation(config::read_scenario(r.dir / "circle.toml"));
     signals::RinexNavData data;
     data.ephemerides = nav.ephemerides;
     data.klobuchar = nav.klobuchar;

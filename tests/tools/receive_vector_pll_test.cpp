@@ -23,7 +23,7 @@
 #include "receive_output_readers.hpp"
 #include "run_command.hpp"
 #include "vector_carrier_runs.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
 #include "simulation_run.hpp"
@@ -33,6 +33,7 @@
 namespace fs = std::filesystem;
 namespace signals = ultratrack::signals;
 using namespace ultratrack::tools;
+using namespace ultratrack::config;
 using namespace ultratrack::sim;
 
 namespace {

@@ -1,6 +1,6 @@
 // Scenario files: the keys parse to the stated values; unknown keys, wrong types and conflicting
 // keys are InputErrors naming the file, the key and the line; the echo (to_toml) reads back the same.
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,6 +9,7 @@
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {
+using namespace ultratrack::config;
 namespace {
 
 using namespace ultratrack::sim;

@@ -15,7 +15,7 @@
 #include "ins/strapdown.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/input_error.hpp"
 #include "signals/satellite_state.hpp"
@@ -25,6 +25,7 @@
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
+using namespace ultratrack::config;
 namespace {
 
 using namespace ultratrack::sim;

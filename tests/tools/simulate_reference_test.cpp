@@ -28,7 +28,7 @@
 
 #include "brute_force_fine_search.hpp"
 #include "commands.hpp"
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/sample_reader.hpp"
 #include "sim/navigation_source.hpp"
@@ -37,6 +37,7 @@
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
+using namespace ultratrack::config;
 namespace {
 
 using namespace ultratrack::sim;

@@ -9,7 +9,7 @@
 #include <set>
 #include <sstream>
 
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/input_error.hpp"
 #include "signals/sample_reader.hpp"
 #include "sim/navigation_source.hpp"
@@ -19,6 +19,7 @@
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
+using namespace ultratrack::config;
 namespace {
 
 using namespace ultratrack::sim;

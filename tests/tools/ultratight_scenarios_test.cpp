@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "signals/input_error.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
@@ -23,6 +23,7 @@
 #include "support/test_data.hpp"
 
 namespace ultratrack::tools {
+using namespace ultratrack::config;
 namespace {
 
 using namespace ultratrack::sim;

@@ -24,11 +24,11 @@
 
 #include "pipelines/fuse_config.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 
 using pipelines::FuseConfig;  // the plain struct (pipelines/fuse_config.hpp); this file reads it from TOML
 
 // Reads the file over the defaults; throws io::InputError.
 FuseConfig read_fuse_config(const std::filesystem::path& path);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

@@ -1,4 +1,4 @@
-#include "scenario_toml.hpp"
+#include "config/scenario_toml.hpp"
 
 #include <fmt/core.h>
 #include <fmt/format.h>
@@ -16,7 +16,7 @@
 #include "ins/trajectory.hpp"
 #include "io/input_error.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 namespace {
 
 using io::InputError;
@@ -715,4 +715,4 @@ std::string to_toml(const Scenario& s) {
   return out + events_toml(s);
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

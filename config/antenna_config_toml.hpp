@@ -15,7 +15,7 @@
 
 #include "receiver/attitude_solver.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 
 struct AntennaConfig {
   receiver::AttitudeSolverOptions solver;  // solver.array from the [[antenna]] tables
@@ -26,4 +26,4 @@ struct AntennaConfig {
 // antennas, or solver options that do not validate.
 AntennaConfig read_antenna_config(const std::filesystem::path& path);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

@@ -51,7 +51,7 @@
 
 #include "sim/scenario.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 
 // Parses scenario text; `source` names it in errors and anchors relative paths. Throws InputError.
 sim::Scenario parse_scenario(std::string_view text, const std::filesystem::path& source);
@@ -62,4 +62,4 @@ sim::Scenario read_scenario(const std::filesystem::path& path);
 // gives the same scenario.
 std::string to_toml(const sim::Scenario& scenario);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

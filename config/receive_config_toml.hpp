@@ -7,9 +7,9 @@
 
 #include "receiver/receiver_options.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 
 // Applies the file's settings over `options` (fields not in the file keep their values).
 void apply_receive_config(const std::filesystem::path& path, receiver::ReceiverOptions& options);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

@@ -1,4 +1,4 @@
-#include "antenna_config.hpp"
+#include "config/antenna_config_toml.hpp"
 
 #include <fmt/core.h>
 #include <toml++/toml.h>
@@ -9,7 +9,7 @@
 
 #include "signals/input_error.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 namespace {
 
 using signals::InputError;
@@ -113,4 +113,4 @@ AntennaConfig read_antenna_config(const std::filesystem::path& path) {
   return c;
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

@@ -1,4 +1,4 @@
-#include "fuse_config.hpp"
+#include "config/fuse_config_toml.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -8,7 +8,7 @@
 
 #include "io/input_error.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 namespace {
 
 struct Value {
@@ -170,4 +170,4 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
   return c;
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config

@@ -1,4 +1,4 @@
-#include "receive_config.hpp"
+#include "config/receive_config_toml.hpp"
 
 #include <functional>
 #include <map>
@@ -7,7 +7,7 @@
 
 #include "signals/input_error.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::config {
 namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
@@ -141,4 +141,4 @@ void apply_receive_config(const std::filesystem::path& path, receiver::ReceiverO
   }
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::config
