@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "pipelines/fuse.hpp"
-#include "gnss_fix_simulation.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
@@ -54,18 +54,18 @@ std::vector<ins::ImuIncrement> corrupt(const Scenario& s, const std::string& pre
 pipelines::FuseResult run_once(const Scenario& s, const ins::TruthInterpolator& truth, const std::string& preset,
                            std::uint64_t seed, fusion::FilterKind filter, std::vector<std::pair<double, double>> outages,
                            double gnss_rate_hz) {
-  tools::GnssFixSimulationOptions g;
+  ultratrack::pipelines::GnssFixSimulationOptions g;
   g.rate_hz = gnss_rate_hz;
   g.first_time_s = 0.0;
   g.seed = seed + 1000;
-  const auto fixes = tools::simulate_gnss_fixes(truth, g);
+  const auto fixes = ultratrack::pipelines::simulate_gnss_fixes(truth, g);
   pipelines::FuseSettings settings;
   settings.filter = filter;
   settings.align = pipelines::AlignMode::Motion;
   settings.config.imu_preset = preset;
   settings.config.velocity_sigma_mps = 0.05;
   settings.outages = std::move(outages);
-  return pipelines::fuse(corrupt(s, preset, seed), fixes, tools::truth_samples_from_nav(s.truth), settings);
+  return pipelines::fuse(corrupt(s, preset, seed), fixes, ultratrack::pipelines::truth_samples_from_nav(s.truth), settings);
 }
 
 void BM_LooseRms(benchmark::State& state, std::string profile, fusion::FilterKind filter) {

@@ -1,6 +1,6 @@
 // The external measurements `fuse` takes besides the IMU increments: GNSS fixes on the IMU time line (a geodetic
 // antenna position, optional NED velocity, NED position 1-sigmas) and GPS attitude rows of a multi-antenna receiver
-// (GPS time tags; angles of the antenna-array frame relative to NED). tools/gnss_csv.hpp and tools/attitude_csv.hpp
+// (GPS time tags; angles of the antenna-array frame relative to NED). pipelines/gnss_fix_csv.hpp and pipelines/gps_attitude_csv.hpp
 // read them from files. Units: rad, m, m/s, s.
 #pragma once
 

@@ -3,7 +3,7 @@
 // tracks each satellite on the master and correlates every antenna against the master's replica
 // (ReceiverOptions::num_antennas), each antenna's phase follows from the between-antenna prompt phase
 // (receiver/antenna_phase_tracker.hpp), and the AttitudeSolver turns each epoch into roll, pitch and yaw.
-// Outputs (tools/attitude_outputs.hpp): attitude.csv, antenna_phases.csv, summary.json, position/ (as `receive`).
+// Outputs (receiver/attitude_outputs.hpp): attitude.csv, antenna_phases.csv, summary.json, position/ (as `receive`).
 // Exit: 0 with at least one attitude; 2 for bad input; 3 when the signal ended before an attitude (outputs written).
 #include <fmt/core.h>
 
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "config/antenna_config_toml.hpp"
-#include "attitude_outputs.hpp"
+#include "receiver/attitude_outputs.hpp"
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
@@ -73,7 +73,7 @@ void run_attitude(const AttitudeArgs& args) {
   std::int64_t to_process = source.total_samples();
   if (duration_s > 0.0) to_process = std::min<std::int64_t>(to_process, std::llround(duration_s * options.fs_hz));
 
-  AttitudeOutputs outputs(args.out, options.fs_hz, options.observation_interval_s, antennas.solver,
+  receiver::AttitudeOutputs outputs(args.out, options.fs_hz, options.observation_interval_s, antennas.solver,
                           antennas.line_bias_cycles);
   receiver::ReceiverEngine engine(options, outputs);
   if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);

@@ -1,5 +1,5 @@
 // `ultratrack compare --solution S --truth T [--skip S] [--json]`: a receiver's solution.csv against a
-// simulation's truth.csv (tools/solution_compare.hpp): position errors (3-D, horizontal, vertical RMS, max,
+// simulation's truth.csv (pipelines/solution_compare.hpp): position errors (3-D, horizontal, vertical RMS, max,
 // mean ENU bias) and velocity errors, over the fixes the truth covers. Exit 3 when no fix could be compared.
 #include <fmt/core.h>
 
@@ -11,7 +11,7 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "io/input_error.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 
 namespace ultratrack::tools {
 
@@ -23,14 +23,14 @@ struct CompareArgs {
 };
 
 void run_compare(const CompareArgs& args) {
-  ComparisonOptions options;
+  pipelines::ComparisonOptions options;
   options.skip_s = parse_double_option("--skip", args.skip);
   if (!(options.skip_s >= 0.0)) throw io::InputError("command line", "--skip: must be >= 0 s");
-  const auto solution = read_solution_csv(args.solution);
-  const auto truth = read_simulation_truth_csv(args.truth);
-  const SolutionComparison c = compare_solution(solution, truth, options);
+  const auto solution = pipelines::read_solution_csv(args.solution);
+  const auto truth = pipelines::read_simulation_truth_csv(args.truth);
+  const pipelines::SolutionComparison c = pipelines::compare_solution(solution, truth, options);
   if (args.json) {
-    fmt::print("{}", to_json(c));
+    fmt::print("{}", pipelines::to_json(c));
   } else {
     fmt::print("compare: {} fixes (tow {:.1f} .. {:.1f} s){}\n", c.fixes, c.first_tow_s, c.last_tow_s,
                c.fixes_outside_truth ? fmt::format(", {} outside the truth's span", c.fixes_outside_truth) : "");

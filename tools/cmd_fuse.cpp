@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "attitude_csv.hpp"
+#include "pipelines/gps_attitude_csv.hpp"
 #include "config/fuse_config_toml.hpp"
-#include "gnss_csv.hpp"
-#include "gnss_fix_simulation.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 #include "interrupt_guard.hpp"
 #include "pipelines/fuse.hpp"
 #include "pipelines/fuse_summary.hpp"
@@ -24,7 +24,7 @@
 #include "ins/imu_csv.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
-#include "truth_csv.hpp"
+#include "sim/truth_csv.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -80,14 +80,14 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.config.attitude_gps_time_at_imu_zero = signals::GpsTime{static_cast<int>(week), tow};
   }
   if (!o.attitude_file.empty()) {
-    s.attitude = read_attitude_csv(o.attitude_file);
+    s.attitude = pipelines::read_attitude_csv(o.attitude_file);
     s.attitude_file = o.attitude_file;
   }
 
   const auto imu = ins::read_imu_csv(o.imu_file);
-  const auto gnss = read_gnss_csv(o.gnss_file);
+  const auto gnss = pipelines::read_gnss_csv(o.gnss_file);
   std::vector<ins::NavState> truth;
-  if (!o.truth_file.empty()) truth = read_truth_csv(o.truth_file);
+  if (!o.truth_file.empty()) truth = sim::read_truth_csv(o.truth_file);
   if (!o.quiet)
     fmt::print("fuse: {} IMU rows ({:.3f}-{:.3f} s), {} GNSS fixes ({:.3f}-{:.3f} s), loose {}, align {}\n",
                imu.size(), imu.front().t_s, imu.back().t_s, gnss.size(), gnss.front().t_s, gnss.back().t_s, o.filter,
@@ -99,7 +99,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   InterruptGuard interrupt;  // Ctrl-C ends the run early; nav.csv and summary.json cover it so far
   const pipelines::FuseResult r = pipelines::fuse(
-      imu, gnss, truth_samples_from_nav(truth), s,
+      imu, gnss, pipelines::truth_samples_from_nav(truth), s,
       [&](const ins::NavState& state, const pipelines::NavSigma& sigma) {
         if (rows++ % o.decimate == 0) nav.write(state, sigma);
       },

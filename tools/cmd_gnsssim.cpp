@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "gnss_csv.hpp"
-#include "gnss_fix_simulation.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 #include "io/input_error.hpp"
-#include "truth_csv.hpp"
+#include "sim/truth_csv.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -27,11 +27,11 @@ struct GnssSimOptions {
 };
 
 void run_gnsssim(const GnssSimOptions& o) {
-  const auto nav = read_truth_csv(o.truth_file);
+  const auto nav = sim::read_truth_csv(o.truth_file);
   if (nav.size() < 2) throw io::InputError(o.truth_file, "needs at least two rows");
   if (!(o.velocity_sigma_mps > 0.0)) throw io::InputError("command line", "--velocity-sigma must be positive");
   if (o.correlation_s < 0.0) throw io::InputError("command line", "--correlation must not be negative");
-  GnssFixSimulationOptions s;
+  pipelines::GnssFixSimulationOptions s;
   s.rate_hz = o.rate_hz;
   s.first_time_s = o.first_s;
   s.sigma_ned_m = {o.sigma_m[0], o.sigma_m[1], o.sigma_m[2]};
@@ -40,10 +40,10 @@ void run_gnsssim(const GnssSimOptions& o) {
   s.sigma_velocity_mps = o.velocity_sigma_mps;
   s.lever_arm_b = {o.lever_arm_m[0], o.lever_arm_m[1], o.lever_arm_m[2]};
   s.seed = o.seed;
-  const ins::TruthInterpolator truth(truth_samples_from_nav(nav));
-  const auto fixes = simulate_gnss_fixes(truth, s);
+  const ins::TruthInterpolator truth(pipelines::truth_samples_from_nav(nav));
+  const auto fixes = pipelines::simulate_gnss_fixes(truth, s);
   if (fixes.empty()) throw io::InputError(o.truth_file, "no fix time falls inside the truth span");
-  write_gnss_csv(o.out_file, fixes);
+  pipelines::write_gnss_csv(o.out_file, fixes);
   fmt::print("gnsssim: {} fixes at {} Hz from {:.3f} s to {:.3f} s; wrote {}\n", fixes.size(), o.rate_hz,
              fixes.front().t_s, fixes.back().t_s, o.out_file);
 }

@@ -23,7 +23,7 @@
 #include "ins/strapdown.hpp"
 #include "interrupt_guard.hpp"
 #include "io/atomic_file.hpp"
-#include "truth_csv.hpp"
+#include "sim/truth_csv.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -80,7 +80,7 @@ void run_ins(const InsOptions& o) {
   if (o.decimate < 1) throw InputError("command line", "--decimate must be at least 1");
   const std::vector<ins::ImuIncrement> imu = ins::read_imu_csv(o.imu_file);
   std::vector<ins::NavState> truth;
-  if (!o.init_file.empty()) truth = read_truth_csv(o.init_file);
+  if (!o.init_file.empty()) truth = sim::read_truth_csv(o.init_file);
 
   ins::NavState init;
   std::size_t first = 0;  // first IMU row to navigate with

@@ -16,15 +16,15 @@
 #include <string>
 #include <vector>
 
-#include "attitude_csv.hpp"
+#include "pipelines/gps_attitude_csv.hpp"
 #include "commands.hpp"
-#include "gnss_fix_simulation.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/attitude.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
 #include "signals/gps_time.hpp"
 #include "support/test_data.hpp"
-#include "truth_csv.hpp"
+#include "sim/truth_csv.hpp"
 
 namespace fs = std::filesystem;
 using ultratrack::io::InputError;
@@ -71,8 +71,8 @@ struct AttitudeFile {
 // attitude.csv at t = 0.61 + k (GPS time kOrigin + t): the array frame (mounting `m` off the IMU) from the truth,
 // Euler noise of sigma (0.1, 0.1, 0.2) deg; unfixed (nan) rows: 20 % at random and all of [60, 70) s.
 AttitudeFile write_attitude(const fs::path& truth_csv, const fs::path& out, const Eigen::Quaterniond& q_ba) {
-  const auto nav = ultratrack::tools::read_truth_csv(truth_csv);
-  const ultratrack::ins::TruthInterpolator truth(ultratrack::tools::truth_samples_from_nav(nav));
+  const auto nav = ultratrack::sim::read_truth_csv(truth_csv);
+  const ultratrack::ins::TruthInterpolator truth(ultratrack::pipelines::truth_samples_from_nav(nav));
   std::mt19937_64 rng(77);
   std::normal_distribution<double> n01;
   std::uniform_real_distribution<double> u01;
@@ -203,7 +203,7 @@ TEST_F(FuseAttitude, BadAttitudeInputIsOneInputError) {
     const fs::path f = d / "bad_attitude.csv";
     write_text(f, header + c.body);
     try {
-      ultratrack::tools::read_attitude_csv(f);
+      ultratrack::pipelines::read_attitude_csv(f);
       ADD_FAILURE() << "no error for: " << c.body;
     } catch (const InputError& e) {
       EXPECT_EQ(e.line(), c.line) << e.what();
@@ -212,10 +212,10 @@ TEST_F(FuseAttitude, BadAttitudeInputIsOneInputError) {
     }
   }
   write_text(d / "bad_header.csv", "gps_week,tow_s,roll_deg\n" + good);
-  EXPECT_THROW(ultratrack::tools::read_attitude_csv(d / "bad_header.csv"), InputError);
+  EXPECT_THROW(ultratrack::pipelines::read_attitude_csv(d / "bad_header.csv"), InputError);
   // Unfixed rows may be nan; a file of them alone reads.
   write_text(d / "unfixed.csv", header + "2190,604791.0,nan,nan,nan,nan,nan,nan,4,0,0.0\n");
-  EXPECT_EQ(ultratrack::tools::read_attitude_csv(d / "unfixed.csv").size(), 1u);
+  EXPECT_EQ(ultratrack::pipelines::read_attitude_csv(d / "unfixed.csv").size(), 1u);
   // Through the command: no origin -> InputError; an origin that puts the file outside the IMU data -> InputError.
   try {
     run(with(fuse_args("no_origin"), {"--attitude", (d / "attitude.csv").string()}));

@@ -15,7 +15,7 @@
 
 #include "commands.hpp"
 #include "pipelines/fused_nav_csv.hpp"
-#include "gnss_csv.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
 #include "io/input_error.hpp"
 #include "support/test_data.hpp"
 
@@ -106,7 +106,7 @@ TEST(FuseCommand, ForeignRatesAndTimesAlignInMotionAndConverge) {
   ASSERT_GT(rows.size(), 40000u);
   EXPECT_EQ(rows.front().nav.t_s, t0);  // starts exactly at the alignment time, between IMU samples
   EXPECT_NEAR(rows.back().nav.t_s, 240.0, 1e-9);
-  const auto fixes = ultratrack::tools::read_gnss_csv(dir / "gnss.csv");
+  const auto fixes = ultratrack::pipelines::read_gnss_csv(dir / "gnss.csv");
   long long after = 0;
   for (const auto& f : fixes) after += f.t_s > t0 ? 1 : 0;
   EXPECT_EQ(json_number(summary, "fixes_used"), after);
@@ -187,7 +187,7 @@ TEST(FuseCommand, PositionOnlyFixesAlignFromPositionDifferences) {
        "--out", (dir / "sim").string()});
   run({"gnsssim", "--truth", (dir / "sim/truth.csv").string(), "--rate", "5", "--first", "0.137", "--no-velocity",
        "--seed", "5", "--out", (dir / "gnss.csv").string()});
-  EXPECT_FALSE(ultratrack::tools::read_gnss_csv(dir / "gnss.csv").front().has_velocity);
+  EXPECT_FALSE(ultratrack::pipelines::read_gnss_csv(dir / "gnss.csv").front().has_velocity);
   run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", (dir / "gnss.csv").string(), "--truth",
        (dir / "sim/truth.csv").string(), "--quiet", "--out", (dir / "fuse").string()});
   const fs::path summary = dir / "fuse/summary.json";

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "pipelines/fused_nav_csv.hpp"
-#include "gnss_csv.hpp"
-#include "gnss_fix_simulation.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
@@ -21,7 +21,7 @@
 
 namespace fs = std::filesystem;
 using ultratrack::io::InputError;
-using ultratrack::tools::GnssCsvRow;
+using ultratrack::pipelines::GnssCsvRow;
 
 namespace {
 
@@ -38,7 +38,7 @@ fs::path write(const std::string& body) {
 void expect_error_at(const std::string& body, int line, const std::string& words) {
   const fs::path f = write(body);
   try {
-    ultratrack::tools::read_gnss_csv(f);
+    ultratrack::pipelines::read_gnss_csv(f);
     ADD_FAILURE() << "accepted: " << body;
   } catch (const InputError& e) {
     EXPECT_EQ(e.line(), line) << e.what();
@@ -61,8 +61,8 @@ TEST(FuseGnssCsv, RoundTripIsExactWithAndWithoutVelocity) {
     in[k].sigma_ned_m = {1.5, 1.6, 3.1};
   }
   const fs::path f = ultratrack::test::scratch_dir() / "g.csv";
-  ultratrack::tools::write_gnss_csv(f, in);
-  const auto out = ultratrack::tools::read_gnss_csv(f);
+  ultratrack::pipelines::write_gnss_csv(f, in);
+  const auto out = ultratrack::pipelines::read_gnss_csv(f);
   ASSERT_EQ(out.size(), 3u);
   for (int k = 0; k < 3; ++k) {
     EXPECT_EQ(out[k].t_s, in[k].t_s);
@@ -77,7 +77,7 @@ TEST(FuseGnssCsv, RoundTripIsExactWithAndWithoutVelocity) {
 
 TEST(FuseGnssCsv, EmptyVelocityColumnsMeanPositionOnly) {
   const auto fixes =
-      ultratrack::tools::read_gnss_csv(write(std::string(kHeader) + "# comment\n\n1.5,36,127,50, , ,,2,2,4\n"));
+      ultratrack::pipelines::read_gnss_csv(write(std::string(kHeader) + "# comment\n\n1.5,36,127,50, , ,,2,2,4\n"));
   ASSERT_EQ(fixes.size(), 1u);
   EXPECT_FALSE(fixes[0].has_velocity);
   EXPECT_EQ(fixes[0].sigma_ned_m, Eigen::Vector3d(2, 2, 4));
@@ -103,7 +103,7 @@ TEST(FuseGnssCsv, MalformedRowsAreInputErrorsWithTheLine) {
 }
 
 TEST(FuseGnssCsv, MissingFileIsAnInputError) {
-  EXPECT_THROW(ultratrack::tools::read_gnss_csv(ultratrack::test::scratch_dir() / "absent.csv"), InputError);
+  EXPECT_THROW(ultratrack::pipelines::read_gnss_csv(ultratrack::test::scratch_dir() / "absent.csv"), InputError);
 }
 
 TEST(FuseNavCsv, RoundTripKeepsStateAndSigmas) {
@@ -139,13 +139,13 @@ TEST(FuseNavCsv, RoundTripKeepsStateAndSigmas) {
 TEST(FuseGnssFixSimulation, TimesAndErrorStatistics) {
   const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * kDeg, 127.0 * kDeg, 100.0);
   const ultratrack::ins::TruthInterpolator truth(ultratrack::ins::simulate(spec, 20.0).truth);
-  ultratrack::tools::GnssFixSimulationOptions o;
+  ultratrack::pipelines::GnssFixSimulationOptions o;
   o.rate_hz = 5.0;
   o.first_time_s = 0.137;
   o.sigma_ned_m = {2.0, 3.0, 4.0};
   o.sigma_velocity_mps = 0.05;
   o.seed = 9;
-  const auto fixes = ultratrack::tools::simulate_gnss_fixes(truth, o);
+  const auto fixes = ultratrack::pipelines::simulate_gnss_fixes(truth, o);
   ASSERT_EQ(fixes.size(), 2005u);  // 0.137 ... 400.937
   Eigen::Vector3d sum2 = Eigen::Vector3d::Zero();
   double vel2 = 0.0;

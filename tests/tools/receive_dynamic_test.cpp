@@ -14,11 +14,12 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
+using namespace ultratrack::pipelines;
 
 namespace {
 

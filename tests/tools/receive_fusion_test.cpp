@@ -25,7 +25,7 @@
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
 #include "simulation_run.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -39,7 +39,7 @@ constexpr double kC = 299792458.0;
 
 struct Sim {
   fs::path dir, sim, nav;
-  std::vector<tools::TruthPoint> truth;
+  std::vector<ultratrack::pipelines::TruthPoint> truth;
   std::vector<int> prns_by_elevation;  // highest first
 };
 
@@ -65,7 +65,7 @@ Sim& simulated() {
     data.utc = nav.utc;
     r.nav = r.dir / "nominal.rnx";
     signals::write_rinex_nav_304(r.nav, data);
-    r.truth = tools::read_simulation_truth_csv(r.sim / "truth.csv");
+    r.truth = ultratrack::pipelines::read_simulation_truth_csv(r.sim / "truth.csv");
     std::ifstream sats(r.sim / "satellites.csv");
     std::string line;
     std::getline(sats, line);
@@ -86,9 +86,9 @@ Sim& simulated() {
 
 // Truth ECEF position at a true GPS time of week (linear between the 10 Hz rows; the 100 m circle at 8.3 m/s
 // bends by 0.35 mm over 0.1 s).
-Eigen::Vector3d truth_at(const std::vector<tools::TruthPoint>& truth, double tow_s) {
+Eigen::Vector3d truth_at(const std::vector<ultratrack::pipelines::TruthPoint>& truth, double tow_s) {
   auto it = std::lower_bound(truth.begin(), truth.end(), tow_s,
-                             [](const tools::TruthPoint& p, double t) { return p.tow_s < t; });
+                             [](const ultratrack::pipelines::TruthPoint& p, double t) { return p.tow_s < t; });
   if (it == truth.begin()) return it->r_e_m;
   if (it == truth.end()) return truth.back().r_e_m;
   const auto& b = *it;
@@ -126,7 +126,7 @@ struct Rms {
 Rms compare(const fs::path& rx) {
   const auto& s = simulated();
   const auto nav = pipelines::read_fused_nav_csv(rx / "nav.csv");
-  const auto fixes = tools::read_solution_csv(rx / "solution.csv");
+  const auto fixes = ultratrack::pipelines::read_solution_csv(rx / "solution.csv");
   Rms r;
   double f2 = 0.0, g2 = 0.0, since_start = 0.0, bound2 = 0.0;
   int n_since_start = 0;

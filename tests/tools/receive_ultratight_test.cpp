@@ -27,7 +27,7 @@
 #include "io/input_error.hpp"
 #include "pipelines/ultratight_loop.hpp"
 #include "run_command.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -90,7 +90,7 @@ struct NavError {
   double rms_m = 0.0, sigma_m = 0.0;
 };
 NavError nav_error(const fs::path& rx, double t0) {
-  const auto truth = tools::read_simulation_truth_csv(sim().sim / "truth.csv");
+  const auto truth = ultratrack::pipelines::read_simulation_truth_csv(sim().sim / "truth.csv");
   const auto nav = pipelines::read_fused_nav_csv(rx / "nav.csv");
   NavError e;
   double s2 = 0.0, g2 = 0.0;
@@ -98,7 +98,7 @@ NavError nav_error(const fs::path& rx, double t0) {
     const double tow = 518776.0 + r.nav.t_s;
     if (r.nav.t_s < t0) continue;
     auto it = std::lower_bound(truth.begin(), truth.end(), tow,
-                               [](const tools::TruthPoint& p, double t) { return p.tow_s < t; });
+                               [](const ultratrack::pipelines::TruthPoint& p, double t) { return p.tow_s < t; });
     if (it == truth.begin() || it == truth.end()) continue;
     const double w = (tow - (it - 1)->tow_s) / (it->tow_s - (it - 1)->tow_s);
     const Eigen::Vector3d p = (it - 1)->r_e_m + w * (it->r_e_m - (it - 1)->r_e_m);

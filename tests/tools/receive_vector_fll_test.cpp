@@ -17,7 +17,7 @@
 
 #include "run_command.hpp"
 #include "vector_carrier_runs.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/rinex_nav.hpp"
@@ -26,6 +26,7 @@
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
+using namespace ultratrack::pipelines;
 namespace signals = ultratrack::signals;
 
 namespace {

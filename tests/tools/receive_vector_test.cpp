@@ -16,11 +16,12 @@
 #include <vector>
 
 #include "run_command.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "receive_output_readers.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
+using namespace ultratrack::pipelines;
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "gnss_csv.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
 
 #include <fmt/core.h>
 
@@ -12,7 +12,7 @@
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -83,4 +83,4 @@ void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssCsvRo
   out.commit();
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

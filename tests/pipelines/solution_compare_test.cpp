@@ -11,10 +11,10 @@
 #include <string>
 
 #include "io/input_error.hpp"
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "support/test_data.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kLat = 35.274016, kLon = 137.013759, kH = 100.0;
@@ -135,4 +135,4 @@ TEST(SolutionCompare, AMissingColumnOrABadNumberNamesTheFileAndLine) {
 }
 
 }  // namespace
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

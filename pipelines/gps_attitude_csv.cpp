@@ -1,4 +1,4 @@
-#include "attitude_csv.hpp"
+#include "pipelines/gps_attitude_csv.hpp"
 
 #include <fmt/core.h>
 
@@ -11,7 +11,7 @@
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -75,4 +75,4 @@ std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file)
   return rows;
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

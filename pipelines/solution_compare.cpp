@@ -1,4 +1,4 @@
-#include "solution_compare.hpp"
+#include "pipelines/solution_compare.hpp"
 
 #include <fmt/format.h>
 
@@ -16,7 +16,7 @@
 #include "io/numeric_csv.hpp"
 #include "signals/gps_constants.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kSecondsPerWeek = 604800.0;
@@ -190,4 +190,4 @@ std::string to_json(const SolutionComparison& c) {
       c.rms_velocity_horizontal_mps, c.rms_velocity_vertical_mps, c.max_velocity_mps);
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -1,4 +1,4 @@
-#include "gnss_fix_simulation.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 
 #include <GeographicLib/Geocentric.hpp>
 
@@ -9,7 +9,7 @@
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 
 std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth, const GnssFixSimulationOptions& o) {
   if (!(o.rate_hz > 0.0 && o.rate_hz <= 100.0)) throw io::InputError("GNSS simulation", "rate must be in (0, 100] Hz");
@@ -62,4 +62,4 @@ std::vector<ins::TruthSample> truth_samples_from_nav(const std::vector<ins::NavS
   return out;
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -1,4 +1,4 @@
-#include "attitude_outputs.hpp"
+#include "receiver/attitude_outputs.hpp"
 
 #include <fmt/core.h>
 
@@ -7,7 +7,7 @@
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::receiver {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
@@ -116,4 +116,4 @@ void AttitudeOutputs::finish(const receiver::ReceiverEngine& engine, const recei
   io::write_file_atomically(dir_ / "summary.json", json);
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::receiver

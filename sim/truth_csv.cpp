@@ -1,4 +1,4 @@
-#include "truth_csv.hpp"
+#include "sim/truth_csv.hpp"
 
 #include <fmt/core.h>
 
@@ -14,7 +14,7 @@
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::sim {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
@@ -64,4 +64,4 @@ std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file) {
   return out;
 }
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::sim

@@ -11,7 +11,7 @@
 
 #include "pipelines/fuse_inputs.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 
 using GnssCsvRow = pipelines::GnssFixRow;  // the row (pipelines/fuse_inputs.hpp); this file reads and writes it
 
@@ -20,4 +20,4 @@ std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file);
 // Writes fixes with round-trip precision (empty velocity fields where has_velocity is false), atomically.
 void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssCsvRow> fixes);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

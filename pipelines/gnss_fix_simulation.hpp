@@ -8,11 +8,11 @@
 #include <cstdint>
 #include <vector>
 
-#include "gnss_csv.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
 #include "ins/nav_state.hpp"
 #include "ins/truth_interpolator.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 
 struct GnssFixSimulationOptions {
   double rate_hz = 1.0;
@@ -30,4 +30,4 @@ std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth,
 // TruthSamples from navigation rows (no body rate: the lever arm's rotational velocity is then ignored).
 std::vector<ins::TruthSample> truth_samples_from_nav(const std::vector<ins::NavState>& nav);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -17,7 +17,7 @@
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::receiver {
 
 struct AttitudeStats {
   int epochs = 0;            // epochs with antenna phases
@@ -58,4 +58,4 @@ class AttitudeOutputs final : public receiver::ReceiverObserver {
   AttitudeStats stats_;
 };
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::receiver

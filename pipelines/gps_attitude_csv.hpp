@@ -1,4 +1,4 @@
-// Reader of the multi-antenna receiver's attitude.csv (tools/attitude_outputs.hpp, `ultratrack attitude`) for
+// Reader of the multi-antenna receiver's attitude.csv (receiver/attitude_outputs.hpp, `ultratrack attitude`) for
 // `ultratrack fuse --attitude`: gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,
 // sigma_yaw_deg,num_sats,fixed,ratio. Angles of the antenna-array frame relative to NED; GPS time tags.
 // Rows with fixed = 0 may carry nan angles (no validated attitude); a fixed row needs finite angles in range and
@@ -10,10 +10,10 @@
 
 #include "pipelines/fuse_inputs.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 
 using AttitudeCsvRow = pipelines::GpsAttitudeRow;  // the row (pipelines/fuse_inputs.hpp); this file reads it
 
 std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace ultratrack::tools {
+namespace ultratrack::pipelines {
 
 // One solution.csv row (receiver/solution_writer.hpp), the fields the comparison needs.
 struct SolutionFix {
@@ -54,4 +54,4 @@ SolutionComparison compare_solution(const std::vector<SolutionFix>& solution, co
 // The comparison as a JSON object (one line per key).
 std::string to_json(const SolutionComparison& c);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::pipelines

@@ -9,8 +9,8 @@
 
 #include "ins/nav_state.hpp"
 
-namespace ultratrack::tools {
+namespace ultratrack::sim {
 
 std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file);
 
-}  // namespace ultratrack::tools
+}  // namespace ultratrack::sim
