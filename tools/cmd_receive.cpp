@@ -1,6 +1,5 @@
-// `ultratrack receive`: the receiver end to end on a recording (pipelines/receiver_pipeline.hpp fed by
-// receiver/sample_source.hpp), writing solution.csv, NMEA, KML, RINEX 3.04 obs + nav, tracking.csv and
-// summary.json into --out (receiver/receiver_outputs.hpp) and the coupling's logs (pipelines/receive_csv_files.hpp).
+// `ultratrack receive`: the receiver end to end on a recording (pipelines/receive_file.hpp), writing solution.csv,
+// NMEA, KML, RINEX 3.04 obs + nav, tracking.csv and summary.json into --out, and the coupling's logs.
 // Options: command-line flags over --config (TOML, config/receive_config_toml.hpp) over the defaults; the coupling's in
 // tools/receive_fusion_options.hpp. A progress bar on a terminal, plain lines otherwise.
 // Exit: 0 with a fix; 2 (InputError) for bad input, including a file in which no satellite is found (no
@@ -14,27 +13,22 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
-#include <chrono>
 #include <cmath>
 #include <memory>
 #include <string>
-#include <vector>
 
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "format_options.hpp"
 #include "interrupt_guard.hpp"
-#include "pipelines/receive_csv_files.hpp"
-#include "pipelines/receiver_pipeline.hpp"
+#include "pipelines/receive_file.hpp"
 #include "config/receive_config_toml.hpp"
 #include "receive_fusion_options.hpp"
 #include "receive_progress.hpp"
-#include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
-#include "signals/sample_format.hpp"
 
 namespace ultratrack::tools {
 
@@ -49,20 +43,22 @@ struct ReceiveArgs {
 };
 
 void run_receive(const ReceiveArgs& args) {
-  const auto format = parse_format(args.format);
-  receiver::SampleSourceOptions source_options;
-  source_options.two_bit = parse_two_bit_layout(args.format);
-  source_options.fs_hz = parse_double_option("--fs", args.fs);
-  source_options.if_hz = parse_double_option("--if", args.if_hz);
-  source_options.iq_swap = args.iq_swap;
-  source_options.q_negate = args.q_negate;
+  pipelines::ReceiveFileJob job;
+  job.input = args.input;
+  job.out = args.out;
+  job.format = parse_format(args.format);
+  receiver::SampleSourceOptions& source = job.source;
+  source.two_bit = parse_two_bit_layout(args.format);
+  source.fs_hz = parse_double_option("--fs", args.fs);
+  source.if_hz = parse_double_option("--if", args.if_hz);
+  source.iq_swap = args.iq_swap;
+  source.q_negate = args.q_negate;
   const double skip_s = args.skip.empty() ? 0.0 : parse_double_option("--skip", args.skip);
   if (skip_s < 0.0) throw signals::InputError("command line", "--skip: must not be negative");
-  source_options.start_sample = std::llround(skip_s * source_options.fs_hz);
+  source.start_sample = std::llround(skip_s * source.fs_hz);
 
-  pipelines::ReceiveOptions pipeline;
-  receiver::ReceiverOptions& options = pipeline.receiver;
-  options.fs_hz = source_options.fs_hz;
+  receiver::ReceiverOptions& options = job.options.receiver;
+  options.fs_hz = source.fs_hz;
   if (!args.config.empty()) config::apply_receive_config(args.config, options);
   if (!args.elevation_mask.empty())
     options.pvt.elevation_mask_rad = parse_double_option("--elevation-mask-deg", args.elevation_mask) * M_PI / 180.0;
@@ -71,80 +67,33 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.channels.empty()) options.channels = parse_int_option("--channels", args.channels);
   if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
-  signals::RinexNavData nav;
-  if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
+  if (!args.nav.empty()) job.navigation = signals::read_rinex_nav(args.nav);
   if (!args.reference_week.empty()) {
     options.reference_week = parse_int_option("--reference-week", args.reference_week);
     options.reference_week_is_signal_week = true;
-  } else if (options.reference_week == 0) {
-    // A nav file dates the recording; the build date only bounds it (+-512 weeks for the 10-bit WN).
-    options.reference_week = nav.ephemerides.empty() ? build_gps_week() : nav.ephemerides.front().week;
-    options.reference_week_is_signal_week = !nav.ephemerides.empty();
   }
-  const double duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
-  if (duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
+  pipelines::date_recording(options, job.navigation, build_gps_week());
+  job.duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
+  if (job.duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
   if (args.out.empty()) throw signals::InputError("command line", "--out: an output folder is required");
   if (const std::string why = options.validate(); !why.empty()) throw signals::InputError(args.config.empty() ? "command line" : args.config, why);
+  apply_receive_coupling_args(args.fusion, job.options);
+  if (std::string why; !job.options.IsValid(&why)) throw signals::InputError("command line", why);
+  const bool fused = pipelines::uses_imu(job.options.coupling);
+  if (fused) job.imu = read_receive_imu(args.fusion.imu);
 
-  receiver::SampleSource source(args.input, format, source_options);
-  const std::int64_t available = source.total_samples() - source_options.start_sample;
-  std::int64_t to_process = available;
-  if (duration_s > 0.0) to_process = std::min<std::int64_t>(to_process, std::llround(duration_s * options.fs_hz));
-  const receiver::AcquisitionOptions acq = [&] {
-    auto a = options.acquisition;
-    a.fs_hz = options.fs_hz;
-    return a;
-  }();
-  const auto needed = static_cast<std::int64_t>(acq.noncoherent * std::llround(acq.coherent_s() * options.fs_hz));
-  if (to_process < needed)
-    throw signals::InputError(args.input, fmt::format("holds {} samples to process, fewer than the {} that one "
-                                                      "acquisition needs ({} x {} ms)",
-                                                      to_process, needed, acq.noncoherent, acq.coherent_ms));
-
-  apply_receive_coupling_args(args.fusion, pipeline);
-  if (std::string why; !pipeline.IsValid(&why)) throw signals::InputError("command line", why);
-  std::vector<ins::ImuIncrement> imu;
-  if (pipelines::uses_imu(pipeline.coupling)) imu = read_receive_imu(args.fusion.imu);
-
-  receiver::ReceiverOutputs outputs(args.out, options.fs_hz, options.observation_interval_s);
-  pipelines::ReceiveCsvFiles logs(args.out, pipeline.coupling, options.fs_hz);
-  pipelines::Receiver receiver(pipeline, std::move(imu), nav, outputs, logs);
-  ReceiveProgress progress(args.quiet, static_cast<double>(to_process) / options.fs_hz);
-  const auto wall_start = std::chrono::steady_clock::now();
+  ReceiveProgress progress(args.quiet);
   InterruptGuard interrupt;  // Ctrl-C ends the loop; every output is still finished
-  receiver.run(source, to_process, interrupt.token(),
-               [&](const receiver::ReceiverEngine& engine) { progress.update(engine); });
-  const pipelines::ReceiveSummary summary = receiver.finish();
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  progress.update(receiver.engine(), true);
-  if (!summary.satellites_found && !summary.interrupted)
-    throw signals::InputError(args.input, fmt::format("no GPS L1 C/A satellite found in {:.1f} s of signal: check "
-                                                      "--format, --fs, --if, --iq-swap/--q-negate",
-                                                      summary.processed_s));
-
-  receiver::RunDescription run;
-  run.input = args.input;
-  run.format = args.format.format;
-  if (signals::is_two_bit(format))
-    run.format += fmt::format(" ({}, {})", signals::to_string(source_options.two_bit.coding),
-                              signals::to_string(source_options.two_bit.order));
-  run.fs_hz = options.fs_hz;
-  run.if_hz = source_options.if_hz;
-  run.skip_s = skip_s;
-  run.wall_time_s = wall_s;
-  run.interrupted = summary.interrupted;
-  run.coupling = pipelines::to_string(pipeline.coupling);
-  run.extra_json = summary.summary_json;
-  outputs.finish(receiver.engine(), run);
-  logs.commit();
-
+  const pipelines::ReceiveFileResult result = pipelines::receive_file(
+      std::move(job), interrupt.token(), [&](const pipelines::ReceiveProgressEvent& e) { progress.update(e); });
+  const pipelines::ReceiveSummary& summary = result.summary;
+  const double wall_s = result.wall_s;
   const double t = summary.processed_s;
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
-             wall_s > 0 ? t / wall_s : 0.0, summary.threads, run.interrupted ? ", interrupted" : "");
+             wall_s > 0 ? t / wall_s : 0.0, summary.threads, summary.interrupted ? ", interrupted" : "");
   fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", summary.satellites_tracked,
              summary.satellites_used, summary.fixes, summary.ephemerides_decoded);
   for (const std::string& line : summary.report) fmt::print("{}\n", line);
-  const bool fused = pipelines::uses_imu(pipeline.coupling);
   if (fused && !summary.navigation_started)
     throw CommandExit(3, fmt::format("{}: no fused solution ({}); outputs up to the end are in {}", args.input,
                                      summary.navigation_not_started, args.out));

@@ -11,11 +11,13 @@
 
 namespace ultratrack::tools {
 
-ReceiveProgress::ReceiveProgress(bool quiet, double total_s)
-    : quiet_(quiet), tty_(isatty(fileno(stderr)) != 0), total_s_(total_s) {}
+ReceiveProgress::ReceiveProgress(bool quiet) : quiet_(quiet), tty_(isatty(fileno(stderr)) != 0) {}
 
-void ReceiveProgress::update(const receiver::ReceiverEngine& engine, bool final) {
+void ReceiveProgress::update(const pipelines::ReceiveProgressEvent& event) {
   if (quiet_) return;
+  const receiver::ReceiverEngine& engine = event.engine;
+  const bool final = event.final;
+  const double total_s = event.total_s;
   const double t = receiver::processed_seconds(engine);
   const auto now = std::chrono::steady_clock::now();
   if (!final) {
@@ -30,13 +32,13 @@ void ReceiveProgress::update(const receiver::ReceiverEngine& engine, bool final)
                                  : "no fix";
   const int tracked = engine.channels_in_use(), synced = engine.channels_synchronised();
   if (tty_) {
-    const double fraction = total_s_ > 0.0 ? std::min(1.0, t / total_s_) : 0.0;
+    const double fraction = total_s > 0.0 ? std::min(1.0, t / total_s) : 0.0;
     const int width = 30, filled = static_cast<int>(fraction * width);
     fmt::print(stderr, "\r[{}{}] {:6.1f}/{:.1f} s  tracking {:2d} (synced {:2d})  {}   ", std::string(filled, '#'),
-               std::string(width - filled, '.'), t, total_s_, tracked, synced, status);
+               std::string(width - filled, '.'), t, total_s, tracked, synced, status);
     if (final) fmt::print(stderr, "\n");
   } else {
-    fmt::print(stderr, "receive: {:.1f}/{:.1f} s, tracking {} (synced {}), {}\n", t, total_s_, tracked, synced, status);
+    fmt::print(stderr, "receive: {:.1f}/{:.1f} s, tracking {} (synced {}), {}\n", t, total_s, tracked, synced, status);
   }
 }
 

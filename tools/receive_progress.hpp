@@ -4,18 +4,17 @@
 
 #include <chrono>
 
-#include "receiver/receiver_engine.hpp"
+#include "pipelines/receive_file.hpp"
 
 namespace ultratrack::tools {
 
 class ReceiveProgress {
  public:
-  ReceiveProgress(bool quiet, double total_s);
-  void update(const receiver::ReceiverEngine& engine, bool final = false);
+  explicit ReceiveProgress(bool quiet);
+  void update(const pipelines::ReceiveProgressEvent& event);
 
  private:
   bool quiet_, tty_;
-  double total_s_;
   double next_line_s_ = 0.0;
   std::chrono::steady_clock::time_point last_{};
 };
