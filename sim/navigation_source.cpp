@@ -39,4 +39,12 @@ NavigationSource load_navigation(const Scenario& s) {
   return nav;
 }
 
+signals::RinexNavData to_rinex_nav(const NavigationSource& navigation) {
+  signals::RinexNavData nav;
+  nav.ephemerides = navigation.ephemerides;
+  nav.klobuchar = navigation.klobuchar;
+  nav.utc = navigation.utc;
+  return nav;
+}
+
 }  // namespace ultratrack::sim

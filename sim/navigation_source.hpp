@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "signals/rinex_nav.hpp"
 #include "signals/ephemeris.hpp"
 #include "sim/scenario.hpp"
 
@@ -20,5 +21,8 @@ struct NavigationSource {
 
 // Throws io::InputError naming the RINEX file when it cannot be read or no ephemeris is valid at the start.
 NavigationSource load_navigation(const Scenario& scenario);
+// What a receiver of the scenario's signal could load from a nav file of that day (a hot start): the same
+// ephemerides, ionosphere and UTC parameters.
+signals::RinexNavData to_rinex_nav(const NavigationSource& navigation);
 
 }  // namespace ultratrack::sim

@@ -1,50 +1,34 @@
-// 10 s of the built-in constellation simulated into memory (sim::simulate) and received as it is made by the
-// library's receiver (pipelines::Receiver, scalar coupling), with the simulator's ephemerides as a hot start; prints
-// the last fix and its distance from the true position.
-#include <GeographicLib/Geocentric.hpp>
+// The library from outside the tree: 10 s of the built-in constellation simulated into a folder (sim/), then received
+// from that file with a hot start (pipelines/receive_file.hpp); prints the mean fix and its distance from the truth.
+#include <GeographicLib/LocalCartesian.hpp>
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 
-#include "pipelines/receiver_pipeline.hpp"
+#include "pipelines/receive_file.hpp"
 #include "sim/navigation_source.hpp"
-#include "sim/simulation.hpp"
+#include "sim/simulation_files.hpp"
 
 using namespace ultratrack;
 
-struct ToReceiver final : sim::SimulationSink {  // antenna 0's blocks straight into the receiver
-  pipelines::Receiver* receiver = nullptr;
-  std::int64_t next_sample = 0;
-  void samples(int, std::span<const std::complex<float>> block) override {
-    receiver->process(block, next_sample);
-    next_sample += static_cast<std::int64_t>(block.size());
-  }
-};
-
 int main() {
-  sim::Scenario scenario;  // defaults: static receiver, nominal constellation, 45 dB-Hz, i8 at 2.6 MHz
+  sim::Scenario scenario;  // a static receiver, nominal constellation, 45 dB-Hz, i8 at 2.6 MHz
   scenario.duration_s = 10.0;
-  scenario.tow_s = 518398.0;  // subframes start at 2 s and 8 s of signal
-  pipelines::ReceiveOptions options;
-  options.receiver.fs_hz = scenario.sample_rate_hz;
-  options.receiver.reference_week = scenario.gps_week;
-  options.receiver.reference_week_is_signal_week = true;
-  options.receiver.pvt.troposphere = scenario.troposphere;  // the receiver corrects what the scenario simulates
-  const sim::NavigationSource nav = sim::load_navigation(scenario);
-  signals::RinexNavData hot_start;
-  hot_start.ephemerides = nav.ephemerides;
-  hot_start.klobuchar = nav.klobuchar;
-  hot_start.utc = nav.utc;
-  receiver::ReceiverObserver no_outputs;
-  pipelines::ReceiveSink no_logs;
-  pipelines::Receiver receiver(options, {}, hot_start, no_outputs, no_logs);
-  ToReceiver sink;
-  sink.receiver = &receiver;
-  sim::simulate(scenario, sink);
-  const pipelines::ReceiveSummary summary = receiver.finish();
-  const auto& fix = receiver.engine().last_fix();
-  if (!fix) return std::puts("no fix"), 1;
-  Eigen::Vector3d truth;
-  GeographicLib::Geocentric::WGS84().Forward(scenario.llh_deg_m[0], scenario.llh_deg_m[1], scenario.llh_deg_m[2],
-                                             truth.x(), truth.y(), truth.z());
-  std::printf("fix: ECEF %.1f %.1f %.1f m after %d fixes (first at %.1f s), %.2f m from the truth\n", fix->r_e_m.x(),
-              fix->r_e_m.y(), fix->r_e_m.z(), summary.fixes, summary.ttff_s, (fix->r_e_m - truth).norm());
+  scenario.tow_s = 518398.0;  // subframes (and their time of week) begin 2 s and 8 s into the signal
+  const auto dir = std::filesystem::temp_directory_path() / "ultratrack_consumer";
+  sim::simulate_to_folder(scenario, dir, "");
+  pipelines::ReceiveFileJob job;
+  job.input = dir / "antenna0.i8.bin";
+  job.out = dir / "receiver";
+  job.source.fs_hz = job.options.receiver.fs_hz = scenario.sample_rate_hz;
+  job.options.receiver.pvt.troposphere = scenario.troposphere;  // correct what the scenario simulates
+  job.navigation = sim::to_rinex_nav(sim::load_navigation(scenario));  // as a nav file of the day would give it
+  pipelines::date_recording(job.options.receiver, job.navigation, scenario.gps_week);
+  const pipelines::ReceiveSummary fix = pipelines::receive_file(job).summary;
+  double e, n, u;
+  GeographicLib::LocalCartesian(scenario.llh_deg_m[0], scenario.llh_deg_m[1], scenario.llh_deg_m[2])
+      .Forward(fix.mean_lat_deg, fix.mean_lon_deg, fix.mean_height_m, e, n, u);
+  std::printf("fix: %.7f %.7f %.1f m (%d fixes, first at %.1f s), %.2f m from the truth\n", fix.mean_lat_deg,
+              fix.mean_lon_deg, fix.mean_height_m, fix.fixes, fix.ttff_s, std::hypot(e, n, u));
+  return fix.fixes > 0 ? 0 : 1;
 }
