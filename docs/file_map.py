@@ -2,15 +2,17 @@
 """The file tables of docs/architecture.md, read from the code: one row per module (a .hpp with its .cpp, or a
 lone .cpp), its job the first sentence of the module's opening comment. Run from the repository root:
 
-    python3 docs/file_map.py            # every layer's table, to paste into docs/architecture.md
-    python3 docs/file_map.py --check    # exit 1 and name each module that docs/architecture.md does not list
+    python3 docs/file_map.py            # every layer's table
+    python3 docs/file_map.py --write    # the tables of docs/architecture.md's "Modules" rewritten in place
+    python3 docs/file_map.py --check    # exit 1 when a table there differs from the code (ctest docs.file_map)
 
 A header whose first sentence does not say what the module does is the thing to fix, not this script."""
 import os
 import re
 import sys
 
-LAYERS = ["io", "signals", "ins", "sim", "receiver", "fusion", "pipelines", "tools"]
+LAYERS = ["io", "signals", "ins", "sim", "receiver", "fusion", "pipelines", "config", "tools"]
+DOC = "docs/architecture.md"
 
 
 def opening_comment(path):
@@ -58,23 +60,56 @@ def modules(layer):
         yield stem, stem + suffixes, first_sentence(opening_comment(os.path.join(layer, source)))
 
 
-def main():
-    check = "--check" in sys.argv
-    doc = open("docs/architecture.md", encoding="utf-8").read() if check else ""
-    missing = 0
+def table(layer):
+    lines = ["| file | job |", "|---|---|"]
+    lines += [f"| `{label}` | {job} |" for _, label, job in modules(layer)]
+    return lines
+
+
+def with_tables(doc_lines):
+    """The document with the table under each "### <layer>/" heading of "## Modules" made from the code; a layer
+    without a heading there is an error (its heading and prose are written by hand)."""
+    out, missing = list(doc_lines), []
+    start = out.index("## Modules")
     for layer in LAYERS:
-        rows = list(modules(layer))
-        if check:
-            for stem, label, _ in rows:
-                if f"`{stem}." not in doc and f"`{stem}`" not in doc:
-                    print(f"docs/architecture.md does not list {layer}/{label}")
-                    missing += 1
+        try:
+            at = out.index(f"### {layer}/", start)
+        except ValueError:
+            missing.append(layer)
             continue
-        print(f"### {layer}/\n| file | job |\n|---|---|")
-        for _, label, job in rows:
-            print(f"| `{label}` | {job} |")
+        first = at + 1
+        while first < len(out) and not out[first].startswith("|"):
+            if out[first].startswith("#"):
+                break
+            first += 1
+        last = first
+        while last < len(out) and out[last].startswith("|"):
+            last += 1
+        out[first:last] = table(layer)
+    return out, missing
+
+
+def main():
+    if "--write" in sys.argv or "--check" in sys.argv:
+        os.chdir(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+        lines = open(DOC, encoding="utf-8").read().split("\n")
+        new, missing = with_tables(lines)
+        for layer in missing:
+            print(f"{DOC}: no '### {layer}/' section under '## Modules'")
+        if "--write" in sys.argv:
+            open(DOC, "w", encoding="utf-8").write("\n".join(new))
+            return 1 if missing else 0
+        stale = [l for l in new if l not in lines] + [l for l in lines if l.startswith("| `") and l not in new]
+        for l in stale:
+            print(f"{DOC}: differs from the code: {l[:110]}")
+        if stale:
+            print("run `python3 docs/file_map.py --write` and review the rows (a header's first sentence is the row)")
+        return 1 if missing or stale else 0
+    for layer in LAYERS:
+        print(f"### {layer}/")
+        print("\n".join(table(layer)))
         print()
-    return 1 if missing else 0
+    return 0
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-// tools/solution_compare: a known error put on a known trajectory comes back. The truth is a 100 m circle at
+// pipelines/solution_compare: a known error put on a known trajectory comes back. The truth is a 100 m circle at
 // 8.33 m/s in a local tangent plane, turned into ECEF by GeographicLib's LocalCartesian (not by the code under
 // test); the solution is that circle at times between the truth rows plus a fixed ENU position offset and a
 // fixed velocity offset, so every RMS is the offset's norm (to the truth's interpolation error, < 1 mm).

@@ -2,7 +2,7 @@
 // drives the antenna round a circle of radius 100 m at 30 km/h (centripetal 0.69 m/s^2, line-of-sight
 // accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with brdc0010.22n; `ultratrack receive` starts hot
 // (--nav) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the truth by
-// tools/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
+// pipelines/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
