@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 #include <limits>
 
-#include "fusion/chi_square.hpp"
+#include "receiver/chi_square.hpp"
 #include "fusion/covariance_utils.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"

@@ -9,7 +9,7 @@
 #include <cstddef>
 #include <limits>
 
-#include "fusion/chi_square.hpp"
+#include "receiver/chi_square.hpp"
 #include "fusion/filter_types.hpp"
 
 namespace ultratrack::fusion {
@@ -27,10 +27,10 @@ inline double gate_threshold(double probability, int dof) {
     return a;
   }();
   thread_local std::array<double, kMemo> memo_q{};
-  if (dof <= 0 || dof >= kMemo) return chi_square_quantile(probability, dof);
+  if (dof <= 0 || dof >= kMemo) return receiver::chi_square_lower_quantile(dof, probability);
   const auto i = static_cast<std::size_t>(dof);
   if (memo_p[i] != probability) {
-    memo_q[i] = chi_square_quantile(probability, dof);
+    memo_q[i] = receiver::chi_square_lower_quantile(dof, probability);
     memo_p[i] = probability;
   }
   return memo_q[i];

@@ -15,7 +15,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "fusion/chi_square.hpp"
+#include "receiver/chi_square.hpp"
 #include "fusion/covariance_utils.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"

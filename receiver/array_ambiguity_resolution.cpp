@@ -39,7 +39,7 @@ BaselineSet constrained_candidates(const ArrayFitter& fitter, int k, double leng
   const Eigen::MatrixXd Q = dd.covariance.block(set.begin, set.begin, set.count, set.count);
   const Eigen::VectorXd y = dd.dd_cycles.segment(set.begin, set.count);
   const double p_gate = std::erfc(o.gate_sigma / std::sqrt(2.0));  // two-sided normal tail of the gate
-  const double q = chi_square_quantile(dof, p_gate);
+  const double q = chi_square_upper_quantile(dof, p_gate);
   // Prior weight that minimises the enumerated volume (3 geometry dimensions against dof noise dimensions).
   const double alpha2 = 3.0 * q / dof;
   const double sigma_b = length_m / std::sqrt(alpha2);
@@ -180,7 +180,7 @@ AmbiguityResolution resolve_array_ambiguities(const ArrayFitter& fitter,
     }
     out.candidates.push_back(c);
   }
-  const double chi2_max = chi_square_quantile(std::max(out.fit.dof, 1), o.residual_test_pfa);
+  const double chi2_max = chi_square_upper_quantile(std::max(out.fit.dof, 1), o.residual_test_pfa);
   out.fixed = out.fit.ok && out.fit.chi2 <= chi2_max && out.ratio >= o.ratio_threshold &&
               out.difference >= o.difference_threshold;
   return out;

@@ -176,7 +176,7 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
 
   const Eigen::Matrix3d C_en = ned_to_ecef_rotation(epoch.master_position_e);
   const double pfa = options_.residual_test_pfa;
-  auto passes = [&](const ArrayFit& f) { return f.ok && f.dof >= 1 && f.chi2 <= chi_square_quantile(f.dof, pfa); };
+  auto passes = [&](const ArrayFit& f) { return f.ok && f.dof >= 1 && f.chi2 <= chi_square_upper_quantile(f.dof, pfa); };
   // Carried DDs: the satellites with a kept ambiguity, on the baselines that keep at least 4 of them (3 DDs).
   auto carried_dd = [&]() {
     std::vector<int> kept_sats(lever.size(), 0);
@@ -349,7 +349,7 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
     const double j1 = pending_.front().chi2_sum;
     const double j2 = pending_.size() > 1 ? pending_[1].chi2_sum : std::numeric_limits<double>::infinity();
     sol.ratio = std::isfinite(j2) ? j2 / std::max(j1, 1e-12) : 1e9;
-    if (j1 <= chi_square_quantile(pending_dof_, pfa) && j2 - j1 >= options_.multi_epoch_difference_threshold) {
+    if (j1 <= chi_square_upper_quantile(pending_dof_, pfa) && j2 - j1 >= options_.multi_epoch_difference_threshold) {
       const ArrayFit f = fitter.fit(pending_.front().integers);
       if (passes(f)) {
         integers = pending_.front().integers;

@@ -1,3 +1,4 @@
+#include "receiver/chi_square.hpp"
 #include "receiver/pvt.hpp"
 
 #include <GeographicLib/Geocentric.hpp>
@@ -181,20 +182,6 @@ std::string PvtOptions::validate() const {
   if (!(sigma_zenith_m > 0.0) || !(sigma_doppler_mps > 0.0)) return "measurement sigmas must be positive";
   if (max_iterations < 1) return "max_iterations must be at least 1";
   return {};
-}
-
-double chi_square_upper_quantile(int dof, double probability) {
-  // Standard normal upper quantile z with Q(z) = probability, by bisection on erfc (monotone).
-  double lo = -10.0, hi = 10.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (0.5 * std::erfc(mid / std::sqrt(2.0)) > probability ? lo : hi) = mid;
-  }
-  const double z = 0.5 * (lo + hi);
-  const double k = dof;
-  const double a = 2.0 / (9.0 * k);
-  const double term = 1.0 - a + z * std::sqrt(a);
-  return k * term * term * term;
 }
 
 PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& meas, const signals::GpsTime& receive_time,

@@ -77,8 +77,5 @@ PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& measurements, con
                       const signals::KlobucharParameters& iono, const PvtOptions& options,
                       const Eigen::Vector3d& initial_r_e_m = Eigen::Vector3d::Zero());
 
-// Upper quantile of the chi-square distribution with `dof` degrees of freedom: the value x such that
-// P(X > x) = probability (Wilson-Hilferty approximation, accurate to a few per cent for dof >= 1).
-double chi_square_upper_quantile(int dof, double probability);
 
 }  // namespace ultratrack::receiver

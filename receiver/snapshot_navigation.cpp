@@ -1,3 +1,4 @@
+#include "receiver/chi_square.hpp"
 #include "receiver/snapshot_navigation.hpp"
 
 #include <GeographicLib/Geocentric.hpp>

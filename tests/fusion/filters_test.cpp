@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "fusion/chi_square.hpp"
+#include "receiver/chi_square.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/ekf.hpp"
 #include "fusion/ins_error_model.hpp"
@@ -17,10 +17,10 @@ namespace {
 
 TEST(ChiSquare, MatchesTabulatedQuantiles) {
   // Published table values (e.g. NIST/SEMATECH e-Handbook, upper-tail critical values).
-  EXPECT_NEAR(chi_square_quantile(0.95, 1), 3.841459, 1e-6);
-  EXPECT_NEAR(chi_square_quantile(0.95, 10), 18.307038, 1e-6);
-  EXPECT_NEAR(chi_square_quantile(0.99, 4), 13.276704, 1e-6);
-  EXPECT_NEAR(chi_square_cdf(2.0, 2), 1.0 - std::exp(-1.0), 1e-12);  // closed form for 2 dof
+  EXPECT_NEAR(receiver::chi_square_lower_quantile(1, 0.95), 3.841459, 1e-6);
+  EXPECT_NEAR(receiver::chi_square_lower_quantile(10, 0.95), 18.307038, 1e-6);
+  EXPECT_NEAR(receiver::chi_square_lower_quantile(4, 0.99), 13.276704, 1e-6);
+  EXPECT_NEAR(receiver::chi_square_cdf(2, 2.0), 1.0 - std::exp(-1.0), 1e-12);  // closed form for 2 dof
 }
 
 // Double integrator driven by white acceleration: Phi = [1 dt; 0 1], Qd = q [dt^3/3 dt^2/2; dt^2/2 dt].
@@ -283,7 +283,7 @@ std::vector<double> nees_monte_carlo(int runs, int steps, typename Filter::Matri
 TEST(Filters, NeesOfBothFiltersInChiSquareBandOnNonlinearModel) {
   const int runs = 100, steps = 40, n = 4;
   // Run-averaged NEES: runs * mean ~ chi2(runs * n). 95 % two-sided band.
-  const double lo = chi_square_quantile(0.025, runs * n) / runs, hi = chi_square_quantile(0.975, runs * n) / runs;
+  const double lo = receiver::chi_square_lower_quantile(runs * n, 0.025) / runs, hi = receiver::chi_square_lower_quantile(runs * n, 0.975) / runs;
   StateMatrix<4> P0 = Eigen::Vector4d(25.0, 25.0, 1.0, 1.0).asDiagonal();
   auto ekf_mean = nees_monte_carlo<Ekf<4>>(runs, steps, P0, [] {
     EkfOptions o;

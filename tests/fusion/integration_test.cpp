@@ -9,7 +9,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "fusion/chi_square.hpp"
+#include "receiver/chi_square.hpp"
 #include "fusion/gnss_ins_integration.hpp"
 #include "fusion_sim.hpp"
 #include "ins/nav_correction.hpp"
@@ -137,7 +137,7 @@ TEST(TightIntegration, BoundedWithThreeSatellites) {
                 f == FilterKind::Ekf ? "tight EKF" : "tight UKF", max_after, with3.pos_err_m.back().head<2>().norm(),
                 none.outage_drift_h_m);
     EXPECT_LT(max_after, 0.5 * none.outage_drift_h_m);
-    EXPECT_LT(with3.nees.back(), chi_square_quantile(0.999, 17));
+    EXPECT_LT(with3.nees.back(), receiver::chi_square_lower_quantile(17, 0.999));
   }
 }
 

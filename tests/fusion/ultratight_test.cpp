@@ -10,7 +10,7 @@
 #include <map>
 
 #include "correlation_sim.hpp"
-#include "fusion/chi_square.hpp"
+#include "receiver/chi_square.hpp"
 #include "fusion/iq_measurements.hpp"
 #include "fusion/ultratight_integration.hpp"
 #include "signals/gps_constants.hpp"
@@ -349,7 +349,7 @@ double nees_monte_carlo(FilterKind f, int runs, double clock_bias_psd, const cha
               rms3(ms_err, 0), rms3(ms_sig, 0), rms3(ms_err, 3), rms3(ms_sig, 3), 1e3 * rms3(ms_err, 6),
               1e3 * rms3(ms_sig, 6));
   const double mean = sum / runs;
-  const double lo = chi_square_quantile(0.025, 17 * runs) / runs, hi = chi_square_quantile(0.975, 17 * runs) / runs;
+  const double lo = receiver::chi_square_lower_quantile(17 * runs, 0.025) / runs, hi = receiver::chi_square_lower_quantile(17 * runs, 0.975) / runs;
   std::printf("%s NEES over %d runs: mean %.2f, 95%% band [%.2f, %.2f]; filter time %.2f s\n", what, runs, mean, lo, hi,
               cpu);
   std::printf("  mean (error / sigma)^2 per state (pos, vel, att, ba, bg, clock):");
@@ -401,7 +401,7 @@ double mean_iq_nis(double start_phase_sigma_rad, bool tell, int& count) {
 TEST(UltraTight, ClosedPllStartPhaseInRKeepsIqNisInItsBand) {
   int n = 0;
   const double realigned = mean_iq_nis(0.0, true, n);
-  const double lo = chi_square_quantile(0.005, 6 * n) / n, hi = chi_square_quantile(0.995, 6 * n) / n;
+  const double lo = receiver::chi_square_lower_quantile(6 * n, 0.005) / n, hi = receiver::chi_square_lower_quantile(6 * n, 0.995) / n;
   int n1 = 0, n2 = 0;
   const double told = mean_iq_nis(0.05, true, n1);
   const double seed_model = mean_iq_nis(0.05, false, n2);
@@ -442,8 +442,8 @@ TEST(UltraTight, ContinuousCarrierStartPhaseRemovesTheVelocityBias) {
       for (std::size_t i = r.nis.size() / 4; i < r.nis.size(); ++i, ++nis_n) nis_sum += r.nis[i];
     }
     nis = nis_sum / nis_n;
-    lo = chi_square_quantile(0.005, 6 * nis_n) / nis_n;
-    hi = chi_square_quantile(0.995, 6 * nis_n) / nis_n;
+    lo = receiver::chi_square_lower_quantile(6 * nis_n, 0.005) / nis_n;
+    hi = receiver::chi_square_lower_quantile(6 * nis_n, 0.995) / nis_n;
   };
   Eigen::Vector3d told, zero;
   double nis_told, nis_zero, lo, hi;

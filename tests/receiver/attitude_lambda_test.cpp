@@ -140,10 +140,13 @@ TEST(AttitudeLambda, EnumeratesTheWholeEllipsoid) {
 
 TEST(AttitudeLambda, ChiSquareQuantilesMatchTables) {
   // NIST/SEMATECH e-Handbook, table of upper critical values of the chi-square distribution.
-  EXPECT_NEAR(chi_square_quantile(1, 0.05), 3.841, 0.002);
-  EXPECT_NEAR(chi_square_quantile(2, 0.01), 9.210, 0.002);
-  EXPECT_NEAR(chi_square_quantile(3, 0.05), 7.815, 0.05);
-  EXPECT_NEAR(chi_square_quantile(10, 0.01), 23.209, 0.1);
-  EXPECT_NEAR(chi_square_quantile(20, 0.001), 45.315, 0.3);
+  // Published table values (3 decimals: within 0.0005 of the exact quantile).
+  EXPECT_NEAR(chi_square_upper_quantile(1, 0.05), 3.841, 0.0005);
+  EXPECT_NEAR(chi_square_upper_quantile(2, 0.01), 9.210, 0.0005);
+  EXPECT_NEAR(chi_square_upper_quantile(3, 0.05), 7.815, 0.0005);
+  EXPECT_NEAR(chi_square_upper_quantile(10, 0.01), 23.209, 0.0005);
+  EXPECT_NEAR(chi_square_upper_quantile(20, 0.001), 45.315, 0.0005);
+  EXPECT_NEAR(chi_square_upper_tail(2, -2.0 * std::log(1e-12)), 1e-12, 1e-20);  // closed form for 2 dof, deep tail
+  EXPECT_NEAR(chi_square_lower_quantile(5, 0.3) , chi_square_upper_quantile(5, 0.7), 1e-9);
   EXPECT_NEAR(normal_upper_quantile(0.025), 1.959964, 1e-5);
 }

@@ -1,5 +1,6 @@
 // PVT against simulator truth: pseudoranges and Dopplers are generated here from a known receiver
 // position, velocity and clock with an independent light-time iteration, then solved for.
+#include "receiver/chi_square.hpp"
 #include "receiver/pvt.hpp"
 
 #include <Eigen/Cholesky>
@@ -228,10 +229,11 @@ TEST(Pvt, UnhealthySatelliteIsNotUsedByDefault) {
 
 TEST(Pvt, ChiSquareQuantileMatchesPublishedTable) {
   // Standard chi-square table values (upper tail). Wilson-Hilferty is within ~2 % for dof >= 2.
-  EXPECT_NEAR(receiver::chi_square_upper_quantile(2, 0.05), 5.991, 0.02 * 5.991);
-  EXPECT_NEAR(receiver::chi_square_upper_quantile(4, 0.001), 18.467, 0.02 * 18.467);
-  EXPECT_NEAR(receiver::chi_square_upper_quantile(10, 0.01), 23.209, 0.01 * 23.209);
-  EXPECT_NEAR(receiver::chi_square_upper_quantile(30, 0.05), 43.773, 0.005 * 43.773);
+  // Published table values to 3 decimals.
+  EXPECT_NEAR(receiver::chi_square_upper_quantile(2, 0.05), 5.991, 0.0005);
+  EXPECT_NEAR(receiver::chi_square_upper_quantile(4, 0.001), 18.467, 0.0005);
+  EXPECT_NEAR(receiver::chi_square_upper_quantile(10, 0.01), 23.209, 0.0005);
+  EXPECT_NEAR(receiver::chi_square_upper_quantile(30, 0.05), 43.773, 0.0005);
 }
 
 // The a-priori covariances (new with the GNSS/INS integration, which weights the fixes by them): the weights
