@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "io/units.hpp"
 #include "pipelines/fuse.hpp"
 #include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/imu_error_model.hpp"
@@ -21,7 +22,6 @@ using namespace ultratrack;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Scenario {
   std::vector<ins::NavState> truth;
@@ -30,7 +30,7 @@ struct Scenario {
 };
 
 Scenario make_scenario(const std::string& profile, double duration_s, double rate_hz) {
-  const auto spec = ins::profile_spec(profile, duration_s, 36.37 * kDeg, 127.36 * kDeg, 300.0);
+  const auto spec = ins::profile_spec(profile, duration_s, 36.37 * io::kRadPerDeg, 127.36 * io::kRadPerDeg, 300.0);
   ins::SimulatedRun run = ins::simulate(spec, rate_hz);
   Scenario s;
   for (const auto& t : run.truth) s.truth.push_back(t.nav());

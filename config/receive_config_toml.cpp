@@ -5,12 +5,12 @@
 #include <string>
 #include <toml++/toml.h>
 
+#include "io/units.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::config {
 namespace {
 
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
 struct Setter {
   std::string file, key;
@@ -102,7 +102,7 @@ const std::map<std::string, Table>& sections() {
         {"presence_false_loss_per_min", [](const Setter& v, O& o) { o.tracking.presence_false_loss_per_min = v.number(); }},
         {"presence_relock_dbhz", [](const Setter& v, O& o) { o.tracking.presence_relock_dbhz = v.number(); }}}},
       {"pvt",
-       {{"elevation_mask_deg", [](const Setter& v, O& o) { o.pvt.elevation_mask_rad = v.number() * kDegToRad; }},
+       {{"elevation_mask_deg", [](const Setter& v, O& o) { o.pvt.elevation_mask_rad = v.number() * io::kRadPerDeg; }},
         {"troposphere", [](const Setter& v, O& o) { o.pvt.troposphere = v.boolean(); }},
         {"ionosphere", [](const Setter& v, O& o) { o.pvt.ionosphere = v.boolean(); }},
         {"exclude_unhealthy", [](const Setter& v, O& o) { o.pvt.exclude_unhealthy = v.boolean(); }},

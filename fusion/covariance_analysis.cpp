@@ -11,6 +11,7 @@
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/look_angles.hpp"
 #include "signals/nominal_constellation.hpp"
@@ -19,10 +20,9 @@
 namespace ultratrack::fusion {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kC = 299792458.0;
 constexpr double kMicroG = 9.80665e-6;
-constexpr double kDegPerHour = kDeg / 3600.0;
+constexpr double kDegPerHour = io::kRadPerDeg / 3600.0;
 
 // Satellites above the mask seen from the antenna at GPS time t, with the observables an error-free
 // receiver on the truth would measure (so the innovation is zero).

@@ -1,4 +1,5 @@
 #include "ins/earth_model.hpp"
+#include "io/units.hpp"
 
 #include <GeographicLib/Constants.hpp>
 #include <GeographicLib/Geocentric.hpp>
@@ -9,7 +10,6 @@
 namespace ultratrack::ins {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 }  // namespace
 
@@ -36,7 +36,7 @@ Eigen::Vector3d transport_rate_n(double lat_rad, double height_m, const Eigen::V
 Eigen::Vector3d gravity_n(double lat_rad, double height_m) {
   static const GeographicLib::NormalGravity& model = GeographicLib::NormalGravity::WGS84();
   double gamma_north = 0.0, gamma_up = 0.0;
-  model.Gravity(lat_rad * kRadToDeg, height_m, gamma_north, gamma_up);
+  model.Gravity(lat_rad * io::kDegPerRad, height_m, gamma_north, gamma_up);
   return {gamma_north, 0.0, -gamma_up};
 }
 
@@ -48,7 +48,7 @@ Eigen::Vector3d geodetic_rates(double lat_rad, double height_m, const Eigen::Vec
 Eigen::Vector3d ecef_from_geodetic(double lat_rad, double lon_rad, double height_m) {
   static const GeographicLib::Geocentric& earth = GeographicLib::Geocentric::WGS84();
   double x = 0.0, y = 0.0, z = 0.0;
-  earth.Forward(lat_rad * kRadToDeg, lon_rad * kRadToDeg, height_m, x, y, z);
+  earth.Forward(lat_rad * io::kDegPerRad, lon_rad * io::kDegPerRad, height_m, x, y, z);
   return {x, y, z};
 }
 

@@ -4,13 +4,13 @@
 #include <numbers>
 
 #include "ins/ins_error.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::ins {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kDegPerHour = kDeg / 3600.0;    // rad/s
-constexpr double kDegPerSqrtHour = kDeg / 60.0;  // rad/sqrt(s)
+constexpr double kDegPerHour = io::kRadPerDeg / 3600.0;    // rad/s
+constexpr double kDegPerSqrtHour = io::kRadPerDeg / 60.0;  // rad/sqrt(s)
 constexpr double kG = 9.80665;
 constexpr double kFoot = 0.3048;
 
@@ -32,8 +32,8 @@ ImuErrorSpec make_dmu6x() {
   // Seed 003 Table 1: gyro bias +-1 deg/s, accelerometer bias +-10 mg (taken as 1 sigma). Noise, scale
   // factor and misalignment are typical values of that MEMS class (Crossbow DMU-6X data sheet order).
   ImuErrorSpec s;
-  s.gyro.bias_sigma = 1.0 * kDeg;
-  s.gyro.bias_instability_sigma = 0.01 * kDeg;
+  s.gyro.bias_sigma = 1.0 * io::kRadPerDeg;
+  s.gyro.bias_instability_sigma = 0.01 * io::kRadPerDeg;
   s.gyro.bias_correlation_time_s = 300.0;
   s.gyro.random_walk = 2.25 * kDegPerSqrtHour;
   s.gyro.scale_factor_sigma = 0.01;
@@ -65,7 +65,7 @@ ImuErrorSpec make_mems() {
   // Consumer MEMS (smartphone class, factory calibrated): 0.5 deg/s and 30 mg turn-on biases,
   // 10 deg/h and 0.1 mg instabilities, 0.5 deg/sqrt(h) and 0.1 m/s/sqrt(h) random walks, 0.5 % scale factor.
   ImuErrorSpec s;
-  s.gyro.bias_sigma = 0.5 * kDeg;
+  s.gyro.bias_sigma = 0.5 * io::kRadPerDeg;
   s.gyro.bias_instability_sigma = 10.0 * kDegPerHour;
   s.gyro.bias_correlation_time_s = 100.0;
   s.gyro.random_walk = 0.5 * kDegPerSqrtHour;

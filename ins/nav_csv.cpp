@@ -12,11 +12,11 @@
 #include "ins/ins_error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::ins {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 const std::vector<std::string>& nav_header() {
   static const std::vector<std::string> h{"t_s",       "lat_deg",   "lon_deg",  "height_m",  "vel_n_mps",
@@ -36,11 +36,11 @@ std::vector<NavState> read_nav_csv(const std::filesystem::path& file) {
     if (std::fabs(v[8]) > 90.0) throw InputError(file.string(), "pitch_deg outside [-90, 90]", line_no);
     NavState s;
     s.t_s = v[0];
-    s.lat_rad = v[1] * kDeg;
-    s.lon_rad = v[2] * kDeg;
+    s.lat_rad = v[1] * io::kRadPerDeg;
+    s.lon_rad = v[2] * io::kRadPerDeg;
     s.height_m = v[3];
     s.v_n = {v[4], v[5], v[6]};
-    s.q_nb = quaternion_from_euler({v[7] * kDeg, v[8] * kDeg, v[9] * kDeg});
+    s.q_nb = quaternion_from_euler({v[7] * io::kRadPerDeg, v[8] * io::kRadPerDeg, v[9] * io::kRadPerDeg});
     out.push_back(s);
   });
   return out;
@@ -56,8 +56,8 @@ NavCsvWriter::~NavCsvWriter() = default;
 
 void NavCsvWriter::write(const NavState& s) {
   const EulerAngles e = euler_from_quaternion(s.q_nb);
-  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m,
-                          s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg));
+  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / io::kRadPerDeg, s.lon_rad / io::kRadPerDeg, s.height_m,
+                          s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg));
 }
 
 void NavCsvWriter::commit() { out_->commit(); }

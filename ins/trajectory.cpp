@@ -6,11 +6,11 @@
 
 #include "ins/ins_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::ins {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 // Aircraft roll into and out of turns over 3 s (peak roll rate about 30 deg/s when the S reverses its
 // 24 deg bank): realistic, and it keeps the two-sample algorithms' error far below the tolerance.
 constexpr double kAircraftRamp_s = 3.0;
@@ -64,17 +64,17 @@ TrajectorySpec profile_spec(std::string_view name, double duration_s, double lat
         {10.0},                              // stopped
         {10.0, 2.0},                         // 0 -> 20 m/s
         {20.0},                              // cruise
-        {20.0, 0.0, 0.0, 0.0, 4.0 * kDeg},   // uphill 4 %
-        {20.0, 0.0, 0.0, 0.0, -4.0 * kDeg},  // downhill
+        {20.0, 0.0, 0.0, 0.0, 4.0 * io::kRadPerDeg},   // uphill 4 %
+        {20.0, 0.0, 0.0, 0.0, -4.0 * io::kRadPerDeg},  // downhill
         {10.0, -1.0},                        // 20 -> 10 m/s
-        {10.0, 0.0, 9.0 * kDeg},             // 90 deg right turn
+        {10.0, 0.0, 9.0 * io::kRadPerDeg},             // 90 deg right turn
         {10.0, 2.0},                         // 10 -> 30 m/s
         {30.0},                              // cruise
         {10.0, -3.0},                        // 30 -> 0 m/s
         {10.0},                              // stopped
         {10.0, 1.0},                         // 0 -> 10 m/s
-        {15.0, 0.0, -6.0 * kDeg},            // 90 deg left turn
-        {25.0, 0.0, 0.0, 0.0, 2.0 * kDeg},   // gentle hill
+        {15.0, 0.0, -6.0 * io::kRadPerDeg},            // 90 deg left turn
+        {25.0, 0.0, 0.0, 0.0, 2.0 * io::kRadPerDeg},   // gentle hill
         {10.0, -1.0},                        // 10 -> 0 m/s
     };
     double t = 0.0;
@@ -102,7 +102,7 @@ TrajectorySpec read_segments_csv(const std::filesystem::path& file, const Trajec
   io::read_numeric_csv(file, "segment file", header, [&](int line, std::span<const double> v) {
     if (!(v[0] > 0.0)) throw InputError(file.string(), "segment duration must be positive", line);
     if (std::fabs(v[4]) >= 80.0) throw InputError(file.string(), "grade must be within +-80 deg", line);
-    spec.segments.push_back({v[0], v[1], v[2] * kDeg, v[3], v[4] * kDeg});
+    spec.segments.push_back({v[0], v[1], v[2] * io::kRadPerDeg, v[3], v[4] * io::kRadPerDeg});
   });
   return spec;
 }

@@ -12,11 +12,11 @@
 #include "ins/imu_error_model.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // GNSS position/velocity linearly interpolated at t (clamped to the fixes' span).
 struct GnssState {
@@ -110,17 +110,17 @@ ErrorRms rms_of(const std::vector<RowError>& e, double from_t) {
   r.vertical_m = std::sqrt(v2 / n);
   r.position_3d_m = std::sqrt((h2 + v2) / n);
   r.velocity_mps = std::sqrt(vel2 / n);
-  r.attitude_deg = std::sqrt(att2 / n) / kDeg;
-  r.heading_deg = std::sqrt(hd2 / n) / kDeg;
+  r.attitude_deg = std::sqrt(att2 / n) / io::kRadPerDeg;
+  r.heading_deg = std::sqrt(hd2 / n) / io::kRadPerDeg;
   r.within_3sigma = inside / n;
   return r;
 }
 
 fusion::AttitudeAidingOptions attitude_aiding_options(const FuseConfig& c) {
   fusion::AttitudeAidingOptions o;
-  const Eigen::Vector3d m = c.attitude_misalignment_deg * kDeg;
+  const Eigen::Vector3d m = c.attitude_misalignment_deg * io::kRadPerDeg;
   o.q_ba = ins::quaternion_from_euler({m.x(), m.y(), m.z()});
-  o.max_abs_pitch_rad = c.attitude_max_pitch_deg * kDeg;
+  o.max_abs_pitch_rad = c.attitude_max_pitch_deg * io::kRadPerDeg;
   return o;
 }
 
@@ -177,13 +177,13 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   // --- initial state (pipelines/navigation_initialisation.hpp) ---
   FuseResult result;
   AttitudeStart start;
-  const double lat_hint = c.position_deg_m ? c.position_deg_m->x() * kDeg : gnss.front().lat_rad;
+  const double lat_hint = c.position_deg_m ? c.position_deg_m->x() * io::kRadPerDeg : gnss.front().lat_rad;
   if (s.align == AlignMode::Static) {
     const std::size_t end = static_span_end(imu, imu_start, c, "IMU file");
     start = align_static(std::span(imu).first(end), imu_start, lat_hint, preset);
-    if (start.heading_sigma_rad > 10.0 * kDeg)
+    if (start.heading_sigma_rad > 10.0 * io::kRadPerDeg)
       start.note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
-                                start.heading_sigma_rad / kDeg);
+                                start.heading_sigma_rad / io::kRadPerDeg);
   } else if (s.align == AlignMode::Motion) {
     // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
     const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
@@ -209,7 +209,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     // One GPS attitude's accuracy: its Euler sigmas as NED rotation sigmas (fusion/attitude_measurement.hpp).
     const Eigen::Matrix3d M = fusion::euler_rate_to_rotation_n(it->attitude.euler_a);
     const Eigen::Matrix3d R = M * it->attitude.sigma_euler_rad.cwiseAbs2().asDiagonal() * M.transpose();
-    start.sigma_att_rad = R.diagonal().cwiseSqrt().cwiseMax(0.01 * kDeg);
+    start.sigma_att_rad = R.diagonal().cwiseSqrt().cwiseMax(0.01 * io::kRadPerDeg);
     start.sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
     start.note = fmt::format("GPS attitude at {:.3f} s (line {})", it->t_s, it->line);
   } else {
@@ -261,7 +261,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   auto emit = [&](const fusion::IntegrationOutput& out) {
     NavSigma sig{out.sigma_pos_ned_m, out.sigma_vel_n_mps, out.sigma_att_rad};
     if (on_row) on_row(out.nav, sig);
-    if (sig.attitude_ned_rad.z() > c.convergence_heading_sigma_deg * kDeg)
+    if (sig.attitude_ned_rad.z() > c.convergence_heading_sigma_deg * io::kRadPerDeg)
       converged_since.reset();
     else if (!converged_since)
       converged_since = out.nav.t_s;

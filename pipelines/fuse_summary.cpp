@@ -5,11 +5,11 @@
 #include <numbers>
 
 #include "io/json_text.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 }  // namespace
 
@@ -30,8 +30,8 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
                    s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
   j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
                    "\"yaw_deg\": {:.6f}}},\n",
-                   io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / kDeg,
-                   r.initial_attitude.pitch_rad / kDeg, r.initial_attitude.yaw_rad / kDeg);
+                   io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / io::kRadPerDeg,
+                   r.initial_attitude.pitch_rad / io::kRadPerDeg, r.initial_attitude.yaw_rad / io::kRadPerDeg);
   j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
   j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
                    r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
@@ -59,7 +59,7 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   j += fmt::format("  \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, \"vel_mps\": {:.6g}, "
                    "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
                    g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
-                   g.attitude_ned_rad.x() / kDeg, g.attitude_ned_rad.y() / kDeg, g.attitude_ned_rad.z() / kDeg);
+                   g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg, g.attitude_ned_rad.z() / io::kRadPerDeg);
   if (r.rms_all) j += "  \"rms_all\": " + rms_json(*r.rms_all) + ",\n";
   if (r.rms_converged) j += "  \"rms_converged\": " + rms_json(*r.rms_converged) + ",\n";
   if (r.gnss_rms) j += "  \"gnss_only_rms\": " + rms_json(*r.gnss_rms) + ",\n";

@@ -10,11 +10,11 @@
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 const std::vector<std::string>& header() {
   static const std::vector<std::string> h{
@@ -38,11 +38,11 @@ FusedNavCsvWriter::~FusedNavCsvWriter() = default;
 
 void FusedNavCsvWriter::write(const ins::NavState& s, const NavSigma& g) {
   const ins::EulerAngles e = ins::euler_from_quaternion(s.q_nb);
-  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / kDeg,
-                          s.lon_rad / kDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg,
-                          e.pitch_rad / kDeg, e.yaw_rad / kDeg, g.position_ned_m.x(), g.position_ned_m.y(),
+  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / io::kRadPerDeg,
+                          s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / io::kRadPerDeg,
+                          e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg, g.position_ned_m.x(), g.position_ned_m.y(),
                           g.position_ned_m.z(), g.velocity_ned_mps.x(), g.velocity_ned_mps.y(), g.velocity_ned_mps.z(),
-                          g.attitude_ned_rad.x() / kDeg, g.attitude_ned_rad.y() / kDeg, g.attitude_ned_rad.z() / kDeg));
+                          g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg, g.attitude_ned_rad.z() / io::kRadPerDeg));
 }
 
 void FusedNavCsvWriter::commit() { out_->commit(); }
@@ -58,14 +58,14 @@ std::vector<FusedNavRow> read_fused_nav_csv(const std::filesystem::path& file) {
       if (v[i] < 0.0) throw io::InputError(file.string(), "negative sigma", line);
     FusedNavRow r;
     r.nav.t_s = v[0];
-    r.nav.lat_rad = v[1] * kDeg;
-    r.nav.lon_rad = v[2] * kDeg;
+    r.nav.lat_rad = v[1] * io::kRadPerDeg;
+    r.nav.lon_rad = v[2] * io::kRadPerDeg;
     r.nav.height_m = v[3];
     r.nav.v_n = {v[4], v[5], v[6]};
-    r.nav.q_nb = ins::quaternion_from_euler({v[7] * kDeg, v[8] * kDeg, v[9] * kDeg});
+    r.nav.q_nb = ins::quaternion_from_euler({v[7] * io::kRadPerDeg, v[8] * io::kRadPerDeg, v[9] * io::kRadPerDeg});
     r.sigma.position_ned_m = {v[10], v[11], v[12]};
     r.sigma.velocity_ned_mps = {v[13], v[14], v[15]};
-    r.sigma.attitude_ned_rad = Eigen::Vector3d(v[16], v[17], v[18]) * kDeg;
+    r.sigma.attitude_ned_rad = Eigen::Vector3d(v[16], v[17], v[18]) * io::kRadPerDeg;
     rows.push_back(r);
   });
   return rows;

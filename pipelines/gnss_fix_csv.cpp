@@ -11,11 +11,11 @@
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr int kColumns = 10;
 
 const std::vector<std::string>& gnss_header() {
@@ -58,8 +58,8 @@ std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file) {
                            line);
     GnssCsvRow f;
     f.t_s = v[0];
-    f.lat_rad = v[1] * kDeg;
-    f.lon_rad = v[2] * kDeg;
+    f.lat_rad = v[1] * io::kRadPerDeg;
+    f.lon_rad = v[2] * io::kRadPerDeg;
     f.height_m = v[3];
     f.has_velocity = n_vel == 3;
     if (f.has_velocity) f.v_n = {v[4], v[5], v[6]};
@@ -77,7 +77,7 @@ void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssCsvRo
   for (const auto& f : fixes) {
     const std::string vel =
         f.has_velocity ? fmt::format("{},{},{}", f.v_n.x(), f.v_n.y(), f.v_n.z()) : std::string(",,");
-    out.write(fmt::format("{},{},{},{},{},{},{},{}\n", f.t_s, f.lat_rad / kDeg, f.lon_rad / kDeg, f.height_m, vel,
+    out.write(fmt::format("{},{},{},{},{},{},{},{}\n", f.t_s, f.lat_rad / io::kRadPerDeg, f.lon_rad / io::kRadPerDeg, f.height_m, vel,
                           f.sigma_ned_m.x(), f.sigma_ned_m.y(), f.sigma_ned_m.z()));
   }
   out.commit();

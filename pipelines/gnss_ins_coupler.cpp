@@ -15,6 +15,7 @@
 #include "ins/strapdown.hpp"
 #include "io/input_error.hpp"
 #include "io/json_text.hpp"
+#include "io/units.hpp"
 #include "pipelines/navigation_initialisation.hpp"
 #include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
@@ -23,7 +24,6 @@
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kDllUpdate_s = 0.020;  // the DLL's update interval after bit sync (the tight filter starts after frame sync)
 
@@ -222,7 +222,7 @@ struct GnssInsCoupler::Impl {
         not_started = "--align static: the static span has not ended";
         return false;
       }
-      const double lat = pos_fix ? pos_fix->lat_rad : c.position_deg_m->x() * kDeg;
+      const double lat = pos_fix ? pos_fix->lat_rad : c.position_deg_m->x() * io::kRadPerDeg;
       start = align_static(std::span(imu).first(end), imu.front().t_s, lat, preset);
     } else {
       const auto a = align_moving(imu, velocities, c, c.motion_window_s, false);
@@ -299,8 +299,8 @@ struct GnssInsCoupler::Impl {
       // time: an error of tens of metres there is tens of nanoseconds).
       const FuseConfig& c = settings.navigation;
       const Eigen::Vector3d r_e =
-          ins::ecef_from_geodetic(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg, c.position_deg_m->z());
-      const Eigen::Vector3d v_e = ins::C_en(c.position_deg_m->x() * kDeg, c.position_deg_m->y() * kDeg) *
+          ins::ecef_from_geodetic(c.position_deg_m->x() * io::kRadPerDeg, c.position_deg_m->y() * io::kRadPerDeg, c.position_deg_m->z());
+      const Eigen::Vector3d v_e = ins::C_en(c.position_deg_m->x() * io::kRadPerDeg, c.position_deg_m->y() * io::kRadPerDeg) *
                                   c.velocity_ned_mps.value_or(Eigen::Vector3d::Zero());
       if (const auto clock = fit_clock(e, r_e, v_e)) g = signals::add_seconds(e.receive_time, -clock->first / kC);
     } else if (integration && last_fix_clock) {
@@ -453,7 +453,7 @@ std::string GnssInsCoupler::summary_json() const {
   const auto& e = m.initial_attitude;
   j += fmt::format(", \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
                    "\"yaw_deg\": {:.6f}}}",
-                   io::json_escape(m.alignment_note), m.start_s, e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+                   io::json_escape(m.alignment_note), m.start_s, e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
   j += fmt::format(", \"start_s\": {}, \"end_s\": {}, \"imu_steps\": {}, \"updates_accepted\": {}, "
                    "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
                    m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
@@ -469,7 +469,7 @@ std::string GnssInsCoupler::summary_json() const {
   j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
                    "\"vel_mps\": {:.6g}, \"heading_deg\": {:.6g}}}}}",
                    g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
-                   g.attitude_ned_rad.z() / kDeg);
+                   g.attitude_ned_rad.z() / io::kRadPerDeg);
   return j;
 }
 

@@ -10,11 +10,11 @@
 
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr std::size_t kColumns = 11;
 
 const std::vector<std::string>& attitude_header() {
@@ -52,10 +52,10 @@ std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file)
     AttitudeCsvRow r;
     r.line = line;
     r.time = signals::GpsTime{static_cast<int>(v[0]), v[1]};
-    r.euler = {v[2] * kDeg, v[3] * kDeg, v[4] * kDeg};
-    r.sigma_roll_rad = v[5] * kDeg;
-    r.sigma_pitch_rad = v[6] * kDeg;
-    r.sigma_yaw_rad = v[7] * kDeg;
+    r.euler = {v[2] * io::kRadPerDeg, v[3] * io::kRadPerDeg, v[4] * io::kRadPerDeg};
+    r.sigma_roll_rad = v[5] * io::kRadPerDeg;
+    r.sigma_pitch_rad = v[6] * io::kRadPerDeg;
+    r.sigma_yaw_rad = v[7] * io::kRadPerDeg;
     r.num_sats = static_cast<int>(v[8]);
     r.fixed = v[9] == 1.0;
     r.ratio = v[10];

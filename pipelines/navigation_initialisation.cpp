@@ -11,11 +11,11 @@
 #include "ins/coarse_alignment.hpp"
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kG = 9.80665;
 
 }  // namespace
@@ -50,8 +50,8 @@ AttitudeStart align_static(std::span<const ins::ImuIncrement> span, double t0_s,
   const Eigen::Vector3d noise = ins::alignment_noise_sigma(preset, a.duration_s, lat_rad, kG);
   const double tilt = std::hypot(preset.accel.bias_sigma / kG, noise.x());
   s.heading_sigma_rad = std::hypot(preset.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(lat_rad)), noise.z());
-  s.sigma_att_rad = {std::max(2.0 * tilt, 0.05 * kDeg), std::max(2.0 * tilt, 0.05 * kDeg),
-                     std::clamp(2.0 * s.heading_sigma_rad, 0.5 * kDeg, 60.0 * kDeg)};
+  s.sigma_att_rad = {std::max(2.0 * tilt, 0.05 * io::kRadPerDeg), std::max(2.0 * tilt, 0.05 * io::kRadPerDeg),
+                     std::clamp(2.0 * s.heading_sigma_rad, 0.5 * io::kRadPerDeg, 60.0 * io::kRadPerDeg)};
   s.note = fmt::format("static over {:.1f} s", a.duration_s);
   return s;
 }
@@ -66,8 +66,8 @@ std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu
   s.q_nb = a->q_nb;
   s.v_n = a->v_n;
   s.sigma_vel_n_mps = Eigen::Vector3d::Constant(position_only ? 1.0 : config.velocity_sigma_mps * 2.0);
-  s.sigma_att_rad = position_only ? Eigen::Vector3d(3.0 * kDeg, 3.0 * kDeg, 5.0 * kDeg)
-                                  : Eigen::Vector3d(1.0 * kDeg, 1.0 * kDeg, 3.0 * kDeg);
+  s.sigma_att_rad = position_only ? Eigen::Vector3d(3.0 * io::kRadPerDeg, 3.0 * io::kRadPerDeg, 5.0 * io::kRadPerDeg)
+                                  : Eigen::Vector3d(1.0 * io::kRadPerDeg, 1.0 * io::kRadPerDeg, 3.0 * io::kRadPerDeg);
   s.note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
   return s;
 }
@@ -76,8 +76,8 @@ AttitudeStart align_from_config(double t_s, const FuseConfig& config) {
   AttitudeStart s;
   s.t_s = t_s;
   const Eigen::Vector3d& e = *config.attitude_deg;
-  s.q_nb = ins::quaternion_from_euler({e.x() * kDeg, e.y() * kDeg, e.z() * kDeg});
-  s.sigma_att_rad = Eigen::Vector3d(1.0, 1.0, 5.0) * kDeg;
+  s.q_nb = ins::quaternion_from_euler({e.x() * io::kRadPerDeg, e.y() * io::kRadPerDeg, e.z() * io::kRadPerDeg});
+  s.sigma_att_rad = Eigen::Vector3d(1.0, 1.0, 5.0) * io::kRadPerDeg;
   s.sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
   s.note = "attitude from the configuration";
   return s;
@@ -92,8 +92,8 @@ NavigationStart initialise_navigation(const AttitudeStart& a, const GnssPosition
   s.sigma_vel_n_mps = a.sigma_vel_n_mps;
   s.sigma_att_rad = a.sigma_att_rad;
   if (c.position_deg_m) {
-    s.nav.lat_rad = c.position_deg_m->x() * kDeg;
-    s.nav.lon_rad = c.position_deg_m->y() * kDeg;
+    s.nav.lat_rad = c.position_deg_m->x() * io::kRadPerDeg;
+    s.nav.lon_rad = c.position_deg_m->y() * io::kRadPerDeg;
     s.nav.height_m = c.position_deg_m->z();
     s.sigma_pos_ned_m = sigma_configured_position_m;
   } else {
@@ -107,7 +107,7 @@ NavigationStart initialise_navigation(const AttitudeStart& a, const GnssPosition
   }
   if (c.sigma_position_m) s.sigma_pos_ned_m = *c.sigma_position_m;
   if (c.sigma_velocity_mps) s.sigma_vel_n_mps = *c.sigma_velocity_mps;
-  if (c.sigma_attitude_deg) s.sigma_att_rad = *c.sigma_attitude_deg * kDeg;
+  if (c.sigma_attitude_deg) s.sigma_att_rad = *c.sigma_attitude_deg * io::kRadPerDeg;
   return s;
 }
 

@@ -8,6 +8,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/json_text.hpp"
+#include "io/units.hpp"
 #include "pipelines/snapshot_file.hpp"
 #include "receiver/solution_writer.hpp"
 
@@ -15,7 +16,6 @@ namespace ultratrack::pipelines {
 
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 std::string number_or_null(double v, const char* format = "{:.3f}") {
   return std::isfinite(v) ? fmt::format(fmt::runtime(format), v) : "null";
@@ -38,8 +38,8 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotFileJo
   const bool solved = s.used >= 5;
   if (solved) {
     fmt::print(out, "  \"ecef_m\": [{:.3f}, {:.3f}, {:.3f}],\n", s.r_e_m.x(), s.r_e_m.y(), s.r_e_m.z());
-    fmt::print(out, "  \"llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n", s.lat_rad * kDeg,
-               s.lon_rad * kDeg, s.height_m);
+    fmt::print(out, "  \"llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n", s.lat_rad * io::kDegPerRad,
+               s.lon_rad * io::kDegPerRad, s.height_m);
     fmt::print(out, "  \"time\": {{\"week\": {}, \"tow_s\": {:.9f}}},\n  \"time_correction_s\": {:.9f},\n", s.time.week,
                s.time.tow_s, s.time_correction_s);
     fmt::print(out, "  \"clock_bias_m\": {:.3f},\n  \"clock_drift_mps\": {:.3f},\n", s.clock_bias_m, s.clock_drift_mps);
@@ -84,7 +84,7 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotFileJo
       fmt::print(out,
                  ", \"used\": {}, \"elevation_deg\": {:.2f}, \"azimuth_deg\": {:.2f}, \"residual_m\": {:.3f}, "
                  "\"sigma_m\": {:.3f}, \"doppler_residual_hz\": {:.2f}",
-                 sat->used, sat->elevation_rad * kDeg, sat->azimuth_rad * kDeg, sat->residual_m, sat->sigma_m,
+                 sat->used, sat->elevation_rad * io::kDegPerRad, sat->azimuth_rad * io::kDegPerRad, sat->residual_m, sat->sigma_m,
                  sat->doppler_residual_hz);
     else
       fmt::print(out, ", \"used\": false");

@@ -4,13 +4,13 @@
 
 #include <cmath>
 
+#include "io/units.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::receiver {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 std::filesystem::path made(const std::filesystem::path& dir) {
   std::error_code ec;
@@ -54,7 +54,7 @@ void AttitudeOutputs::on_antenna_phases(const receiver::AntennaPhaseEpoch& epoch
     for (int k = 0; k < sat.num_antennas; ++k) {
       const auto i = static_cast<std::size_t>(k);
       ph << fmt::format("{},{:.4f},{},{},{:.3f},{:.5f},{:.2f},{},{}\n", epoch.receive_time.week, epoch.receive_time.tow_s,
-                        sat.prn, k, sat.elevation_rad / kDeg, sat.carrier_phase_cycles[i], sat.cn0_dbhz[i],
+                        sat.prn, k, sat.elevation_rad / io::kRadPerDeg, sat.carrier_phase_cycles[i], sat.cn0_dbhz[i],
                         sat.usable[i] ? 1 : 0, sat.slip[i] ? 1 : 0);
       if (sat.slip[i]) ++stats_.slips[i];
       if (!sat.usable[i]) ++stats_.unusable[i];
@@ -71,9 +71,9 @@ void AttitudeOutputs::on_antenna_phases(const receiver::AntennaPhaseEpoch& epoch
     ++stats_.attitude_epochs;
     stats_.sum_sats += sol.num_sats;
     if (!stats_.first_attitude_sample) stats_.first_attitude_sample = epoch.sample_index;
-    const auto sd = [&](int i) { return std::sqrt(std::max(0.0, sol.covariance_rad2(i, i))) / kDeg; };
-    out << fmt::format("{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},", sol.roll_rad / kDeg, sol.pitch_rad / kDeg,
-                       sol.yaw_rad / kDeg, sd(0), sd(1), sd(2));
+    const auto sd = [&](int i) { return std::sqrt(std::max(0.0, sol.covariance_rad2(i, i))) / io::kRadPerDeg; };
+    out << fmt::format("{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},", sol.roll_rad / io::kRadPerDeg, sol.pitch_rad / io::kRadPerDeg,
+                       sol.yaw_rad / io::kRadPerDeg, sd(0), sd(1), sd(2));
   } else {
     out << "nan,nan,nan,nan,nan,nan,";
   }

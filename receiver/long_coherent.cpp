@@ -1,4 +1,5 @@
 #include "receiver/long_coherent.hpp"
+#include "io/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +8,6 @@ namespace ultratrack::receiver {
 namespace {
 
 constexpr double kBitPeriod_s = 0.02;
-constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 constexpr int kCoherentEpochChoices[] = {1, 2, 5, 10, 20};
 constexpr double kCn0Slow_s = 1.0;  // C/N0 low-pass for the long-coherent loss test
 // The PLI's time constant in long updates (its spread from one update at SNR c T = 10, 20 dB-Hz at 100 ms, is
@@ -35,7 +35,7 @@ int choose_coherent_epochs(const ScalarTrackingOptions& o, double cn0_dbhz, int 
     for (const int n : kCoherentEpochChoices) {
       if (n > max_epochs) break;
       chosen = n;
-      if (pll_thermal_jitter_rad(long_coherent_pll_bw_hz(o, n), n * kBitPeriod_s, cn0) <= o.coherent_jitter_deg * kDegToRad)
+      if (pll_thermal_jitter_rad(long_coherent_pll_bw_hz(o, n), n * kBitPeriod_s, cn0) <= o.coherent_jitter_deg * io::kRadPerDeg)
         break;
     }
     return chosen;

@@ -7,6 +7,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/json_text.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -55,11 +56,10 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
              prn_list(acquired), prn_list(tracked), prn_list(used));
   if (fix) {
     const double n = s.fixes;
-    const double kDeg = 180.0 / 3.14159265358979323846;
     fmt::print(out,
                "  \"mean_llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n"
                "  \"mean_ecef_m\": [{:.3f}, {:.3f}, {:.3f}],\n",
-               s.sum_lat_rad / n * kDeg, s.sum_lon_rad / n * kDeg, s.sum_height_m / n, s.sum_r_e_m.x() / n,
+               s.sum_lat_rad / n * io::kDegPerRad, s.sum_lon_rad / n * io::kDegPerRad, s.sum_height_m / n, s.sum_r_e_m.x() / n,
                s.sum_r_e_m.y() / n, s.sum_r_e_m.z() / n);
   } else {
     fmt::print(out, "  \"mean_llh\": null,\n  \"mean_ecef_m\": null,\n");

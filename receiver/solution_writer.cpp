@@ -1,4 +1,5 @@
 #include "receiver/solution_writer.hpp"
+#include "io/units.hpp"
 
 #include <fmt/format.h>
 
@@ -7,7 +8,6 @@
 namespace ultratrack::receiver {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr double kMpsToKnots = 3600.0 / 1852.0;
 
 // NMEA angle "ddmm.mmmmmm" (latitude, 2 degree digits) or "dddmm.mmmmmm" (longitude, 3 digits).
@@ -41,7 +41,7 @@ SolutionCsvWriter::SolutionCsvWriter(const std::filesystem::path& path) : file_(
 void SolutionCsvWriter::write(const PvtSolution& f) {
   file_.stream() << fmt::format(
       "{},{:.4f},{:.9f},{:.9f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.3f},{:.3f},{:.3f},{}\n",
-      f.time.week, f.time.tow_s, f.lat_rad * kRadToDeg, f.lon_rad * kRadToDeg, f.height_m, f.r_e_m.x(), f.r_e_m.y(),
+      f.time.week, f.time.tow_s, f.lat_rad * io::kDegPerRad, f.lon_rad * io::kDegPerRad, f.height_m, f.r_e_m.x(), f.r_e_m.y(),
       f.r_e_m.z(), f.v_enu_mps.x(), f.v_enu_mps.y(), f.v_enu_mps.z(), f.clock_bias_m, f.clock_drift_mps,
       f.used_prns.size(), f.pdop, f.hdop, f.vdop, f.excluded_prn ? std::to_string(*f.excluded_prn) : std::string());
 }
@@ -58,14 +58,14 @@ NmeaWriter::NmeaWriter(const std::filesystem::path& path, int leap_seconds)
 void NmeaWriter::write(const PvtSolution& f) {
   auto& out = file_.stream();
   const UtcStamp utc = utc_stamp(f.time, leap_seconds_);
-  const double lat_deg = f.lat_rad * kRadToDeg, lon_deg = f.lon_rad * kRadToDeg;
+  const double lat_deg = f.lat_rad * io::kDegPerRad, lon_deg = f.lon_rad * io::kDegPerRad;
   const std::string lat = nmea_angle(lat_deg, 2), lon = nmea_angle(lon_deg, 3);
   const char ns = lat_deg >= 0 ? 'N' : 'S', ew = lon_deg >= 0 ? 'E' : 'W';
   out << nmea_sentence(fmt::format("GPGGA,{},{},{},{},{},1,{:02d},{:.1f},{:.3f},M,0.000,M,,", utc.hhmmss, lat, ns, lon,
                                    ew, f.used_prns.size(), f.hdop, f.height_m))
       << "\r\n";
   const double speed = std::hypot(f.v_enu_mps.x(), f.v_enu_mps.y());
-  double course = std::atan2(f.v_enu_mps.x(), f.v_enu_mps.y()) * kRadToDeg;
+  double course = std::atan2(f.v_enu_mps.x(), f.v_enu_mps.y()) * io::kDegPerRad;
   if (course < 0) course += 360.0;
   out << nmea_sentence(fmt::format("GPRMC,{},A,{},{},{},{},{:.3f},{:.2f},{},,,A", utc.hhmmss, lat, ns, lon, ew,
                                    speed * kMpsToKnots, course, utc.ddmmyy))
@@ -81,8 +81,8 @@ void NmeaWriter::write(const PvtSolution& f) {
     std::string gsv = fmt::format("GPGSV,{},{},{:02d}", messages, m + 1, in_view);
     for (int k = 4 * m; k < std::min(in_view, 4 * m + 4); ++k) {
       const auto& s = f.satellites[k];
-      gsv += fmt::format(",{:02d},{:02.0f},{:03.0f},{:02.0f}", s.prn, s.elevation_rad * kRadToDeg,
-                         s.azimuth_rad * kRadToDeg, std::clamp(s.cn0_dbhz, 0.0, 99.0));
+      gsv += fmt::format(",{:02d},{:02.0f},{:03.0f},{:02.0f}", s.prn, s.elevation_rad * io::kDegPerRad,
+                         s.azimuth_rad * io::kDegPerRad, std::clamp(s.cn0_dbhz, 0.0, 99.0));
     }
     out << nmea_sentence(gsv) << "\r\n";
   }
@@ -91,7 +91,7 @@ void NmeaWriter::write(const PvtSolution& f) {
 KmlWriter::KmlWriter(const std::filesystem::path& path) : file_(path) {}
 
 void KmlWriter::write(const PvtSolution& f) {
-  const double lat = f.lat_rad * kRadToDeg, lon = f.lon_rad * kRadToDeg;
+  const double lat = f.lat_rad * io::kDegPerRad, lon = f.lon_rad * io::kDegPerRad;
   coordinates_.push_back(fmt::format("{:.9f},{:.9f},{:.3f}", lon, lat, f.height_m));
   sum_lat_deg_ += lat;
   sum_lon_deg_ += lon;

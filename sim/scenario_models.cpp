@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "sim/ins_truth_motion.hpp"
 #include "sim/local_frame.hpp"
@@ -15,13 +16,12 @@ namespace ultratrack::sim {
 namespace {
 
 using io::InputError;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 }  // namespace
 
 ins::TrajectorySpec trajectory_spec(const Scenario& s) {
   if (!s.trajectory_enabled()) throw InputError(s.source.string(), "the scenario has no [trajectory]");
-  const double lat = s.llh_deg_m[0] * kDeg, lon = s.llh_deg_m[1] * kDeg, h = s.llh_deg_m[2];
+  const double lat = s.llh_deg_m[0] * io::kRadPerDeg, lon = s.llh_deg_m[1] * io::kRadPerDeg, h = s.llh_deg_m[2];
   ins::TrajectorySpec spec;
   if (!s.trajectory_profile.empty()) {
     try {
@@ -30,9 +30,9 @@ ins::TrajectorySpec trajectory_spec(const Scenario& s) {
       throw InputError(s.source.string(), std::string("[trajectory]: ") + e.what());
     }
     if (s.trajectory_profile == "static") {
-      spec.roll0_rad = s.attitude_deg[0] * kDeg;
-      spec.pitch0_rad = s.attitude_deg[1] * kDeg;
-      spec.heading0_rad = s.attitude_deg[2] * kDeg;
+      spec.roll0_rad = s.attitude_deg[0] * io::kRadPerDeg;
+      spec.pitch0_rad = s.attitude_deg[1] * io::kRadPerDeg;
+      spec.heading0_rad = s.attitude_deg[2] * io::kRadPerDeg;
     }
   } else {
     ins::TrajectorySpec start;
@@ -40,7 +40,7 @@ ins::TrajectorySpec trajectory_spec(const Scenario& s) {
     start.lon0_rad = lon;
     start.height0_m = h;
     start.speed0_mps = s.start_speed_mps;
-    start.heading0_rad = s.start_heading_deg * kDeg;
+    start.heading0_rad = s.start_heading_deg * io::kRadPerDeg;
     start.coordinated_turns = s.coordinated_turns;
     start.ramp_s = s.ramp_s;
     const auto file = resolve_path(s, s.trajectory_file);
@@ -59,8 +59,8 @@ ins::ImuErrorSpec imu_error_spec(const Scenario& s) {
   } catch (const InputError& err) {
     throw InputError(s.source.string(), std::string("[imu]: ") + err.what());
   }
-  constexpr double kDph = kDeg / 3600.0;  // deg/h -> rad/s
-  constexpr double kDpsh = kDeg / 60.0;   // deg/sqrt(h) -> rad/sqrt(s)
+  constexpr double kDph = io::kRadPerDeg / 3600.0;  // deg/h -> rad/s
+  constexpr double kDpsh = io::kRadPerDeg / 60.0;   // deg/sqrt(h) -> rad/sqrt(s)
   constexpr double kMg = 9.80665e-3;      // milli-g -> m/s^2
   if (s.gyro_bias_dph) e.gyro.bias_sigma = *s.gyro_bias_dph * kDph;
   if (s.accel_bias_mg) e.accel.bias_sigma = *s.accel_bias_mg * kMg;
@@ -89,7 +89,7 @@ std::shared_ptr<const signals::ReceiverMotion> make_motion(const Scenario& s,
   }
   Eigen::Vector3d r0;
   GeographicLib::Geocentric::WGS84().Forward(s.llh_deg_m[0], s.llh_deg_m[1], s.llh_deg_m[2], r0.x(), r0.y(), r0.z());
-  const Eigen::Matrix3d C_ned_e = ned_from_ecef(s.llh_deg_m[0] * kDeg, s.llh_deg_m[1] * kDeg);
+  const Eigen::Matrix3d C_ned_e = ned_from_ecef(s.llh_deg_m[0] * io::kRadPerDeg, s.llh_deg_m[1] * io::kRadPerDeg);
   std::vector<Eigen::Vector3d> antennas;
   for (const auto& o : s.antenna_offsets_enu_m) {
     const Eigen::Vector3d d_ned(o[1], o[0], -o[2]);
@@ -109,7 +109,7 @@ signals::SynthesiserOptions synthesiser_options(const Scenario& s, const Navigat
   o.start = {s.gps_week, s.tow_s};
   o.default_cn0_dbhz = s.cn0_dbhz;
   o.cn0_dbhz_by_prn = s.cn0_dbhz_by_prn;
-  o.elevation_mask_rad = s.elevation_mask_deg * kDeg;
+  o.elevation_mask_rad = s.elevation_mask_deg * io::kRadPerDeg;
   o.include_unhealthy = s.include_unhealthy;
   o.ionosphere = s.ionosphere;
   o.troposphere = s.troposphere;

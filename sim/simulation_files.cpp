@@ -12,13 +12,13 @@
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "io/json_text.hpp"
+#include "io/units.hpp"
 #include "signals/sample_writer.hpp"
 #include "sim/local_frame.hpp"
 
 namespace ultratrack::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 const char* const kTruthHeader =
     "t_s,gps_week,tow_s,ecef_x_m,ecef_y_m,ecef_z_m,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,"
@@ -28,14 +28,14 @@ const char* const kTruthHeader =
 std::string truth_line(const TruthRow& r) {
   double lat = 0, lon = 0, h = 0;
   GeographicLib::Geocentric::WGS84().Reverse(r.r_e_m.x(), r.r_e_m.y(), r.r_e_m.z(), lat, lon, h);
-  const Eigen::Vector3d v_n = ned_from_ecef(lat * kDeg, lon * kDeg) * r.v_e_mps;
+  const Eigen::Vector3d v_n = ned_from_ecef(lat * io::kRadPerDeg, lon * io::kRadPerDeg) * r.v_e_mps;
   std::string row =
       fmt::format("{:.9f},{},{:.9f},{:.4f},{:.4f},{:.4f},{:.10f},{:.10f},{:.4f},{:.5f},{:.5f},{:.5f},{:.5f},{:.6f}",
                   r.t_s, r.gps.week, r.gps.tow_s, r.r_e_m.x(), r.r_e_m.y(), r.r_e_m.z(), lat, lon, h, v_n.x(), v_n.y(),
                   v_n.z(), r.clock_bias_m, r.clock_drift_mps);
   if (r.q_nb) {
     const ins::EulerAngles e = ins::euler_from_quaternion(*r.q_nb);
-    row += fmt::format(",{:.8f},{:.8f},{:.8f}", e.roll_rad / kDeg, e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+    row += fmt::format(",{:.8f},{:.8f},{:.8f}", e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
   }
   return row + "\n";
 }
@@ -76,8 +76,8 @@ void SimulationFiles::odometer(std::span<const ins::OdometerSample> samples) {
 void SimulationFiles::satellites(std::span<const signals::SatelliteView> in_view) {
   satellites_ = "prn,elevation_deg,azimuth_deg,cn0_dbhz,doppler_hz,code_phase_chips\n";
   for (const auto& v : in_view) {
-    satellites_ += fmt::format("{},{:.4f},{:.4f},{:.2f},{:.4f},{:.6f}\n", v.prn, v.elevation_rad / kDeg,
-                               v.azimuth_rad / kDeg, v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
+    satellites_ += fmt::format("{},{:.4f},{:.4f},{:.2f},{:.4f},{:.6f}\n", v.prn, v.elevation_rad / io::kRadPerDeg,
+                               v.azimuth_rad / io::kRadPerDeg, v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
   }
 }
 

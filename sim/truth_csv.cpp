@@ -13,11 +13,11 @@
 #include "io/numeric_csv.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::sim {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 const std::vector<std::string>& simulate_truth_header() {
   static const std::vector<std::string> h{"t_s",       "gps_week",  "tow_s",        "ecef_x_m",        "ecef_y_m",
@@ -54,11 +54,11 @@ std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file) {
     if (std::fabs(v[15]) > 90.0) throw io::InputError(name, "pitch_deg outside [-90, 90]", line_no);
     ins::NavState s;
     s.t_s = t_s;
-    s.lat_rad = v[6] * kDeg;
-    s.lon_rad = v[7] * kDeg;
+    s.lat_rad = v[6] * io::kRadPerDeg;
+    s.lon_rad = v[7] * io::kRadPerDeg;
     s.height_m = v[8];
     s.v_n = {v[9], v[10], v[11]};
-    s.q_nb = ins::quaternion_from_euler({v[14] * kDeg, v[15] * kDeg, v[16] * kDeg});
+    s.q_nb = ins::quaternion_from_euler({v[14] * io::kRadPerDeg, v[15] * io::kRadPerDeg, v[16] * io::kRadPerDeg});
     out.push_back(s);
   });
   return out;

@@ -13,12 +13,12 @@
 #include "fusion/covariance_analysis.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 #include "signals/rinex_nav.hpp"
 
 namespace ultratrack::tools {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct CovarianceCommandOptions {
   std::string trajectory, coupling = "tight", filter = "ekf", nav_file, csv_file, iq_measurement = "iq";
@@ -72,8 +72,8 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
   }
   o.duration_s = c.duration_s > 0.0 ? c.duration_s : last;
   o.use_range_rate = c.range_rate;
-  o.lat_rad = c.lat_deg * kDeg;
-  o.lon_rad = c.lon_deg * kDeg;
+  o.lat_rad = c.lat_deg * io::kRadPerDeg;
+  o.lon_rad = c.lon_deg * io::kRadPerDeg;
   o.height_m = c.height_m;
   if (!c.nav_file.empty()) o.ephemerides = signals::read_rinex_nav(c.nav_file).ephemerides;
   const fusion::CovarianceAnalysisResult r = fusion::run_covariance_analysis(o);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "io/units.hpp"
 #include "pipelines/gps_attitude_csv.hpp"
 #include "config/fuse_config_toml.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
@@ -31,7 +32,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using pipelines::AlignMode;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct FuseCommandOptions {
   std::string imu_file, gnss_file, truth_file, config_file, out_dir, attitude_file;
@@ -113,8 +113,8 @@ void run_fuse_command(const FuseCommandOptions& o) {
                             pipelines::fuse_summary_json(r, s, o.imu_file, o.gnss_file, o.truth_file));
 
   const auto& e = r.initial_attitude;
-  fmt::print("fuse: aligned {}: roll {:.3f} pitch {:.3f} yaw {:.3f} deg\n", r.alignment_note, e.roll_rad / kDeg,
-             e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+  fmt::print("fuse: aligned {}: roll {:.3f} pitch {:.3f} yaw {:.3f} deg\n", r.alignment_note, e.roll_rad / io::kRadPerDeg,
+             e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
   fmt::print("fuse: {:.1f} s navigated in {:.2f} s; fixes used {}, updates accepted {}, rejected {}{}\n",
              r.end_s - r.start_s, wall_s, r.fixes_used, r.counters.accepted, r.counters.rejected,
              r.fixes_in_outage ? fmt::format(", {} dropped in outages", r.fixes_in_outage) : std::string());
@@ -123,7 +123,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
                                             s.config.convergence_heading_sigma_deg, *r.converged_at_s)
                               : std::string("NOT converged"),
              r.final_sigma.position_ned_m.head<2>().norm(), r.final_sigma.position_ned_m.z(),
-             r.final_sigma.attitude_ned_rad.z() / kDeg);
+             r.final_sigma.attitude_ned_rad.z() / io::kRadPerDeg);
   if (r.rms_all)
     fmt::print("fuse: against truth: position RMS {:.3f} m (horizontal {:.3f}, vertical {:.3f}), velocity {:.4f} m/s, "
                "attitude {:.4f} deg; GNSS fixes alone {:.3f} m\n",

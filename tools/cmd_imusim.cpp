@@ -18,6 +18,7 @@
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "io/atomic_file.hpp"
+#include "io/units.hpp"
 #include "sim/imu_simulation.hpp"
 #include "sim/simulation_files.hpp"
 
@@ -26,7 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using ins::InputError;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct ImuSimOptions {
   std::string profile;
@@ -50,14 +50,14 @@ void run_imusim(const ImuSimOptions& o) {
   ins::TrajectorySpec spec;
   if (!o.profile.empty()) {
     if (!(o.duration_s > 0.0)) throw InputError("command line", "--duration must be positive");
-    spec = ins::profile_spec(o.profile, o.duration_s, o.lat_deg * kDeg, o.lon_deg * kDeg, o.height_m);
+    spec = ins::profile_spec(o.profile, o.duration_s, o.lat_deg * io::kRadPerDeg, o.lon_deg * io::kRadPerDeg, o.height_m);
   } else {
     ins::TrajectorySpec start;
-    start.lat0_rad = o.lat_deg * kDeg;
-    start.lon0_rad = o.lon_deg * kDeg;
+    start.lat0_rad = o.lat_deg * io::kRadPerDeg;
+    start.lon0_rad = o.lon_deg * io::kRadPerDeg;
     start.height0_m = o.height_m;
     start.speed0_mps = o.speed_mps;
-    start.heading0_rad = o.heading_deg * kDeg;
+    start.heading0_rad = o.heading_deg * io::kRadPerDeg;
     spec = ins::read_segments_csv(o.segments_file, start);
     if (o.duration_s > 0.0) throw InputError("command line", "--duration is the segment file's own with --segments");
   }

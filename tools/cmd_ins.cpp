@@ -23,6 +23,7 @@
 #include "ins/strapdown.hpp"
 #include "interrupt_guard.hpp"
 #include "io/atomic_file.hpp"
+#include "io/units.hpp"
 #include "sim/truth_csv.hpp"
 
 namespace ultratrack::tools {
@@ -30,7 +31,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using ins::InputError;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct InsOptions {
   std::string imu_file;
@@ -55,7 +55,7 @@ void compare(const ins::NavState& nav, const ins::NavState& truth, TruthComparis
   const Eigen::Vector3d d_n = ins::C_en(truth.lat_rad, truth.lon_rad).transpose() * d_e;
   c.final_horizontal_m = d_n.head<2>().norm();
   c.final_vertical_m = std::fabs(d_n.z());
-  c.final_attitude_deg = ins::attitude_error_n(nav.q_nb, truth.q_nb).norm() / kDeg;
+  c.final_attitude_deg = ins::attitude_error_n(nav.q_nb, truth.q_nb).norm() / io::kRadPerDeg;
   c.max_horizontal_m = std::max(c.max_horizontal_m, c.final_horizontal_m);
   c.max_vertical_m = std::max(c.max_vertical_m, c.final_vertical_m);
   c.max_attitude_deg = std::max(c.max_attitude_deg, c.final_attitude_deg);
@@ -69,8 +69,8 @@ std::string state_json(const ins::NavState& s) {
       "{{\"t_s\": {}, \"lat_deg\": {:.10f}, \"lon_deg\": {:.10f}, \"height_m\": {:.4f}, \"vel_n_mps\": {:.6f}, "
       "\"vel_e_mps\": {:.6f}, \"vel_d_mps\": {:.6f}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": "
       "{:.6f}}}",
-      s.t_s, s.lat_rad / kDeg, s.lon_rad / kDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / kDeg,
-      e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+      s.t_s, s.lat_rad / io::kRadPerDeg, s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / io::kRadPerDeg,
+      e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
 }
 
 void run_ins(const InsOptions& o) {
@@ -90,8 +90,8 @@ void run_ins(const InsOptions& o) {
   } else {
     if (o.position.size() != 3)
       throw InputError("command line", "--align without --init needs --position LAT_DEG LON_DEG HEIGHT_M");
-    init.lat_rad = o.position[0] * kDeg;
-    init.lon_rad = o.position[1] * kDeg;
+    init.lat_rad = o.position[0] * io::kRadPerDeg;
+    init.lon_rad = o.position[1] * io::kRadPerDeg;
     init.height_m = o.position[2];
     // the first row's interval is taken to be as long as the second's
     init.t_s = imu.size() > 1 ? imu[0].t_s - (imu[1].t_s - imu[0].t_s) : imu[0].t_s - 0.01;
@@ -147,8 +147,8 @@ void run_ins(const InsOptions& o) {
   if (alignment) {
     json += fmt::format(
         "  \"alignment\": {{\"duration_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": {:.6f}}},\n",
-        alignment->duration_s, alignment->euler.roll_rad / kDeg, alignment->euler.pitch_rad / kDeg,
-        alignment->euler.yaw_rad / kDeg);
+        alignment->duration_s, alignment->euler.roll_rad / io::kRadPerDeg, alignment->euler.pitch_rad / io::kRadPerDeg,
+        alignment->euler.yaw_rad / io::kRadPerDeg);
   }
   json += "  \"initial\": " + state_json(init) + ",\n";
   json += "  \"final\": " + state_json(nav.state()) + ",\n";
@@ -170,12 +170,12 @@ void run_ins(const InsOptions& o) {
   const ins::EulerAngles e = ins::euler_from_quaternion(nav.state().q_nb);
   fmt::print("ins: {} steps from t = {:.3f} s to {:.3f} s ({})\n", steps, init.t_s, nav.state().t_s,
              alignment ? fmt::format("aligned over {:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg",
-                                     alignment->duration_s, alignment->euler.roll_rad / kDeg,
-                                     alignment->euler.pitch_rad / kDeg, alignment->euler.yaw_rad / kDeg)
+                                     alignment->duration_s, alignment->euler.roll_rad / io::kRadPerDeg,
+                                     alignment->euler.pitch_rad / io::kRadPerDeg, alignment->euler.yaw_rad / io::kRadPerDeg)
                        : "initial state from " + o.init_file);
   fmt::print("ins: final lat {:.8f} lon {:.8f} deg, h {:.2f} m, attitude {:.4f} {:.4f} {:.4f} deg\n",
-             nav.state().lat_rad / kDeg, nav.state().lon_rad / kDeg, nav.state().height_m, e.roll_rad / kDeg,
-             e.pitch_rad / kDeg, e.yaw_rad / kDeg);
+             nav.state().lat_rad / io::kRadPerDeg, nav.state().lon_rad / io::kRadPerDeg, nav.state().height_m, e.roll_rad / io::kRadPerDeg,
+             e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
   if (cmp.matched > 0)
     fmt::print("ins: against truth ({} rows): max horizontal {:.3f} m, vertical {:.3f} m, attitude {:.2e} deg\n",
                cmp.matched, cmp.max_horizontal_m, cmp.max_vertical_m, cmp.max_attitude_deg);

@@ -18,6 +18,7 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "format_options.hpp"
+#include "io/units.hpp"
 #include "pipelines/snapshot_file.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
@@ -26,7 +27,6 @@ namespace ultratrack::tools {
 
 namespace {
 
-constexpr double kDeg = 180.0 / 3.14159265358979323846;
 
 struct SnapshotArgs {
   std::string input, fs, if_hz = "0", nav, time, time_sigma = "10", approx_llh, ms = "100", out;
@@ -101,7 +101,7 @@ void run_snapshot(const SnapshotArgs& args) {
   if (args.quiet) return;
   fmt::print("{} satellites detected, {} used; ", result.detections.size(), solution.used);
   fmt::print("fix {:.7f} {:.7f} {:.1f} m, time correction {:+.3f} s, quality {} (residual rms {:.1f} m)\n",
-             solution.lat_rad * kDeg, solution.lon_rad * kDeg, solution.height_m, solution.time_correction_s,
+             solution.lat_rad * io::kDegPerRad, solution.lon_rad * io::kDegPerRad, solution.height_m, solution.time_correction_s,
              solution.quality, solution.residual_rms_m);
 }
 

@@ -22,11 +22,11 @@
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::fusion {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 Eigen::Matrix3d dcm(const ins::EulerAngles& e) { return ins::quaternion_from_euler(e).toRotationMatrix(); }
 
@@ -37,8 +37,8 @@ Eigen::Vector3d rotation_between(const Eigen::Matrix3d& Ca, const Eigen::Matrix3
 }
 
 TEST(AttitudeMeasurement, EulerToRotationMapMatchesNumericalDifferentiation) {
-  for (const ins::EulerAngles e : {ins::EulerAngles{20 * kDeg, -35 * kDeg, 150 * kDeg},
-                                   ins::EulerAngles{-170 * kDeg, 70 * kDeg, -60 * kDeg}}) {
+  for (const ins::EulerAngles e : {ins::EulerAngles{20 * io::kRadPerDeg, -35 * io::kRadPerDeg, 150 * io::kRadPerDeg},
+                                   ins::EulerAngles{-170 * io::kRadPerDeg, 70 * io::kRadPerDeg, -60 * io::kRadPerDeg}}) {
     const Eigen::Matrix3d M = euler_rate_to_rotation_n(e);
     const double h = 1e-6;
     for (int j = 0; j < 3; ++j) {
@@ -57,8 +57,8 @@ TEST(AttitudeMeasurement, EulerToRotationMapMatchesNumericalDifferentiation) {
 // psi convention (C_est = (I - [psi x]) C_true) is the seed's, so H_G must equal -M^-1, and must match the
 // Euler errors of an attitude really rotated by -psi.
 TEST(AttitudeMeasurement, RotationFormCarriesSeedZeroHg) {
-  const double beta = 25 * kDeg, gamma = -120 * kDeg;  // pitch, yaw
-  const ins::EulerAngles e{8 * kDeg, beta, gamma};
+  const double beta = 25 * io::kRadPerDeg, gamma = -120 * io::kRadPerDeg;  // pitch, yaw
+  const ins::EulerAngles e{8 * io::kRadPerDeg, beta, gamma};
   Eigen::Matrix3d HG;
   HG << -std::cos(gamma) / std::cos(beta), -std::sin(gamma) / std::cos(beta), 0, std::sin(gamma), -std::cos(gamma), 0,
       -std::tan(beta) * std::cos(gamma), -std::tan(beta) * std::sin(gamma), -1;
@@ -73,18 +73,18 @@ TEST(AttitudeMeasurement, RotationFormCarriesSeedZeroHg) {
 // to the truth yields z = e_psi exactly, also across yaw +-180 deg and through a non-identity mounting.
 TEST(AttitudeMeasurement, InnovationIsTheInsErrorAcrossYawWrap) {
   NominalState truth;
-  truth.nav.lat_rad = 36 * kDeg;
-  truth.nav.lon_rad = 127 * kDeg;
-  truth.nav.q_nb = ins::quaternion_from_euler({3 * kDeg, -2 * kDeg, 179.95 * kDeg});
+  truth.nav.lat_rad = 36 * io::kRadPerDeg;
+  truth.nav.lon_rad = 127 * io::kRadPerDeg;
+  truth.nav.q_nb = ins::quaternion_from_euler({3 * io::kRadPerDeg, -2 * io::kRadPerDeg, 179.95 * io::kRadPerDeg});
   StateVector<15> e = StateVector<15>::Zero();
-  e << 4, -3, 2, 0.3, -0.2, 0.1, 1e-3, -2e-3, -0.2 * kDeg, 0, 0, 0, 0, 0, 0;
+  e << 4, -3, 2, 0.3, -0.2, 0.1, 1e-3, -2e-3, -0.2 * io::kRadPerDeg, 0, 0, 0, 0, 0, 0;
   const NominalState nom = corrected<15>(truth, StateVector<15>(-e));
-  EXPECT_LT(ins::euler_from_quaternion(nom.nav.q_nb).yaw_rad, -179.8 * kDeg);  // INS yaw past 180, truth +179.95
+  EXPECT_LT(ins::euler_from_quaternion(nom.nav.q_nb).yaw_rad, -179.8 * io::kRadPerDeg);  // INS yaw past 180, truth +179.95
   AttitudeAidingOptions o;
-  o.q_ba = ins::quaternion_from_euler({1 * kDeg, -0.5 * kDeg, 2 * kDeg});
+  o.q_ba = ins::quaternion_from_euler({1 * io::kRadPerDeg, -0.5 * io::kRadPerDeg, 2 * io::kRadPerDeg});
   GnssAttitude a;
   a.euler_a = ins::euler_from_quaternion(truth.nav.q_nb * o.q_ba);  // what the array frame reads
-  a.sigma_euler_rad = Eigen::Vector3d(0.1, 0.1, 0.2) * kDeg;
+  a.sigma_euler_rad = Eigen::Vector3d(0.1, 0.1, 0.2) * io::kRadPerDeg;
   const AttitudeMeasurement<15> m(nom, a, o);
   EXPECT_LT((m.z() - e.segment<3>(ix::kAtt)).norm(), 1e-12) << m.z().transpose();
   // Predicted at the true error: zero innovation.
@@ -92,10 +92,10 @@ TEST(AttitudeMeasurement, InnovationIsTheInsErrorAcrossYawWrap) {
   // Noise: a pure yaw sigma maps to the down axis only, a pure roll sigma to the body x axis in NED.
   const Eigen::Matrix3d R = m.R();
   const Eigen::Vector3d roll_axis = dcm(a.euler_a).col(0);
-  const Eigen::Matrix3d Rexp = 0.01 * kDeg * kDeg * (roll_axis * roll_axis.transpose()) +
-                               0.01 * kDeg * kDeg * euler_rate_to_rotation_n(a.euler_a).col(1) *
+  const Eigen::Matrix3d Rexp = 0.01 * io::kRadPerDeg * io::kRadPerDeg * (roll_axis * roll_axis.transpose()) +
+                               0.01 * io::kRadPerDeg * io::kRadPerDeg * euler_rate_to_rotation_n(a.euler_a).col(1) *
                                    euler_rate_to_rotation_n(a.euler_a).col(1).transpose() +
-                               0.04 * kDeg * kDeg * Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
+                               0.04 * io::kRadPerDeg * io::kRadPerDeg * Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
   EXPECT_LT((R - Rexp).cwiseAbs().maxCoeff(), 1e-15);
 }
 
@@ -112,14 +112,14 @@ MeasurementJacobian<N> numerical_jacobian(const M& m, const StateVector<N>& at, 
 
 TEST(AttitudeMeasurement, JacobianMatchesNumericalDifferentiation) {
   NominalState nom;
-  nom.nav.lat_rad = 50 * kDeg;
-  nom.nav.lon_rad = 8 * kDeg;
+  nom.nav.lat_rad = 50 * io::kRadPerDeg;
+  nom.nav.lon_rad = 8 * io::kRadPerDeg;
   nom.nav.height_m = 1500;
   nom.nav.v_n = Eigen::Vector3d(120, -80, 5);
-  nom.nav.q_nb = ins::quaternion_from_euler({10 * kDeg, -5 * kDeg, 130 * kDeg});
+  nom.nav.q_nb = ins::quaternion_from_euler({10 * io::kRadPerDeg, -5 * io::kRadPerDeg, 130 * io::kRadPerDeg});
   nom.gyro_bias_b = Eigen::Vector3d(1e-5, 2e-5, -1e-5);
   GnssAttitude a;
-  a.euler_a = {10.3 * kDeg, -5.2 * kDeg, 129.5 * kDeg};
+  a.euler_a = {10.3 * io::kRadPerDeg, -5.2 * io::kRadPerDeg, 129.5 * io::kRadPerDeg};
   const AttitudeMeasurement<15> m15(nom, a, {});
   const AttitudeMeasurement<17> m17(nom, a, {});
   const MeasurementJacobian<15> J15 = numerical_jacobian<15>(m15, StateVector<15>::Zero(), 0.1);
@@ -135,11 +135,11 @@ TEST(AttitudeMeasurement, JacobianMatchesNumericalDifferentiation) {
 
 TEST(AttitudeMeasurement, NearVerticalIsRefused) {
   GnssAttitude a;
-  a.euler_a = {0.0, 85 * kDeg, 30 * kDeg};
+  a.euler_a = {0.0, 85 * io::kRadPerDeg, 30 * io::kRadPerDeg};
   AttitudeAidingOptions o;
   EXPECT_FALSE(attitude_usable(a, o));
   EXPECT_THROW(AttitudeMeasurement<15>(NominalState{}, a, o), std::invalid_argument);
-  o.max_abs_pitch_rad = 89 * kDeg;
+  o.max_abs_pitch_rad = 89 * io::kRadPerDeg;
   EXPECT_TRUE(attitude_usable(a, o));
   a.sigma_euler_rad.z() = 0.0;
   EXPECT_FALSE(attitude_usable(a, o));
@@ -154,13 +154,13 @@ struct AttitudeSim {
   FilterKind filter = FilterKind::Ekf;
   std::uint64_t seed = 3;
   bool attitude = true;
-  Eigen::Vector3d sigma_euler_rad = Eigen::Vector3d(0.1, 0.1, 0.2) * kDeg;
+  Eigen::Vector3d sigma_euler_rad = Eigen::Vector3d(0.1, 0.1, 0.2) * io::kRadPerDeg;
   double attitude_offset_s = 0.61;  // GPS attitude at 0.61 + k, fixes at 0.37 + k: unrelated times
   double drop_fraction = 0.0;       // attitudes with fixed = 0 (skipped)
   double gap_start_s = 1e9, gap_length_s = 0.0;
   Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();
-  Eigen::Vector3d att_error0_rad = Eigen::Vector3d(0.5, -0.5, 12.0) * kDeg;  // initial INS attitude error
-  Eigen::Vector3d sigma0_att_rad = Eigen::Vector3d(1.0, 1.0, 20.0) * kDeg;
+  Eigen::Vector3d att_error0_rad = Eigen::Vector3d(0.5, -0.5, 12.0) * io::kRadPerDeg;  // initial INS attitude error
+  Eigen::Vector3d sigma0_att_rad = Eigen::Vector3d(1.0, 1.0, 20.0) * io::kRadPerDeg;
 };
 
 struct AttitudeRun {
@@ -171,7 +171,7 @@ struct AttitudeRun {
 };
 
 AttitudeRun run_attitude_sim(const AttitudeSim& c) {
-  const ins::TrajectorySpec spec = ins::profile_spec(c.profile, c.duration_s, 36.4 * kDeg, 127.4 * kDeg, 80.0);
+  const ins::TrajectorySpec spec = ins::profile_spec(c.profile, c.duration_s, 36.4 * io::kRadPerDeg, 127.4 * io::kRadPerDeg, 80.0);
   const ins::SimulatedRun run = ins::simulate(spec, 100.0);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(c.preset);
@@ -279,16 +279,16 @@ void check_static_heading(FilterKind filter) {
   const double yaw_sigma = with.att_sigma_rad.back().z();
   std::printf("static MEMS %s: with GPS attitude yaw RMS (last 60 s) %.6f deg, final error %.4f deg, 1-sigma %.4f deg"
               " (GPS yaw sigma %.2f deg); without: final error %.2f deg, 1-sigma %.1f deg\n",
-              filter == FilterKind::Ekf ? "EKF" : "UKF", yaw_rms / kDeg, with.att_err_rad.back().z() / kDeg,
-              yaw_sigma / kDeg, c.sigma_euler_rad.z() / kDeg, without.att_err_rad.back().z() / kDeg,
-              without.att_sigma_rad.back().z() / kDeg);
+              filter == FilterKind::Ekf ? "EKF" : "UKF", yaw_rms / io::kRadPerDeg, with.att_err_rad.back().z() / io::kRadPerDeg,
+              yaw_sigma / io::kRadPerDeg, c.sigma_euler_rad.z() / io::kRadPerDeg, without.att_err_rad.back().z() / io::kRadPerDeg,
+              without.att_sigma_rad.back().z() / io::kRadPerDeg);
   EXPECT_LT(yaw_rms, c.sigma_euler_rad.z());
   EXPECT_LE(yaw_sigma, c.sigma_euler_rad.z());
   EXPECT_LT(std::abs(with.att_err_rad.back().z()), 4.0 * yaw_sigma);
   EXPECT_EQ(with.counters.attitude_accepted, with.attitudes_given);
   EXPECT_EQ(with.counters.attitude_rejected, 0);
-  EXPECT_GT(without.att_sigma_rad.back().z(), 10.0 * kDeg);
-  EXPECT_GT(std::abs(without.att_err_rad.back().z()), 5.0 * kDeg);
+  EXPECT_GT(without.att_sigma_rad.back().z(), 10.0 * io::kRadPerDeg);
+  EXPECT_GT(std::abs(without.att_err_rad.back().z()), 5.0 * io::kRadPerDeg);
   EXPECT_EQ(without.counters.attitude_epochs, 0);
   EXPECT_EQ(without.counters.fixes_without_attitude, without.counters.epochs);
 }
@@ -309,9 +309,9 @@ TEST(AttitudeAiding, DropoutsStayConsistentAndAreCounted) {
   c.drop_fraction = 0.2;
   c.gap_start_s = 70.0;
   c.gap_length_s = 10.0;
-  c.q_ba = ins::quaternion_from_euler({1 * kDeg, -0.5 * kDeg, 2 * kDeg});
-  c.att_error0_rad = Eigen::Vector3d(0.05, -0.05, 0.5) * kDeg;
-  c.sigma0_att_rad = Eigen::Vector3d(0.1, 0.1, 1.0) * kDeg;
+  c.q_ba = ins::quaternion_from_euler({1 * io::kRadPerDeg, -0.5 * io::kRadPerDeg, 2 * io::kRadPerDeg});
+  c.att_error0_rad = Eigen::Vector3d(0.05, -0.05, 0.5) * io::kRadPerDeg;
+  c.sigma0_att_rad = Eigen::Vector3d(0.1, 0.1, 1.0) * io::kRadPerDeg;
   const AttitudeRun r = run_attitude_sim(c);
   int inside3 = 0, n = 0;
   double worst = 0.0;
@@ -326,7 +326,7 @@ TEST(AttitudeAiding, DropoutsStayConsistentAndAreCounted) {
               "fixes; worst |error|/sigma %.2f, %.1f %% inside 3 sigma; final yaw error %.4f deg (1-sigma %.4f)\n",
               r.attitudes_given, r.attitudes_dropped, r.counters.attitude_accepted, r.counters.attitude_rejected,
               r.counters.fixes_without_attitude, r.counters.epochs, worst, 100.0 * inside3 / n,
-              r.att_err_rad.back().z() / kDeg, r.att_sigma_rad.back().z() / kDeg);
+              r.att_err_rad.back().z() / io::kRadPerDeg, r.att_sigma_rad.back().z() / io::kRadPerDeg);
   EXPECT_LT(worst, 4.0);
   EXPECT_GE(static_cast<double>(inside3) / n, 0.95);
   EXPECT_GE(r.attitudes_dropped, 10 + 20);  // the gap plus about a fifth of the rest
@@ -350,7 +350,7 @@ TEST(AttitudeAiding, SameTimeNearVerticalInvalidAndLate) {
   const ins::EulerAngles truth_e = ins::euler_from_quaternion(run.truth[0].q_nb);
   GnssAttitude a;
   a.euler_a = truth_e;
-  a.sigma_euler_rad = Eigen::Vector3d::Constant(0.1 * kDeg);
+  a.sigma_euler_rad = Eigen::Vector3d::Constant(0.1 * io::kRadPerDeg);
   GnssFix fix;
   fix.lat_rad = run.truth[0].lat_rad;
   fix.lon_rad = run.truth[0].lon_rad;
@@ -360,7 +360,7 @@ TEST(AttitudeAiding, SameTimeNearVerticalInvalidAndLate) {
   integ.add_attitude(a);
   GnssAttitude vertical = a;
   vertical.t_s = 2.005;
-  vertical.euler_a.pitch_rad = 88 * kDeg;
+  vertical.euler_a.pitch_rad = 88 * io::kRadPerDeg;
   integ.add_attitude(vertical);
   GnssAttitude bad = a;
   bad.t_s = 2.5;
@@ -394,20 +394,20 @@ TEST(AttitudeAiding, TightCouplingTakesAttitudeToo) {
   opt.coupling = Coupling::kTight;
   opt.sigma_att_rad = Eigen::Vector3d(0.01, 0.01, 0.05);
   ins::NavState init = run.truth[0].nav();
-  ins::correct_attitude(init, Eigen::Vector3d(0.0, 0.0, 2.0 * kDeg));
+  ins::correct_attitude(init, Eigen::Vector3d(0.0, 0.0, 2.0 * io::kRadPerDeg));
   GnssInsIntegration integ(init, opt);
   for (std::size_t k = 0; k + 1 < run.truth.size(); ++k) {
     if (k % 100 == 50) {
       GnssAttitude a;
       a.t_s = run.truth[k].t_s + 0.003;
       a.euler_a = ins::euler_from_quaternion(run.truth[k].q_nb);
-      a.sigma_euler_rad = Eigen::Vector3d::Constant(0.01 * kDeg);
+      a.sigma_euler_rad = Eigen::Vector3d::Constant(0.01 * io::kRadPerDeg);
       integ.add_attitude(a);
     }
     integ.add_imu(run.imu[k]);
   }
   const double yaw_err = ins::attitude_error_n(integ.output().nav.q_nb, run.truth.back().q_nb).z();
-  EXPECT_LT(std::abs(yaw_err), 4.0 * 0.01 * kDeg) << yaw_err / kDeg;
+  EXPECT_LT(std::abs(yaw_err), 4.0 * 0.01 * io::kRadPerDeg) << yaw_err / io::kRadPerDeg;
   EXPECT_EQ(integ.counters().attitude_accepted, 20);
   EXPECT_EQ(integ.covariance().rows(), 17);
 }

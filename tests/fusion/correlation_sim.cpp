@@ -14,13 +14,13 @@
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/nominal_constellation.hpp"
 
 namespace ultratrack::fusion::test {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kLambda = signals::kL1Wavelength_m;
 constexpr double kChip = kC / signals::kCaChipRate_hz;
@@ -44,7 +44,7 @@ IqTaps ideal_correlation(const std::vector<double>& code, const std::vector<doub
 }
 
 CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg) {
-  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s + 1.0, 37.0 * kDeg, 127.0 * kDeg, 100.0);
+  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s + 1.0, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
   const ins::SimulatedRun run = ins::simulate(spec, cfg.imu_rate_hz);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(cfg.imu_preset);

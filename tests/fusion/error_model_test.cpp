@@ -17,20 +17,20 @@
 #include "ins/strapdown.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
+#include "io/units.hpp"
 #include "signals/nominal_constellation.hpp"
 
 namespace ultratrack::fusion {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 
 ins::NavState moving_state() {
   ins::NavState s;
-  s.lat_rad = 50.0 * kDeg;
-  s.lon_rad = 8.0 * kDeg;
+  s.lat_rad = 50.0 * io::kRadPerDeg;
+  s.lon_rad = 8.0 * io::kRadPerDeg;
   s.height_m = 1500.0;
   s.v_n = Eigen::Vector3d(120.0, -80.0, 5.0);
-  s.q_nb = ins::quaternion_from_euler({10.0 * kDeg, -5.0 * kDeg, 130.0 * kDeg});
+  s.q_nb = ins::quaternion_from_euler({10.0 * io::kRadPerDeg, -5.0 * io::kRadPerDeg, 130.0 * io::kRadPerDeg});
   return s;
 }
 
@@ -233,7 +233,7 @@ TEST(TightMeasurement, SigmaPointFormEqualsCorrectedNominalComposition) {
 TEST(TightMeasurement, PredictionAtTruthReproducesSimulatedObservables) {
   const signals::GpsTime t0{2300, 300000.0};
   const auto constellation = signals::nominal_constellation(t0);
-  const ins::TrajectorySpec spec = ins::profile_spec("circle", 20.0, 37.0 * kDeg, 127.0 * kDeg, 300.0);
+  const ins::TrajectorySpec spec = ins::profile_spec("circle", 20.0, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 300.0);
   const ins::SimulatedRun run = ins::simulate(spec, 100.0);
   const ins::TruthInterpolator interp(run.truth);
   const Eigen::Vector3d lever(0.5, 0.2, -1.0);
@@ -265,7 +265,7 @@ TEST(TightMeasurement, PredictionAtTruthReproducesSimulatedObservables) {
 TEST(InsErrorModel, PresetNoiseSettings) {
   const auto o = error_model_from_preset(ins::imu_preset("hg1700ae"));
   EXPECT_EQ(o.gyro.bias_model, BiasModel::RandomConstant);
-  EXPECT_NEAR(o.gyro.bias_sigma, 1.0 * kDeg / 3600.0, 1e-12);
+  EXPECT_NEAR(o.gyro.bias_sigma, 1.0 * io::kRadPerDeg / 3600.0, 1e-12);
   EXPECT_NEAR(o.accel.bias_sigma, 1e-3 * 9.80665, 1e-9);
   const auto m = error_model_from_preset(ins::imu_preset("mems"));
   EXPECT_GT(m.gyro.bias_random_walk_psd, 0.0);  // turn-on + instability

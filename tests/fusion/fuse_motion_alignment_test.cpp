@@ -13,17 +13,17 @@
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "io/units.hpp"
 
 namespace {
 
 using namespace ultratrack;
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 TEST(FuseMotionAlignment, LevellingRecoversRollAndPitchForAnyHeadingAndAcceleration) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (int trial = 0; trial < 200; ++trial) {
-    ins::EulerAngles e{u(rng) * 60.0 * kDeg, u(rng) * 45.0 * kDeg, u(rng) * 180.0 * kDeg};
+    ins::EulerAngles e{u(rng) * 60.0 * io::kRadPerDeg, u(rng) * 45.0 * io::kRadPerDeg, u(rng) * 180.0 * io::kRadPerDeg};
     // specific force: gravity plus up to 5 m/s^2 of manoeuvre in any direction
     const Eigen::Vector3d f_n = Eigen::Vector3d(0, 0, -9.8) + 5.0 * Eigen::Vector3d(u(rng), u(rng), u(rng));
     const Eigen::Vector3d f_b = ins::quaternion_from_euler(e).conjugate() * f_n;
@@ -58,21 +58,21 @@ void check_alignment(const ins::TrajectorySpec& spec, double tol_tilt_deg, doubl
   const auto a = fusion::align_in_motion(run.imu, gnss, {5.0, 2.0});
   ASSERT_TRUE(a.has_value());
   const ins::EulerAngles e_true = ins::euler_from_quaternion(truth.attitude(a->t_s));
-  EXPECT_NEAR(a->euler.roll_rad / kDeg, e_true.roll_rad / kDeg, tol_tilt_deg);
-  EXPECT_NEAR(a->euler.pitch_rad / kDeg, e_true.pitch_rad / kDeg, tol_tilt_deg);
-  EXPECT_NEAR(ins::wrap_pi(a->euler.yaw_rad - e_true.yaw_rad) / kDeg, 0.0, tol_heading_deg);
+  EXPECT_NEAR(a->euler.roll_rad / io::kRadPerDeg, e_true.roll_rad / io::kRadPerDeg, tol_tilt_deg);
+  EXPECT_NEAR(a->euler.pitch_rad / io::kRadPerDeg, e_true.pitch_rad / io::kRadPerDeg, tol_tilt_deg);
+  EXPECT_NEAR(ins::wrap_pi(a->euler.yaw_rad - e_true.yaw_rad) / io::kRadPerDeg, 0.0, tol_heading_deg);
 }
 
 // A banked turn (24 deg roll at 500 km/h, pi/100 rad/s): the levelling must use the centripetal acceleration.
 // Remaining error: chord versus arc of the 2 s window (~1e-3 m/s^2 -> ~0.005 deg).
 TEST(FuseMotionAlignment, BankedCircleAlignsToTruth) {
-  const auto spec = ins::profile_spec("circle", 20.0, 36.0 * kDeg, 127.0 * kDeg, 1000.0);
+  const auto spec = ins::profile_spec("circle", 20.0, 36.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 1000.0);
   check_alignment(spec, 0.02, 0.02);
 }
 
 // A car accelerating from rest at 2 m/s^2: the first fast-enough window is during the acceleration.
 TEST(FuseMotionAlignment, AcceleratingCarAlignsToTruth) {
-  const auto spec = ins::profile_spec("land", 40.0, 36.0 * kDeg, 127.0 * kDeg, 100.0);
+  const auto spec = ins::profile_spec("land", 40.0, 36.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
   check_alignment(spec, 0.02, 0.02);
 }
 

@@ -13,6 +13,7 @@
 #include "ins/nav_correction.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
+#include "io/units.hpp"
 #include "receiver/pvt.hpp"
 #include "signals/atmosphere.hpp"
 #include "signals/gps_constants.hpp"
@@ -23,14 +24,13 @@
 namespace ultratrack::fusion::test {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kC = signals::kSpeedOfLight_mps;
 
 void geodetic(const Eigen::Vector3d& r_e, double& lat, double& lon, double& h) {
   double la = 0, lo = 0;
   GeographicLib::Geocentric::WGS84().Reverse(r_e.x(), r_e.y(), r_e.z(), la, lo, h);
-  lat = la * kDeg;
-  lon = lo * kDeg;
+  lat = la * io::kRadPerDeg;
+  lon = lo * io::kRadPerDeg;
 }
 
 // Receiver clock truth on the IMU grid: bias random walk (white frequency) and drift random walk.
@@ -91,14 +91,14 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
       az = la.azimuth_rad;
       double lat, lon, h;
       geodetic(r_rx, lat, lon, h);
-      double delay = troposphere ? signals::troposphere_delay_m(lat, h, std::max(el, 5.0 * kDeg)) : 0.0;
+      double delay = troposphere ? signals::troposphere_delay_m(lat, h, std::max(el, 5.0 * io::kRadPerDeg)) : 0.0;
       if (iono.valid) delay += kC * signals::klobuchar_delay_s(iono, lat, lon, la.azimuth_rad, el, t_tx.tow_s);
       return kC * tau + b - kC * signals::l1_ca_clock_correction_s(eph, t_tx) + delay;
     };
     double el = 0.0, el2 = 0.0;
     const double pr = pseudorange(t_true_s, clock.bias_m, el);
     const double az0 = az;
-    if (el < 10.0 * kDeg) continue;
+    if (el < 10.0 * io::kRadPerDeg) continue;
     const double dt = 0.05;
     const double rate = (pseudorange(t_true_s + dt, clock.bias_m + clock.drift_mps * dt, el2) -
                          pseudorange(t_true_s - dt, clock.bias_m - clock.drift_mps * dt, el2)) /
@@ -117,7 +117,7 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
 
 RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion::FilterKind filter) {
   const bool tight = coupling == fusion::Coupling::kTight;
-  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s, 37.0 * kDeg, 127.0 * kDeg, 100.0);
+  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
   const ins::SimulatedRun run = ins::simulate(spec, cfg.imu_rate_hz);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(cfg.imu_preset);

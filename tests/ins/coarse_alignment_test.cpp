@@ -13,11 +13,11 @@
 #include "ins/earth_model.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory_simulator.hpp"
+#include "io/units.hpp"
 
 using namespace ultratrack::ins;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Static vehicle at an arbitrary attitude: the simulator's static profile with a given initial attitude
 // is level, so rotate the analytic rest data instead (dtheta = C_bn w_ie dt, dv = -C_bn g dt).
@@ -33,7 +33,7 @@ std::vector<ImuIncrement> rest_data(const Eigen::Quaterniond& q_nb, double lat, 
 TEST(CoarseAlignment, ExactWithErrorFreeSimulatorData) {
   // On the ellipsoid (h = 0) normal gravity is along the ellipsoid normal; above it, it leans north by
   // ~8e-10 rad per metre, which levelling reads as tilt.
-  const TrajectorySpec spec = profile_spec("static", 60.0, 36.37 * kDeg, 127.36 * kDeg, 0.0);
+  const TrajectorySpec spec = profile_spec("static", 60.0, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 0.0);
   const SimulatedRun run = simulate(spec, 100.0);
   const AlignmentResult a = coarse_align(run.imu, 0.0, spec.lat0_rad);
   EXPECT_LT(attitude_error_n(a.q_nb, run.truth.back().q_nb).norm(), 1e-9);
@@ -42,16 +42,16 @@ TEST(CoarseAlignment, ExactWithErrorFreeSimulatorData) {
 TEST(CoarseAlignment, ExactAtArbitraryAttitudes) {
   for (const EulerAngles e : {EulerAngles{0.05, -0.1, 2.0}, EulerAngles{-0.3, 0.2, -2.5}, EulerAngles{0.0, 0.0, 0.7}}) {
     const Eigen::Quaterniond q = quaternion_from_euler(e);
-    const auto imu = rest_data(q, -33.0 * kDeg, 0.0, 100.0, 10.0);
-    const AlignmentResult a = coarse_align(imu, 0.0, -33.0 * kDeg);
+    const auto imu = rest_data(q, -33.0 * ultratrack::io::kRadPerDeg, 0.0, 100.0, 10.0);
+    const AlignmentResult a = coarse_align(imu, 0.0, -33.0 * ultratrack::io::kRadPerDeg);
     EXPECT_LT(attitude_error_n(a.q_nb, q).norm(), 1e-9);
     EXPECT_NEAR(a.euler.yaw_rad, e.yaw_rad, 1e-9);
   }
 }
 
 TEST(CoarseAlignment, Hg1700aeErrorsMatchClosedFormFromBiases) {
-  const double lat = 36.37 * kDeg, h = 100.0, T = 600.0, rate = 100.0;
-  const Eigen::Quaterniond q_true = quaternion_from_euler({1.5 * kDeg, -2.0 * kDeg, 40.0 * kDeg});
+  const double lat = 36.37 * ultratrack::io::kRadPerDeg, h = 100.0, T = 600.0, rate = 100.0;
+  const Eigen::Quaterniond q_true = quaternion_from_euler({1.5 * ultratrack::io::kRadPerDeg, -2.0 * ultratrack::io::kRadPerDeg, 40.0 * ultratrack::io::kRadPerDeg});
   const auto ideal = rest_data(q_true, lat, h, rate, T);
   const ImuErrorSpec spec = imu_preset("hg1700ae");
   const double g = gravity_n(lat, h).z();
@@ -80,9 +80,9 @@ TEST(CoarseAlignment, Hg1700aeErrorsMatchClosedFormFromBiases) {
     std::printf(
         "[ alignment ] seed %llu: psi N/E/D = %+.5f %+.5f %+.3f deg, closed form %+.5f %+.5f %+.3f deg "
         "(noise 1 sigma %.5f %.5f %.3f deg)\n",
-        static_cast<unsigned long long>(seed), psi.x() / kDeg, psi.y() / kDeg, psi.z() / kDeg, predicted.x() / kDeg,
-        predicted.y() / kDeg, predicted.z() / kDeg, sigma_noise.x() / kDeg, sigma_noise.y() / kDeg,
-        sigma_noise.z() / kDeg);
+        static_cast<unsigned long long>(seed), psi.x() / ultratrack::io::kRadPerDeg, psi.y() / ultratrack::io::kRadPerDeg, psi.z() / ultratrack::io::kRadPerDeg, predicted.x() / ultratrack::io::kRadPerDeg,
+        predicted.y() / ultratrack::io::kRadPerDeg, predicted.z() / ultratrack::io::kRadPerDeg, sigma_noise.x() / ultratrack::io::kRadPerDeg, sigma_noise.y() / ultratrack::io::kRadPerDeg,
+        sigma_noise.z() / ultratrack::io::kRadPerDeg);
     // 4 sigma of noise plus the second-order terms the closed form drops (tilt^2, ~2e-6 rad here).
     const double second_order = predicted.head<2>().squaredNorm();
     for (int i = 0; i < 3; ++i)

@@ -13,12 +13,12 @@
 #include "ins/odometer.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "io/units.hpp"
 
 using namespace ultratrack::ins;
 
 namespace {
-constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kLat = 36.37 * kDeg, kLon = 127.36 * kDeg;
+constexpr double kLat = 36.37 * ultratrack::io::kRadPerDeg, kLon = 127.36 * ultratrack::io::kRadPerDeg;
 
 double speed_h(const TruthSample& s) { return std::hypot(s.v_n.x(), s.v_n.y()); }
 }  // namespace
@@ -81,7 +81,7 @@ TEST(Profiles, LandStaysWithin0To30mpsStopsTurnsAndClimbs) {
   EXPECT_NEAR(vmax, 30.0, 1e-6);
   EXPECT_GE(vmin, -1e-9);
   EXPECT_GT(stopped, 2000);  // at least 20 s standing still
-  EXPECT_NEAR(pitch_max, 4.0 * kDeg, 1e-9);
+  EXPECT_NEAR(pitch_max, 4.0 * ultratrack::io::kRadPerDeg, 1e-9);
 }
 
 TEST(TruthInterpolator, AntennaMotionMatchesExactSamplesAndDerivatives) {

@@ -13,7 +13,7 @@
 #include "receiver/wahba_rotation.hpp"
 
 using namespace ultratrack::receiver;
-using testsim::kDeg;
+using ultratrack::io::kRadPerDeg;
 
 TEST(AttitudeGeometry, DoubleDifferenceCovarianceHasTheSharedTerms) {
   // 3 antennas, 3 satellites, the highest (prn 2) the reference: rows (1,1) (1,3) (2,1) (2,3).
@@ -60,7 +60,7 @@ TEST(AttitudeGeometry, WahbaRecoversARotationIncludingTheDeterminantFix) {
 }
 
 TEST(AttitudeGeometry, EulerRoundTripAndNedFrame) {
-  const EulerAngles e{10 * kDeg, -25 * kDeg, 300 * kDeg};
+  const EulerAngles e{10 * kRadPerDeg, -25 * kRadPerDeg, 300 * kRadPerDeg};
   const Eigen::Matrix3d C = C_nb_from_euler(e);
   EXPECT_LT((C - testsim::dcm_nb(e.roll_rad, e.pitch_rad, e.yaw_rad)).norm(), 1e-14);
   const EulerAngles back = euler_from_C_nb(C);

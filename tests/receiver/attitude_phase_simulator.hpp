@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include "io/units.hpp"
 #include "receiver/antenna_phase.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/nominal_constellation.hpp"
@@ -18,7 +19,6 @@
 
 namespace ultratrack::receiver::testsim {
 
-inline constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
 struct Sky {
   int prn;
@@ -83,7 +83,7 @@ struct PhaseSimulator {
   long& ambiguity(int antenna, int prn) { return integer_ambiguity[static_cast<std::size_t>(antenna * 64 + prn)]; }
 
   // A random sky of n satellites above min_elevation (elevation uniform in sin, azimuth uniform).
-  std::vector<Sky> random_sky(int n, double min_elevation_rad = 15.0 * kDeg) {
+  std::vector<Sky> random_sky(int n, double min_elevation_rad = 15.0 * io::kRadPerDeg) {
     std::uniform_real_distribution<double> u(0.0, 1.0);
     std::vector<Sky> sky;
     for (int i = 0; i < n; ++i) {
@@ -94,7 +94,7 @@ struct PhaseSimulator {
   }
 
   // The satellites of the nominal 24-slot constellation above the mask at time t, seen from the master.
-  std::vector<Sky> nominal_sky(const signals::GpsTime& t, double mask_rad = 10.0 * kDeg) const {
+  std::vector<Sky> nominal_sky(const signals::GpsTime& t, double mask_rad = 10.0 * io::kRadPerDeg) const {
     std::vector<Sky> sky;
     for (const signals::Ephemeris& eph : signals::nominal_constellation(t).ephemerides) {
       const Eigen::Vector3d d_n = C_en.transpose() * (signals::satellite_state(eph, t).r_e_m - r_master_e);

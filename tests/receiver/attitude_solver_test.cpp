@@ -15,7 +15,7 @@
 #include "attitude_phase_simulator.hpp"
 
 using namespace ultratrack::receiver;
-using testsim::kDeg;
+using ultratrack::io::kRadPerDeg;
 using testsim::PhaseSimulator;
 
 namespace {
@@ -54,8 +54,8 @@ struct MonteCarlo {
   int trials = 0, fixed = 0, correct = 0, wrong = 0;
   double sum_sq[3] = {0, 0, 0}, sum_var[3] = {0, 0, 0};
   int within_3sigma = 0;
-  double rms(int i) const { return std::sqrt(sum_sq[i] / correct) / kDeg; }
-  double theory(int i) const { return std::sqrt(sum_var[i] / correct) / kDeg; }
+  double rms(int i) const { return std::sqrt(sum_sq[i] / correct) / kRadPerDeg; }
+  double theory(int i) const { return std::sqrt(sum_var[i] / correct) / kRadPerDeg; }
 };
 
 // Single-epoch trials: each with a fresh sky, attitude, integers and line biases, and a reset solver. num_sats > 0:
@@ -66,7 +66,7 @@ MonteCarlo run_single_epoch(int num_sats, int trials, bool constrained, std::uin
   AttitudeSolverOptions o = seed_options();
   o.use_length_constraint = constrained;
   AttitudeSolver solver(o);
-  std::uniform_real_distribution<double> tilt(-20.0 * kDeg, 20.0 * kDeg), heading(0.0, 2.0 * M_PI);
+  std::uniform_real_distribution<double> tilt(-20.0 * kRadPerDeg, 20.0 * kRadPerDeg), heading(0.0, 2.0 * M_PI);
   MonteCarlo mc;
   for (int t = 0; t < trials; ++t) {
     sim.reseed_biases();
@@ -181,8 +181,8 @@ struct Sessions {
   double sum_sq[3] = {0, 0, 0}, sum_var[3] = {0, 0, 0};
   int correct = 0, within_3sigma = 0;
   double worst_sigma = 0.0;
-  double rms(int i) const { return std::sqrt(sum_sq[i] / correct) / kDeg; }
-  double theory(int i) const { return std::sqrt(sum_var[i] / correct) / kDeg; }
+  double rms(int i) const { return std::sqrt(sum_sq[i] / correct) / kRadPerDeg; }
+  double theory(int i) const { return std::sqrt(sum_var[i] / correct) / kRadPerDeg; }
 };
 
 Sessions run_sessions(int num_sats, int sessions, int max_epochs, bool multi_epoch, std::uint64_t seed) {
@@ -190,8 +190,8 @@ Sessions run_sessions(int num_sats, int sessions, int max_epochs, bool multi_epo
   AttitudeSolverOptions o = seed_options();
   o.multi_epoch = multi_epoch;
   AttitudeSolver solver(o);
-  std::uniform_real_distribution<double> tilt(-20.0 * kDeg, 20.0 * kDeg), heading(0.0, 2.0 * M_PI),
-      rate(-10.0 * kDeg, 10.0 * kDeg);
+  std::uniform_real_distribution<double> tilt(-20.0 * kRadPerDeg, 20.0 * kRadPerDeg), heading(0.0, 2.0 * M_PI),
+      rate(-10.0 * kRadPerDeg, 10.0 * kRadPerDeg);
   Sessions r;
   r.fixed_by.assign(static_cast<std::size_t>(max_epochs), 0);
   for (int n = 0; n < sessions; ++n) {

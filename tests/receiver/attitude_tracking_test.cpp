@@ -13,7 +13,7 @@
 #include "attitude_phase_simulator.hpp"
 
 using namespace ultratrack::receiver;
-using testsim::kDeg;
+using ultratrack::io::kRadPerDeg;
 using testsim::PhaseSimulator;
 
 namespace {
@@ -67,7 +67,7 @@ double start_with_eight(const PhaseSimulator& sim, double seconds) {
 TEST(AttitudeTracking, SlipsAndBlockageNeverGiveAWrongAttitudeAndRefixAtOnce) {
   PhaseSimulator sim(testsim::seed_lever_arms(), 21);
   AttitudeSolver solver = seed_solver();
-  const double roll = 3 * kDeg, pitch = -4 * kDeg, yaw = 123 * kDeg;
+  const double roll = 3 * kRadPerDeg, pitch = -4 * kRadPerDeg, yaw = 123 * kRadPerDeg;
   const Eigen::Matrix3d C_nb = testsim::dcm_nb(roll, pitch, yaw);
   const double kT0 = start_with_eight(sim, 60);
   int valid = 0;
@@ -140,8 +140,8 @@ TEST(AttitudeTracking, TurningArrayAndARisingSatellite) {
   const double kT0 = start_with_eight(sim, 60) - 7200;
   for (int i = 0; i < 60; ++i) {
     const double t = i;  // 1 Hz: the array turns 10 deg between epochs
-    const double yaw = std::fmod(10.0 * kDeg * t, 2 * M_PI);
-    const double roll = 10 * kDeg * std::sin(2 * M_PI * t / 20.0), pitch = 5 * kDeg * std::cos(2 * M_PI * t / 15.0);
+    const double yaw = std::fmod(10.0 * kRadPerDeg * t, 2 * M_PI);
+    const double roll = 10 * kRadPerDeg * std::sin(2 * M_PI * t / 20.0), pitch = 5 * kRadPerDeg * std::cos(2 * M_PI * t / 15.0);
     auto sky = sim.nominal_sky({2300, kT0 + 7200 + t});
     ASSERT_GE(sky.size(), 8u);
     if (i == 0) rising_prn = sky.back().prn;
@@ -161,15 +161,15 @@ TEST(AttitudeTracking, TurningArrayAndARisingSatellite) {
     sum_var_yaw += s.covariance_rad2(2, 2);
     ++n;
   }
-  std::printf("turning array: yaw RMS %.3f deg, theory %.3f deg over %d epochs\n", std::sqrt(sum_sq_yaw / n) / kDeg,
-              std::sqrt(sum_var_yaw / n) / kDeg, n);
-  EXPECT_LE(std::sqrt(sum_sq_yaw / n) / kDeg, 0.15 * 1.5);  // 60 samples: RMS known to ~10 %
+  std::printf("turning array: yaw RMS %.3f deg, theory %.3f deg over %d epochs\n", std::sqrt(sum_sq_yaw / n) / kRadPerDeg,
+              std::sqrt(sum_var_yaw / n) / kRadPerDeg, n);
+  EXPECT_LE(std::sqrt(sum_sq_yaw / n) / kRadPerDeg, 0.15 * 1.5);  // 60 samples: RMS known to ~10 %
 }
 
 TEST(AttitudeTracking, LineBiasCalibrationMatchesTheSimulatedBias) {
   PhaseSimulator sim(testsim::seed_lever_arms(), 23);
   AttitudeSolver solver = seed_solver();
-  const Eigen::Matrix3d C_nb = testsim::dcm_nb(-2 * kDeg, 1 * kDeg, 250 * kDeg);
+  const Eigen::Matrix3d C_nb = testsim::dcm_nb(-2 * kRadPerDeg, 1 * kRadPerDeg, 250 * kRadPerDeg);
   AttitudeSolution s;
   const double kT0 = start_with_eight(sim, 100) - 20000;
   for (int i = 0; i < 100; ++i) {
@@ -198,7 +198,7 @@ TEST(AttitudeTracking, FourAntennasKeepTheAttitudeWhileOneIsBlocked) {
   AttitudeSolverOptions o;
   o.array.lever_arm_body_m = lever;
   AttitudeSolver solver(o);
-  const double roll = -5 * kDeg, pitch = 2 * kDeg, yaw = 42 * kDeg;
+  const double roll = -5 * kRadPerDeg, pitch = 2 * kRadPerDeg, yaw = 42 * kRadPerDeg;
   const double kT0 = start_with_eight(sim, 20);
   for (int i = 0; i < 20; ++i) {
     const auto sky = sim.nominal_sky({2300, kT0 + i});

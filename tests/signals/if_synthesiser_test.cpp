@@ -2,6 +2,7 @@
 // visible satellite at the Doppler, code phase and C/N0 the synthesiser states; noise and gain levels
 // follow the documented convention; the pseudorange implied by the synthesised code equals the
 // receiver-side model range + c (b - dt_sv) + I + T; synthesised samples follow the exact timing.
+#include "io/units.hpp"
 #include "signals/if_synthesiser.hpp"
 
 #include <gtest/gtest.h>
@@ -23,7 +24,6 @@ using test_support::BruteForceAcquisition;
 using test_support::ecef_from_llh;
 using test_support::walker_constellation;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 const GpsTime kStart{2190, 518400.0};
 
 SynthesiserOptions base_options(double fs) {
@@ -97,7 +97,7 @@ TEST(IfSynthesiser, BruteForceAcquisitionFindsEverySatelliteAtStatedDopplerCodeP
     // checks the level tightly).
     EXPECT_NEAR(r.cn0_dbhz, v.cn0_dbhz, 1.5);
     std::printf("PRN %2d el %5.1f deg: doppler %9.2f / %9.2f Hz  code %8.3f / %8.3f chips  C/N0 %5.2f / %5.2f dB-Hz\n",
-                v.prn, v.elevation_rad / kDeg, r.doppler_hz, v.doppler_hz, r.code_phase_chips, v.code_phase_chips,
+                v.prn, v.elevation_rad / io::kRadPerDeg, r.doppler_hz, v.doppler_hz, r.code_phase_chips, v.code_phase_chips,
                 r.cn0_dbhz, v.cn0_dbhz);
   }
   // A satellite that is not transmitted is not found (its best cell is noise or another satellite's
@@ -275,16 +275,16 @@ TEST(IfSynthesiser, PseudorangeEqualsRangePlusClockTermsPlusDelays) {
       const Eigen::Vector3d r_sat = rotate_to_receive_frame(st.r_e_m, flight);
       const double range = (r_sat - r_rx).norm();
       const Eigen::Vector3d u = (r_sat - r_rx).normalized();
-      const Eigen::Vector3d up(std::cos(lat * kDeg) * std::cos(lon * kDeg), std::cos(lat * kDeg) * std::sin(lon * kDeg),
-                               std::sin(lat * kDeg));
-      const Eigen::Vector3d east(-std::sin(lon * kDeg), std::cos(lon * kDeg), 0.0);
+      const Eigen::Vector3d up(std::cos(lat * io::kRadPerDeg) * std::cos(lon * io::kRadPerDeg), std::cos(lat * io::kRadPerDeg) * std::sin(lon * io::kRadPerDeg),
+                               std::sin(lat * io::kRadPerDeg));
+      const Eigen::Vector3d east(-std::sin(lon * io::kRadPerDeg), std::cos(lon * io::kRadPerDeg), 0.0);
       const Eigen::Vector3d north = up.cross(east);
       const double el = std::asin(u.dot(up));
       double az = std::atan2(u.dot(east), u.dot(north));
       if (az < 0) az += 2 * std::numbers::pi;
-      const double iono_m = kSpeedOfLight_mps * klobuchar_delay_s(o.klobuchar, lat * kDeg, lon * kDeg, az, el,
+      const double iono_m = kSpeedOfLight_mps * klobuchar_delay_s(o.klobuchar, lat * io::kRadPerDeg, lon * io::kRadPerDeg, az, el,
                                                                   add_seconds(t_rx_clock, -b).tow_s);
-      const double tropo_m = troposphere_delay_m(lat * kDeg, h, el);
+      const double tropo_m = troposphere_delay_m(lat * io::kRadPerDeg, h, el);
       const double model = range + kSpeedOfLight_mps * (b - dt_sv) + iono_m + tropo_m;
       EXPECT_NEAR(rho - model, 0.0, 1e-4) << "PRN " << v.prn << " sample " << sample;
       EXPECT_NEAR(t.geometric_range_m, range, 1e-4);
@@ -326,7 +326,7 @@ TEST(IfSynthesiser, SamplesFollowTheExactTimingOnEveryAntenna) {
   o.output_rms = 1.0;
   o.if_hz = 0.2e6;
   const Eigen::Vector3d r0 = ecef_from_llh(35.274016, 137.013759, 100.0);
-  const Eigen::Vector3d east(-std::sin(137.013759 * kDeg), std::cos(137.013759 * kDeg), 0.0);
+  const Eigen::Vector3d east(-std::sin(137.013759 * io::kRadPerDeg), std::cos(137.013759 * io::kRadPerDeg), 0.0);
   std::vector<TrajectorySample> traj;
   for (int i = 0; i <= 20; ++i) {
     const double t = 0.05 * i;

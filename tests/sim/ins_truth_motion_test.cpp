@@ -2,6 +2,7 @@
 // 500 km/h with two antennas 1.2 m apart, the carrier phase difference between the antennas equals the
 // baseline projected on the line of sight over the wavelength (the attitude receiver's observable), and the
 // code timing of each antenna follows its own position.
+#include "io/units.hpp"
 #include "sim/ins_truth_motion.hpp"
 
 #include <gtest/gtest.h>
@@ -20,8 +21,7 @@ namespace ultratrack::sim {
 namespace {
 
 TEST(InsTruthMotion, CarrierPhaseDifferenceBetweenAntennasIsBaselineOnLineOfSight) {
-  constexpr double kDeg = std::numbers::pi / 180.0;
-  const auto spec = ins::profile_spec("circle", 3.0, 35.274016 * kDeg, 137.013759 * kDeg, 100.0);
+  const auto spec = ins::profile_spec("circle", 3.0, 35.274016 * io::kRadPerDeg, 137.013759 * io::kRadPerDeg, 100.0);
   auto truth = std::make_shared<ins::TruthInterpolator>(ins::simulate(spec, 100.0).truth);
   const std::vector<Eigen::Vector3d> levers = {{0.0, 0.0, -0.3}, {1.2, 0.0, -0.3}};
   auto motion = std::make_shared<InsTruthMotion>(truth, levers);

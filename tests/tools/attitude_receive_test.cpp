@@ -15,6 +15,7 @@
 #include <map>
 #include <vector>
 
+#include "io/units.hpp"
 #include "receiver/multi_sample_source.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "config/scenario_toml.hpp"
@@ -36,7 +37,6 @@ struct Collector final : receiver::ReceiverObserver {
   void on_antenna_phases(const receiver::AntennaPhaseEpoch& e) override { epochs.push_back(e); }
 };
 
-constexpr double kDeg = M_PI / 180.0;
 
 sim::Scenario attitude_scenario() {
   sim::Scenario s;
@@ -51,8 +51,8 @@ sim::Scenario attitude_scenario() {
   s.ionosphere = false;
   // Master, 1 m at azimuth 35 deg, 1.025 m at azimuth 125 deg (the seed array turned by 35 deg of yaw).
   s.antenna_offsets_enu_m = {{0.0, 0.0, 0.0},
-                             {std::sin(35 * kDeg), std::cos(35 * kDeg), 0.0},
-                             {1.025 * std::sin(125 * kDeg), 1.025 * std::cos(125 * kDeg), 0.0}};
+                             {std::sin(35 * io::kRadPerDeg), std::cos(35 * io::kRadPerDeg), 0.0},
+                             {1.025 * std::sin(125 * io::kRadPerDeg), 1.025 * std::cos(125 * io::kRadPerDeg), 0.0}};
   s.antenna_impairments = {{0.0, 0.003}, {0.23, 0.003}, {-0.41, 0.003}};
   return s;
 }

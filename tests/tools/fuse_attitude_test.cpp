@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "io/units.hpp"
 #include "pipelines/gps_attitude_csv.hpp"
 #include "commands.hpp"
 #include "pipelines/gnss_fix_simulation.hpp"
@@ -31,7 +32,6 @@ using ultratrack::io::InputError;
 
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 const ultratrack::signals::GpsTime kOrigin{2190, 604790.0};  // IMU t = 0; the week rolls over 10 s in
 
 void run(std::vector<std::string> args) {
@@ -90,8 +90,8 @@ AttitudeFile write_attitude(const fs::path& truth_csv, const fs::path& out, cons
     } else {
       const auto e = ultratrack::ins::euler_from_quaternion(truth.attitude(t) * q_ba);
       std::snprintf(line, sizeof line, "%d,%.4f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,7,1,8.500\n", g.week, g.tow_s,
-                    e.roll_rad / kDeg + sigma_deg.x() * n01(rng), e.pitch_rad / kDeg + sigma_deg.y() * n01(rng),
-                    e.yaw_rad / kDeg + sigma_deg.z() * n01(rng), sigma_deg.x(), sigma_deg.y(), sigma_deg.z());
+                    e.roll_rad / ultratrack::io::kRadPerDeg + sigma_deg.x() * n01(rng), e.pitch_rad / ultratrack::io::kRadPerDeg + sigma_deg.y() * n01(rng),
+                    e.yaw_rad / ultratrack::io::kRadPerDeg + sigma_deg.z() * n01(rng), sigma_deg.x(), sigma_deg.y(), sigma_deg.z());
     }
     text += line;
     ++f.rows;
@@ -108,7 +108,7 @@ class FuseAttitude : public ::testing::Test {
          "--out", (*dir_ / "sim").string()});
     run({"gnsssim", "--truth", (*dir_ / "sim/truth.csv").string(), "--rate", "1", "--first", "0.37", "--seed", "5",
          "--out", (*dir_ / "gnss.csv").string()});
-    mounting_ = ultratrack::ins::quaternion_from_euler({0.5 * kDeg, -0.3 * kDeg, 3.0 * kDeg});
+    mounting_ = ultratrack::ins::quaternion_from_euler({0.5 * ultratrack::io::kRadPerDeg, -0.3 * ultratrack::io::kRadPerDeg, 3.0 * ultratrack::io::kRadPerDeg});
     file_ = write_attitude(*dir_ / "sim/truth.csv", *dir_ / "attitude.csv", mounting_);
     write_text(*dir_ / "mounted.toml", "[imu]\npreset = \"mems\"\n[attitude]\ngps_time_at_imu_zero = [2190, 604790.0]\n"
                                        "misalignment_deg = [0.5, -0.3, 3.0]\n");

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "io/units.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
 #include "pipelines/gnss_fix_simulation.hpp"
@@ -25,7 +26,6 @@ using ultratrack::pipelines::GnssCsvRow;
 
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 const char* kHeader = "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m\n";
 
 fs::path write(const std::string& body) {
@@ -53,8 +53,8 @@ TEST(FuseGnssCsv, RoundTripIsExactWithAndWithoutVelocity) {
   std::vector<GnssCsvRow> in(3);
   for (int k = 0; k < 3; ++k) {
     in[k].t_s = 0.137 + 0.2 * k;
-    in[k].lat_rad = (36.1234567891 + 1e-7 * k) * kDeg;
-    in[k].lon_rad = 127.3 * kDeg - 1e-9 * k;
+    in[k].lat_rad = (36.1234567891 + 1e-7 * k) * ultratrack::io::kRadPerDeg;
+    in[k].lon_rad = 127.3 * ultratrack::io::kRadPerDeg - 1e-9 * k;
     in[k].height_m = 100.0 / 3.0 + k;
     in[k].has_velocity = k != 1;
     if (in[k].has_velocity) in[k].v_n = {1.0 / 3.0, -2.5, 0.01 * k};
@@ -137,7 +137,7 @@ TEST(FuseNavCsv, RoundTripKeepsStateAndSigmas) {
 // Simulated fixes: exact non-integer times, and errors with the requested white statistics (2000 fixes: the
 // sample standard deviation is within 5 sampling sigmas, sqrt(1 / (2 n)) ~ 1.6 %, of the setting).
 TEST(FuseGnssFixSimulation, TimesAndErrorStatistics) {
-  const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * kDeg, 127.0 * kDeg, 100.0);
+  const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * ultratrack::io::kRadPerDeg, 127.0 * ultratrack::io::kRadPerDeg, 100.0);
   const ultratrack::ins::TruthInterpolator truth(ultratrack::ins::simulate(spec, 20.0).truth);
   ultratrack::pipelines::GnssFixSimulationOptions o;
   o.rate_hz = 5.0;

@@ -16,6 +16,7 @@
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "config/scenario_toml.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/input_error.hpp"
 #include "signals/satellite_state.hpp"
@@ -30,7 +31,6 @@ namespace {
 
 using namespace ultratrack::sim;
 
-constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kLat = 35.274016, kLon = 137.013759, kH = 100.0;
 
 std::vector<std::string> read_lines(const std::filesystem::path& p) {
@@ -57,7 +57,7 @@ std::vector<std::vector<double>> read_rows(const std::filesystem::path& p) {
 
 Eigen::Vector3d ecef(double lat_rad, double lon_rad, double h) {
   Eigen::Vector3d r;
-  GeographicLib::Geocentric::WGS84().Forward(lat_rad / kDeg, lon_rad / kDeg, h, r.x(), r.y(), r.z());
+  GeographicLib::Geocentric::WGS84().Forward(lat_rad / io::kRadPerDeg, lon_rad / io::kRadPerDeg, h, r.x(), r.y(), r.z());
   return r;
 }
 
@@ -135,7 +135,7 @@ lever_arm_body_m = [-2.0, 1.0, -0.8]
   EXPECT_EQ(to_toml(read_scenario(out / "scenario.toml")), to_toml(s));
 
   // The same trajectory, run independently.
-  const auto ref = ins::simulate(ins::profile_spec("circle", 1.5, kLat * kDeg, kLon * kDeg, kH), 100.0).truth;
+  const auto ref = ins::simulate(ins::profile_spec("circle", 1.5, kLat * io::kRadPerDeg, kLon * io::kRadPerDeg, kH), 100.0).truth;
   ASSERT_EQ(ref.size(), 151u);
   const std::vector<Eigen::Vector3d> levers = {{0.5, 0.2, -1.0}, {-2.0, 1.0, -0.8}};
 
@@ -159,7 +159,7 @@ lever_arm_body_m = [-2.0, 1.0, -0.8]
     const Eigen::Matrix3d C = r.q_nb.toRotationMatrix();
     const double roll = std::atan2(C(2, 1), C(2, 2)), pitch = -std::asin(C(2, 0)), yaw = std::atan2(C(1, 0), C(0, 0));
     worst_att = std::max(
-        {worst_att, std::abs(row[14] - roll / kDeg), std::abs(row[15] - pitch / kDeg), std::abs(row[16] - yaw / kDeg)});
+        {worst_att, std::abs(row[14] - roll / io::kRadPerDeg), std::abs(row[15] - pitch / io::kRadPerDeg), std::abs(row[16] - yaw / io::kRadPerDeg)});
   }
   std::printf("truth.csv vs independent trajectory: position %.2e m, attitude %.2e deg\n", worst_pos, worst_att);
   EXPECT_LT(worst_pos, 1e-3);
@@ -238,9 +238,9 @@ lever_arm_body_m = [1.5, 0.4, -0.3]
   const auto out = dir / "out";
   run_simulation(s, out);
 
-  const Eigen::Matrix3d C_nb = C_nb_from_euler(12.0 * kDeg, -7.0 * kDeg, 63.0 * kDeg);
-  const Eigen::Vector3d r0 = ecef(kLat * kDeg, kLon * kDeg, kH);
-  const Eigen::Vector3d baseline_e = C_en(kLat * kDeg, kLon * kDeg) * C_nb * Eigen::Vector3d(1.5, 0.4, -0.3);
+  const Eigen::Matrix3d C_nb = C_nb_from_euler(12.0 * io::kRadPerDeg, -7.0 * io::kRadPerDeg, 63.0 * io::kRadPerDeg);
+  const Eigen::Vector3d r0 = ecef(kLat * io::kRadPerDeg, kLon * io::kRadPerDeg, kH);
+  const Eigen::Vector3d baseline_e = C_en(kLat * io::kRadPerDeg, kLon * io::kRadPerDeg) * C_nb * Eigen::Vector3d(1.5, 0.4, -0.3);
 
   // truth.csv carries the parked attitude; imu.csv's specific force levels to it.
   const auto truth = read_rows(out / "truth.csv");
@@ -251,8 +251,8 @@ lever_arm_body_m = [1.5, 0.4, -0.3]
   EXPECT_LT((Eigen::Vector3d(truth[0][3], truth[0][4], truth[0][5]) - r0).norm(), 1e-3);
   const auto imu = ins::read_imu_csv(out / "imu.csv");
   const Eigen::Vector3d f = imu.front().dv_b / 0.01;
-  EXPECT_NEAR(std::atan2(-f.y(), -f.z()) / kDeg, 12.0, 1e-3);
-  EXPECT_NEAR(std::atan2(f.x(), std::hypot(f.y(), f.z())) / kDeg, -7.0, 1e-3);
+  EXPECT_NEAR(std::atan2(-f.y(), -f.z()) / io::kRadPerDeg, 12.0, 1e-3);
+  EXPECT_NEAR(std::atan2(f.x(), std::hypot(f.y(), f.z())) / io::kRadPerDeg, -7.0, 1e-3);
 
   // The synthesiser wired as in the run: carrier phase difference at sample 0 = baseline . LOS / lambda.
   const NavigationSource nav = load_navigation(s);
@@ -306,11 +306,11 @@ preset = "ideal"
   auto state_of = [](const std::vector<double>& row) {
     ins::NavState n;
     n.t_s = row[0];
-    n.lat_rad = row[6] * kDeg;
-    n.lon_rad = row[7] * kDeg;
+    n.lat_rad = row[6] * io::kRadPerDeg;
+    n.lon_rad = row[7] * io::kRadPerDeg;
     n.height_m = row[8];
     n.v_n = {row[9], row[10], row[11]};
-    n.q_nb = Eigen::Quaterniond(C_nb_from_euler(row[14] * kDeg, row[15] * kDeg, row[16] * kDeg));
+    n.q_nb = Eigen::Quaterniond(C_nb_from_euler(row[14] * io::kRadPerDeg, row[15] * io::kRadPerDeg, row[16] * io::kRadPerDeg));
     return n;
   };
   ins::Strapdown ins(state_of(truth[0]));
@@ -323,7 +323,7 @@ preset = "ideal"
     const auto& st = ins.state();
     worst =
         std::max(worst, (ecef(st.lat_rad, st.lon_rad, st.height_m) - Eigen::Vector3d(row[3], row[4], row[5])).norm());
-    worst_att = std::max(worst_att, Eigen::AngleAxisd(st.q_nb.conjugate() * state_of(row).q_nb).angle() / kDeg);
+    worst_att = std::max(worst_att, Eigen::AngleAxisd(st.q_nb.conjugate() * state_of(row).q_nb).angle() / io::kRadPerDeg);
   }
   std::printf("imu.csv (ideal) mechanised over 60 s of circle: position error %.3e m, attitude %.2e deg\n", worst,
               worst_att);
@@ -374,8 +374,8 @@ imu_rate_hz = 200.0
   EXPECT_EQ(result.imu_rows, 2000u);  // 10 s at 200 Hz
   const auto truth = read_rows(dir / "out" / "truth.csv");
   ASSERT_EQ(truth.size(), 101u);
-  EXPECT_NEAR(truth[0][9], 10.0 * std::cos(30.0 * kDeg), 1e-5);
-  EXPECT_NEAR(truth[0][10], 10.0 * std::sin(30.0 * kDeg), 1e-5);
+  EXPECT_NEAR(truth[0][9], 10.0 * std::cos(30.0 * io::kRadPerDeg), 1e-5);
+  EXPECT_NEAR(truth[0][10], 10.0 * std::sin(30.0 * io::kRadPerDeg), 1e-5);
   EXPECT_NEAR(truth[0][16], 30.0, 1e-6);
   // 1 m/s^2 for 5 s, blended in over the first 1 s (quintic: half of the ramp's acceleration is lost)
   EXPECT_NEAR(std::hypot(truth[50][9], truth[50][10]), 10.0 + 4.5, 1e-4);
