@@ -1,8 +1,8 @@
 // The scalar receiver on a moving antenna (issue 3's dynamic check, shortened for CI): `ultratrack simulate`
 // drives the antenna round a circle of radius 100 m at 30 km/h (centripetal 0.69 m/s^2, line-of-sight
-// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with the shipped brdc3540 file; `ultratrack receive`
-// starts hot (--nav) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the
-// truth by tools/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
+// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with tests/data's brdc3540; `ultratrack receive` starts hot
+// (--nav) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the truth by
+// tools/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
