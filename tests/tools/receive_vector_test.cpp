@@ -217,8 +217,9 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
 // sight acceleration when its channel joins the vector loop; from then on the aiding brings it, so the integrator
 // must be cleared at the hand-over (counted twice, it lost 7 of 10 satellites within a second). Every satellite
 // kept to the end, fixes at 10 Hz from ~12.1 s, within 2 m 3-D RMS. Stays on the shared brdc0010.22n: on the
-// shipped file's sky PRNs 1 (17 deg) and 2 (10 deg) are acquired and lost 4 times each and never frame-synced in
-// this circle (the other 10 kept; 80 fixes, 1.43 m): not yet explained.
+// shipped file's sky PRNs 1 (17 deg) and 2 (10 deg) are acquired and lost 4 times each, each time ~0.5 s after bit
+// sync, and never frame-synced in this circle, by the scalar loops too (the other 10 kept, PRN 11 at a higher
+// Doppler rate included; 80 fixes, 1.43 m): not yet explained.
 TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
