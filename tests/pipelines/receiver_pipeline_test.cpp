@@ -1,7 +1,8 @@
-// pipelines::Receiver in process: `simulate` writes 16 s of a static receiver at 45 dB-Hz (10 satellites,
-// brdc0010.22n, 2 MHz i8); the receiver starts hot. With vector coupling every filter epoch reaches the sink, 20 ms
-// apart, and the summary's counts are those of the sink's epochs; the observer sees the fixes the summary counts;
-// no navigation or ultra-tight epoch is sent. A stop requested before the run processes nothing and says so.
+// pipelines::Receiver in process: `simulate` writes 16 s of a static receiver at 45 dB-Hz (12 satellites, the
+// shipped brdc3540 file, 2 MHz i8); the receiver starts hot. With vector coupling every filter epoch reaches the
+// sink, 20 ms apart, and the summary's counts are those of the sink's epochs; the observer sees the fixes the
+// summary counts; no navigation or ultra-tight epoch is sent. A stop requested before the run processes nothing
+// and says so.
 // ReceiveOptions::IsValid names what does not fit together.
 #include "pipelines/receiver_pipeline.hpp"
 
@@ -48,7 +49,7 @@ pipelines::ReceiveOptions options(pipelines::Coupling coupling) {
   o.coupling = coupling;
   o.receiver.fs_hz = kFs;
   o.receiver.pvt.troposphere = false;
-  o.receiver.reference_week = 2190;
+  o.receiver.reference_week = ultratrack::test::shipped_nav_week;
   o.receiver.reference_week_is_signal_week = true;
   return o;
 }
@@ -56,7 +57,7 @@ pipelines::ReceiveOptions options(pipelines::Coupling coupling) {
 }  // namespace
 
 TEST(ReceiverPipeline, VectorEpochsReachTheSinkAndTheSummaryCountsThem) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const auto sim = dir / "sim";

@@ -1,5 +1,6 @@
-// Ephemeris selection: health, IODE/IODC consistency, fit interval and nearest toe, on brdc0010.22n's
-// known cases (PRN 14/18 IODC, PRN 28 unhealthy) and on hand-made sets for the rules.
+// Ephemeris selection: health, IODE/IODC consistency, fit interval and nearest toe, on the shipped
+// brdc3540_0000-0200.14n (PRN 8 unhealthy, 01:59:44 sets), on brdc0010.22n's known cases (PRN 14/18 IODC, PRN 28
+// unhealthy; shared data) and on hand-made sets for the rules.
 #include "signals/ephemeris_selection.hpp"
 
 #include <gtest/gtest.h>
@@ -102,4 +103,34 @@ TEST(EphemerisSelection, Brdc0010KnownCases) {
   const auto e1 = select_ephemeris(nav.ephemerides, 1, {2190, 518400.0 + 7140.0});
   ASSERT_TRUE(e1.has_value());
   EXPECT_DOUBLE_EQ(e1->toe_s, 525600.0);
+}
+
+// The shipped brdc3540_0000-0200.14n (tests/data/README.md): PRN 8 is flagged unhealthy; PRNs 1, 3, 12 and 22 have
+// an extra set with toe 01:59:44 (525584) beside the 02:00 one, so "nearest toe" chooses between sets 16 s apart.
+TEST(EphemerisSelection, ShippedFileKnownCases) {
+  const RinexNavData nav = read_rinex_nav(ultratrack::test::shipped_nav_file());
+  const GpsTime t{ultratrack::test::shipped_nav_week, ultratrack::test::shipped_nav_tow_s};
+  EXPECT_FALSE(select_ephemeris(nav.ephemerides, 8, t).has_value());
+  const auto unhealthy = select_ephemeris(nav.ephemerides, 8, t, {.include_unhealthy = true});
+  ASSERT_TRUE(unhealthy.has_value());
+  EXPECT_EQ(unhealthy->health, 63);
+  // Every other PRN has its 00:00 set chosen at 00:00.
+  int found = 0;
+  for (int prn = 1; prn <= 32; ++prn) {
+    const auto e = select_ephemeris(nav.ephemerides, prn, t);
+    if (!e) continue;
+    ++found;
+    EXPECT_DOUBLE_EQ(e->toe_s, 518400.0) << "PRN " << prn;
+  }
+  EXPECT_EQ(found, 31);
+  // PRN 1 at 01:59:00: the 01:59:44 set (IODE 5) is nearer than the 02:00 one (IODE 94); at 02:00:00 the 02:00 set.
+  const auto early = select_ephemeris(nav.ephemerides, 1, add_seconds(t, 7140.0));
+  ASSERT_TRUE(early.has_value());
+  EXPECT_DOUBLE_EQ(early->toe_s, 525584.0);
+  EXPECT_EQ(early->iode, 5);
+  const auto on_time = select_ephemeris(nav.ephemerides, 1, add_seconds(t, 7200.0));
+  ASSERT_TRUE(on_time.has_value());
+  EXPECT_EQ(on_time->iode, 94);
+  // Past the last fit interval (02:00 + 2 h) nothing is valid.
+  EXPECT_FALSE(select_ephemeris(nav.ephemerides, 1, add_seconds(t, 14401.0)).has_value());
 }

@@ -228,9 +228,79 @@ TEST(RinexNav, ReadsBrdc0010_22n) {
   EXPECT_TRUE(saw28);
 }
 
+// The broadcast ephemeris shipped with the tests (tests/data/README.md): a RINEX 2 file as CDDIS merged it,
+// header and the records of 00:00-02:00, checked field by field against the file text.
+TEST(RinexNav, ReadsShippedBrdc3540) {
+  const RinexNavData nav = read_rinex_nav(ultratrack::test::shipped_nav_file());
+  EXPECT_NEAR(nav.version, 2.0, 1e-12);
+  EXPECT_EQ(nav.ephemerides.size(), 68u);  // (552 - 8 header lines) / 8
+  const Ephemeris& e = nav.ephemerides.at(0);
+  EXPECT_EQ(e.prn, 1);
+  EXPECT_EQ(e.week, 1823);
+  EXPECT_DOUBLE_EQ(e.toc_s, 518400.0);
+  EXPECT_DOUBLE_EQ(e.af0_s, -0.109937973321e-04);
+  EXPECT_DOUBLE_EQ(e.af1_sps, 0.341060513165e-12);
+  EXPECT_DOUBLE_EQ(e.af2_sps2, 0.0);
+  EXPECT_EQ(e.iode, 92);
+  EXPECT_DOUBLE_EQ(e.crs_m, 0.183125000000e+02);
+  EXPECT_DOUBLE_EQ(e.delta_n_radps, 0.486413118202e-08);
+  EXPECT_DOUBLE_EQ(e.m0_rad, 0.206468198931e+01);
+  EXPECT_DOUBLE_EQ(e.cuc_rad, 0.944361090660e-06);
+  EXPECT_DOUBLE_EQ(e.e, 0.373082933947e-02);
+  EXPECT_DOUBLE_EQ(e.cus_rad, 0.576488673687e-05);
+  EXPECT_DOUBLE_EQ(e.sqrt_a_sqrtm, 0.515366174698e+04);
+  EXPECT_DOUBLE_EQ(e.toe_s, 518400.0);
+  EXPECT_DOUBLE_EQ(e.cic_rad, -0.540167093277e-07);
+  EXPECT_DOUBLE_EQ(e.omega0_rad, 0.952167249062e+00);
+  EXPECT_DOUBLE_EQ(e.cis_rad, 0.204890966415e-07);
+  EXPECT_DOUBLE_EQ(e.i0_rad, 0.961377027886e+00);
+  EXPECT_DOUBLE_EQ(e.crc_m, 0.266968750000e+03);
+  EXPECT_DOUBLE_EQ(e.omega_rad, 0.444935335171e+00);
+  EXPECT_DOUBLE_EQ(e.omega_dot_radps, -0.814641075928e-08);
+  EXPECT_DOUBLE_EQ(e.idot_radps, 0.415017287136e-09);
+  EXPECT_EQ(e.code_on_l2, 1);
+  EXPECT_EQ(e.l2p_data_flag, 0);
+  EXPECT_EQ(e.ura_index, 0);  // 2.0 m
+  EXPECT_EQ(e.health, 0);
+  EXPECT_DOUBLE_EQ(e.tgd_s, 0.558793544769e-08);
+  EXPECT_EQ(e.iodc, 92);
+  EXPECT_DOUBLE_EQ(nav.transmit_tow_s.at(0), 511218.0);
+  EXPECT_EQ(e.fit_interval_flag, 0);  // 4 hours
+  // Header: ION ALPHA / ION BETA / DELTA-UTC / LEAP SECONDS (16 s in 2014).
+  EXPECT_TRUE(nav.klobuchar.valid);
+  EXPECT_DOUBLE_EQ(nav.klobuchar.alpha[0], 0.2887e-07);
+  EXPECT_DOUBLE_EQ(nav.klobuchar.alpha[2], -0.1192e-06);
+  EXPECT_DOUBLE_EQ(nav.klobuchar.beta[1], -0.1966e+06);
+  EXPECT_DOUBLE_EQ(nav.klobuchar.beta[3], 0.3932e+06);
+  EXPECT_DOUBLE_EQ(nav.utc.a0_s, 0.186264514923e-08);
+  EXPECT_DOUBLE_EQ(nav.utc.a1_sps, 0.799360577730e-14);
+  EXPECT_EQ(nav.utc.tot_s, 61440);
+  EXPECT_EQ(nav.utc.wnt, 1824);
+  EXPECT_TRUE(nav.has_leap_seconds);
+  EXPECT_EQ(nav.utc.delta_t_ls_s, 16);
+  // The last record (PRN 32 at 02:00), the 01:59:44 set of PRN 22, and PRN 8: unhealthy in every record.
+  EXPECT_EQ(nav.ephemerides.back().prn, 32);
+  EXPECT_DOUBLE_EQ(nav.ephemerides.back().toe_s, 525600.0);
+  EXPECT_DOUBLE_EQ(nav.transmit_tow_s.back(), 518418.0);
+  int sets22 = 0, sets8 = 0;
+  for (const Ephemeris& x : nav.ephemerides) {
+    EXPECT_EQ(x.week, 1823);
+    if (x.prn == 22 && x.toe_s == 525584.0) {
+      ++sets22;
+      EXPECT_EQ(x.iode, 6);
+      EXPECT_DOUBLE_EQ(x.toc_s, 525584.0);
+    }
+    if (x.prn == 8) {
+      ++sets8;
+      EXPECT_EQ(x.health, 63);
+    }
+  }
+  EXPECT_EQ(sets22, 1);
+  EXPECT_EQ(sets8, 2);
+}
+
 TEST(RinexNav, WriteThenReadGivesTheSameValues) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(path, "brdc0010.22n");
-  const RinexNavData in = read_rinex_nav(path);
+  const RinexNavData in = read_rinex_nav(ultratrack::test::shipped_nav_file());
   const auto out_path = ultratrack::test::scratch_dir() / "out.rnx";
   write_rinex_nav_304(out_path, in);
   EXPECT_FALSE(std::filesystem::exists(out_path.string() + ".tmp"));
@@ -271,7 +341,7 @@ TEST(RinexNav, WriteThenReadGivesTheSameValues) {
   EXPECT_NEAR(back.utc.a1_sps, in.utc.a1_sps, 1e-9 * std::abs(in.utc.a1_sps));
   EXPECT_EQ(back.utc.tot_s, in.utc.tot_s);
   EXPECT_EQ(back.utc.wnt, in.utc.wnt);
-  EXPECT_EQ(back.utc.delta_t_ls_s, 18);
+  EXPECT_EQ(back.utc.delta_t_ls_s, 16);  // the file's (not the default 18)
 }
 
 TEST(RinexNav, RoundTripsExtendedFitIntervalAndUraIndices) {
@@ -351,9 +421,8 @@ TEST(RinexNav, MissingFileThrowsInputErrorNamingIt) {
 // RTKLIB (an independent RINEX implementation) must read what we write: when its convbin is installed,
 // our 3.04 file goes through convbin (RINEX 3.04 in, RINEX 3.04 out) and the result is read back.
 TEST(RinexNav, RtklibConvbinReadsOurFile) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(path, "brdc0010.22n");
   if (std::system("command -v convbin >/dev/null 2>&1") != 0) GTEST_SKIP() << "RTKLIB convbin not installed";
-  const RinexNavData in = read_rinex_nav(path);
+  const RinexNavData in = read_rinex_nav(ultratrack::test::shipped_nav_file());
   const auto dir = ultratrack::test::scratch_dir();
   write_rinex_nav_304(dir / "ours.rnx", in);
   const std::string cmd = "cd '" + dir.string() + "' && convbin -r rinex -v 3.04 -n rtklib.rnx ours.rnx >/dev/null 2>&1";

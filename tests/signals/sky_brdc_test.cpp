@@ -1,11 +1,13 @@
-// Sky geometry from brdc0010.22n cross-checked with what gps-sdr-sim (an independent simulator) printed
-// for the same file, and the sky over the seed scenario's receiver listed for the record.
+// Sky geometry from broadcast ephemerides cross-checked with what gps-sdr-sim (an independent simulator) printed
+// for the same file: the shipped brdc3540_0000-0200.14n (tests/data) and the shared brdc0010.22n; and the sky over
+// the seed scenario's receiver listed for the record.
 #include <GeographicLib/Geocentric.hpp>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <vector>
 
 #include "signals/atmosphere.hpp"
 #include "signals/ephemeris_selection.hpp"
@@ -74,6 +76,45 @@ void expect_matches_printout(const std::vector<Seen>& ours, const std::map<int, 
 }
 
 }  // namespace
+
+// gps-sdr-sim on brdc3540.14n (the day the shipped file is cut from), user motion circle.csv of its repository,
+// start 2014/12/20,00:00:00 (1823:518400), ionosphere on: the list it prints at the start, for the first point of
+// circle.csv (ECEF -3813477.954, 3554276.552, 3662785.237 m, Nagoya), as published in a public README of a
+// HackRF test set-up (its command line names brdc0970.22n, but the start time it printed is this file's first
+// epoch). Every satellite above the horizon, the unhealthy PRN 8 included, were it up (gps-sdr-sim ignores health).
+TEST(SkyBrdc, ShippedFileMatchesGpsSdrSimAtCircleStart) {
+  const RinexNavData nav = read_rinex_nav(ultratrack::test::shipped_nav_file());
+  const std::map<int, Seen> printed = {
+      {1, {1, 75.5, 19.0, 23842014.1, 17.4}},    {2, {2, 278.2, 8.6, 25211959.5, 16.6}},
+      {3, {3, 44.8, 38.2, 22161310.3, 11.1}},    {6, {6, 298.1, 43.4, 21779609.4, 9.6}},
+      {9, {9, 144.3, 29.1, 22867978.9, 13.9}},   {10, {10, 222.8, 34.6, 22165342.9, 11.6}},
+      {11, {11, 98.7, 7.0, 25049095.4, 24.3}},   {12, {12, 326.9, 5.0, 25187588.2, 16.5}},
+      {17, {17, 350.8, 83.8, 20316661.5, 7.3}},  {20, {20, 47.2, 49.4, 21274204.2, 9.3}},
+      {23, {23, 106.0, 35.7, 22595053.5, 12.2}}, {28, {28, 201.9, 27.9, 22755566.1, 13.5}},
+      {32, {32, 43.1, 2.2, 25691385.0, 25.0}}};
+  double lat_deg = 0, lon_deg = 0, h_m = 0;
+  GeographicLib::Geocentric::WGS84().Reverse(-3813477.954, 3554276.552, 3662785.237, lat_deg, lon_deg, h_m);
+  const GpsTime t{ultratrack::test::shipped_nav_week, ultratrack::test::shipped_nav_tow_s};
+  expect_matches_printout(sky(nav, lat_deg, lon_deg, h_m, t, 0.0, true), printed, true);
+}
+
+// The shipped file over the seed scenario's receiver (Nagoya) at its first epoch, for the tests that simulate it:
+// the healthy satellites above 10 deg: gps-sdr-sim's list above (printed 100 m away) cut at 10 deg. PRN 8, the
+// file's unhealthy satellite, is below the horizon there.
+TEST(SkyBrdc, ShippedFileSatellitesAboveTenDegreesAtNagoya) {
+  const RinexNavData nav = read_rinex_nav(ultratrack::test::shipped_nav_file());
+  const GpsTime t{ultratrack::test::shipped_nav_week, ultratrack::test::shipped_nav_tow_s};
+  const auto healthy = sky(nav, 35.274016, 137.013759, 100.0, t, 10.0, false);
+  std::printf("brdc3540_0000-0200.14n, 2014-12-20 00:00:00 GPST, receiver 35.274016 N 137.013759 E 100 m, el > 10 deg:\n");
+  std::vector<int> prns;
+  for (const Seen& s : healthy) {
+    std::printf("  PRN %02d  az %6.1f deg  el %5.1f deg  range %11.1f m  iono %4.1f m\n", s.prn, s.az_deg, s.el_deg,
+                s.range_m, s.iono_m);
+    prns.push_back(s.prn);
+  }
+  EXPECT_EQ(prns, (std::vector<int>{1, 3, 6, 9, 10, 17, 20, 23, 28}));
+  EXPECT_EQ(healthy.size(), sky(nav, 35.274016, 137.013759, 100.0, t, 10.0, true).size());
+}
 
 // gps-sdr-sim, Tokyo (35.681298, 139.766247, 10 m), 2022-01-01 00:00:00 GPST, ionosphere off, mask 0 deg;
 // printout committed by ashfordeOU/kshana (tests/fixtures/iq_gpssdrsim_cross_generator/gpssdrsim_stderr.txt).

@@ -31,6 +31,10 @@ std::filesystem::path scenarios_dir() {
   return ULTRATRACK_SCENARIOS_DIR;
 }
 
+std::filesystem::path shipped_nav_file() {
+  return std::filesystem::path(ULTRATRACK_TEST_DATA_DIR) / "brdc3540_0000-0200.14n";
+}
+
 namespace {
 
 // A number as hexadecimal digits (a folder name).

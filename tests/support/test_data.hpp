@@ -1,4 +1,5 @@
-// Test helpers: where the optional shared recordings are, a scratch folder per test, and reading outputs back.
+// Test helpers: where the optional shared recordings and the shipped test data are, a scratch folder per test,
+// and reading outputs back.
 #pragma once
 
 #include <filesystem>
@@ -12,6 +13,14 @@ namespace ultratrack::test {
 std::optional<std::filesystem::path> shared_data_dir();
 // The checkout's scenarios/ folder (ULTRATRACK_SCENARIOS in the environment overrides).
 std::filesystem::path scenarios_dir();
+
+// The broadcast ephemeris shipped with the tests (tests/data/brdc3540_0000-0200.14n; source and cut in
+// tests/data/README.md): IGS broadcast orbits of 2014-12-20 with records at 00:00-02:00 GPST, valid from
+// 2014-12-19 22:00 to 2014-12-20 04:00. Always present, so a test that only needs "an ephemeris" runs on a
+// bare clone. Scenarios on it start at (shipped_nav_week, shipped_nav_tow_s), the toe of its first records.
+std::filesystem::path shipped_nav_file();
+inline constexpr int shipped_nav_week = 1823;          // full GPS week of 2014-12-20
+inline constexpr double shipped_nav_tow_s = 518400.0;  // 2014-12-20 00:00:00 GPST
 // A fresh empty folder under the system temp dir, unique to the calling test; called outside a test (in
 // SetUpTestSuite) unique to the suite and this process, and removed when the process exits.
 std::filesystem::path scratch_dir();

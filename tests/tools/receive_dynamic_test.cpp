@@ -1,6 +1,6 @@
 // The scalar receiver on a moving antenna (issue 3's dynamic check, shortened for CI): `ultratrack simulate`
 // drives the antenna round a circle of radius 100 m at 30 km/h (centripetal 0.69 m/s^2, line-of-sight
-// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with brdc0010.22n; `ultratrack receive` starts hot
+// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with tests/data's brdc3540; `ultratrack receive` starts hot
 // (--nav) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the truth by
 // pipelines/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
 #include <gtest/gtest.h>
@@ -45,13 +45,13 @@ double json_number(const fs::path& file, const std::string& key) {
 // metres per second) or on a lever-arm or time-tag error of a few milliseconds (8.3 m/s x 1 ms = 8 mm each).
 // TTFF: hot, the first subframe starts 6.07 s into the file; a fix needs frame sync and its time tag.
 TEST(ReceiveDynamic, CircleOf100mAt30kmhHotStartWithinTheIssuesTolerances) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "circle.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
                                        "25.0,0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
   std::ofstream(dir / "circle.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 25.0\n"
                                         "cn0_dbhz = 45.0\nseed = 2\n"
-                                        "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                        "[time]\ngps_week = 1823\ntow_s = 518772.0\n"
                                         "[navigation]\nrinex = \""
                                      << brdc.generic_string()
                                      << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
@@ -83,11 +83,11 @@ TEST(ReceiveDynamic, CircleOf100mAt30kmhHotStartWithinTheIssuesTolerances) {
 // pseudorange, a third to a sixth of it as the Hatch filter converges (DLL noise correlated over ~0.3 s), times
 // PDOP ~2: 1.5-3.5 m expected, 6 m allowed (the fixes span ~18 s, so their errors are strongly correlated).
 TEST(ReceiveDynamic, Static35DbHzHotStartTracksEverySatelliteAndFixes) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "static.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 30.0\n"
                                         "cn0_dbhz = 35.0\nseed = 4\n"
-                                        "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                        "[time]\ngps_week = 1823\ntow_s = 518772.0\n"
                                         "[navigation]\nrinex = \""
                                      << brdc.generic_string()
                                      << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"

@@ -1,6 +1,7 @@
 // `ultratrack receive --imu --coupling ultra-tight` end to end (issue 7), short for CI: `simulate` writes 21 s of a
-// car on a 100 m circle at 30 km/h (45 dB-Hz, 2 MHz, brdc0010.22n; IF samples, imu.csv (HG1700) and truth.csv
-// from one trajectory) with every signal absent from 14.0 to 18.0 s (a short tunnel; 4 s: the filter-driven
+// car on a 100 m circle at 30 km/h (45 dB-Hz, 2 MHz, the shipped brdc3540_0000-0200.14n from TOW 518476, 4 s into a
+// subframe, when no satellite is within 1 deg of the 10 deg measurement mask; IF samples, imu.csv (HG1700) and
+// truth.csv from one trajectory) with every signal absent from 14.0 to 18.0 s (a short tunnel; 4 s: the filter-driven
 // channels' presence test declares a loss 1-2 s after it, within 3 s with probability 1 - 0.085^2). The receiver starts hot,
 // pulls in scalar, the tight integration aligns in motion, and ~2 s later the ultra-tight loop takes the channels
 // over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
@@ -36,6 +37,7 @@ using namespace ultratrack;
 namespace {
 
 constexpr double kGapStart_s = 14.0, kGapEnd_s = 18.0, kDuration_s = 21.0;
+constexpr double kStartTow_s = 518476.0;  // the scenario's [time] tow_s (week 1823)
 
 double json_number(const std::string& json, const std::string& key) {
   const auto at = json.find("\"" + key + "\":");
@@ -44,15 +46,12 @@ double json_number(const std::string& json, const std::string& key) {
 
 struct Sim {
   fs::path dir, sim, nav;
-  bool ok = false;
 };
 
 Sim& sim() {
   static Sim s = [] {
     Sim r;
-    const auto shared = test::shared_data_dir();
-    if (!shared || !fs::exists(*shared / "brdc0010.22n")) return r;
-    const fs::path brdc = *shared / "brdc0010.22n";
+    const fs::path brdc = test::shipped_nav_file();
     r.dir = test::scratch_dir();
     r.sim = r.dir / "sim";
     r.nav = brdc;
@@ -61,7 +60,7 @@ Sim& sim() {
     std::ofstream(r.dir / "circle.toml")
         << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = "
         << kDuration_s << "\ncn0_dbhz = 45.0\nseed = 4\n"
-           "[time]\ngps_week = 2190\ntow_s = 518776.0\n[navigation]\nrinex = \""
+           "[time]\ngps_week = 1823\ntow_s = 518476.0\n[navigation]\nrinex = \""
         << brdc.generic_string()
         << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
            "[trajectory]\nfile = \"circle.csv\"\nspeed_mps = 8.333333333\nheading_deg = 0.0\nimu_rate_hz = 100.0\n"
@@ -70,7 +69,6 @@ Sim& sim() {
         << kGapStart_s << "\nduration_s = " << kGapEnd_s - kGapStart_s << "\n";
     test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
     std::ofstream(r.dir / "motion.toml") << "[alignment]\nmotion_window_s = 1.0\n";
-    r.ok = true;
     return r;
   }();
   return s;
@@ -95,7 +93,7 @@ NavError nav_error(const fs::path& rx, double t0) {
   NavError e;
   double s2 = 0.0, g2 = 0.0;
   for (const auto& r : nav) {
-    const double tow = 518776.0 + r.nav.t_s;
+    const double tow = kStartTow_s + r.nav.t_s;
     if (r.nav.t_s < t0) continue;
     auto it = std::lower_bound(truth.begin(), truth.end(), tow,
                                [](const ultratrack::pipelines::TruthPoint& p, double t) { return p.tow_s < t; });
@@ -113,10 +111,10 @@ NavError nav_error(const fs::path& rx, double t0) {
   return e;
 }
 
-// ultratight.csv: per PRN, (time, ultratight, coasting) rows.
+// ultratight.csv: per PRN, (time, ultratight, coasting, updated, accepted, carrier runaway) rows.
 struct Row {
   double t;
-  bool ultratight, coasting, updated, accepted;
+  bool ultratight, coasting, updated, accepted, runaway;
 };
 std::map<int, std::vector<Row>> read_log(const fs::path& rx) {
   std::ifstream in(rx / "ultratight.csv");
@@ -125,11 +123,12 @@ std::map<int, std::vector<Row>> read_log(const fs::path& rx) {
   const auto header = test::split_csv_line(line);
   const auto col = [&](const std::string& name) { return test::csv_column(header, name); };
   const std::size_t t = col("time_s"), prn = col("prn"), ut = col("ultratight"), co = col("coasting"),
-                    acc = col("accepted"), upd = col("updated");
+                    acc = col("accepted"), upd = col("updated"), run = col("carrier_runaway");
   std::map<int, std::vector<Row>> out;
   while (std::getline(in, line)) {
     const auto f = test::split_csv_line(line);
-    out[std::stoi(f[prn])].push_back({std::stod(f[t]), f[ut] == "1", f[co] == "1", f[upd] == "1", f[acc] == "1"});
+    out[std::stoi(f[prn])].push_back(
+        {std::stod(f[t]), f[ut] == "1", f[co] == "1", f[upd] == "1", f[acc] == "1", f[run] == "1"});
   }
   return out;
 }
@@ -172,17 +171,14 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
   EXPECT_GT(handover_s, 9.0);
   EXPECT_LT(handover_s, kGapStart_s - 1.0);
   EXPECT_EQ(json_number(summary, "releases"), 0.0);
-  // The carrier-runaway check (below 30 dB-Hz only) leaves a 45 dB-Hz run alone: no aiding step, no correlation
-  // left out; in the gap the channels coast (the monitor restarts) before it has 1 s of faded epochs.
+  // The carrier-runaway check (below 30 dB-Hz only) leaves a 45 dB-Hz run alone; per channel below.
   std::printf("carrier re-centres %g, left out %g\n", json_number(summary, "carrier_recentres"),
               json_number(summary, "runaway_left_out"));
-  EXPECT_EQ(json_number(summary, "carrier_recentres"), 0.0);
-  EXPECT_EQ(json_number(summary, "runaway_left_out"), 0.0);
   EXPECT_EQ(json_number(summary, "runaway_releases"), 0.0);
 
   const auto log = read_log(rx);
-  // The channels commanded at the hand-over: at least 6 (the file's 10 satellites: 8 above 10 deg, the others
-  // above the 5 deg command mask).
+  // The channels commanded at the hand-over: at least 6 (the file's sky at the start: 9 healthy satellites above
+  // 10 deg, PRNs 2 (8.9 deg) and 11 (6.6 deg) above the 5 deg command mask, PRN 12 at 5.4 deg).
   std::set<int> handed;
   for (const auto& [prn, rows] : log)
     if (!rows.empty() && rows.front().ultratight) handed.insert(prn);
@@ -213,6 +209,7 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
       EXPECT_TRUE(handed.count(prn)) << "PRN " << prn << " at " << el << " deg";
     }
   }
+  int late_losses = 0;  // channels whose loss the presence test declared a window late (below)
   for (int prn : handed) {
     const bool measured = elevation_deg[prn] >= 10.0;
     const auto& rows = log.at(prn);
@@ -236,6 +233,18 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
     // when noise passes (probability 0.085 each): before the return (3 windows) with 1 - 0.085^3.
     EXPECT_GE(loss_s, 1.0) << "PRN " << prn;
     EXPECT_LE(loss_s, kGapEnd_s - kGapStart_s) << "PRN " << prn;
+    // The carrier-runaway check (C/N0 below 30 dB-Hz, 1 s means of the replica's offset from the prediction) never
+    // flags a channel while its 45 dB-Hz signal is there. In the gap a channel coasts, and the monitor restarts,
+    // before it has a whole 1 s mean of faded epochs (the C/N0 estimate falls below 30 dB-Hz ~0.1 s in; the loss
+    // comes 1-2 s in) unless the presence test declares the loss a window late (2-3 s in): then the PLL on noise may
+    // be judged a runaway in the gap before it coasts, and stays flagged until it re-locks (seen on the shipped
+    // file's sky: PRN 9 lost 2.14 s in, flagged from 2.06 s in to its re-lock).
+    const bool late = loss_s > 2.0;
+    late_losses += late;
+    for (const Row& r : rows) {
+      const bool in_fade = r.t >= kGapStart_s && r.t <= kGapEnd_s + relock_s;
+      EXPECT_FALSE(r.runaway && !(late && in_fade)) << "PRN " << prn << " judged a runaway at " << r.t << " s";
+    }
     std::printf("PRN %d: loss declared %.2f s into the gap, re-lock %.2f s after the return\n", prn, loss_s, relock_s);
     EXPECT_LE(relock_s, 1.0) << "PRN " << prn;  // issue 7: back in lock within 1 s, no acquisition
     // Measurements pass the gate (p = 0.9999): before the gap nearly all (97-100 % seen); from 1.5 s after the
@@ -249,6 +258,13 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
     EXPECT_GE(after_ok, 0.75 * after) << "PRN " << prn;
     EXPECT_GE(before, 100) << "PRN " << prn;
   }
+  // No aiding step and no correlation left out unless a late-declared loss let the check act in the gap (at most one
+  // re-centring per such channel).
+  if (late_losses == 0) {
+    EXPECT_EQ(json_number(summary, "carrier_recentres"), 0.0);
+    EXPECT_EQ(json_number(summary, "runaway_left_out"), 0.0);
+  }
+  EXPECT_LE(json_number(summary, "carrier_recentres"), static_cast<double>(late_losses));
   // No re-acquisition: each handed-over satellite acquired once (summary per_satellite).
   for (int prn : handed) {
     const auto at = summary.find("\"prn\": " + std::to_string(prn) + ",");
@@ -286,23 +302,19 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
 // The default loop is pipelined: job 0 of the next block's correlation, its commands one 20 ms vector epoch later.
 // The lock, coasting, re-lock, NIS and accuracy checks hold with that latency.
 TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ekf", "iq");
 }
 
 TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ukf", "discriminator");
 }
 
 // The serial loop (--ut-serial: on the caller between blocks, its commands at once) passes the same checks.
 TEST(ReceiveUltraTight, SerialEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ekf", "iq", {"--ut-serial"});
 }
 
 TEST(ReceiveUltraTight, SerialUkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   check_run("ukf", "discriminator", {"--ut-serial"});
 }
 
@@ -329,7 +341,6 @@ std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::str
 // Pipelined (the default): every thread count runs the same jobs on the same inputs (--threads 1 runs the loop's
 // job in turn): the same bytes.
 TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto text = outputs_by_thread_count("rx_threads", {});
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
@@ -346,7 +357,6 @@ TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
 // bytes for one thread and two. The latency is real: its commands, and so its log, differ from the pipelined
 // loop's. --ut-pipelined=false selects it too.
 TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipelined) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto text = outputs_by_thread_count("rx_serial_threads", {"--ut-serial"});
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
@@ -365,7 +375,6 @@ TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipeli
 }
 
 TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto& s = sim();
   const std::vector<std::string> base = {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs",
                                          "2.0e6", "--nav", s.nav.string()};

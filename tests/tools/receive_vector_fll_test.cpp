@@ -149,7 +149,7 @@ std::map<int, bool> kept_in_vector_mode(const fs::path& vector_csv) {
 // discriminator's range is +-12.5 Hz). Every satellite kept, in vector mode to the end, none lost; the RINEX
 // carrier phase of every FLL epoch carries the loss-of-lock flag.
 TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const auto sim = dir / "sim", fll = dir / "fll", pll = dir / "pll";
@@ -197,7 +197,7 @@ TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth)
 // 4.6 Hz average-horizon lag of a line of sight along the acceleration, the straight part before it as static
 // (0.3 Hz). No satellite lost, every channel in vector mode to the end, fixes to the end.
 TEST(ReceiveVectorFll, TwoGTurnKeepsEveryChannelWithTheCommandedDopplerOnTheTruth) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc);
   const auto sim = dir / "sim", fll = dir / "fll", pll = dir / "pll";
@@ -246,6 +246,8 @@ TEST(ReceiveVectorFll, RejectsAnUnknownCarrierModeAndOneWithoutVectorCoupling) {
 // bit-synced again once two presence windows, or its C/N0 estimate 3 dB above the loss threshold, find the signal.
 // Bounds as there (issue 7's): no satellite acquired twice or lost, each coasting window starting 1-3 s into the
 // blockage (PRN 24's within its 2 s fade) and ending within 1 s of the return, fixes resuming, 2 m 3-D RMS.
+// Stays on the shared brdc0010.22n (week 2190): on the shipped file's sky (fading PRN 6) every coasting and
+// return bound holds but the fixes' 3-D RMS is 2.10 m (the short-window spread of ReceiveVector's first test).
 TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
@@ -254,7 +256,7 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 22.0,
                                               "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
                                               "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
-                                              "fade_s = 2.0\n");
+                                              "fade_s = 2.0\n", 2190);
   const auto sim = dir / "sim", fll = dir / "fll";
   run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});
   ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
@@ -312,7 +314,7 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
 // is an eighth of the +-25 Hz range; (3) the filter's position RMS over the weak part within 5 m (the threshold
 // runs at 20 dB-Hz: 0.7-2.4 m).
 TEST(ReceiveVectorFll, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 20.0;
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "weak.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, kEnd,

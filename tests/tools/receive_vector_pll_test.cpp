@@ -198,7 +198,7 @@ void print(const char* what, const Runs& r) {
 // sigma_f, measured against the synthesiser). Bound: RMS within 1.5 x sqrt(jitter^2 + (sigma_f h)^2). No epoch
 // beyond 0.1 cycles: a Costas slip needs 0.25 (and would leave a 0.5-cycle step, far outside).
 TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitter) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const Runs r = run_three(dir, brdc, (dir / "static.toml").string(), 13.5, 16.0);
@@ -232,11 +232,13 @@ TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitt
 // over 14-20 s within 0.03 cycles (a second-order loop of ~13 Hz, w0 ~ 24 rad/s, takes a 4.6 Hz frequency step
 // at a peak of ~0.5 x 4.6 / 24 = 0.1 cycles decaying within ~0.15 s, and the straight second and the rest of the
 // turn near the static level, 0.01 cycles). NCO Doppler within the FLL's (the residual removes the lag): RMS below
-// half the FLL's.
+// half the FLL's. Stays on the shared brdc0010.22n: on the shipped file's sky the vector PLL slips in this turn
+// (3 phase losses, 14 arcs for 12 satellites, max 2.36 cycles, RMS 0.20) while the aided PLL holds (RMS 0.033,
+// max 0.14): not yet explained.
 TEST(ReceiveVectorPll, TwoGTurnKeepsEveryPhaseArcWithoutSlips) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
-  const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc);
+  const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc, 2190);
   const Runs r = run_three(dir, brdc, turn.string(), 14.0, 20.0);
   print("2 g turn (14-20 s)", r);
   EXPECT_EQ(ultratrack::test::total_losses(dir / "pll"), 0);
@@ -261,17 +263,17 @@ TEST(ReceiveVectorPll, RejectsAnUnknownCarrierMode) {
 }
 
 // Fades (the blockage scenario of ReceiveVectorFll.ChannelsCoastThroughFadesAndReturnWithoutAcquisition: every
-// signal absent 14-17 s, PRN 24 alone 18.5-20.5 s, 22 s): a faded channel's phase arc ends at once (no
+// signal absent 14-17 s, PRN 6 alone 18.5-20.5 s, 22 s): a faded channel's phase arc ends at once (no
 // discriminator holds it) and it is commanded as in the FLL, coasting on the filter; back above the loss threshold
 // + 3 dB for 1 s it starts a new arc. So: no satellite acquired twice or lost, every satellite's arc lost once in
-// the blockage (PRN 24 twice), each re-entered (arcs = satellites + losses, the last fade ending 1.5 s before the
+// the blockage (PRN 6 twice), each re-entered (arcs = satellites + losses, the last fade ending 1.5 s before the
 // end), and the last epoch's phases locked again (no LLI) with fixes to the end.
 TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 22.0,
                                               "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
-                                              "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
+                                              "[[cycle_slip]]\nantenna = 0\nprn = 6\ntime_s = 18.5\ncycles = 0.0\n"
                                               "fade_s = 2.0\n");
   const auto sim = dir / "sim", pll = dir / "pll";
   run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});

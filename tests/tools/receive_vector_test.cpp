@@ -61,6 +61,10 @@ void drop_prn(const fs::path& in_path, const fs::path& out_path, int prn) {
 // the filter's prediction errors (its position sigma ~0.6 m 3-D here) plus the code discriminator noise, so
 // 2 m 3-D RMS (issue 3's fix tolerance) and no more than 1 m above the scalar run (the scalar RMS over these
 // ~4 s of fixes varies by ~0.5 m with the noise seed). The filter's own position: 2 m RMS from 13.5 s on.
+// Stays on the shared brdc0010.22n: on the shipped file's sky (12 satellites, PDOP 1.7) every lock check holds
+// but the fixes miss the bound: scalar 4.20 m, vector 3.97 m 3-D RMS (filter 1.01 m). The scalar RMS over these
+// ~4 s of fixes spreads 0.9-2.9 m over seeds 1-4 on that sky and 1.5-2.8 m over seeds 1 and 4 on this one
+// (ionosphere off), more than the ~0.5 m assumed above: the bound is to be re-derived from that spread.
 TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsScalar) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
@@ -162,13 +166,13 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
 // filter's predicted Doppler, which all channels' measurements pull onto the turn within a few epochs: no
 // satellite may be lost and fixes must continue to the end, within 2 m 3-D RMS of the truth.
 TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "turn.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
                                      "15.0,0.0,0.0,0.0,0.0\n5.0,0.0,8.09,0.0,0.0\n";
   std::ofstream(dir / "turn.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 20.0\n"
                                       "cn0_dbhz = 45.0\nseed = 4\n"
-                                      "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                      "[time]\ngps_week = 1823\ntow_s = 518772.0\n"
                                       "[navigation]\nrinex = \""
                                    << brdc.generic_string()
                                    << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 1000.0]\n"
@@ -213,7 +217,10 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
 // which the scalar loops track without a loss. Each third-order PLL's frequency-rate integrator holds the line-of-
 // sight acceleration when its channel joins the vector loop; from then on the aiding brings it, so the integrator
 // must be cleared at the hand-over (counted twice, it lost 7 of 10 satellites within a second). Every satellite
-// kept to the end, fixes at 10 Hz from ~12.1 s, within 2 m 3-D RMS.
+// kept to the end, fixes at 10 Hz from ~12.1 s, within 2 m 3-D RMS. Stays on the shared brdc0010.22n: on the
+// shipped file's sky PRNs 1 (17 deg) and 2 (10 deg) are acquired and lost 4 times each, each time ~0.5 s after bit
+// sync, and never frame-synced in this circle, by the scalar loops too (the other 10 kept, PRN 11 at a higher
+// Doppler rate included; 80 fixes, 1.43 m): not yet explained.
 TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
@@ -256,7 +263,8 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
 // gate keeps the faded epochs out of the filter from the first one either way). When the signal returns each must re-lock from
 // the predicted replica (leave "coasting") within 1 s (the issue's bound); the fixes, which resume after the
 // blockage and continue through the single fade on the other nine, stay within 2 m 3-D RMS of the truth (issue
-// 3's fix tolerance).
+// 3's fix tolerance). Stays on the shared brdc0010.22n: on the shipped file's sky (fading PRN 6) every coasting
+// and re-lock bound holds but the fixes' 3-D RMS is 2.96 m (the short-window spread of the first test).
 TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
@@ -333,12 +341,12 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
 // the simulator's truth: the filter's position RMS over the weak part within 5 m (the threshold runs at 22-24
 // dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code loop is slow and its sigma optimistic).
 TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 22.0;
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "weak.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " << kEnd
                                    << "\ncn0_dbhz = 45.0\nseed = 4\n"
-                                      "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+                                      "[time]\ngps_week = 1823\ntow_s = 518772.0\n"
                                       "[navigation]\nrinex = \""
                                    << brdc.generic_string()
                                    << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"

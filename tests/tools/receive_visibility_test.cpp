@@ -1,8 +1,8 @@
 // Acquisition skips satellites below the horizon: a receiver with a rough position (here the simulator's
 // truth) and the broadcast ephemerides of the whole constellation searches, once its clock is set, only the
 // PRNs the orbits put above the horizon, plus at most one hidden PRN per hidden_prn_check_interval_s. Truth:
-// the elevations of the 2022-01-01 broadcast orbits seen from Nagoya (brdc0010.22n), from the ephemeris
-// alone; the simulator transmits only the satellites above its 9 degree mask.
+// the elevations of the 2014-12-20 broadcast orbits seen from Nagoya (the shipped brdc3540 file), from the
+// ephemeris alone; the simulator transmits only the satellites above its 9 degree mask.
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
@@ -46,11 +46,11 @@ struct SearchLog : receiver::ReceiverObserver {
 }  // namespace
 
 TEST(ReceiveVisibility, SearchesOnlyPredictedVisiblePrnsOnceTheClockIsSet) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   const auto scenario = dir / "visibility.toml";
   std::ofstream(scenario) << "[signal]\nsample_rate_hz = 2.6e6\nformat = \"i8\"\nduration_s = 16.0\ncn0_dbhz = 45.0\n"
-                             "seed = 3\n[time]\ngps_week = 2190\ntow_s = 518398.0\n[navigation]\nrinex = \""
+                             "seed = 3\n[time]\ngps_week = 1823\ntow_s = 518398.0\n[navigation]\nrinex = \""
                           << brdc.string()
                           << "\"\nelevation_mask_deg = 9\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n";
   const auto sim = dir / "sim";
@@ -84,7 +84,7 @@ TEST(ReceiveVisibility, SearchesOnlyPredictedVisiblePrnsOnceTheClockIsSet) {
   const double fs_hz = 2.6e6;
   receiver::ReceiverOptions options;
   options.fs_hz = fs_hz;
-  options.reference_week = 2190;
+  options.reference_week = 1823;
   options.reference_week_is_signal_week = true;
   options.reacquisition_interval_s = 1.0;
   options.reacquisition_latency_s = 0.5;
@@ -116,7 +116,7 @@ TEST(ReceiveVisibility, SearchesOnlyPredictedVisiblePrnsOnceTheClockIsSet) {
   for (const auto& [snapshot, prns] : log.searches) {
     if (snapshot < log.first_epoch) continue;  // before the clock: no prediction possible
     ++predicted_snapshots;
-    const signals::GpsTime t{2190, 518398.0 + static_cast<double>(snapshot) / fs_hz};
+    const signals::GpsTime t{ultratrack::test::shipped_nav_week, 518398.0 + static_cast<double>(snapshot) / fs_hz};
     std::set<int> visible;
     for (const auto& e : nav.ephemerides) {
       if (std::abs(signals::seconds_between(t, e.toe())) > 7200.0) continue;

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -151,6 +152,45 @@ TEST(SimulateReference, SameSatellitesInViewAsGpsSdrSim) {
     EXPECT_NEAR(r.elevation_deg, g->elevation_deg, 0.051) << "PRN " << r.prn;
     EXPECT_NEAR(r.azimuth_deg, g->azimuth_deg, 0.051) << "PRN " << r.prn;
   }
+}
+
+// The same check on the shipped brdc3540_0000-0200.14n (runs on a bare clone): gps-sdr-sim's printout for that day's
+// file at the first point of its circle.csv (ECEF -3813477.954, 3554276.552, 3662785.237 m) at 2014/12/20,00:00:00
+// (1823:518400), reproduced in tests/signals/sky_brdc_test.cpp (SkyBrdc.ShippedFileMatchesGpsSdrSimAtCircleStart):
+// PRN, azimuth, elevation, with gps-sdr-sim's modelling choices (mask 0 deg, no health check).
+TEST(SimulateReference, ShippedFileSameSatellitesInViewAsGpsSdrSim) {
+  struct Printed {
+    int prn;
+    double azimuth_deg, elevation_deg;
+  };
+  constexpr Printed kPrinted[] = {{1, 75.5, 19.0},   {2, 278.2, 8.6},  {3, 44.8, 38.2},  {6, 298.1, 43.4},
+                                  {9, 144.3, 29.1},  {10, 222.8, 34.6}, {11, 98.7, 7.0},  {12, 326.9, 5.0},
+                                  {17, 350.8, 83.8}, {20, 47.2, 49.4},  {23, 106.0, 35.7}, {28, 201.9, 27.9},
+                                  {32, 43.1, 2.2}};
+  double lat_deg = 0, lon_deg = 0, h_m = 0;
+  GeographicLib::Geocentric::WGS84().Reverse(-3813477.954, 3554276.552, 3662785.237, lat_deg, lon_deg, h_m);
+  const auto dir = test::scratch_dir();
+  std::ostringstream text;
+  text.precision(12);
+  text << "[signal]\nsample_rate_hz = 2.6e6\nformat = \"i8\"\nduration_s = 0.01\ncn0_dbhz = 45.0\nseed = 1\n"
+       << "[time]\ngps_week = " << test::shipped_nav_week << "\ntow_s = 518400.0\n"
+       << "[navigation]\nrinex = \"" << test::shipped_nav_file().generic_string()
+       << "\"\nelevation_mask_deg = 0.0\ninclude_unhealthy = true\n"
+       << "[receiver]\nllh_deg_m = [" << lat_deg << ", " << lon_deg << ", " << h_m
+       << "]\nclock_bias_m = 0.0\nclock_drift_mps = 0.0\n[atmosphere]\nionosphere = true\ntroposphere = false\n";
+  std::ofstream(dir / "s.toml") << text.str();
+  run_simulation(read_scenario(dir / "s.toml"), dir / "out");
+  const auto rows = read_satellites_csv(dir / "out" / "satellites.csv");
+  std::set<int> ours, theirs;
+  for (const auto& r : rows) ours.insert(r.prn);
+  for (const auto& p : kPrinted) theirs.insert(p.prn);
+  EXPECT_EQ(ours, theirs);
+  for (const auto& r : rows)
+    for (const auto& p : kPrinted)
+      if (p.prn == r.prn) {
+        EXPECT_NEAR(r.elevation_deg, p.elevation_deg, 0.051) << "PRN " << r.prn;
+        EXPECT_NEAR(r.azimuth_deg, p.azimuth_deg, 0.051) << "PRN " << r.prn;
+      }
 }
 
 TEST(SimulateReference, SatellitesCsvDopplerAndCodePhaseMatchGpsSdrSim) {

@@ -1,7 +1,7 @@
 // `ultratrack simulate` end to end: the files it writes, and an independent brute-force acquisition
 // (tests/support) of the written samples that must find every satellite of satellites.csv at the stated
-// Doppler, code phase and C/N0, with the nominal constellation and (when shared data is present) the
-// broadcast ephemeris brdc0010.22n at the issue's position and time.
+// Doppler, code phase and C/N0, with the nominal constellation and with a broadcast ephemeris (the shipped
+// brdc3540_0000-0200.14n) at the issue's position.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -136,27 +136,34 @@ troposphere = true
 }
 
 TEST(Simulate, BroadcastEphemerisScenarioOfTheIssue) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = test::shipped_nav_file();
   const auto dir = test::scratch_dir();
   Scenario s = parse_scenario("[signal]\nsample_rate_hz = 2.048e6\nduration_s = 0.13\n", dir / "s.toml");
   s.constellation.clear();
   s.rinex = brdc.string();
+  s.gps_week = test::shipped_nav_week;
+  s.tow_s = test::shipped_nav_tow_s;
   const auto result = run_simulation(s, dir / "out");
   const auto rows = read_satellites(dir / "out" / "satellites.csv");
   std::set<int> prns;
   for (const auto& r : rows) prns.insert(r.prn);
-  // Healthy satellites above 10 deg at 2022-01-01 00:00 GPST from this position (shared/data README and
-  // the sky test); PRN 28 is in view but flagged unhealthy, so it is not transmitted.
-  for (int prn : {5, 13, 14, 15, 18, 23, 24}) EXPECT_TRUE(prns.count(prn)) << "PRN " << prn;
-  EXPECT_FALSE(prns.count(28));
+  // Satellites above 10 deg at 2014-12-20 00:00 GPST from this position (gps-sdr-sim's printout for this file,
+  // tests/signals/sky_brdc_test.cpp); all healthy.
+  for (int prn : {1, 3, 6, 9, 10, 17, 20, 23, 28}) EXPECT_TRUE(prns.count(prn)) << "PRN " << prn;
   expect_acquired_as_stated(read_samples(result.sample_files.at(0), signals::SampleFormat::i8), 2.048e6, rows);
-  // With include_unhealthy the flagged satellite is transmitted too.
-  s.include_unhealthy = true;
+  // The file's unhealthy PRN 8 is below the horizon here. Seen from under it (its sub-satellite point at this
+  // time, 3.0 S 126.3 W, from the same orbits: elevation 90 deg) it is left out, and transmitted with
+  // include_unhealthy.
+  s.llh_deg_m = {-3.0, -126.3, 0.0};
   s.duration_s = 0.01;
+  const auto healthy_only = run_simulation(s, dir / "out_healthy");
+  s.include_unhealthy = true;
   const auto with_unhealthy = run_simulation(s, dir / "out_unhealthy");
-  bool has28 = false;
-  for (const auto& v : with_unhealthy.satellites) has28 = has28 || v.prn == 28;
-  EXPECT_TRUE(has28);
+  bool has8 = false;
+  for (const auto& v : healthy_only.satellites) EXPECT_NE(v.prn, 8);
+  for (const auto& v : with_unhealthy.satellites) has8 = has8 || v.prn == 8;
+  EXPECT_TRUE(has8);
+  EXPECT_EQ(with_unhealthy.satellites.size(), healthy_only.satellites.size() + 1);
 }
 
 TEST(Simulate, SeveralAntennasGiveOneSynchronousFileEach) {

@@ -213,9 +213,10 @@ TEST(UltratightScenarios, TunnelDrives25MetresPerSecondWithATenSecondBlockageOfE
 // Signal level: the tunnel's blockage, moved to the first milliseconds, leaves exact zeros (noise off) on the
 // only antenna while it lasts, and the signal is back afterwards.
 TEST(UltratightScenarios, TunnelBlockageSilencesTheReceiver) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(nav, "brdc0010.22n");
+  const std::filesystem::path nav = ultratrack::test::shipped_nav_file();
   Scenario s = read_scenario(scenarios_dir() / "ultratight_tunnel.toml");
   s.rinex = nav.string();
+  s.gps_week = ultratrack::test::shipped_nav_week;  // the scenario's tow_s (518776) on the shipped file's week
   s.noise = false;
   s.cn0_dbhz = 80.0;  // so that the noiseless signal survives i8 quantisation
   s.duration_s = 0.008;
