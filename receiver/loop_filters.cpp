@@ -3,7 +3,7 @@
 namespace ultratrack::receiver {
 
 CarrierLoopFilter::CarrierLoopFilter(int order, double pll_bw_hz, double fll_bw_hz, double initial_frequency_hz)
-    : order_(order == 3 ? 3 : 2), frequency_hz_(initial_frequency_hz) {
+    : order_(checked_order(order)), frequency_hz_(initial_frequency_hz) {
   set_bandwidths(pll_bw_hz, fll_bw_hz);
 }
 

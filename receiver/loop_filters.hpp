@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cmath>
+#include <stdexcept>
 
 namespace ultratrack::receiver {
 
@@ -19,13 +20,14 @@ inline constexpr double kFirstOrderBnPerW0 = 0.25;
 // FLL-assisted PLL). State: frequency (Hz) and, for order 3, frequency rate (Hz/s).
 class CarrierLoopFilter final {
  public:
-  // pll_bw_hz > 0; fll_bw_hz >= 0 (0 = no FLL assist); order 2 or 3.
+  // pll_bw_hz > 0; fll_bw_hz >= 0 (0 = no FLL assist); order 2 or 3 (std::invalid_argument otherwise: the tracking
+  // options have checked it, so another value here is a programming error, not something to round).
   CarrierLoopFilter(int order, double pll_bw_hz, double fll_bw_hz, double initial_frequency_hz);
 
   void set_bandwidths(double pll_bw_hz, double fll_bw_hz);
   // Switches between 2nd and 3rd order keeping the frequency; the frequency-rate state restarts at 0.
   void set_order(int order) {
-    order_ = order == 3 ? 3 : 2;
+    order_ = checked_order(order);
     rate_hzps_ = 0.0;
   }
   // Restarts the integrators (e.g. when the integration time changes and the old state is too noisy).
@@ -52,6 +54,11 @@ class CarrierLoopFilter final {
   double fll_bw_hz() const { return fll_bw_hz_; }
 
  private:
+  static int checked_order(int order) {
+    if (order != 2 && order != 3) throw std::invalid_argument("carrier loop: order must be 2 or 3");
+    return order;
+  }
+
   int order_;
   double pll_bw_hz_ = 0.0, fll_bw_hz_ = 0.0;
   double frequency_hz_;     // velocity integrator

@@ -378,3 +378,16 @@ TEST(DelayLockLoop, WhiteEquivalentSigmaFactorMatchesTheClosedLoopsBlockMeans) {
   EXPECT_NEAR(dll_white_equivalent_sigma_factor(1.0, 0.020, 0.1), 2.21, 0.01);  // rho = 0.92^5 = 0.659
   EXPECT_NEAR(dll_white_equivalent_sigma_factor(1.0, 0.020, 10.0), 1.0, 1e-6);  // epochs far apart: white
 }
+
+// An order other than 2 or 3 is refused, not rounded to 2 (the tracking options check it at the edge).
+TEST(CarrierLoopFilter, OrderOtherThanTwoOrThreeIsRefused) {
+  using ultratrack::receiver::CarrierLoopFilter;
+  EXPECT_THROW(CarrierLoopFilter(4, 15.0, 0.0, 0.0), std::invalid_argument);
+  EXPECT_THROW(CarrierLoopFilter(1, 15.0, 0.0, 0.0), std::invalid_argument);
+  CarrierLoopFilter loop(3, 15.0, 0.0, 100.0);
+  EXPECT_THROW(loop.set_order(0), std::invalid_argument);
+  EXPECT_EQ(loop.order(), 3);
+  loop.set_order(2);
+  EXPECT_EQ(loop.order(), 2);
+  EXPECT_DOUBLE_EQ(loop.frequency_hz(), 100.0);
+}
