@@ -1,4 +1,4 @@
-// `ultratrack`: one program, one subcommand per job (see docs/architecture.md, "Command line").
+// `ultratrack`: one program, one subcommand per job (docs/cli.md lists every flag).
 // Errors from the edges arrive here as exceptions and leave as one line on stderr and a non-zero exit.
 #include <CLI/CLI.hpp>
 #include <fmt/core.h>

@@ -15,8 +15,9 @@
 #include <vector>
 
 #include "support/test_data.hpp"
-#include "tools/run_command.hpp"
-#include "tools/vector_carrier_runs.hpp"
+#include "config/scenario_toml.hpp"
+#include "sim/simulation_files.hpp"
+#include "support/vector_carrier_scenarios.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack;
@@ -61,7 +62,7 @@ TEST(ReceiverPipeline, VectorEpochsReachTheSinkAndTheSummaryCountsThem) {
   const auto dir = ultratrack::test::scratch_dir();
   std::ofstream(dir / "static.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 16.0, "");
   const auto sim = dir / "sim";
-  test_support::run_command("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
+  sim::simulate_to_folder(config::read_scenario(dir / "static.toml"), sim, "");
   const signals::RinexNavData nav = signals::read_rinex_nav(brdc);
   receiver::SampleSourceOptions source_options;
   source_options.fs_hz = kFs;
