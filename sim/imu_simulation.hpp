@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <stop_token>
 
 #include "ins/imu_error_model.hpp"
 #include "ins/nav_state.hpp"
@@ -15,6 +16,7 @@ namespace ultratrack::sim {
 
 struct ImuSimulationResult {
   std::size_t imu_rows = 0;
+  bool interrupted = false;  // stopped by the stop token before the trajectory's end
   ins::ImuErrors turn_on;  // the unit's drawn turn-on errors
   double distance_m = 0.0;
 };
@@ -25,7 +27,9 @@ struct ImuSimulationCallbacks {
   std::function<void(int percent)> on_progress;             // every 10 % of long runs (>= 500000 rows); optional
 };
 
+// A stop request ends the run between two IMU intervals: what was handed over is a consistent prefix.
 ImuSimulationResult simulate_imu(const ins::TrajectorySpec& spec, double imu_rate_hz, const ins::ImuErrorSpec& errors,
-                                 std::uint64_t seed, const ImuSimulationCallbacks& callbacks);
+                                 std::uint64_t seed, const ImuSimulationCallbacks& callbacks,
+                                 std::stop_token stop = {});
 
 }  // namespace ultratrack::sim

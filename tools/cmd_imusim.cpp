@@ -9,6 +9,7 @@
 #include <numbers>
 #include <string>
 
+#include "interrupt_guard.hpp"
 #include "commands.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
@@ -74,7 +75,9 @@ void run_imusim(const ImuSimOptions& o) {
     if (o.odometer) truth_for_odometer.push_back(t);
   };
   callbacks.on_progress = [](int percent) { fmt::print(stderr, "imusim: IMU {}%\n", percent); };
-  const sim::ImuSimulationResult r = sim::simulate_imu(spec, o.rate_hz, error_spec, o.seed, callbacks);
+  InterruptGuard interrupt;  // Ctrl-C ends the run; imu.csv and truth.csv hold the trajectory so far
+  const sim::ImuSimulationResult r =
+      sim::simulate_imu(spec, o.rate_hz, error_spec, o.seed, callbacks, interrupt.token());
   imu_out.commit();
   truth_out.commit();
   if (o.odometer) {
@@ -86,14 +89,16 @@ void run_imusim(const ImuSimOptions& o) {
   std::string json = "{\n";
   json += fmt::format("  \"trajectory\": \"{}\",\n  \"duration_s\": {},\n  \"imu_rate_hz\": {},\n  \"imu_rows\": {},\n",
                       o.profile.empty() ? o.segments_file : o.profile, spec.duration_s(), o.rate_hz, rows);
-  json += fmt::format("  \"preset\": \"{}\",\n  \"seed\": {},\n", o.preset, o.seed);
+  json += fmt::format("  \"preset\": \"{}\",\n  \"seed\": {},\n  \"interrupted\": {},\n", o.preset, o.seed,
+                      r.interrupted);
   json += sim::turn_on_bias_json(r.turn_on);
   json += fmt::format("  \"distance_m\": {:.3f}\n}}\n", r.distance_m);
   io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
   summary.write(json);
   summary.commit();
-  fmt::print("imusim: {} IMU rows at {} Hz ({} s, preset {}, seed {}); wrote {}/imu.csv, truth.csv{}\n", rows,
-             o.rate_hz, spec.duration_s(), o.preset, o.seed, o.out_dir, o.odometer ? ", odometer.csv" : "");
+  fmt::print("imusim: {} IMU rows at {} Hz ({} s, preset {}, seed {}{}); wrote {}/imu.csv, truth.csv{}\n", rows,
+             o.rate_hz, spec.duration_s(), o.preset, o.seed, r.interrupted ? ", interrupted" : "", o.out_dir,
+             o.odometer ? ", odometer.csv" : "");
 }
 
 }  // namespace
