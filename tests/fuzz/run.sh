@@ -20,7 +20,7 @@ for target in "$build"/fuzz/fuzz_*; do
   mkdir -p "$work/corpus" "$work/artifacts"
   cp "$here/corpus/$name"/* "$work/corpus/" 2>/dev/null
   # Every input found so far that crashed once stays a seed, so a fixed bug that returns is found at once.
-  cp "$here/regressions/$name"-* "$work/corpus/" 2>/dev/null
+  cp "$here/regressions/$name"-* "$work/corpus/" 2>/dev/null  # none yet: the folder appears with the first finding
   if "$target" -max_total_time="$seconds" -print_final_stats=1 -timeout=10 -rss_limit_mb=2048 -artifact_prefix="$work/artifacts/" \
        "$work/corpus" > "$work/log.txt" 2>&1; then
     echo "$name: clean, $(grep -o 'stat::number_of_executed_units: [0-9]*' "$work/log.txt" | cut -d' ' -f2) runs"
