@@ -44,6 +44,7 @@ class NavigationDataChannel {
   bool take_new_ephemeris();
   // The bits ahead, from the decoded subframes (and a supplied source, if given one).
   NavBitPredictor& bit_predictor() { return predictor_; }
+  const NavBitPredictor& bit_predictor() const { return predictor_; }
 
  private:
   static constexpr int kHistory = 302;  // a subframe and the two bits before it
