@@ -13,16 +13,6 @@ constexpr double kSubframe_s = 6.0;
 constexpr double kBit_s = 0.02;
 constexpr std::uint32_t kTowCountModulus = 100800;  // 6 s counts in a week
 
-// The issue of data a subframe 1-3 carries (IODC in subframe 1, IODE in 2 and 3).
-std::uint32_t issue_of_data(const signals::LnavDataWords& w, int subframe_id) {
-  namespace l = signals::lnav;
-  if (subframe_id == 1)
-    return signals::get_lnav_field(w, l::kIodcMsb.first, l::kIodcMsb.length) << 8 |
-           signals::get_lnav_field(w, l::kIodcLsb.first, l::kIodcLsb.length);
-  const l::Field f = subframe_id == 2 ? l::kIode2 : l::kIode3;
-  return signals::get_lnav_field(w, f.first, f.length);
-}
-
 }  // namespace
 
 bool NavBitPredictor::supply_navigation(int prn, const std::vector<signals::Ephemeris>& sets,
@@ -45,26 +35,58 @@ bool NavBitPredictor::supply_navigation(int prn, const std::vector<signals::Ephe
   return true;
 }
 
-// Words 3-10 of a decoded subframe 1-3 against the nav file's under the same issue of data, once per stored copy.
+bool NavBitPredictor::nav_file_subframe(const signals::GpsTime& start) {
+  if (start.week == nav_start_.week && start.tow_s == nav_start_.tow_s) return nav_ok_;
+  nav_start_ = start;
+  try {
+    nav_data_ = transmitter_->subframe_data(start);
+    nav_bits_ = transmitter_->subframe_starting_at(start);
+    nav_ok_ = true;
+  } catch (const io::InputError&) {
+    nav_ok_ = false;  // a nav-file field that does not fit its bits: nothing to verify
+  }
+  return nav_ok_;
+}
+
+bool NavBitPredictor::issue_of_data_trusted(int id) const {
+  const auto& t = trusted_[static_cast<std::size_t>(id - 1)];
+  return id == 1 ? t[2] && t[7] : id == 2 ? t[2] : t[9];
+}
+
+void NavBitPredictor::add_word(const signals::GpsTime& start, int index, std::uint32_t data24, int prev_d29,
+                               int prev_d30) {
+  const int id = signals::lnav_subframe_id_at(start.tow_s);
+  if (!transmitter_ || id > 3 || index < 2 || index > 9 || !nav_file_subframe(start)) return;
+  const auto w = static_cast<std::size_t>(index);
+  const std::uint32_t mask = index == 9 ? 0xFFFFFCu : 0xFFFFFFu;  // word 10's last two bits solve its parity
+  const bool agrees = ((nav_data_[w] ^ data24) & mask) == 0 && nav_bits_[30 * w - 2] == prev_d29 &&
+                      nav_bits_[30 * w - 1] == prev_d30;
+  auto& trusted = trusted_[static_cast<std::size_t>(id - 1)];
+  auto& rejected = rejected_[static_cast<std::size_t>(id - 1)];
+  if (agrees && !trusted[w]) {
+    ++nav_words_agreed_;
+    trusted.set(w);
+    rejected.reset(w);
+    ++version_;
+  } else if (!agrees && !rejected[w]) {
+    ++nav_words_disagreed_;
+    rejected.set(w);
+    trusted.reset(w);
+    const bool holds_issue = id == 1 ? (index == 2 || index == 7) : id == 2 ? index == 2 : index == 9;
+    if (holds_issue) trusted.reset();
+    ++version_;
+  }
+}
+
+// Words 3-10 of a decoded subframe 1-3 against the nav file's, once per stored copy.
 void NavBitPredictor::compare_with_nav_file(std::size_t index) {
   auto& stored = subframes_[index];
   if (!transmitter_ || !stored || stored->compared) return;
   stored->compared = true;
-  signals::LnavDataWords predicted{};
-  try {
-    predicted = transmitter_->subframe_data(stored->start);
-  } catch (const io::InputError&) {
-    return;  // a nav-file field that does not fit its bits: nothing to compare
-  }
-  const int id = static_cast<int>(index) + 1;
-  if (issue_of_data(predicted, id) != issue_of_data(stored->words, id)) return;
-  for (std::size_t w = 2; w < 10; ++w) {
-    const std::uint32_t mask = w == 9 ? 0xFFFFFCu : 0xFFFFFFu;  // word 10's last two bits solve its parity
-    if (((predicted[w] ^ stored->words[w]) & mask) == 0)
-      ++nav_words_agreed_;
-    else
-      ++nav_words_disagreed_;
-  }
+  const signals::SubframeBits bits = signals::encode_lnav_subframe(stored->words);
+  for (int w = 2; w < 10; ++w)
+    add_word(stored->start, w, stored->words[static_cast<std::size_t>(w)], bits[static_cast<std::size_t>(30 * w - 2)],
+             bits[static_cast<std::size_t>(30 * w - 1)]);
 }
 
 void NavBitPredictor::add_subframe(const signals::LnavSubframe& sf, const signals::GpsTime& start) {
@@ -113,7 +135,11 @@ void NavBitPredictor::build(const signals::GpsTime& start) {
   const auto& stored = id <= 3 ? subframes_[static_cast<std::size_t>(id - 1)] : std::nullopt;
   // Subframe 1 carries the week: a stored one from another week does not repeat.
   const bool data_known = stored && stored->start.week == start.week;
+  // Else the nav file's words the signal confirmed (their bits depend on the words before them only through the
+  // preceding D29*, D30*, which were confirmed with them).
+  const bool nav_words = !data_known && id <= 3 && transmitter_ && issue_of_data_trusted(id) && nav_file_subframe(start);
   if (data_known) w = stored->words;
+  if (nav_words) w = nav_data_;
   w[0] = *tlm_;
   const auto tow_count = static_cast<std::uint32_t>(
       (static_cast<std::int64_t>(std::llround(start.tow_s / kSubframe_s)) + 1) % kTowCountModulus);
@@ -125,6 +151,10 @@ void NavBitPredictor::build(const signals::GpsTime& start) {
                           static_cast<std::uint32_t>(id));
   bits_ = signals::encode_lnav_subframe(w);  // words 1-2 do not depend on the later words
   for (int i = 0; i < (data_known ? 300 : 60); ++i) known_.set(static_cast<std::size_t>(i));
+  if (nav_words)
+    for (std::size_t k = 2; k < 10; ++k)
+      if (trusted_[static_cast<std::size_t>(id - 1)][k])
+        for (std::size_t i = 30 * k; i < 30 * k + 30; ++i) known_.set(i);
 }
 
 std::optional<int> NavBitPredictor::bit_at(const signals::GpsTime& t) {

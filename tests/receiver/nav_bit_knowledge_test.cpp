@@ -83,10 +83,21 @@ TEST(NavBitKnowledge, ANavFileWordThatDisagreesWithTheDecodedCopyIsNeverUsed) {
   for (int b = 0; b < 1500; b += 7) EXPECT_FALSE(predictor.bit_at(signals::add_seconds(frame, 0.02 * b))) << b;
 
   decode_frame(predictor, signal, frame);
-  // Crs sits in subframe 2 word 3 (with the IODE): that word's data differ (on the air its parity too, and word 4
-  // is inverted where word 3's D30 changed). Every other subframe 1-3 word agrees.
-  EXPECT_EQ(predictor.nav_words_disagreed(), 1);
-  EXPECT_EQ(predictor.nav_words_agreed(), 3 * 8 - 1);
+  // Crs sits in subframe 2 word 3 (with the IODE): that word's data differ, and on the air its parity, which sets
+  // the polarity and parity of the words after it: a word agrees when its data and the two bits before it do.
+  int differ = 0;
+  for (int sf = 0; sf < 3; ++sf) {
+    const GpsTime t = signals::add_seconds(frame, 6.0 * sf);
+    const auto a = signal.tx->subframe_starting_at(t), b = nav_file_air.tx->subframe_starting_at(t);
+    for (int w = 2; w < 10; ++w) {
+      bool same = true;
+      for (int i = 30 * w - 2; i < 30 * w + (w == 9 ? 22 : 24); ++i) same = same && a[i] == b[i];
+      differ += !same;
+    }
+  }
+  EXPECT_GE(differ, 1);
+  EXPECT_EQ(predictor.nav_words_disagreed(), differ);
+  EXPECT_EQ(predictor.nav_words_agreed(), 3 * 8 - differ);
 
   int nav_file_differs = 0, known = 0;
   for (int bit = 0; bit < 2 * 1500; ++bit) {
@@ -105,6 +116,44 @@ TEST(NavBitKnowledge, ANavFileWordThatDisagreesWithTheDecodedCopyIsNeverUsed) {
   }
   EXPECT_GT(nav_file_differs, 0);  // word 3 (and word 4 where word 3's D30 changed), each frame
   EXPECT_EQ(known, 2 * (900 + 120));
+}
+
+// Words read one by one (their own parity held; the subframe around them need not): the nav file's words they
+// confirm are known from the next frame on, the others not; subframe 2's issue-of-data word (with Crs) disagrees,
+// which withdraws the whole subframe.
+TEST(NavBitKnowledge, NavFileWordsConfirmedOneByOneAreKnownAndOnlyThose) {
+  const GpsTime frame{kWeek, 518400.0 + 30.0 * 9};
+  const int prn = test::brdc_2022_001_ephemerides()[2].prn;
+  Air signal(prn, test::brdc_2022_001_ephemerides(), frame);
+  const auto nav_file = sets_with_crs_offset(prn, std::ldexp(1.0, -5));
+  NavBitPredictor predictor;
+  ASSERT_TRUE(predictor.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
+  // Subframe 4 decoded whole (TLM, HOW flags); of subframes 1-3 single words only, subframe 3's word 5 missed.
+  const GpsTime sf4 = signals::add_seconds(frame, 18.0);
+  predictor.add_subframe(signals::decode_lnav_subframe(signal.tx->subframe_starting_at(sf4)).subframe, sf4);
+  for (int sf = 1; sf <= 3; ++sf) {
+    const GpsTime t = signals::add_seconds(frame, 6.0 * (sf - 1));
+    const auto words = signal.tx->subframe_data(t);
+    const auto bits = signal.tx->subframe_starting_at(t);
+    for (int w = 2; w < 10; ++w) {
+      if (sf == 3 && w == 4) continue;
+      std::uint32_t data = words[static_cast<std::size_t>(w)];
+      if (w == 9) data = signals::decode_lnav_subframe(bits).subframe.words[9];  // with its parity-solving bits
+      predictor.add_word(t, w, data, bits[static_cast<std::size_t>(30 * w - 2)], bits[static_cast<std::size_t>(30 * w - 1)]);
+    }
+  }
+  EXPECT_GE(predictor.nav_words_disagreed(), 1);
+  for (int sf = 1; sf <= 3; ++sf) {
+    int known = 0;
+    for (int index = 0; index < 300; ++index) {
+      const GpsTime t = signals::add_seconds(frame, 30.0 + 6.0 * (sf - 1) + 0.02 * index);
+      const auto predicted = predictor.bit_at(t);
+      if (!predicted) continue;
+      ++known;
+      ASSERT_EQ(*predicted, signal.bit(t)) << "subframe " << sf << " bit " << index;
+    }
+    EXPECT_EQ(known, sf == 1 ? 300 : sf == 2 ? 60 : 270) << "subframe " << sf;
+  }
 }
 
 TEST(NavBitKnowledge, SubframeFourAndFivePagesAreUnknownByDefaultEvenWithANavFile) {
