@@ -7,10 +7,12 @@
 // trip_words contradicted words stop the source. A clean source at any C/N0 makes a word contradicted with
 // probability <= word_false_alarm, so it trips within W words with probability <= C(W, 2) alpha^2: 1.8e-5 for an
 // hour (6000 words) at the defaults (alpha = 1e-6, two words). t at n = 30 with the 3 dB margin, by the measured
-// C/N0: 1 at 35 dB-Hz, 2 at 30 (p = 3.8e-6), 3 at 28, 5 at 25 (p = 5.9e-3), 9 at 22, 13 at 20 (p = 0.079): a word
-// the source inverts (30 wrong bits) is caught at any checked C/N0, one with a single wrong field from ~28 dB-Hz
-// up (a field off by one unit in the last place changes ~4 bits with the parity). Bits below min_cn0_dbhz are
-// not checked (the Costas sign is then no evidence). Units: dB-Hz, seconds.
+// C/N0: 1 at 35 dB-Hz, 2 at 30 (p = 3.8e-6), 3 at 28, 5 at 25 (p = 5.9e-3): a word the source inverts (30 wrong
+// bits) is caught at any checked C/N0, one with a single wrong field from ~28 dB-Hz up (a field off by one unit in
+// the last place changes ~4 bits with the parity). Bits below min_cn0_dbhz (25 dB-Hz) are not checked: on our own
+// clean signal at a true 20 dB-Hz (ultra-tight, 0.2 s C/N0 estimates) a 20 dB-Hz floor contradicted ~1 % of words
+// (estimates several dB high, bit errors in bursts while the PLL's phase wanders), where the binomial model says
+// 1e-6. Units: dB-Hz, seconds.
 #pragma once
 
 #include <cstdint>
@@ -39,7 +41,7 @@ double bit_error_probability(double cn0_dbhz, double bit_s = 0.02);
 int word_contradiction_threshold(int n, double p, double false_alarm);
 
 struct NavBitCheckOptions {
-  double min_cn0_dbhz = 20.0;       // bits are checked at or above this C/N0 estimate
+  double min_cn0_dbhz = 25.0;       // bits are checked at or above this C/N0 estimate
   double cn0_margin_db = 3.0;       // p at the estimate minus this
   double word_false_alarm = 1e-6;   // a clean word's contradiction probability, (0, 0.1]
   int trip_words = 2;               // contradicted words (since arming) that stop the source, >= 1

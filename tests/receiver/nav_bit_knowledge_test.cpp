@@ -246,7 +246,7 @@ TEST(NavBitCheck, BitErrorProbabilityAndThresholdAgainstClosedForms) {
 // 3 dB margin making it far smaller), so two of W = 50 000 words (8.3 h) trip with probability
 // <= C(W, 2) alpha^2 = 1.25e-3: none expected. Corrupted source: one word per frame (every 50th) with 4 wrong bits
 // (a field one unit off with its parity) at 30 dB-Hz is contradicted every frame (t = 2 there) and trips at the
-// second; one word per frame inverted trips at 22 dB-Hz as well (t = 9 of 30).
+// second; one word per frame inverted trips at 25 dB-Hz as well (t = 5 of 30), where the 4-bit word is not seen.
 TEST(NavBitCheck, TripsOnACorruptedSourceAndNotOnACleanOne) {
   std::mt19937_64 rng(27);
   const auto run = [&rng](double cn0_dbhz, int words, int wrong_bits_every_50th) {
@@ -263,7 +263,7 @@ TEST(NavBitCheck, TripsOnACorruptedSourceAndNotOnACleanOne) {
     check.add(words, true, NAN);  // closes the last word (an unchecked bit)
     return std::pair{tripped_at, check.counts()};
   };
-  for (const double cn0 : {22.0, 25.0, 30.0, 40.0}) {
+  for (const double cn0 : {25.0, 27.0, 30.0, 40.0}) {
     const auto [tripped, counts] = run(cn0, 50000, 0);
     EXPECT_EQ(tripped, -1) << cn0;
     EXPECT_EQ(counts.words_contradicted, 0) << cn0;
@@ -275,12 +275,12 @@ TEST(NavBitCheck, TripsOnACorruptedSourceAndNotOnACleanOne) {
     EXPECT_EQ(counts.words_contradicted, 10);
   }
   {
-    const auto [tripped, counts] = run(22.0, 500, 30);
+    const auto [tripped, counts] = run(25.0, 500, 30);
     EXPECT_EQ(tripped, 58);
     EXPECT_EQ(counts.words_contradicted, 10);
   }
   {  // below min_cn0_dbhz nothing is checked
-    const auto [tripped, counts] = run(18.0, 500, 30);
+    const auto [tripped, counts] = run(24.0, 500, 30);
     EXPECT_EQ(tripped, -1);
     EXPECT_EQ(counts.bits_checked, 0);
   }
