@@ -48,6 +48,15 @@ struct Air {  // what the satellite transmits: the transmitter as `simulate` bui
   std::optional<signals::LnavTransmitter> tx;
 };
 
+// The signal from the broadcast sets, the nav file with Crs one unit off for its PRN.
+struct OneUnitOff {
+  GpsTime frame{kWeek, 518400.0 + 30.0 * 7};
+  int prn = test::brdc_2022_001_ephemerides()[3].prn;
+  Air signal{prn, test::brdc_2022_001_ephemerides(), frame};
+  std::vector<signals::Ephemeris> nav_file = sets_with_crs_offset(prn, std::ldexp(1.0, -5));
+  Air nav_file_air{prn, nav_file, frame};
+};
+
 void decode_frame(NavBitPredictor& p, Air& air, const GpsTime& frame_start) {
   for (int k = 0; k < 5; ++k) {
     const GpsTime t = signals::add_seconds(frame_start, 6.0 * k);
@@ -70,11 +79,11 @@ double binomial_tail(int n, double p, int t) {  // P(X >= t), X ~ Binomial(n, p)
 }  // namespace
 
 TEST(NavBitKnowledge, ANavFileWordThatDisagreesWithTheDecodedCopyIsNeverUsed) {
-  const GpsTime frame{kWeek, 518400.0 + 30.0 * 7};
-  const int prn = test::brdc_2022_001_ephemerides()[3].prn;
-  Air signal(prn, test::brdc_2022_001_ephemerides(), frame);
-  const auto nav_file = sets_with_crs_offset(prn, std::ldexp(1.0, -5));
-  Air nav_file_air(prn, nav_file, frame);
+  OneUnitOff c;
+  const GpsTime& frame = c.frame;
+  const int prn = c.prn;
+  Air &signal = c.signal, &nav_file_air = c.nav_file_air;
+  const auto& nav_file = c.nav_file;
 
   NavBitPredictor predictor;  // the default source
   EXPECT_EQ(predictor.source(), NavBitSource::kDecoded);
@@ -175,11 +184,11 @@ TEST(NavBitKnowledge, SubframeFourAndFivePagesAreUnknownByDefaultEvenWithANavFil
 }
 
 TEST(NavBitKnowledge, OracleReproducesTheNavFilesEveryBitWhateverWasDecoded) {
-  const GpsTime frame{kWeek, 518400.0 + 30.0 * 7};
-  const int prn = test::brdc_2022_001_ephemerides()[3].prn;
-  Air signal(prn, test::brdc_2022_001_ephemerides(), frame);
-  const auto nav_file = sets_with_crs_offset(prn, std::ldexp(1.0, -5));
-  Air nav_file_air(prn, nav_file, frame);
+  OneUnitOff c;
+  const GpsTime& frame = c.frame;
+  const int prn = c.prn;
+  Air &signal = c.signal, &nav_file_air = c.nav_file_air;
+  const auto& nav_file = c.nav_file;
   NavBitPredictor oracle(NavBitSource::kOracle);
   ASSERT_TRUE(oracle.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
   decode_frame(oracle, signal, frame);
