@@ -1,5 +1,5 @@
-// Data wipe-off end to end (issue 27): `simulate` writes 36 s of a static receiver at 45 dB-Hz (brdc0010.22n,
-// 2 MHz i8); the receiver starts hot from a nav file whose every ephemeris has Crs one unit (2^-5 m) off in the
+// Data wipe-off end to end (issue 27): 36 s of a static receiver at 45 dB-Hz simulated in process (the shipped
+// brdc3540 file, 2 MHz i8); the receiver starts hot from a nav file whose every ephemeris has Crs one unit (2^-5 m) off in the
 // last place, as a generator that quantises differently makes it, so subframe 2's word 3 differs from the signal's.
 // The scalar loops sum 100 ms coherently whenever 5 bits are known (adaptive_coherent off), so the bits are asked
 // for at 45 dB-Hz, where every wrong wiped word shows in the prompt's signs. Default (decoded): the nav file's
@@ -13,11 +13,12 @@
 #include <stop_token>
 #include <string>
 
+#include "config/scenario_toml.hpp"
 #include "pipelines/receiver_pipeline.hpp"
 #include "receiver/receiver_summary.hpp"
+#include "sim/simulation_files.hpp"
 #include "support/test_data.hpp"
-#include "tools/run_command.hpp"
-#include "tools/vector_carrier_runs.hpp"
+#include "support/vector_carrier_scenarios.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack;
@@ -38,7 +39,7 @@ Totals receive(const fs::path& samples, const signals::RinexNavData& nav, receiv
   o.coupling = pipelines::Coupling::kScalar;
   o.receiver.fs_hz = kFs;
   o.receiver.pvt.troposphere = false;
-  o.receiver.reference_week = 2190;
+  o.receiver.reference_week = test::shipped_nav_week;
   o.receiver.reference_week_is_signal_week = true;
   o.receiver.tracking.adaptive_coherent = false;
   o.receiver.tracking.max_coherent_ms = 100;
@@ -66,11 +67,11 @@ Totals receive(const fs::path& samples, const signals::RinexNavData& nav, receiv
 }  // namespace
 
 TEST(NavBitsEndToEnd, DefaultNeverWipesWithANavFilesWrongWordsWhileTheOracleDoes) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const fs::path brdc = test::shipped_nav_file();
   const auto dir = test::scratch_dir();
   std::ofstream(dir / "static.toml") << test::vector_carrier_scenario(brdc, 100.0, 36.0, "");
   const auto sim = dir / "sim";
-  test_support::run_command("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
+  sim::simulate_to_folder(config::read_scenario(dir / "static.toml"), sim, "");
   signals::RinexNavData nav = signals::read_rinex_nav(brdc);
   for (auto& e : nav.ephemerides) e.crs_m += std::ldexp(1.0, -5);
 
