@@ -24,7 +24,8 @@
 #   benchmarks/tracking_threshold.sh [--levels "24 26 28 30 32"] [--files 4] [--duration 60] [--fs 2.6e6]
 #       [--seed0 100] [--out DIR] [--ultratrack build/tools/ultratrack] [--receive-args "..."]
 #       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep] [--coupling scalar|vector]
-#       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--scenario FILE] [--reuse]
+#       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--filter ekf|ukf]
+#       [--scenario FILE] [--reuse]
 # Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3 (the report). CPU: about 15 s per file at
 # 2.6 MHz on one core. Files are deleted after their receive unless --keep. --reuse: a file kept by an earlier
 # --keep run in the same --out (same level, file number and options: the same seed and content) is received
@@ -41,7 +42,7 @@
 #                 early end;
 #   not locked at the step (left out of the fractions, like not acquired: pull-in is not what is measured).
 # --couplings runs every file through `receive --coupling X` for each X (the same files for every coupling);
-# loose, tight and ultra-tight get --imu DIR/imu.csv --filter ekf (needs --scenario with [trajectory]); a
+# loose, tight and ultra-tight get --imu DIR/imu.csv --filter ekf or --filter F (needs --scenario with [trajectory]); a
 # coupling that `receive` rejects is skipped with a message. Per coupling: the per-level table, the 90 %
 # threshold with its 68 % range, and the 3-D position RMS of solution.csv against truth.csv over the weak part
 # (fixes at and after T0, `ultratrack compare`): positions.csv, one row per file and coupling; for GNSS/INS
@@ -55,7 +56,7 @@ root=$(cd "$here/.." && pwd)
 levels="24 26 28 30 32"; files=4; duration=60; fs=2.6e6; seed0=100; out=/tmp/ultratrack_threshold
 ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$root/../shared/data/brdc0010.22n
 lock_deadline_s=5; extra_config=""; report_only=0; reuse=0
-strong_s=0; strong_cn0=45; couplings=""; scenario=""
+strong_s=0; strong_cn0=45; couplings=""; scenario=""; filter=ekf
 while [ $# -gt 0 ]; do
   case "$1" in
     --levels) levels=$2; shift 2 ;;
@@ -73,6 +74,7 @@ while [ $# -gt 0 ]; do
     --strong-s) strong_s=$2; shift 2 ;;
     --strong-cn0) strong_cn0=$2; shift 2 ;;
     --couplings) couplings=$2; shift 2 ;;
+    --filter) filter=$2; shift 2 ;;  # the GNSS/INS couplings' filter
     --scenario) scenario=$(realpath "$2"); shift 2 ;;
     --keep) keep=1; shift ;;
     --reuse) reuse=1; keep=1; shift ;;
@@ -191,7 +193,7 @@ TOML
               echo "tracking_threshold: coupling $coupling needs an IMU (--scenario with [trajectory]): skipped" >&2
               skipped="$skipped$coupling "; continue
             fi
-            coupling_args+=(--imu "$sim/imu.csv" --filter ekf) ;;
+            coupling_args+=(--imu "$sim/imu.csv" --filter "$filter") ;;
         esac
       fi
       rx=$out/$name${label:+.$label}.rx

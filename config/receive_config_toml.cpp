@@ -56,6 +56,7 @@ const std::map<std::string, Table>& sections() {
         {"initial_travel_time_s", [](const Setter& v, O& o) { o.initial_travel_time_s = v.number(); }},
         {"clock_jump_threshold_s", [](const Setter& v, O& o) { o.clock_jump_threshold_s = v.number(); }},
         {"smoothing_window_s", [](const Setter& v, O& o) { o.smoothing_window_s = v.number(); }},
+        {"nav_bits", [](const Setter& v, O& o) { o.nav_bits = receiver::parse_nav_bit_source(v.file, v.node.value<std::string>().value_or("")); }},
         {"tracking_record_interval_s", [](const Setter& v, O& o) { o.tracking_record_interval_s = v.number(); }}}},
       {"acquisition",
        {{"coherent_ms", [](const Setter& v, O& o) { o.acquisition.coherent_ms = v.integer(); }},

@@ -174,9 +174,10 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     // and the driver carries the previous epoch's measured phase over (ChannelCorrelation::continuous_carrier).
     c.continuous_carrier = true;
     c.integration_time_s = ut_.period_s;
-    // Data wipe-off by the known bit (decoded subframes or --nav: receiver/nav_bit_predictor.hpp), else by the
-    // prompt's sign: the Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms: Q(sqrt(2 C/N0 T)) =
-    // Q(6.3), none in practice; at 20 dB-Hz Q(2) = 2 %, hence the known bits).
+    // Data wipe-off by the known bit (receiver/nav_bit_source.hpp: decoded from the signal by default), else by
+    // the prompt's sign, the Costas form (each 20 ms update holds one bit: nothing sums across an unknown bit): the
+    // Costas loop holds the signal in I (bit errors at 30 dB-Hz, 20 ms: Q(sqrt(2 C/N0 T)) = Q(6.3), none in
+    // practice; at 20 dB-Hz Q(2) = 2 %, hence the known bits).
     const bool known = in.bit_sign != 0;
     const double sign = known ? in.bit_sign : (in.iq_i[1] >= 0.0 ? 1.0 : -1.0);
     for (int k = 0; k < 3; ++k) {

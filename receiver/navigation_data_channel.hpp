@@ -31,6 +31,9 @@ class NavigationDataChannel {
   void add_bit(float soft, std::int64_t first_code_period);
   // Forget the bit history (after loss of lock or a bit slip); the decoded data are kept.
   void reset();
+  // With a time tag every bit's place in its word is known: each word whose parity holds with the two bits before
+  // it goes to the bit predictor (NavBitPredictor::add_word), also from subframes that fail or while frame sync
+  // is lost, so a nav file's words can be confirmed one by one on a weak signal.
 
   // While held (the channel coasts on a vector loop's replica, whose code-period count keeps the bit timing),
   // the time tag survives failed subframes and a dropped frame lock; the next good subframe renews it.
@@ -44,6 +47,7 @@ class NavigationDataChannel {
   bool take_new_ephemeris();
   // The bits ahead, from the decoded subframes (and a supplied source, if given one).
   NavBitPredictor& bit_predictor() { return predictor_; }
+  const NavBitPredictor& bit_predictor() const { return predictor_; }
 
  private:
   static constexpr int kHistory = 302;  // a subframe and the two bits before it
@@ -55,6 +59,10 @@ class NavigationDataChannel {
   int polarity_ = 1;
   bool new_ephemeris_ = false;
   bool holding_ = false;
+  void read_word(float soft, std::int64_t first_code_period);
+  std::array<std::uint8_t, 32> word_bits_{};  // the latest bits (0/1 as received), oldest first
+  int word_fill_ = 0;                         // consecutive bits in word_bits_ (up to 32)
+  std::int64_t last_bit_number_ = -2;         // bits since GPS week 0 of the latest bit
 };
 
 }  // namespace ultratrack::receiver

@@ -194,6 +194,8 @@ void ReceiverChannel::after_epoch(const CorrelationEpoch& e, const TrackingRepor
   if (polarity_votes_left_ > 0 && epoch_bit_sign_ != 0 && report.state == TrackingState::kBitSynced) {
     polarity_vote_ += (e.master().prompt.real() >= 0.0f ? 1 : -1) * epoch_bit_sign_;
     if (--polarity_votes_left_ == 0 && polarity_vote_ < 0) polarity_fix_ = -polarity_fix_;
+  } else {
+    check_known_bit(e, report);
   }
   previous_epoch_ = last_epoch_;
   EpochSummary& s = last_epoch_;
@@ -244,6 +246,29 @@ TrackingRecord ReceiverChannel::record(const CorrelationEpoch& e, const Tracking
   return r;
 }
 
+// The running check (receiver/nav_bit_check.hpp) of a bit wiped by its prediction against the prompt's sign
+// (polarity resolved), phase-locked on 20 ms; a trip stops the decoded source until new data re-arm it, while
+// the oracle's contradictions are only counted.
+void ReceiverChannel::check_known_bit(const CorrelationEpoch& e, const TrackingReport& report) {
+  NavBitPredictor& predictor = nav_.bit_predictor();
+  if (predictor.take_new_data()) bit_check_.rearm();
+  if (epoch_bit_sign_ == 0 || report.state != TrackingState::kBitSynced || e.num_code_periods != 20) return;
+  const bool agrees = (e.master().prompt.real() >= 0.0f ? 1 : -1) == epoch_bit_sign_;
+  const double cn0 = report.cn0_dbhz ? *report.cn0_dbhz : NAN;
+  if (bit_check_.add(epoch_bit_word_, agrees, cn0) && predictor.source() == NavBitSource::kDecoded) {
+    predictor.stop();
+    ++bit_check_.counts().sources_stopped;
+  }
+}
+
+NavBitCounts ReceiverChannel::nav_bit_counts() const {
+  NavBitCounts c = bit_check_.counts();
+  c.nav_words_agreed += nav_.bit_predictor().nav_words_agreed();
+  c.nav_words_disagreed += nav_.bit_predictor().nav_words_disagreed();
+  c.oracle = oracle_used_;
+  return c;
+}
+
 // The signs of the bits from epoch e's on (20 ms epochs on bit edges), while the predictor knows them: transmit
 // time from the frame's time tag, sign = polarity x (+1 for bit 0). Not while a vector loop drives the replica.
 KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
@@ -262,12 +287,19 @@ KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
   }
   for (int i = 0; i < wanted; ++i) {
     const std::int64_t p = e.first_code_period + 20 * static_cast<std::int64_t>(i);
-    const auto bit = predictor.bit_at(signals::add_seconds(tag.transmit_time, 1e-3 * static_cast<double>(p - tag.code_period)));
+    const signals::GpsTime t = signals::add_seconds(tag.transmit_time, 1e-3 * static_cast<double>(p - tag.code_period));
+    const auto bit = predictor.bit_at(t);
+    if (i == 0) {  // the bit's word, from its middle (t may be a hair before its edge)
+      const signals::GpsTime mid = signals::add_seconds(t, 0.01);
+      epoch_bit_word_ = static_cast<std::int64_t>(mid.week) * 1008000 + static_cast<std::int64_t>(std::floor(mid.tow_s / 0.6));
+    }
     if (!bit) break;
     if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity() * polarity_fix_;
     ++k.ahead;
   }
   epoch_bit_sign_ = k.sign;
+  ++(k.sign != 0 ? bit_check_.counts().bits_wiped : bit_check_.counts().bits_unknown);
+  oracle_used_ = oracle_used_ || (predictor.supplied() && predictor.source() == NavBitSource::kOracle);
   return k;
 }
 

@@ -14,6 +14,8 @@
 
 #include "receiver/acquisition.hpp"
 #include "receiver/antenna_phase_tracker.hpp"
+#include "receiver/nav_bit_check.hpp"
+#include "receiver/nav_bit_source.hpp"
 #include "receiver/navigation_data_channel.hpp"
 #include "receiver/receiver_clock.hpp"
 #include "receiver/scalar_tracking.hpp"
@@ -117,8 +119,15 @@ class ReceiverChannel {
            nav_.synchronised();
   }
   bool coasting() const { return loop_.coasting(); }
-  // Known bits for data wipe-off from this source too (from the first time tag on); nullptr: decoded ones only.
-  void supply_navigation(std::shared_ptr<const SuppliedNavigation> navigation) { supplied_ = std::move(navigation); }
+  // Known bits for data wipe-off: from the decoded subframes, and the nav file (from the first time tag on;
+  // nullptr: none) as `source` says (receiver/nav_bit_source.hpp). Before the first epoch.
+  void supply_navigation(std::shared_ptr<const SuppliedNavigation> navigation,
+                         NavBitSource source = NavBitSource::kDecoded) {
+    supplied_ = std::move(navigation);
+    nav_.bit_predictor().set_source(source);
+  }
+  // This channel's data wipe-off so far: bits wiped, unknown, checked against the signal and contradicted.
+  NavBitCounts nav_bit_counts() const;
   // The measurement at next_sample(); nothing unless synchronised() and the time tag's week is known.
   // Marks the track as reported.
   std::optional<ChannelMeasurement> measure();
@@ -141,6 +150,7 @@ class ReceiverChannel {
   TrackingRecord record(const CorrelationEpoch& e, const TrackingReport& report) const;
   NcoCommand merged_command();
   KnownBits known_bits(const CorrelationEpoch& e, int wanted);
+  void check_known_bit(const CorrelationEpoch& e, const TrackingReport& report);
 
   // What vector tracking needs of a completed epoch.
   struct EpochSummary {
@@ -170,6 +180,9 @@ class ReceiverChannel {
   double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
   int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)
+  std::int64_t epoch_bit_word_ = 0;  // its LNAV word number (transmit time / 0.6 s)
+  NavBitCheck bit_check_;
+  bool oracle_used_ = false;  // the oracle source gave this channel's bits
   // After a re-lock from coasting the Costas loop may sit half a cycle from where the frame's polarity was
   // found: the first kPolarityVotes known-bit epochs vote (sign of I_P x known sign) and a negative vote inverts
   // the known signs until a new subframe gives the polarity again.

@@ -51,6 +51,13 @@ double ReceiverEngine::tracked_time_s(int prn) const {
   return t;
 }
 
+NavBitCounts ReceiverEngine::nav_bit_counts(int prn) const {
+  NavBitCounts c = stats_.satellites[static_cast<std::size_t>(prn)].nav_bits;
+  for (const auto& ch : channels_)
+    if (ch && ch->prn() == prn) c += ch->nav_bit_counts();
+  return c;
+}
+
 std::vector<int> ReceiverEngine::tracked_prns() const {
   std::vector<int> out;
   for (const auto& c : channels_)
@@ -87,7 +94,7 @@ void ReceiverEngine::finish_acquisition(std::int64_t start_sample) {
     *free = std::make_unique<ReceiverChannel>(r->prn, start, options_.fs_hz, options_.tracking, options_.reference_week,
                                               options_.reference_week_is_signal_week, record_periods_,
                                               options_.num_antennas);
-    (*free)->supply_navigation(navigation_.supplied());
+    (*free)->supply_navigation(navigation_.supplied(), options_.nav_bits);
     ++stats_.satellites[static_cast<std::size_t>(r->prn)].acquisitions;
   }
 }
@@ -161,6 +168,7 @@ void ReceiverEngine::release_lost_channels(std::int64_t sample) {
     auto& stats = stats_.satellites[static_cast<std::size_t>(channel->prn())];
     ++stats.losses;
     stats.tracked_s += channel->tracked_time_s();
+    stats.nav_bits += channel->nav_bit_counts();
     acquisition_.channel_lost(channel->prn(), sample);
     channel.reset();
   }

@@ -96,6 +96,8 @@ class ReceiverEngine {
   const ReceiverOptions& options() const { return options_; }
   // Time phase-locked on a PRN so far (released channels and the one tracking it now).
   double tracked_time_s(int prn) const;
+  // Data wipe-off on a PRN so far (released channels and the one tracking it now).
+  NavBitCounts nav_bit_counts(int prn) const;
   // PRNs in channels now, and of those the synchronised ones (for progress displays).
   std::vector<int> tracked_prns() const;
 

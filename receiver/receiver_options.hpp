@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "receiver/acquisition.hpp"
+#include "receiver/nav_bit_source.hpp"
 #include "receiver/pvt.hpp"
 #include "receiver/scalar_tracking.hpp"
 
@@ -56,6 +57,9 @@ struct ReceiverOptions {
   double tracking_record_interval_s = 0.02;  // tracking.csv rows per channel
   int num_antennas = 1;                    // antennas on one clock (1..kMaxAntennas); antenna 0 is acquired on
   double smoothing_window_s = 10.0;        // Hatch filter for the PVT's pseudoranges; 0 = off (raw)
+  // Navigation bits data wipe-off may use (receiver/nav_bit_source.hpp): decoded from the signal (a nav file's
+  // words once a decoded copy agrees), or the nav file re-encoded as our simulator does (oracle, studies only).
+  NavBitSource nav_bits = NavBitSource::kDecoded;
   AcquisitionOptions acquisition;          // fs_hz is taken from fs_hz above
   ScalarTrackingOptions tracking;
   PvtOptions pvt;

@@ -41,6 +41,7 @@ struct SatelliteStats {
   int used_in_fixes = 0;
   bool frame_synced = false;
   bool ephemeris_decoded = false;
+  NavBitCounts nav_bits;         // of its released channels (ReceiverEngine::nav_bit_counts adds the live one)
 };
 
 struct ReceiverStats {

@@ -72,6 +72,22 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
                ionosphere_source_name(iono[i].source),
                ionosphere_change_seconds(iono[i], s.first_sample, engine.options().fs_hz));
   fmt::print(out, "]}},\n");
+  // One line, so that a comparison across the change that added it can leave it out.
+  fmt::print(out, "  \"nav_bits\": {{\"mode\": \"{}\", \"per_satellite\": [", to_string(engine.options().nav_bits));
+  bool first_bits = true;
+  for (int prn = 1; prn <= 32; ++prn) {
+    if (s.satellites[static_cast<std::size_t>(prn)].acquisitions == 0) continue;
+    const NavBitCounts b = engine.nav_bit_counts(prn);
+    fmt::print(out,
+               "{}{{\"prn\": {}, \"source\": \"{}\", \"bits_wiped\": {}, \"bits_unknown\": {}, \"bits_checked\": {}, "
+               "\"bits_contradicted\": {}, \"words_contradicted\": {}, \"sources_stopped\": {}, "
+               "\"nav_words_agreed\": {}, \"nav_words_disagreed\": {}}}",
+               first_bits ? "" : ", ", prn, b.oracle ? "oracle" : "decoded", b.bits_wiped, b.bits_unknown,
+               b.bits_checked, b.bits_contradicted, b.words_contradicted, b.sources_stopped, b.nav_words_agreed,
+               b.nav_words_disagreed);
+    first_bits = false;
+  }
+  fmt::print(out, "]}},\n");
   fmt::print(out, "  \"per_satellite\": [");
   bool first = true;
   for (int prn = 1; prn <= 32; ++prn) {

@@ -35,7 +35,7 @@ namespace ultratrack::tools {
 namespace {
 
 struct ReceiveArgs {
-  std::string input, fs, if_hz = "0", config, nav, out;
+  std::string input, fs, if_hz = "0", config, nav, nav_bits, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
   FormatArgs format;
   ReceiveFusionArgs fusion;
@@ -66,6 +66,7 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.ionosphere.empty()) options.pvt.ionosphere = parse_on_off_option("--ionosphere", args.ionosphere, "broadcast", "off");
   if (!args.channels.empty()) options.channels = parse_int_option("--channels", args.channels);
   if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
+  if (!args.nav_bits.empty()) options.nav_bits = receiver::parse_nav_bit_source("command line: --nav-bits", args.nav_bits);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   if (!args.nav.empty()) job.navigation = signals::read_rinex_nav(args.nav);
   if (!args.reference_week.empty()) {
@@ -118,6 +119,7 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "output folder (created when missing)")->required();
   cmd->add_option("--config", args->config, "TOML file with [receiver], [acquisition], [tracking], [pvt] settings");
   cmd->add_option("--nav", args->nav, "RINEX navigation file: ephemerides known from the start (hot start)");
+  cmd->add_option("--nav-bits", args->nav_bits, "decoded|oracle: bits for data wipe-off (default decoded: from the signal; oracle: --nav re-encoded as `simulate` does, for simulation studies)");
   cmd->add_option("--elevation-mask-deg", args->elevation_mask, "PVT elevation mask, degrees (default 10)");
   cmd->add_option("--troposphere", args->troposphere, "on|off (default on)");
   cmd->add_option("--ionosphere", args->ionosphere, "broadcast|off (default broadcast: a default Klobuchar set until the nav file's or the broadcast one is known)");

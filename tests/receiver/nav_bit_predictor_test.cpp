@@ -114,7 +114,7 @@ TEST(NavBitPredictor, SuppliedNavigationKnowsEveryBitTheSimulatorSends) {
     const int prn = all[static_cast<std::size_t>(index)].prn;
     const Simulated sim = simulated(prn, start);
     signals::LnavTransmitter tx(sim.own, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), sim.selected);
-    NavBitPredictor predictor;
+    NavBitPredictor predictor(NavBitSource::kOracle);
     // the receiver selects a few seconds after the file's start (its first time tag)
     ASSERT_TRUE(predictor.supply_navigation(prn, all, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(),
                                             signals::add_seconds(start, 7.3)));

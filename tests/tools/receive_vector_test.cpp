@@ -336,7 +336,8 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
 // 25 s. Vector channels are filter-driven: the scalar loss test (0.2 s C/N0 below 25 dB-Hz for 0.3 s), which
 // lost every vector channel within ~0.5 s of a step to <= 25 dB-Hz, gives way to the presence test (a 60 s run at
 // 22 dB-Hz is falsely lost with probability 4e-11: docs/validation.md), their PLLs integrate 100 ms with the
-// known bits (--nav) wiped, and their discriminators keep updating the filter with C/N0-weighted noise. So every
+// known bits wiped (--nav-bits oracle: every bit of the simulated file; with the default decoded bits, none of
+// subframes 1-3 repeat within 25 s and 2 of 10 channels coasted), and their discriminators keep updating the filter with C/N0-weighted noise. So every
 // channel handed over must stay in vector mode and locked (bit-synced, never coasting or lost) to the end. Against
 // the simulator's truth: the filter's position RMS over the weak part within 5 m (the threshold runs at 22-24
 // dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code loop is slow and its sigma optimistic).
@@ -356,7 +357,8 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   const auto sim = dir / "sim", vector = dir / "vector";
   run("simulate", {"--scenario", (dir / "weak.toml").string(), "--out", sim.string()});
   run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
+                  brdc.string(), "--nav-bits", "oracle", "--troposphere", "off", "--coupling", "vector", "--out",
+                  vector.string()});
   fs::remove(sim / "antenna0.i8.bin");
 
   // vector.csv: the PRNs commanded at the step, and any of them not commanded (or coasting) afterwards; the
