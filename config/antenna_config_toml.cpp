@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "signals/input_error.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::config {
 namespace {
@@ -109,7 +110,7 @@ AntennaConfig read_antenna_config(const std::filesystem::path& path) {
   const auto n = c.solver.array.lever_arm_body_m.size();
   if (n < 2 || n > static_cast<std::size_t>(receiver::kMaxAntennas))
     throw InputError(file, fmt::format("{} antennas: an attitude needs 2..{}", n, receiver::kMaxAntennas));
-  if (const std::string why = receiver::validation_error(c.solver); !why.empty()) throw InputError(file, why);
+  if (const std::string why = io::why_invalid(c.solver); !why.empty()) throw InputError(file, why);
   return c;
 }
 

@@ -10,6 +10,7 @@
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::pipelines {
 
@@ -52,7 +53,7 @@ ReceiveFileResult receive_file(ReceiveFileJob job, std::stop_token stop, const R
     throw signals::InputError("receive options", fmt::format("receiver fs {} Hz differs from the sample source's {} Hz",
                                                              rx.fs_hz, job.source.fs_hz));
   if (job.duration_s < 0.0) throw signals::InputError("receive options", "duration must not be negative");
-  if (const std::string why = rx.validate(); !why.empty()) throw signals::InputError("receive options", why);
+  if (const std::string why = io::why_invalid(rx); !why.empty()) throw signals::InputError("receive options", why);
   if (std::string why; !job.options.IsValid(&why)) throw signals::InputError("receive options", why);
 
   receiver::SampleSource source(job.input, job.format, job.source);

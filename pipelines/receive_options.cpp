@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "ins/imu_error_model.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::pipelines {
 
@@ -12,7 +13,7 @@ bool ReceiveOptions::IsValid(std::string* error) const {
     if (error) *error = std::move(why);
     return false;
   };
-  if (std::string why = receiver.validate(); !why.empty()) return fail(why);
+  if (std::string why = io::why_invalid(receiver); !why.empty()) return fail(why);
   if (coupling != Coupling::kVector && vector_carrier != fusion::VectorCarrier::kAidedPll)
     return fail("--vector-carrier needs --coupling vector");
   if (!uses_imu(coupling)) return true;

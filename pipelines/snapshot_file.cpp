@@ -9,13 +9,14 @@
 #include "receiver/ionosphere_model.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/input_error.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::pipelines {
 
 SnapshotFileResult snapshot_file(const SnapshotFileJob& job) {
   std::string why;
   if (!job.search.IsValid(&why)) throw signals::InputError("snapshot options", why);
-  if (why = job.navigation.validate(); !why.empty()) throw signals::InputError("snapshot options", why);
+  if (why = io::why_invalid(job.navigation); !why.empty()) throw signals::InputError("snapshot options", why);
   if (job.nav.ephemerides.empty()) throw signals::InputError("navigation data", "holds no GPS ephemeris");
   SnapshotFileResult result;
   receiver::SnapshotOptions options = job.navigation;

@@ -17,42 +17,48 @@
 #include "receiver/phase_differences.hpp"
 #include "receiver/wahba_rotation.hpp"
 #include "signals/gps_constants.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::receiver {
 
-std::string validation_error(const AttitudeSolverOptions& o) {
-  const auto& lever = o.array.lever_arm_body_m;
-  if (lever.size() < 3 || lever.size() > static_cast<std::size_t>(kMaxAntennas)) {
-    return "the antenna array needs 3 to " + std::to_string(kMaxAntennas) + " antennas";
-  }
-  bool two_directions = false;
-  for (std::size_t k = 1; k < lever.size(); ++k) {
-    const Eigen::Vector3d bk = lever[k] - lever[0];
-    if (!bk.allFinite() || bk.norm() < 0.1) return "antenna " + std::to_string(k) + " is less than 0.1 m from the master";
-    for (std::size_t j = 1; j < k; ++j) {
-      const Eigen::Vector3d bj = lever[j] - lever[0];
-      if (bj.cross(bk).norm() > 0.1 * bj.norm() * bk.norm()) two_directions = true;
+bool AttitudeSolverOptions::IsValid(std::string* why) const {
+    const AttitudeSolverOptions& o = *this;
+  const std::string problem = [&]() -> std::string {
+    const auto& lever = o.array.lever_arm_body_m;
+    if (lever.size() < 3 || lever.size() > static_cast<std::size_t>(kMaxAntennas)) {
+      return "the antenna array needs 3 to " + std::to_string(kMaxAntennas) + " antennas";
     }
-  }
-  if (!two_directions) return "the baselines are collinear: no full attitude";
-  if (!(o.phase_sigma_m > 0.0 && o.phase_sigma_m < 0.05)) return "phase_sigma_m must be in (0, 0.05) m";
-  if (!(o.elevation_mask_rad >= 0.0 && o.elevation_mask_rad < std::numbers::pi / 2)) {
-    return "elevation_mask_rad must be in [0, pi/2)";
-  }
-  if (o.min_satellites < 5) return "min_satellites must be at least 5";
-  if (!(o.ratio_threshold >= 1.0)) return "ratio_threshold must be at least 1";
-  if (!(o.difference_threshold >= 0.0)) return "difference_threshold must not be negative";
-  if (!(o.constraint_gate_sigma > 0.0)) return "constraint_gate_sigma must be positive";
-  if (!(o.length_tolerance_m >= 0.0)) return "length_tolerance_m must not be negative";
-  if (!(o.residual_test_pfa > 0.0 && o.residual_test_pfa < 1.0)) return "residual_test_pfa must be in (0, 1)";
-  if (o.max_candidates_per_baseline < 2) return "max_candidates_per_baseline must be at least 2";
-  if (!(o.multi_epoch_difference_threshold >= 0.0)) return "multi_epoch_difference_threshold must not be negative";
-  if (o.multi_epoch_max_epochs < 2) return "multi_epoch_max_epochs must be at least 2";
-  return "";
+    bool two_directions = false;
+    for (std::size_t k = 1; k < lever.size(); ++k) {
+      const Eigen::Vector3d bk = lever[k] - lever[0];
+      if (!bk.allFinite() || bk.norm() < 0.1) return "antenna " + std::to_string(k) + " is less than 0.1 m from the master";
+      for (std::size_t j = 1; j < k; ++j) {
+        const Eigen::Vector3d bj = lever[j] - lever[0];
+        if (bj.cross(bk).norm() > 0.1 * bj.norm() * bk.norm()) two_directions = true;
+      }
+    }
+    if (!two_directions) return "the baselines are collinear: no full attitude";
+    if (!(o.phase_sigma_m > 0.0 && o.phase_sigma_m < 0.05)) return "phase_sigma_m must be in (0, 0.05) m";
+    if (!(o.elevation_mask_rad >= 0.0 && o.elevation_mask_rad < std::numbers::pi / 2)) {
+      return "elevation_mask_rad must be in [0, pi/2)";
+    }
+    if (o.min_satellites < 5) return "min_satellites must be at least 5";
+    if (!(o.ratio_threshold >= 1.0)) return "ratio_threshold must be at least 1";
+    if (!(o.difference_threshold >= 0.0)) return "difference_threshold must not be negative";
+    if (!(o.constraint_gate_sigma > 0.0)) return "constraint_gate_sigma must be positive";
+    if (!(o.length_tolerance_m >= 0.0)) return "length_tolerance_m must not be negative";
+    if (!(o.residual_test_pfa > 0.0 && o.residual_test_pfa < 1.0)) return "residual_test_pfa must be in (0, 1)";
+    if (o.max_candidates_per_baseline < 2) return "max_candidates_per_baseline must be at least 2";
+    if (!(o.multi_epoch_difference_threshold >= 0.0)) return "multi_epoch_difference_threshold must not be negative";
+    if (o.multi_epoch_max_epochs < 2) return "multi_epoch_max_epochs must be at least 2";
+    return "";
+  }();
+  if (why) *why = problem;
+  return problem.empty();
 }
 
 AttitudeSolver::AttitudeSolver(AttitudeSolverOptions options) : options_(std::move(options)) {
-  const std::string err = validation_error(options_);
+  const std::string err = io::why_invalid(options_);
   if (!err.empty()) throw std::invalid_argument("AttitudeSolverOptions: " + err);
   reset();
 }

@@ -61,10 +61,10 @@ struct AttitudeSolverOptions {
   bool multi_epoch = true;
   double multi_epoch_difference_threshold = 30.0;
   int multi_epoch_max_epochs = 600;
-};
 
-// "" when the options are usable, else the first problem in words.
-std::string validation_error(const AttitudeSolverOptions& options);
+  // True when the options fit together; otherwise false and *why (when given) says which setting and why.
+  bool IsValid(std::string* why) const;
+};
 
 // One fixed single-difference ambiguity: antenna k (>= 1) minus master, satellite prn, integer cycles. The integers
 // of one antenna share an arbitrary datum (the integer part of the line bias): only differences between two
@@ -105,7 +105,7 @@ struct AttitudeSolution {
 // fix that failed a check: valid = fixed = false then.
 class AttitudeSolver {
  public:
-  // Throws std::invalid_argument when validation_error(options) is not empty.
+  // Throws std::invalid_argument when the options are not valid (IsValid).
   explicit AttitudeSolver(AttitudeSolverOptions options);
 
   // An epoch without a usable master position (not finite, or nearer the geocentre than 1000 km) has no NED frame:

@@ -176,12 +176,16 @@ bool iterate_position(const std::vector<SatelliteMeasurement>& meas, const signa
 
 }  // namespace
 
-std::string PvtOptions::validate() const {
-  if (!(elevation_mask_rad >= -M_PI / 2 && elevation_mask_rad < M_PI / 2)) return "elevation mask outside [-90, 90) deg";
-  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) return "false-alarm probability not in (0, 1)";
-  if (!(sigma_zenith_m > 0.0) || !(sigma_doppler_mps > 0.0)) return "measurement sigmas must be positive";
-  if (max_iterations < 1) return "max_iterations must be at least 1";
-  return {};
+bool PvtOptions::IsValid(std::string* why) const {
+  const std::string problem = [&]() -> std::string {
+    if (!(elevation_mask_rad >= -M_PI / 2 && elevation_mask_rad < M_PI / 2)) return "elevation mask outside [-90, 90) deg";
+    if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) return "false-alarm probability not in (0, 1)";
+    if (!(sigma_zenith_m > 0.0) || !(sigma_doppler_mps > 0.0)) return "measurement sigmas must be positive";
+    if (max_iterations < 1) return "max_iterations must be at least 1";
+    return {};
+  }();
+  if (why) *why = problem;
+  return problem.empty();
 }
 
 PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& meas, const signals::GpsTime& receive_time,

@@ -36,7 +36,8 @@ struct PvtOptions {
   int max_iterations = 10;
 
   // Empty when valid, else the reason.
-  std::string validate() const;
+  // True when the options fit together; otherwise false and *why (when given) says which setting and why.
+  bool IsValid(std::string* why) const;
 };
 
 // A satellite used in a solution, with its geometry as seen from the solved position.

@@ -1,4 +1,5 @@
 #include "receiver/receiver_engine.hpp"
+#include "io/why_invalid.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +9,7 @@ namespace ultratrack::receiver {
 namespace {
 
 const ReceiverOptions& checked(const ReceiverOptions& o) {
-  const std::string why = o.validate();
+  const std::string why = io::why_invalid(o);
   if (!why.empty()) throw std::invalid_argument("ReceiverEngine: " + why);
   return o;
 }

@@ -72,7 +72,8 @@ struct ReceiverOptions {
     acquisition.noncoherent = 5;
   }
   // Empty when valid, else the first problem found.
-  std::string validate() const;
+  // True when the options fit together; otherwise false and *why (when given) says which setting and why.
+  bool IsValid(std::string* why) const;
 };
 
 }  // namespace ultratrack::receiver

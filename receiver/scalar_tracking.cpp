@@ -6,6 +6,7 @@
 
 #include "receiver/discriminators.hpp"
 #include "signals/gps_constants.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -23,7 +24,7 @@ int cn0_window_epochs(Cn0Method method, double window_s, double t_s) {
 }
 
 const ScalarTrackingOptions& valid(const ScalarTrackingOptions& o) {
-  if (auto e = validation_error(o); !e.empty()) throw std::invalid_argument(e);
+  if (auto e = io::why_invalid(o); !e.empty()) throw std::invalid_argument(e);
   return o;
 }
 

@@ -106,7 +106,7 @@ struct ScalarTrackingControl {
 
 class ScalarTracking final {
  public:
-  // options must be valid (validation_error empty) or std::invalid_argument is thrown. initial: the command
+  // options must be valid (IsValid) or std::invalid_argument is thrown. initial: the command
   // the channel started with (from acquisition).
   ScalarTracking(const ScalarTrackingOptions& options, const NcoCommand& initial);
 

@@ -12,7 +12,7 @@
 namespace ultratrack::receiver {
 
 // All scalar-tracking settings, with defaults for L1 C/A in a static or vehicle receiver. Check with
-// validation_error() at the edge (config file, command line) before constructing anything.
+// IsValid() at the edge (config file, command line) before constructing anything.
 struct ScalarTrackingOptions {
   // Carrier loop
   int pll_order = 3;                   // 2 or 3
@@ -118,10 +118,12 @@ struct ScalarTrackingOptions {
   int presence_max_windows = 5;          // [1, 10]
   double presence_false_loss_per_min = 1e-3;  // (0, 1)
   double presence_relock_dbhz = 15.0;    // [presence_threshold_dbhz, 40]
+
+  // True when the options fit together; otherwise false and *why (when given) says which setting and why.
+  bool IsValid(std::string* why) const;
 };
 
 // Empty when the options are valid, else a message naming the first bad field, its value and its range.
-std::string validation_error(const ScalarTrackingOptions& options);
 
 // The channel configuration these options need (correlator layout with the noise tap when kNoiseTap).
 ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz, int num_antennas = 1);

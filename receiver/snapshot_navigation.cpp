@@ -255,15 +255,19 @@ int usable_count(const std::vector<SnapshotMeasurement>& meas) {
 
 }  // namespace
 
-std::string SnapshotOptions::validate() const {
-  if (!(elevation_mask_rad >= -kPi / 2 && elevation_mask_rad < kPi / 2)) return "elevation mask out of range";
-  if (!(model_sigma_m > 0.0)) return "model sigma must be > 0";
-  if (!(time_sigma_s > 0.0 && time_sigma_s <= 600.0)) return "time sigma must be in (0, 600] s";
-  if (!(false_alarm_probability > 0.0 && false_alarm_probability < 0.5)) return "false-alarm probability out of (0, 0.5)";
-  if (max_exclusions < 0) return "max exclusions must be >= 0";
-  if (!(grid_step_m > 1e3 && grid_radius_m >= 0.0)) return "grid step must be > 1 km, radius >= 0";
-  if (max_iterations < 1) return "max iterations must be >= 1";
-  return {};
+bool SnapshotOptions::IsValid(std::string* why) const {
+  const std::string problem = [&]() -> std::string {
+    if (!(elevation_mask_rad >= -kPi / 2 && elevation_mask_rad < kPi / 2)) return "elevation mask out of range";
+    if (!(model_sigma_m > 0.0)) return "model sigma must be > 0";
+    if (!(time_sigma_s > 0.0 && time_sigma_s <= 600.0)) return "time sigma must be in (0, 600] s";
+    if (!(false_alarm_probability > 0.0 && false_alarm_probability < 0.5)) return "false-alarm probability out of (0, 0.5)";
+    if (max_exclusions < 0) return "max exclusions must be >= 0";
+    if (!(grid_step_m > 1e3 && grid_radius_m >= 0.0)) return "grid step must be > 1 km, radius >= 0";
+    if (max_iterations < 1) return "max iterations must be >= 1";
+    return {};
+  }();
+  if (why) *why = problem;
+  return problem.empty();
 }
 
 std::optional<Eigen::Vector3d> doppler_position(const std::vector<SnapshotMeasurement>& meas,

@@ -59,7 +59,8 @@ struct SnapshotOptions {
   int max_iterations = 20;
 
   // Empty when valid, else the reason.
-  std::string validate() const;
+  // True when the options fit together; otherwise false and *why (when given) says which setting and why.
+  bool IsValid(std::string* why) const;
 };
 
 struct SnapshotSatellite {

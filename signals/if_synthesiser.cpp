@@ -14,6 +14,7 @@
 #include "signals/gps_constants.hpp"
 #include "signals/satellite_state.hpp"
 #include "signals/synth_kernels.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::signals {
 namespace {
@@ -286,44 +287,49 @@ struct IfSynthesiser::Impl {
   }
 };
 
-std::string validate(const SynthesiserOptions& o) {
-  if (!(o.sample_rate_hz >= 1e5 && o.sample_rate_hz <= 1e9)) return "sample rate must be between 100 kHz and 1 GHz";
-  if (!(std::abs(o.if_hz) < 0.5 * o.sample_rate_hz)) return "|if_hz| must be below half the sample rate";
-  if (o.real_output && !(o.if_hz > 0.0)) return "real sample formats need an IF above 0 Hz (if_hz > 0)";
-  if (!(o.output_rms > 0.0)) return "output_rms must be positive";
-  if (!(o.default_cn0_dbhz >= 0.0 && o.default_cn0_dbhz <= 80.0)) return "cn0_dbhz must be within 0..80 dB-Hz";
-  for (const auto& [prn, cn0] : o.cn0_dbhz_by_prn) {
-    if (prn < kMinPrn || prn > kMaxPrn) return "C/N0 override for PRN " + std::to_string(prn) + ": PRN must be 1..32";
-    if (!(cn0 >= 0.0 && cn0 <= 80.0)) return "C/N0 of PRN " + std::to_string(prn) + " must be within 0..80 dB-Hz";
-  }
-  if (!(o.start.tow_s >= 0.0 && o.start.tow_s < kSecondsPerWeek) || o.start.week < 0)
-    return "start time must have week >= 0 and 0 <= tow_s < 604800";
-  if (!(o.elevation_mask_rad >= -M_PI / 2 && o.elevation_mask_rad <= M_PI / 2)) return "elevation mask out of range";
-  if (!(o.clock.bias_noise_s_per_sqrt_s >= 0.0) || !(o.clock.drift_noise_sps_per_sqrt_s >= 0.0))
-    return "clock noise densities must be >= 0";
-  if (!(std::abs(o.clock.drift_sps) < 1e-3)) return "clock drift must be below 1e-3 s/s (300 km/s)";
-  if (!std::isfinite(o.clock.bias_s) || std::abs(o.clock.bias_s) > 1.0) return "clock bias must be below 1 s";
-  if (!(o.phase_noise_correlation_s > 0.0)) return "phase noise correlation time must be positive";
-  for (const auto& imp : o.antenna_impairments) {
-    if (!std::isfinite(imp.line_bias_cycles)) return "line bias must be finite";
-    if (!(imp.phase_noise_m >= 0.0 && imp.phase_noise_m < 1.0)) return "phase noise must be within [0, 1) m";
-  }
-  for (const auto& e : o.cycle_slips) {
-    if (e.prn < kMinPrn || e.prn > kMaxPrn) return "cycle slip: PRN must be 1..32";
-    if (e.antenna < 0 || !(e.time_s >= 0.0) || !std::isfinite(e.cycles) || !(e.fade_s >= 0.0))
-      return "cycle slip: antenna >= 0, time_s >= 0, finite cycles and fade_s >= 0 are needed";
-  }
-  for (const auto& b : o.blockages)
-    if (b.antenna < 0 || !(b.start_s >= 0.0) || !(b.duration_s > 0.0))
-      return "blockage: antenna >= 0, start_s >= 0 and duration_s > 0 are needed";
-  for (const auto& c : o.cn0_steps) {
-    if (c.antenna < 0 || !(c.start_s >= 0.0 && c.start_s <= 86400.0))
-      return "C/N0 step: antenna >= 0 and start_s within 0..86400 s are needed";
-    if (!(c.cn0_dbhz >= 0.0 && c.cn0_dbhz <= 80.0)) return "C/N0 step: cn0_dbhz must be within 0..80 dB-Hz";
-    for (int prn : c.prns)
-      if (prn < kMinPrn || prn > kMaxPrn) return "C/N0 step: PRN must be 1..32";
-  }
-  return {};
+bool SynthesiserOptions::IsValid(std::string* why) const {
+    const SynthesiserOptions& o = *this;
+  const std::string problem = [&]() -> std::string {
+    if (!(o.sample_rate_hz >= 1e5 && o.sample_rate_hz <= 1e9)) return "sample rate must be between 100 kHz and 1 GHz";
+    if (!(std::abs(o.if_hz) < 0.5 * o.sample_rate_hz)) return "|if_hz| must be below half the sample rate";
+    if (o.real_output && !(o.if_hz > 0.0)) return "real sample formats need an IF above 0 Hz (if_hz > 0)";
+    if (!(o.output_rms > 0.0)) return "output_rms must be positive";
+    if (!(o.default_cn0_dbhz >= 0.0 && o.default_cn0_dbhz <= 80.0)) return "cn0_dbhz must be within 0..80 dB-Hz";
+    for (const auto& [prn, cn0] : o.cn0_dbhz_by_prn) {
+      if (prn < kMinPrn || prn > kMaxPrn) return "C/N0 override for PRN " + std::to_string(prn) + ": PRN must be 1..32";
+      if (!(cn0 >= 0.0 && cn0 <= 80.0)) return "C/N0 of PRN " + std::to_string(prn) + " must be within 0..80 dB-Hz";
+    }
+    if (!(o.start.tow_s >= 0.0 && o.start.tow_s < kSecondsPerWeek) || o.start.week < 0)
+      return "start time must have week >= 0 and 0 <= tow_s < 604800";
+    if (!(o.elevation_mask_rad >= -M_PI / 2 && o.elevation_mask_rad <= M_PI / 2)) return "elevation mask out of range";
+    if (!(o.clock.bias_noise_s_per_sqrt_s >= 0.0) || !(o.clock.drift_noise_sps_per_sqrt_s >= 0.0))
+      return "clock noise densities must be >= 0";
+    if (!(std::abs(o.clock.drift_sps) < 1e-3)) return "clock drift must be below 1e-3 s/s (300 km/s)";
+    if (!std::isfinite(o.clock.bias_s) || std::abs(o.clock.bias_s) > 1.0) return "clock bias must be below 1 s";
+    if (!(o.phase_noise_correlation_s > 0.0)) return "phase noise correlation time must be positive";
+    for (const auto& imp : o.antenna_impairments) {
+      if (!std::isfinite(imp.line_bias_cycles)) return "line bias must be finite";
+      if (!(imp.phase_noise_m >= 0.0 && imp.phase_noise_m < 1.0)) return "phase noise must be within [0, 1) m";
+    }
+    for (const auto& e : o.cycle_slips) {
+      if (e.prn < kMinPrn || e.prn > kMaxPrn) return "cycle slip: PRN must be 1..32";
+      if (e.antenna < 0 || !(e.time_s >= 0.0) || !std::isfinite(e.cycles) || !(e.fade_s >= 0.0))
+        return "cycle slip: antenna >= 0, time_s >= 0, finite cycles and fade_s >= 0 are needed";
+    }
+    for (const auto& b : o.blockages)
+      if (b.antenna < 0 || !(b.start_s >= 0.0) || !(b.duration_s > 0.0))
+        return "blockage: antenna >= 0, start_s >= 0 and duration_s > 0 are needed";
+    for (const auto& c : o.cn0_steps) {
+      if (c.antenna < 0 || !(c.start_s >= 0.0 && c.start_s <= 86400.0))
+        return "C/N0 step: antenna >= 0 and start_s within 0..86400 s are needed";
+      if (!(c.cn0_dbhz >= 0.0 && c.cn0_dbhz <= 80.0)) return "C/N0 step: cn0_dbhz must be within 0..80 dB-Hz";
+      for (int prn : c.prns)
+        if (prn < kMinPrn || prn > kMaxPrn) return "C/N0 step: PRN must be 1..32";
+    }
+    return {};
+  }();
+  if (why) *why = problem;
+  return problem.empty();
 }
 
 std::int64_t cn0_step_first_sample(const Cn0StepEvent& step, double sample_rate_hz) {
@@ -336,7 +342,7 @@ std::int64_t cn0_step_first_sample(const Cn0StepEvent& step, double sample_rate_
 IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> ephemerides,
                              std::shared_ptr<const ReceiverMotion> motion)
     : options_(std::move(options)), motion_(std::move(motion)) {
-  if (const auto err = validate(options_); !err.empty()) throw std::invalid_argument(err);
+  if (const auto err = io::why_invalid(options_); !err.empty()) throw std::invalid_argument(err);
   if (!motion_ || motion_->antenna_count() < 1) throw std::invalid_argument("the receiver needs at least one antenna");
   const int antennas = motion_->antenna_count();
   for (std::size_t a = static_cast<std::size_t>(antennas); a < options_.antenna_impairments.size(); ++a)

@@ -106,13 +106,13 @@ struct SynthesiserOptions {
   std::vector<CycleSlipEvent> cycle_slips;
   std::vector<BlockageEvent> blockages;
   std::vector<Cn0StepEvent> cn0_steps;
+
+  // True when the options fit together; otherwise false and *why (when given) says which setting and why.
+  bool IsValid(std::string* why) const;
 };
 
 // The first sample of a C/N0 step: the first sample at or after start_s (sample-exact).
 std::int64_t cn0_step_first_sample(const Cn0StepEvent& step, double sample_rate_hz);
-
-// Empty when the options are usable; otherwise what is wrong (the caller names the file).
-std::string validate(const SynthesiserOptions& options);
 
 // A satellite as the receiver sees it from antenna 0 at one sample.
 struct SatelliteView {
@@ -143,7 +143,7 @@ struct SignalTiming {
 class IfSynthesiser {
  public:
   // ephemerides: at most one per PRN (the caller selects them for the start time); motion: the antennas.
-  // Throws std::invalid_argument when validate(options) fails or a PRN repeats.
+  // Throws std::invalid_argument when the options are not valid (IsValid) or a PRN repeats.
   IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> ephemerides,
                 std::shared_ptr<const ReceiverMotion> motion);
   ~IfSynthesiser();

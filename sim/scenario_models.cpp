@@ -11,6 +11,7 @@
 #include "signals/gps_constants.hpp"
 #include "sim/ins_truth_motion.hpp"
 #include "sim/local_frame.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::sim {
 namespace {
@@ -126,7 +127,7 @@ signals::SynthesiserOptions synthesiser_options(const Scenario& s, const Navigat
   o.cycle_slips = s.cycle_slips;
   o.blockages = s.blockages;
   o.cn0_steps = s.cn0_steps;
-  if (const auto err = signals::validate(o); !err.empty()) throw InputError(s.source.string(), err);
+  if (const auto err = io::why_invalid(o); !err.empty()) throw InputError(s.source.string(), err);
   return o;
 }
 

@@ -25,6 +25,7 @@
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -64,7 +65,7 @@ void run_attitude(const AttitudeArgs& args) {
   } else {
     throw signals::InputError("command line", "give --nav or --reference-week (the full GPS week of the recording)");
   }
-  if (const std::string why = options.validate(); !why.empty()) throw signals::InputError("command line", why);
+  if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError("command line", why);
   const double duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
   if (duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
 

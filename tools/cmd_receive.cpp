@@ -29,6 +29,7 @@
 #include "receiver/sample_source.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::tools {
 
@@ -77,7 +78,7 @@ void run_receive(const ReceiveArgs& args) {
   job.duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
   if (job.duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
   if (args.out.empty()) throw signals::InputError("command line", "--out: an output folder is required");
-  if (const std::string why = options.validate(); !why.empty()) throw signals::InputError(args.config.empty() ? "command line" : args.config, why);
+  if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError(args.config.empty() ? "command line" : args.config, why);
   apply_receive_coupling_args(args.fusion, job.options);
   if (std::string why; !job.options.IsValid(&why)) throw signals::InputError("command line", why);
   const bool fused = pipelines::uses_imu(job.options.coupling);

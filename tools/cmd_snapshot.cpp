@@ -22,6 +22,7 @@
 #include "pipelines/snapshot_file.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::tools {
 
@@ -86,7 +87,7 @@ void run_snapshot(const SnapshotArgs& args) {
   job.prns = parse_prn_list_option("--prn", args.prns);
   std::string why;
   if (!job.search.IsValid(&why)) throw signals::InputError("command line", why);
-  if (why = job.navigation.validate(); !why.empty()) throw signals::InputError("command line", why);
+  if (why = io::why_invalid(job.navigation); !why.empty()) throw signals::InputError("command line", why);
   job.nav = signals::read_rinex_nav(args.nav);
   if (job.nav.ephemerides.empty()) throw signals::InputError(args.nav, "holds no GPS ephemeris");
 

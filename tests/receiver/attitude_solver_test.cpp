@@ -13,6 +13,7 @@
 #include <random>
 
 #include "attitude_phase_simulator.hpp"
+#include "io/why_invalid.hpp"
 
 using namespace ultratrack::receiver;
 using ultratrack::io::kRadPerDeg;
@@ -116,16 +117,16 @@ void print(const char* name, const MonteCarlo& mc) {
 
 TEST(AttitudeSolver, RejectsInvalidOptions) {
   AttitudeSolverOptions o = seed_options();
-  EXPECT_EQ(validation_error(o), "");
+  EXPECT_EQ(ultratrack::io::why_invalid(o), "");
   o.array.lever_arm_body_m.pop_back();
-  EXPECT_NE(validation_error(o), "");
+  EXPECT_NE(ultratrack::io::why_invalid(o), "");
   EXPECT_THROW(AttitudeSolver{o}, std::invalid_argument);
   o = seed_options();
   o.array.lever_arm_body_m[2] = Eigen::Vector3d(2.0, 0.0, 0.0);  // collinear with antenna 1
-  EXPECT_NE(validation_error(o), "");
+  EXPECT_NE(ultratrack::io::why_invalid(o), "");
   o = seed_options();
   o.phase_sigma_m = 0.0;
-  EXPECT_NE(validation_error(o), "");
+  EXPECT_NE(ultratrack::io::why_invalid(o), "");
 }
 
 // Seed geometry, 8 satellites, 2000 single epochs: success >= 99.5 % with the constraints; accuracy within the

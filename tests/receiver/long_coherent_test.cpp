@@ -12,6 +12,7 @@
 
 #include "receiver/scalar_tracking.hpp"
 #include "channel_feed.hpp"
+#include "io/why_invalid.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -182,7 +183,7 @@ TEST(LongCoherent, ChoiceFollowsTheJitterThresholdsWithHysteresis) {
   o.max_coherent_ms = 20;
   EXPECT_EQ(choose_coherent_epochs(o, 10.0, 1), 1);
   o.max_coherent_ms = 60;
-  EXPECT_NE(validation_error(o), "");
+  EXPECT_NE(io::why_invalid(o), "");
 }
 
 // The measurement of docs/validation.md (issue 7, long coherent integration): locked at 45 dB-Hz for 3 s, then

@@ -15,6 +15,7 @@
 #include "receiver/correlator_engine.hpp"
 #include "receiver/receiver_channel.hpp"
 #include "test_signal.hpp"
+#include "io/why_invalid.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -126,15 +127,15 @@ TEST(ReceiverEngine, AcquiresAndTracksThePresentSatellitesOnly) {
 TEST(ReceiverOptions, ValidateNamesTheBadField) {
   ReceiverOptions o;
   o.fs_hz = kFs;
-  EXPECT_EQ(o.validate(), "");
+  EXPECT_EQ(io::why_invalid(o), "");
   o.channels = 0;
-  EXPECT_NE(o.validate().find("channels"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("channels"), std::string::npos);
   o.channels = 12;
   o.prns = {33};
-  EXPECT_NE(o.validate().find("PRN 33"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("PRN 33"), std::string::npos);
   o.prns.clear();
   o.tracking.pll_order = 5;
-  EXPECT_NE(o.validate().find("tracking"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("tracking"), std::string::npos);
 }
 
 // A satellite that vanishes at 1.8 s and comes back at 3.5 s: the channel must declare loss of lock (C/N0 and

@@ -12,6 +12,7 @@
 
 #include "signals/gps_constants.hpp"
 #include "channel_feed.hpp"
+#include "io/why_invalid.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -94,21 +95,21 @@ double dll_jitter_chips(double bn_hz, double spacing_chips, double cn0_dbhz, dou
 
 TEST(ScalarTracking, DefaultOptionsAreValidAndBadOnesAreNamed) {
   ScalarTrackingOptions o;
-  EXPECT_EQ(validation_error(o), "");
+  EXPECT_EQ(io::why_invalid(o), "");
   o.pll_order = 4;
-  EXPECT_NE(validation_error(o).find("pll_order"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("pll_order"), std::string::npos);
   o = {};
   o.early_late_offset_chips = 0.7;
-  EXPECT_NE(validation_error(o).find("early_late_offset_chips"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("early_late_offset_chips"), std::string::npos);
   o = {};
   o.coherent_ms = 3;
-  EXPECT_NE(validation_error(o).find("coherent_ms"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("coherent_ms"), std::string::npos);
   o = {};
   o.pullin_timeout_s = 0.5;  // shorter than the FLL stages: could never lock
-  EXPECT_NE(validation_error(o).find("pullin_timeout_s"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("pullin_timeout_s"), std::string::npos);
   o = {};
   o.pli_loss_threshold = 0.9;
-  EXPECT_NE(validation_error(o).find("pli_loss_threshold"), std::string::npos);
+  EXPECT_NE(io::why_invalid(o).find("pli_loss_threshold"), std::string::npos);
   EXPECT_THROW(ScalarTracking(o, NcoCommand{}), std::invalid_argument);
 }
 

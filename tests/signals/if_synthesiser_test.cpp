@@ -16,6 +16,7 @@
 #include "signals/satellite_state.hpp"
 #include "support/brute_force_acquisition.hpp"
 #include "support/test_data.hpp"
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::signals {
 namespace {
@@ -423,14 +424,14 @@ TEST(IfSynthesiser, RejectsInvalidOptions) {
   auto o = base_options(2e6);
   o.real_output = true;
   o.if_hz = 0.0;
-  EXPECT_NE(validate(o), "");
+  EXPECT_NE(io::why_invalid(o), "");
   EXPECT_THROW(IfSynthesiser(o, {}, static_receiver()), std::invalid_argument);
   o = base_options(2e6);
   o.if_hz = 1.5e6;
-  EXPECT_NE(validate(o), "");
+  EXPECT_NE(io::why_invalid(o), "");
   o = base_options(2e6);
   o.cn0_dbhz_by_prn[40] = 45;
-  EXPECT_NE(validate(o), "");
+  EXPECT_NE(io::why_invalid(o), "");
   auto eph = walker_constellation(kStart);
   eph.push_back(eph.front());
   EXPECT_THROW(IfSynthesiser(base_options(2e6), eph, static_receiver()), std::invalid_argument);
@@ -527,7 +528,7 @@ TEST(IfSynthesiser, RejectsImpairmentsOfMissingAntennas) {
   auto eph = test_support::walker_constellation(kStart);
   EXPECT_THROW(IfSynthesiser(o, eph, static_receiver()), std::invalid_argument);
   o.blockages = {{0, 0.0, 0.0}};
-  EXPECT_FALSE(validate(o).empty());
+  EXPECT_FALSE(io::why_invalid(o).empty());
 }
 
 }  // namespace
@@ -632,9 +633,9 @@ TEST(IfSynthesiser, Cn0StepUpSetsTheGainForTheStrongestLevel) {
   const std::vector<std::complex<float>> after(x.begin() + 2000, x.end());
   EXPECT_NEAR((variance(after, false) + variance(after, true)) / 2 / (o.output_rms * o.output_rms), 1.0, 0.01);
   o.cn0_steps = {{0, 0.0, 81.0, {}}};
-  EXPECT_FALSE(validate(o).empty());
+  EXPECT_FALSE(io::why_invalid(o).empty());
   o.cn0_steps = {{0, 0.0, 30.0, {33}}};
-  EXPECT_FALSE(validate(o).empty());
+  EXPECT_FALSE(io::why_invalid(o).empty());
   o.cn0_steps = {{1, 0.0, 30.0, {}}};
   EXPECT_THROW(IfSynthesiser(o, eph, static_receiver()), std::invalid_argument);
 }
