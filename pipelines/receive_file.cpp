@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "pipelines/format_diagnosis.hpp"
 #include "pipelines/receive_csv_files.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/receiver_summary.hpp"
@@ -77,11 +78,20 @@ ReceiveFileResult receive_file(ReceiveFileJob job, std::stop_token stop, const R
   result.summary = receiver.finish();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (progress) progress({receiver.engine(), total_s, true});
-  if (!result.summary.satellites_found && !result.summary.interrupted)
-    throw signals::InputError(job.input.string(),
-                              fmt::format("no GPS L1 C/A satellite found in {:.1f} s of signal: check --format, "
-                                          "--fs, --if, --iq-swap/--q-negate",
-                                          result.summary.processed_s));
+  // Nothing tracked: name a sample convention that would have worked, when one does (format_diagnosis.hpp).
+  if (!result.summary.interrupted && result.summary.satellites_tracked == 0) {
+    const std::string hint = to_sentence(diagnose_sample_format(job.input, job.format, job.source));
+    if (!result.summary.satellites_found)
+      throw signals::InputError(job.input.string(),
+                                fmt::format("no GPS L1 C/A satellite found in {:.1f} s of signal: check --format, "
+                                            "--fs, --if, --iq-swap/--q-negate.{}",
+                                            result.summary.processed_s, hint));
+    if (!hint.empty())
+      throw signals::InputError(job.input.string(),
+                                fmt::format("no satellite tracked in {:.1f} s of signal: the 2-bit packing looks "
+                                            "wrong.{}",
+                                            result.summary.processed_s, hint));
+  }
   outputs.finish(receiver.engine(), describe(job, result.summary, result.wall_s));
   logs.commit();
   return result;

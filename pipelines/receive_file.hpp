@@ -50,8 +50,9 @@ struct ReceiveFileResult {
 void date_recording(receiver::ReceiverOptions& options, const signals::RinexNavData& navigation, int fallback_week);
 
 // Runs the job. Throws signals::InputError naming the file: unreadable or malformed samples, fewer samples than one
-// acquisition needs, no satellite found in the whole signal (no outputs written then), options that do not fit
-// together (checked before anything is written).
+// acquisition needs, no satellite found in the whole signal, or none tracked while another 2-bit packing would
+// find them (the message names its flags: pipelines/format_diagnosis.hpp; no outputs written in these cases),
+// options that do not fit together (checked before anything is written).
 ReceiveFileResult receive_file(ReceiveFileJob job, std::stop_token stop = {}, const ReceiveProgressCallback& progress = {});
 
 }  // namespace ultratrack::pipelines
