@@ -1,4 +1,4 @@
-// `ultratrack receive --imu --coupling ultra-tight` end to end (issue 7), short for CI: `simulate` writes 21 s of a
+// The ultra-tight receive end to end through the library (pipelines::receive_file), short for CI: the simulator writes 21 s of a
 // car on a 100 m circle at 30 km/h (45 dB-Hz, 2 MHz, the shipped brdc3540_0000-0200.14n from TOW 518476, 4 s into a
 // subframe, when no satellite is within 1 deg of the 10 deg measurement mask; IF samples, imu.csv (HG1700) and
 // truth.csv from one trajectory) with every signal absent from 14.0 to 18.0 s (a short tunnel; 4 s: the filter-driven
@@ -8,8 +8,8 @@
 // loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
 // signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
 // UKF + discriminators both with the default pipelined loop (its commands one 20 ms period later), and both again
-// with the serial loop (--ut-serial); the same bytes with one thread and two (either loop). Bad option combinations
-// give one InputError.
+// with the serial loop; the same bytes with one thread and two (either loop). The command line's flags for these
+// options and its errors: tests/tools/receive_ultratight_cli_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,21 +23,25 @@
 #include <string>
 #include <vector>
 
+#include "config/scenario_toml.hpp"
+#include "ins/imu_csv.hpp"
 #include "pipelines/fused_nav_csv.hpp"
+#include "pipelines/receive_file.hpp"
+#include "signals/rinex_nav.hpp"
+#include "sim/simulation_files.hpp"
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
 #include "pipelines/ultratight_loop.hpp"
-#include "run_command.hpp"
 #include "pipelines/solution_compare.hpp"
 #include "support/test_data.hpp"
+#include "support/ultratight_tunnel_scenario.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack;
 
 namespace {
 
-constexpr double kGapStart_s = 14.0, kGapEnd_s = 18.0, kDuration_s = 21.0;
-constexpr double kStartTow_s = 518476.0;  // the scenario's [time] tow_s (week 1823)
+using test::kGapEnd_s, test::kGapStart_s, test::kDuration_s, test::kStartTow_s;
 
 double json_number(const std::string& json, const std::string& key) {
   const auto at = json.find("\"" + key + "\":");
@@ -48,37 +52,40 @@ struct Sim {
   fs::path dir, sim, nav;
 };
 
-Sim& sim() {
+Sim& tunnel() {
   static Sim s = [] {
     Sim r;
     const fs::path brdc = test::shipped_nav_file();
     r.dir = test::scratch_dir();
     r.sim = r.dir / "sim";
     r.nav = brdc;
-    std::ofstream(r.dir / "circle.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
-                                          << kDuration_s << ",0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
-    std::ofstream(r.dir / "circle.toml")
-        << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = "
-        << kDuration_s << "\ncn0_dbhz = 45.0\nseed = 4\n"
-           "[time]\ngps_week = 1823\ntow_s = 518476.0\n[navigation]\nrinex = \""
-        << brdc.generic_string()
-        << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
-           "[trajectory]\nfile = \"circle.csv\"\nspeed_mps = 8.333333333\nheading_deg = 0.0\nimu_rate_hz = 100.0\n"
-           "[imu]\npreset = \"hg1700ae\"\nseed = 7\n[atmosphere]\nionosphere = true\ntroposphere = true\n"
-           "[[blockage]]\nantenna = 0\nstart_s = "
-        << kGapStart_s << "\nduration_s = " << kGapEnd_s - kGapStart_s << "\n";
-    test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
-    std::ofstream(r.dir / "motion.toml") << "[alignment]\nmotion_window_s = 1.0\n";
+    test::write_tunnel_scenario(r.dir, brdc);
+    ultratrack::sim::simulate_to_folder(config::read_scenario(r.dir / "circle.toml"), r.sim, "");
     return r;
   }();
   return s;
 }
 
-std::vector<std::string> receive_args(const fs::path& rx) {
-  const auto& s = sim();
-  return {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string(),
-          "--imu", (s.sim / "imu.csv").string(), "--align", "motion", "--fusion-config",
-          (s.dir / "motion.toml").string(), "--out", rx.string()};
+// The receive of the tunnel file into rx: hot start (the ephemeris file), in-motion alignment over 1 s windows,
+// ultra-tight coupling with the given filter, measurement form and loop, `threads` worker threads (0: all cores).
+pipelines::ReceiveFileResult receive(const fs::path& rx, fusion::FilterKind filter, fusion::UltraTightForm form,
+                                     bool serial, int threads = 0) {
+  const auto& s = tunnel();
+  pipelines::ReceiveFileJob job;
+  job.input = s.sim / "antenna0.i8.bin";
+  job.out = rx;
+  job.source.fs_hz = job.options.receiver.fs_hz = 2.0e6;
+  job.options.receiver.threads = threads;
+  job.navigation = signals::read_rinex_nav(s.nav);
+  pipelines::date_recording(job.options.receiver, job.navigation, 0);
+  job.imu = ins::read_imu_csv(s.sim / "imu.csv");
+  job.options.coupling = pipelines::Coupling::kUltraTight;
+  job.options.filter = filter;
+  job.options.ut_form = form;
+  job.options.ut_pipelined = !serial;
+  job.options.align = pipelines::AlignMode::Motion;
+  job.options.navigation.motion_window_s = 1.0;
+  return pipelines::receive_file(std::move(job));
 }
 
 // Position error of nav.csv against truth.csv (IMU = antenna: no lever arm) from t0 on: 3-D RMS, and the RMS of
@@ -88,7 +95,7 @@ struct NavError {
   double rms_m = 0.0, sigma_m = 0.0;
 };
 NavError nav_error(const fs::path& rx, double t0) {
-  const auto truth = ultratrack::pipelines::read_simulation_truth_csv(sim().sim / "truth.csv");
+  const auto truth = ultratrack::pipelines::read_simulation_truth_csv(tunnel().sim / "truth.csv");
   const auto nav = pipelines::read_fused_nav_csv(rx / "nav.csv");
   NavError e;
   double s2 = 0.0, g2 = 0.0;
@@ -155,13 +162,14 @@ double prompt_i_innovation_variance(const fs::path& rx, double t0, double t1, in
   return n > 1 ? (s2 - s * s / n) / (n - 1) : NAN;
 }
 
-void check_run(const std::string& filter, const std::string& form, const std::vector<std::string>& extra = {}) {
-  const auto rx = sim().dir / ("rx_" + filter + "_" + form + (extra.empty() ? "" : "_" + extra.front().substr(2)));
-  const bool serial = std::find(extra.begin(), extra.end(), "--ut-serial") != extra.end();
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "ultra-tight", "--filter", filter, "--ut-measurement", form});
-  args.insert(args.end(), extra.begin(), extra.end());
-  test_support::run_command("receive", args);
+void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind, bool serial = false) {
+  const std::string filter = filter_kind == fusion::FilterKind::Ekf ? "ekf" : "ukf";
+  const std::string form = form_kind == fusion::UltraTightForm::Iq ? "iq" : "discriminator";
+  const auto rx = tunnel().dir / ("rx_" + filter + "_" + form + (serial ? "_serial" : ""));
+  const pipelines::ReceiveSummary result = receive(rx, filter_kind, form_kind, serial).summary;
+  EXPECT_TRUE(result.handed_over);
+  EXPECT_TRUE(result.navigation_started);
+  EXPECT_GT(result.ultratight_channel_epochs, 0);
   const std::string summary = test::read_text_file(rx / "summary.json");
   ASSERT_NE(summary.find("\"ultratight\": {\"filter\": \"" + filter + "\", \"measurement\": \"" + form +
                          "\", \"handed_over\": true, \"loop\": \"" + (serial ? "serial" : "pipelined") + "\""),
@@ -189,7 +197,7 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
   // in the file's 21 s), none within 0.5 deg of the mask.
   std::map<int, double> elevation_deg;
   {
-    std::ifstream in(sim().sim / "satellites.csv");
+    std::ifstream in(tunnel().sim / "satellites.csv");
     std::string line;
     std::getline(in, line);
     while (std::getline(in, line)) {
@@ -302,34 +310,30 @@ void check_run(const std::string& filter, const std::string& form, const std::ve
 // The default loop is pipelined: job 0 of the next block's correlation, its commands one 20 ms vector epoch later.
 // The lock, coasting, re-lock, NIS and accuracy checks hold with that latency.
 TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  check_run("ekf", "iq");
+  check_run(fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq);
 }
 
 TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  check_run("ukf", "discriminator");
+  check_run(fusion::FilterKind::Ukf, fusion::UltraTightForm::Discriminator);
 }
 
-// The serial loop (--ut-serial: on the caller between blocks, its commands at once) passes the same checks.
+// The serial loop (on the caller between blocks, its commands at once) passes the same checks.
 TEST(ReceiveUltraTight, SerialEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  check_run("ekf", "iq", {"--ut-serial"});
+  check_run(fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq, true);
 }
 
 TEST(ReceiveUltraTight, SerialUkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
-  check_run("ukf", "discriminator", {"--ut-serial"});
+  check_run(fusion::FilterKind::Ukf, fusion::UltraTightForm::Discriminator, true);
 }
 
 namespace {
 
 // ultratight.csv and nav.csv of the ultra-tight receive with 1 and with 2 threads: {threads - 1} x {ut, nav}.
-std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::string& name,
-                                                                  const std::vector<std::string>& extra) {
+std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::string& name, bool serial) {
   std::array<std::array<std::string, 2>, 2> text;
   for (int threads : {1, 2}) {
-    const auto rx = sim().dir / (name + std::to_string(threads));
-    auto args = receive_args(rx);
-    args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", std::to_string(threads)});
-    args.insert(args.end(), extra.begin(), extra.end());
-    test_support::run_command("receive", args);
+    const auto rx = tunnel().dir / (name + std::to_string(threads));
+    receive(rx, fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq, serial, threads);
     text[threads - 1][0] = test::read_text_file(rx / "ultratight.csv");
     text[threads - 1][1] = test::read_text_file(rx / "nav.csv");
   }
@@ -341,71 +345,20 @@ std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::str
 // Pipelined (the default): every thread count runs the same jobs on the same inputs (--threads 1 runs the loop's
 // job in turn): the same bytes.
 TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
-  const auto text = outputs_by_thread_count("rx_threads", {});
+  const auto text = outputs_by_thread_count("rx_threads", false);
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
-  // --ut-pipelined names the default: the same bytes.
-  const auto rx = sim().dir / "rx_pipelined_flag";
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", "2", "--ut-pipelined"});
-  test_support::run_command("receive", args);
-  EXPECT_TRUE(test::read_text_file(rx / "ultratight.csv") == text[0][0]) << "--ut-pipelined is not the default";
 }
 
-// Serial (--ut-serial): the loop runs on the engine's caller thread after the channels' parallel work: the same
-// bytes for one thread and two. The latency is real: its commands, and so its log, differ from the pipelined
-// loop's. --ut-pipelined=false selects it too.
+// Serial: the loop runs on the engine's caller thread after the channels' parallel work: the same bytes for one
+// thread and two. The latency is real: its commands, and so its log, differ from the pipelined loop's.
 TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipelined) {
-  const auto text = outputs_by_thread_count("rx_serial_threads", {"--ut-serial"});
+  const auto text = outputs_by_thread_count("rx_serial_threads", true);
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
-  const auto rx = sim().dir / "rx_pipelined_default";
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "ultra-tight", "--threads", "2"});
-  test_support::run_command("receive", args);
+  const auto rx = tunnel().dir / "rx_pipelined_default";
+  receive(rx, fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq, false, 2);
   EXPECT_FALSE(test::read_text_file(rx / "ultratight.csv") == text[0][0]);
-  // --ut-pipelined=false is --ut-serial.
-  const auto rx_false = sim().dir / "rx_pipelined_false";
-  auto args_false = receive_args(rx_false);
-  args_false.insert(args_false.end(), {"--coupling", "ultra-tight", "--threads", "2", "--ut-pipelined=false"});
-  test_support::run_command("receive", args_false);
-  EXPECT_TRUE(test::read_text_file(rx_false / "ultratight.csv") == text[0][0]) << "--ut-pipelined=false is not serial";
-}
-
-TEST(ReceiveUltraTight, BadOptionsAreOneInputError) {
-  const auto& s = sim();
-  const std::vector<std::string> base = {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs",
-                                         "2.0e6", "--nav", s.nav.string()};
-  auto expect_error = [&](const std::string& name, std::vector<std::string> extra, const std::string& words) {
-    auto args = base;
-    args.insert(args.end(), extra.begin(), extra.end());
-    args.insert(args.end(), {"--out", (s.dir / ("bad_" + name)).string()});
-    try {
-      test_support::run_command("receive", args);
-      ADD_FAILURE() << name << ": no error";
-    } catch (const io::InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << name << ": " << e.what();
-    }
-    EXPECT_FALSE(fs::exists(s.dir / ("bad_" + name) / "summary.json")) << name;
-  };
-  expect_error("no_imu", {"--coupling", "ultra-tight"}, "--coupling ultra-tight needs --imu");
-  expect_error("form_without_ut", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-measurement", "iq"},
-               "--ut-measurement needs --coupling ultra-tight");
-  expect_error("form_scalar", {"--ut-measurement", "iq"}, "--ut-measurement needs --coupling ultra-tight");
-  expect_error("pipelined_scalar", {"--ut-pipelined"}, "--ut-pipelined needs --coupling ultra-tight");
-  expect_error("serial_scalar", {"--ut-serial"}, "--ut-serial needs --coupling ultra-tight");
-  expect_error("serial_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-serial"},
-               "--ut-serial needs --coupling ultra-tight");
-  expect_error("serial_and_pipelined", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight",
-                                        "--ut-serial", "--ut-pipelined"},
-               "--ut-serial and --ut-pipelined exclude each other");
-  expect_error("pipelined_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-pipelined"},
-               "--ut-pipelined needs --coupling ultra-tight");
-  expect_error("bad_form", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement",
-                            "phase"},
-               "--ut-measurement must be iq or discriminator");
-  expect_error("bad_coupling", {"--coupling", "ultratight"}, "ultra-tight");
-  expect_error("missing_imu_file", {"--imu", (s.dir / "none.csv").string(), "--coupling", "ultra-tight"}, "not found");
 }
