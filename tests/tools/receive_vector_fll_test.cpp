@@ -22,7 +22,7 @@
 #include "signals/gps_constants.hpp"
 #include "signals/rinex_nav.hpp"
 #include "signals/satellite_state.hpp"
-#include "receive_output_readers.hpp"
+#include "support/receive_output_readers.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;

@@ -20,7 +20,7 @@
 
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
-#include "receive_output_readers.hpp"
+#include "support/receive_output_readers.hpp"
 #include "run_command.hpp"
 #include "vector_carrier_runs.hpp"
 #include "config/scenario_toml.hpp"

@@ -1,5 +1,5 @@
-// `ultratrack receive --coupling vector` end to end (issue 7, vector tracking without an IMU), short for CI:
-// `ultratrack simulate` writes 16 s of a static receiver at 45 dB-Hz (10 satellites, brdc0010.22n); both
+// Vector tracking without an IMU end to end through the library (pipelines::receive_file), short for CI: the
+// simulator writes 16 s of a static receiver at 45 dB-Hz (10 satellites, brdc0010.22n); both
 // receivers start hot with a nav file from which PRN 20's ephemeris is removed. The scalar run is the reference;
 // in the vector run every other channel must be handed to the filter after frame sync and the first fix and stay
 // in vector mode to the end, PRN 20 (no ephemeris) must stay scalar, no satellite may be lost, and the fixes and
@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "run_command.hpp"
+#include "support/simulated_receive.hpp"
 #include "pipelines/solution_compare.hpp"
-#include "receive_output_readers.hpp"
+#include "support/receive_output_readers.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -25,9 +25,6 @@ using namespace ultratrack::pipelines;
 
 namespace {
 
-void run(const std::string& command, std::vector<std::string> args) {
-  ultratrack::test_support::run_command(command, std::move(args));
-}
 
 // A RINEX 2 nav file without one PRN's records (8 lines each, the PRN in columns 1-2 of the first).
 void drop_prn(const fs::path& in_path, const fs::path& out_path, int prn) {
@@ -76,17 +73,18 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
                                      << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
                                         "[atmosphere]\nionosphere = true\ntroposphere = false\n";
   const auto sim = dir / "sim", scalar = dir / "scalar", vector = dir / "vector";
-  run("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
+  ultratrack::test::simulate_scenario(dir / "static.toml", sim);
   constexpr int kNoEphemeris = 20;
   drop_prn(brdc, dir / "nav.22n", kNoEphemeris);
-  for (const auto& [out, coupling] : {std::pair{scalar, "scalar"}, std::pair{vector, "vector"}})
-    run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                    (dir / "nav.22n").string(), "--troposphere", "off", "--coupling", coupling, "--out", out.string()});
+  for (const auto& [out, coupling] : {std::pair{scalar, ultratrack::pipelines::Coupling::kScalar},
+                                      std::pair{vector, ultratrack::pipelines::Coupling::kVector}})
+    ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = dir / "nav.22n", .out = out,
+                                         .coupling = coupling, .troposphere = false});
   // The vector loop runs on the caller's thread after the channels' parallel work: one thread gives the same bytes.
   const auto one_thread = dir / "vector1";
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  (dir / "nav.22n").string(), "--troposphere", "off", "--coupling", "vector", "--threads", "1", "--out",
-                  one_thread.string()});
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = dir / "nav.22n", .out = one_thread,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false,
+                                       .threads = 1});
   fs::remove(sim / "antenna0.i8.bin");
   for (const char* file : {"vector.csv", "vector_state.csv", "solution.csv", "tracking.csv"})
     EXPECT_EQ(ultratrack::test::read_text_file(vector / file), ultratrack::test::read_text_file(one_thread / file)) << file << " differs between 1 thread and the default";
@@ -142,7 +140,7 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
     EXPECT_FALSE(dropped[prn]) << "PRN " << prn << " fell back to scalar";
   }
 
-  using namespace ultratrack::tools;
+  using namespace ultratrack::pipelines;
   const auto truth = read_simulation_truth_csv(sim / "truth.csv");
   const SolutionComparison s = compare_solution(read_solution_csv(scalar / "solution.csv"), truth);
   const SolutionComparison v = compare_solution(read_solution_csv(vector / "solution.csv"), truth);
@@ -179,10 +177,11 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
                                       "[atmosphere]\nionosphere = true\ntroposphere = false\n"
                                       "[trajectory]\nfile = \"turn.csv\"\nspeed_mps = 138.9\nheading_deg = 0.0\n";
   const auto sim = dir / "sim", scalar = dir / "scalar", vector = dir / "vector";
-  run("simulate", {"--scenario", (dir / "turn.toml").string(), "--out", sim.string()});
-  for (const auto& [out, coupling] : {std::pair{scalar, "scalar"}, std::pair{vector, "vector"}})
-    run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                    brdc.string(), "--troposphere", "off", "--coupling", coupling, "--out", out.string()});
+  ultratrack::test::simulate_scenario(dir / "turn.toml", sim);
+  for (const auto& [out, coupling] : {std::pair{scalar, ultratrack::pipelines::Coupling::kScalar},
+                                      std::pair{vector, ultratrack::pipelines::Coupling::kVector}})
+    ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = out,
+                                         .coupling = coupling, .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
 
   const auto losses = [](const fs::path& out) {
@@ -196,7 +195,7 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
   };
   const auto [scalar_losses, scalar_sats] = losses(scalar);
   const auto [vector_losses, vector_sats] = losses(vector);
-  using namespace ultratrack::tools;
+  using namespace ultratrack::pipelines;
   const auto truth = read_simulation_truth_csv(sim / "truth.csv");
   const auto s_fixes = read_solution_csv(scalar / "solution.csv");
   const auto v_fixes = read_solution_csv(vector / "solution.csv");
@@ -233,9 +232,9 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
                                         "[atmosphere]\nionosphere = true\ntroposphere = false\n"
                                         "[trajectory]\nprofile = \"circle\"\nduration_s = 20.0\nimu_rate_hz = 100.0\n";
   const auto sim = dir / "sim", vector = dir / "vector";
-  run("simulate", {"--scenario", (dir / "circle.toml").string(), "--out", sim.string()});
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
+  ultratrack::test::simulate_scenario(dir / "circle.toml", sim);
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = vector,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
   const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
   int satellites = 0;
@@ -244,7 +243,7 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
     ++satellites;
   }
   EXPECT_GE(satellites, 8);
-  using namespace ultratrack::tools;
+  using namespace ultratrack::pipelines;
   const auto fixes = read_solution_csv(vector / "solution.csv");
   const SolutionComparison v = compare_solution(fixes, read_simulation_truth_csv(sim / "truth.csv"));
   std::printf("circle 500 km/h, vector: %zu fixes, 3-D RMS %.3f m\n", fixes.size(), v.rms_3d_m);
@@ -280,9 +279,9 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
                                      "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
                                      "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\nfade_s = 2.0\n";
   const auto sim = dir / "sim", vector = dir / "vector";
-  run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--coupling", "vector", "--out", vector.string()});
+  ultratrack::test::simulate_scenario(dir / "gap.toml", sim);
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = vector,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
 
   const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
@@ -321,7 +320,7 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
       EXPECT_LE(faded_relock, 1.0) << "PRN " << prn << " re-locked later than 1 s after its fade";
     }
   }
-  using namespace ultratrack::tools;
+  using namespace ultratrack::pipelines;
   const auto fixes = read_solution_csv(vector / "solution.csv");
   const SolutionComparison v = compare_solution(fixes, read_simulation_truth_csv(sim / "truth.csv"));
   std::printf("3 s blockage, vector: %d satellites coasted, last re-lock %.2f s after the return; PRN 24 alone faded "
@@ -355,10 +354,10 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
                                       "[[cn0_step]]\nstart_s = "
                                    << kStep << "\ncn0_dbhz = " << kWeak << "\n";
   const auto sim = dir / "sim", vector = dir / "vector";
-  run("simulate", {"--scenario", (dir / "weak.toml").string(), "--out", sim.string()});
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--nav-bits", "oracle", "--troposphere", "off", "--coupling", "vector", "--out",
-                  vector.string()});
+  ultratrack::test::simulate_scenario(dir / "weak.toml", sim);
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = vector,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false,
+                                       .nav_bits = ultratrack::receiver::NavBitSource::kOracle});
   fs::remove(sim / "antenna0.i8.bin");
 
   // vector.csv: the PRNs commanded at the step, and any of them not commanded (or coasting) afterwards; the
@@ -431,11 +430,4 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   std::printf("pseudorange rows from %.0f s: %d accepted, mean NIS %.3f\n", kStep + 2.0, nis_n, nis);
   EXPECT_GT(nis, 0.85);
   EXPECT_LT(nis, 1.45);
-}
-
-TEST(ReceiveVector, RejectsAnUnknownCoupling) {
-  const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "x.bin", std::ios::binary) << std::string(400000, '\0');
-  EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
-                                   "--coupling", "ultra", "--out", (dir / "rx").string()}));
 }
