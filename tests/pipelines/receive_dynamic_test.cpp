@@ -1,11 +1,10 @@
-// The scalar receiver on a moving antenna (issue 3's dynamic check, shortened for CI): `ultratrack simulate`
+// The scalar receiver on a moving antenna (the dynamic check, shortened for CI), through the library: the simulator
 // drives the antenna round a circle of radius 100 m at 30 km/h (centripetal 0.69 m/s^2, line-of-sight
-// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with tests/data's brdc3540; `ultratrack receive` starts hot
-// (--nav) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the truth by
+// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with tests/data's brdc3540; pipelines::receive_file starts hot
+// (the same nav file) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the truth by
 // pipelines/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
@@ -13,19 +12,14 @@
 #include <string>
 #include <vector>
 
-#include "commands.hpp"
 #include "pipelines/solution_compare.hpp"
-#include "run_command.hpp"
+#include "support/simulated_receive.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack::pipelines;
 
 namespace {
-
-void run(const std::string& command, std::vector<std::string> args) {
-  ultratrack::test_support::run_command(command, std::move(args));
-}
 
 double json_number(const fs::path& file, const std::string& key) {
   std::ifstream in(file);
@@ -59,12 +53,11 @@ TEST(ReceiveDynamic, CircleOf100mAt30kmhHotStartWithinTheIssuesTolerances) {
                                         "[trajectory]\nfile = \"circle.csv\"\nspeed_mps = 8.333333333\n"
                                         "heading_deg = 0.0\n";
   const auto sim = dir / "sim", rx = dir / "rx";
-  run("simulate", {"--scenario", (dir / "circle.toml").string(), "--out", sim.string()});
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--out", rx.string()});
+  ultratrack::test::simulate_scenario(dir / "circle.toml", sim);
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = rx, .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
 
-  using namespace ultratrack::tools;
+  using namespace ultratrack::pipelines;
   const SolutionComparison c =
       compare_solution(read_solution_csv(rx / "solution.csv"), read_simulation_truth_csv(sim / "truth.csv"));
   const double ttff = json_number(rx / "summary.json", "ttff_s");
@@ -93,12 +86,11 @@ TEST(ReceiveDynamic, Static35DbHzHotStartTracksEverySatelliteAndFixes) {
                                      << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
                                         "[atmosphere]\nionosphere = true\ntroposphere = false\n";
   const auto sim = dir / "sim", rx = dir / "rx";
-  run("simulate", {"--scenario", (dir / "static.toml").string(), "--out", sim.string()});
-  run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav",
-                  brdc.string(), "--troposphere", "off", "--out", rx.string()});
+  ultratrack::test::simulate_scenario(dir / "static.toml", sim);
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = rx, .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
 
-  using namespace ultratrack::tools;
+  using namespace ultratrack::pipelines;
   const SolutionComparison c =
       compare_solution(read_solution_csv(rx / "solution.csv"), read_simulation_truth_csv(sim / "truth.csv"));
   const double ttff = json_number(rx / "summary.json", "ttff_s");
