@@ -1,31 +1,35 @@
-// `ultratrack receive --imu --coupling loose|tight` end to end: one `simulate` run (a land vehicle on a circle of
+// GNSS/INS from IF samples (loose and tight coupling) end to end through the library: one simulation (a land vehicle on a circle of
 // radius 100 m at 30 km/h, HG1700AE IMU at 100 Hz, nominal constellation, 2.0 MHz i8, a few seconds) writes the IF
 // samples, imu.csv and truth.csv from ONE trajectory; the receiver starts hot from a RINEX file of the scenario's
 // own ephemerides (no ../shared needed). Checked against the simulator's truth: the fused position (nav.csv, IMU =
 // antenna here: no lever arm) against the PVT fixes (solution.csv) at the same epochs; tight coupling with only
-// three satellites (no PVT fix at all) stays on the truth; bad IMU input is one InputError naming the file and
-// leaves no outputs.
+// three satellites (no PVT fix at all) stays on the truth. Bad IMU input on the command line:
+// tests/tools/receive_fusion_cli_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "command_exit.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
-#include "run_command.hpp"
+#include "config/fuse_config_toml.hpp"
+#include "config/receive_config_toml.hpp"
 #include "config/scenario_toml.hpp"
+#include "ins/imu_csv.hpp"
+#include "pipelines/receive_file.hpp"
 #include "signals/rinex_nav.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
-#include "simulation_run.hpp"
+#include "sim/simulation_files.hpp"
 #include "pipelines/solution_compare.hpp"
+#include "support/fusion_circle_scenario.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -33,8 +37,7 @@ using namespace ultratrack;
 
 namespace {
 
-constexpr double kStartTow_s = 518776.0;  // subframe 518778-518784 arrives at 2.07-8.07 s: first fix ~8.1 s
-constexpr double kDuration_s = 16.0;
+constexpr double kStartTow_s = test::kFusionStartTow_s, kDuration_s = test::kFusionDuration_s;
 constexpr double kC = 299792458.0;
 
 struct Sim {
@@ -48,15 +51,8 @@ Sim& simulated() {
     Sim r;
     r.dir = test::scratch_dir();
     r.sim = r.dir / "sim";
-    std::ofstream(r.dir / "circle.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
-                                          "16.0,0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
-    std::ofstream(r.dir / "circle.toml")
-        << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " << kDuration_s
-        << "\ncn0_dbhz = 45.0\nseed = 4\n[time]\ngps_week = 2190\ntow_s = " << kStartTow_s
-        << "\n[navigation]\nconstellation = \"nominal\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
-           "[trajectory]\nfile = \"circle.csv\"\nspeed_mps = 8.333333333\nheading_deg = 0.0\nimu_rate_hz = 100.0\n"
-           "[imu]\npreset = \"hg1700ae\"\nseed = 7\n[atmosphere]\nionosphere = true\ntroposphere = true\n";
-    test_support::run_command("simulate", {"--scenario", (r.dir / "circle.toml").string(), "--out", r.sim.string()});
+    test::write_fusion_circle_scenario(r.dir);
+    ultratrack::sim::simulate_to_folder(config::read_scenario(r.dir / "circle.toml"), r.sim, "");
     // The scenario's own broadcast data as a RINEX file: the receiver's hot start.
     const sim::NavigationSource nav = sim::load_navigation(config::read_scenario(r.dir / "circle.toml"));
     signals::RinexNavData data;
@@ -151,16 +147,35 @@ Rms compare(const fs::path& rx) {
   return r;
 }
 
-std::vector<std::string> receive_args(const fs::path& rx) {
-  const auto& s = simulated();
-  return {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string(),
-          "--imu", (s.sim / "imu.csv").string(), "--out", rx.string()};
-}
+struct Receive {
+  pipelines::Coupling coupling = pipelines::Coupling::kTight;
+  fusion::FilterKind filter = fusion::FilterKind::Ekf;
+  pipelines::AlignMode align = pipelines::AlignMode::Motion;
+  std::optional<fs::path> fusion_config;   // [initial], [alignment], ...; without it in-motion windows of 1 s
+  std::optional<fs::path> receive_config;  // [receiver], ...
+  std::vector<int> prns;                   // searched (all when empty)
+};
 
-fs::path motion_config() {
-  const auto file = simulated().dir / "motion.toml";
-  std::ofstream(file) << "[alignment]\nmotion_window_s = 1.0\n";
-  return file;
+// The hot-started receive of the scenario's file with its IMU data into rx, through the library.
+pipelines::ReceiveSummary receive(const fs::path& rx, const Receive& o) {
+  const auto& s = simulated();
+  pipelines::ReceiveFileJob job;
+  job.input = s.sim / "antenna0.i8.bin";
+  job.out = rx;
+  job.source.fs_hz = job.options.receiver.fs_hz = 2.0e6;
+  if (o.receive_config) config::apply_receive_config(*o.receive_config, job.options.receiver);
+  if (!o.prns.empty()) job.options.receiver.prns = o.prns;
+  job.navigation = signals::read_rinex_nav(s.nav);
+  pipelines::date_recording(job.options.receiver, job.navigation, 0);
+  job.imu = ins::read_imu_csv(s.sim / "imu.csv");
+  job.options.coupling = o.coupling;
+  job.options.filter = o.filter;
+  job.options.align = o.align;
+  if (o.fusion_config)
+    job.options.navigation = config::read_fuse_config(*o.fusion_config);
+  else
+    job.options.navigation.motion_window_s = 1.0;
+  return pipelines::receive_file(std::move(job)).summary;
 }
 
 }  // namespace
@@ -172,10 +187,7 @@ fs::path motion_config() {
 // of 0.1 s (0.8 m along the track) or a wrong measurement covariance breaks it. (60 s figures: validation.md.)
 TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
   const auto rx = simulated().dir / "rx_loose";
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "loose", "--filter", "ekf", "--align", "motion", "--fusion-config",
-                           motion_config().string()});
-  test_support::run_command("receive", args);
+  receive(rx, {.coupling = pipelines::Coupling::kLoose});
   const Rms r = compare(rx);
   const std::string summary = test::read_text_file(rx / "summary.json");
   std::printf("loose EKF: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m, running-mean bound %.3f m\n", r.epochs,
@@ -193,10 +205,7 @@ TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
 TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
   for (const std::string filter : {"ekf", "ukf"}) {
     const auto rx = simulated().dir / ("rx_tight_" + filter);
-    auto args = receive_args(rx);
-    args.insert(args.end(), {"--coupling", "tight", "--filter", filter, "--align", "motion", "--fusion-config",
-                             motion_config().string()});
-    test_support::run_command("receive", args);
+    receive(rx, {.filter = filter == "ekf" ? fusion::FilterKind::Ekf : fusion::FilterKind::Ukf});
     const Rms r = compare(rx);
     const std::string summary = test::read_text_file(rx / "summary.json");
     std::printf("tight %s: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", filter.c_str(), r.epochs, r.fused_m,
@@ -222,10 +231,7 @@ TEST(ReceiveFusion, TightCouplingCarriesItsClockThroughAReceiverClockJump) {
   std::ofstream(config) << "[initial]\nattitude_deg = [0, 0, 0]\nposition_deg_m = [35.274016, 137.013759, 100.0]\n"
                            "velocity_ned_mps = [8.333333333, 0, 0]\nsigma_position_m = [3, 3, 3]\n";
   const auto rx = s.dir / "rx_jump";
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "tight", "--align", "config", "--fusion-config", config.string(), "--config",
-                           rx_config.string()});
-  test_support::run_command("receive", args);
+  receive(rx, {.align = pipelines::AlignMode::Config, .fusion_config = config, .receive_config = rx_config});
   const std::string summary = test::read_text_file(rx / "summary.json");
   EXPECT_EQ(json_number(summary, "clock_jumps"), 1.0);
   EXPECT_EQ(json_number(summary, "clock_jumps_removed"), 1.0);
@@ -249,11 +255,9 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
                            "position_deg_m = [35.274016, 137.01397883, 100.0]\n"  // 20.0 m east of the start
                            "velocity_ned_mps = [8.333333333, 0, 0]\nsigma_position_m = [20, 20, 20]\n";
   const auto rx = s.dir / "rx_three";
-  auto args = receive_args(rx);
-  args.insert(args.end(), {"--coupling", "tight", "--align", "config", "--fusion-config", config.string(), "--prn",
-                           std::to_string(s.prns_by_elevation[0]) + "," + std::to_string(s.prns_by_elevation[1]) + "," +
-                               std::to_string(s.prns_by_elevation[2])});
-  test_support::run_command("receive", args);
+  receive(rx, {.align = pipelines::AlignMode::Config,
+               .fusion_config = config,
+               .prns = {s.prns_by_elevation[0], s.prns_by_elevation[1], s.prns_by_elevation[2]}});
   const std::string summary = test::read_text_file(rx / "summary.json");
   EXPECT_EQ(json_number(summary, "fixes"), 0.0);
   const std::string solution = test::read_text_file(rx / "solution.csv");
@@ -280,43 +284,4 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
   EXPECT_LT(worst_late_m, 5.0);   // the 20 m start error removed to the pseudorange noise level
   EXPECT_LT(sigma_h_end, 10.0);   // and the filter knows it: bounded, not growing like a free INS
   EXPECT_EQ(outside_3sigma, 0) << "of " << rows << " rows";
-}
-
-// Bad IMU input: one InputError naming the IMU file, and no outputs under their final names.
-TEST(ReceiveFusion, BadImuInputIsOneInputErrorNamingTheFileAndLeavesNoOutputs) {
-  const auto& s = simulated();
-  auto expect_error = [&](const std::string& name, const fs::path& imu, std::vector<std::string> extra,
-                          const std::string& words) {
-    const auto rx = s.dir / ("bad_" + name);
-    auto args = receive_args(rx);
-    args[std::find(args.begin(), args.end(), "--imu") - args.begin() + 1] = imu.string();
-    args.insert(args.end(), {"--coupling", "tight"});
-    args.insert(args.end(), extra.begin(), extra.end());
-    try {
-      test_support::run_command("receive", args);
-      ADD_FAILURE() << name << ": no error";
-    } catch (const io::InputError& e) {
-      EXPECT_EQ(e.file(), imu.string()) << name << ": " << e.what();
-      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << name << ": " << e.what();
-    }
-    for (const char* f : {"summary.json", "nav.csv", "solution.csv", "observations.rnx"})
-      EXPECT_FALSE(fs::exists(rx / f)) << name << ": " << f;
-  };
-  expect_error("missing", s.dir / "no_such_imu.csv", {}, "not found");
-  {
-    std::ifstream in(s.sim / "imu.csv");
-    std::ofstream out(s.dir / "nan_imu.csv");
-    std::string line;
-    for (int i = 0; std::getline(in, line); ++i) {
-      if (i == 5) line = line.substr(0, line.find(',')) + ",nan" + line.substr(line.find(',', line.find(',') + 1));
-      out << line << "\n";
-    }
-  }
-  expect_error("nan", s.dir / "nan_imu.csv", {}, "");
-  // The IMU's times taken as seconds since tow 518000: the signal lies ~776 s after the IMU's 16 s.
-  expect_error("not_covering", s.sim / "imu.csv", {"--imu-time-origin", "518000"}, "does not cover the signal");
-  EXPECT_THROW(test_support::run_command("receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8",
-                                                     "--fs", "2.0e6", "--coupling", "loose", "--out",
-                                                     (s.dir / "bad_no_imu").string()}),
-               io::InputError);
 }
