@@ -14,9 +14,11 @@
 
 namespace ultratrack::test {
 
-// simulate --scenario toml --out out, in process.
+// simulate --scenario toml --out out, in process (out/scenario.toml is the scenario with every key, as simulate
+// writes it).
 inline sim::SimulationResult simulate_scenario(const std::filesystem::path& toml, const std::filesystem::path& out) {
-  return sim::simulate_to_folder(config::read_scenario(toml), out, "");
+  const sim::Scenario scenario = config::read_scenario(toml);
+  return sim::simulate_to_folder(scenario, out, config::to_toml(scenario));
 }
 
 struct SimulatedReceive {
@@ -28,6 +30,7 @@ struct SimulatedReceive {
   bool troposphere = true;
   int threads = 0;  // all cores
   receiver::NavBitSource nav_bits = receiver::NavBitSource::kDecoded;
+  fusion::VectorCarrier vector_carrier = fusion::VectorCarrier::kAidedPll;  // kVector
 };
 
 inline pipelines::ReceiveSummary receive_simulated(const SimulatedReceive& r) {
@@ -39,6 +42,7 @@ inline pipelines::ReceiveSummary receive_simulated(const SimulatedReceive& r) {
   job.options.receiver.pvt.troposphere = r.troposphere;
   job.options.receiver.threads = r.threads;
   job.options.receiver.nav_bits = r.nav_bits;
+  job.options.vector_carrier = r.vector_carrier;
   if (r.nav) job.navigation = signals::read_rinex_nav(*r.nav);
   pipelines::date_recording(job.options.receiver, job.navigation, 0);
   return pipelines::receive_file(std::move(job)).summary;

@@ -21,26 +21,19 @@
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "support/receive_output_readers.hpp"
-#include "run_command.hpp"
-#include "vector_carrier_runs.hpp"
+#include "support/vector_carrier_runs.hpp"
 #include "config/scenario_toml.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
-#include "simulation_run.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
 namespace signals = ultratrack::signals;
-using namespace ultratrack::tools;
 using namespace ultratrack::config;
 using namespace ultratrack::sim;
 
 namespace {
-
-void run(const std::string& command, std::vector<std::string> args) {
-  ultratrack::test_support::run_command(command, std::move(args));
-}
 
 constexpr double kFs = 2.0e6;
 
@@ -156,7 +149,7 @@ struct Runs {
 
 Runs run_three(const fs::path& dir, const fs::path& brdc, const std::string& toml, double from_s, double to_s) {
   const auto sim = dir / "sim";
-  run("simulate", {"--scenario", toml, "--out", sim.string()});
+  ultratrack::test::simulate_scenario(toml, sim);
   for (const char* m : {"pll", "aided-pll", "fll"}) ultratrack::test::receive_vector_carrier(sim, brdc, dir / m, m);
   fs::remove(sim / "antenna0.i8.bin");
   const Scenario s = read_scenario(sim / "scenario.toml");
@@ -251,17 +244,6 @@ TEST(ReceiveVectorPll, TwoGTurnKeepsEveryPhaseArcWithoutSlips) {
   EXPECT_LE(r.d_pll.first, 0.5 * r.d_fll.first);
 }
 
-TEST(ReceiveVectorPll, RejectsAnUnknownCarrierMode) {
-  const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "x.bin", std::ios::binary) << std::string(400000, '\0');
-  for (const char* bad : {"vpll", "PLL", "pll2"})
-    EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
-                                     "--coupling", "vector", "--vector-carrier", bad, "--out", (dir / "rx").string()}))
-        << bad;
-  EXPECT_ANY_THROW(run("receive", {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
-                                   "--vector-carrier", "pll", "--out", (dir / "ry").string()}));
-}
-
 // Fades (the blockage scenario of ReceiveVectorFll.ChannelsCoastThroughFadesAndReturnWithoutAcquisition: every
 // signal absent 14-17 s, PRN 6 alone 18.5-20.5 s, 22 s): a faded channel's phase arc ends at once (no
 // discriminator holds it) and it is commanded as in the FLL, coasting on the filter; back above the loss threshold
@@ -276,7 +258,7 @@ TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
                                               "[[cycle_slip]]\nantenna = 0\nprn = 6\ntime_s = 18.5\ncycles = 0.0\n"
                                               "fade_s = 2.0\n");
   const auto sim = dir / "sim", pll = dir / "pll";
-  run("simulate", {"--scenario", (dir / "gap.toml").string(), "--out", sim.string()});
+  ultratrack::test::simulate_scenario(dir / "gap.toml", sim);
   ultratrack::test::receive_vector_carrier(sim, brdc, pll, "pll");
   fs::remove(sim / "antenna0.i8.bin");
   const std::string summary = ultratrack::test::read_text_file(pll / "summary.json");
