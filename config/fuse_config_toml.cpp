@@ -1,11 +1,13 @@
 #include "config/fuse_config_toml.hpp"
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
 #include <toml++/toml.h>
 
+#include "ins/imu_datasheet.hpp"
 #include "io/input_error.hpp"
 
 namespace ultratrack::config {
@@ -25,9 +27,23 @@ struct Value {
     if (!(v > 0.0)) throw io::InputError(file, "key '" + key + "' must be positive", line());
     return v;
   }
+  double non_negative() const {
+    const double v = number();
+    if (!(v >= 0.0)) throw io::InputError(file, "key '" + key + "' must not be negative", line());
+    return v;
+  }
   bool boolean() const {
-    if (auto v = node.value<bool>()) return *v;
+    if (auto v = node.value_exact<bool>()) return *v;
     throw io::InputError(file, "key '" + key + "' must be true or false", line());
+  }
+  std::int64_t integer() const {
+    if (auto v = node.value_exact<std::int64_t>(); v && *v <= 1000000) return *v;
+    throw io::InputError(file, "key '" + key + "' must be an integer (at most 1000000)", line());
+  }
+  int count() const {
+    const std::int64_t n = integer();
+    if (n < 1) throw io::InputError(file, "key '" + key + "' must be at least 1", line());
+    return static_cast<int>(n);
   }
   std::string text() const {
     if (auto v = node.value<std::string>()) return *v;
@@ -49,10 +65,29 @@ struct Value {
 
 using Table = std::map<std::string, std::function<void(const Value&, FuseConfig&)>>;
 
+// [imu]: the preset and the datasheet keys of ins/imu_datasheet.hpp (the scenario's names).
+Table imu_table() {
+  Table t{{"preset", [](const Value& v, FuseConfig& c) {
+             c.imu_preset = v.text();
+             const auto& names = ins::imu_preset_names();
+             if (std::find(names.begin(), names.end(), c.imu_preset) == names.end())
+               throw io::InputError(v.file, "key '" + v.key + "': unknown preset '" + c.imu_preset + "'", v.line());
+           }},
+          {"max_gap_s", [](const Value& v, FuseConfig& c) { c.imu_max_gap_s = v.positive(); }}};
+  for (const auto& key : ins::imu_datasheet_keys())
+    t.emplace(std::string(key.name), [&key](const Value& v, FuseConfig& c) {
+      const double x = v.number();
+      if (const std::string problem = ins::datasheet_value_problem(key, x); !problem.empty())
+        throw io::InputError(v.file, "key '" + v.key + "' " + problem, v.line());
+      c.imu_datasheet.*(key.member) = x;
+    });
+  return t;
+}
+
 const std::map<std::string, Table>& sections() {
   using C = FuseConfig;
   static const std::map<std::string, Table> s = {
-      {"imu", {{"preset", [](const Value& v, C& c) { c.imu_preset = v.text(); }}}},
+      {"imu", imu_table()},
       {"initial",
        {{"attitude_deg", [](const Value& v, C& c) { c.attitude_deg = v.vector3(); }},
         {"position_deg_m",
@@ -72,6 +107,8 @@ const std::map<std::string, Table>& sections() {
       {"gnss",
        {{"velocity_sigma_mps", [](const Value& v, C& c) { c.velocity_sigma_mps = v.positive(); }},
         {"use_velocity", [](const Value& v, C& c) { c.use_velocity = v.boolean(); }},
+        {"update_interval_s", [](const Value& v, C& c) { c.fix_min_interval_s = v.non_negative(); }},
+        {"error_correlation_time_s", [](const Value& v, C& c) { c.fix_error_correlation_s = v.non_negative(); }},
         {"lever_arm_body_m", [](const Value& v, C& c) { c.lever_arm_b = v.vector3(); }}}},
       {"filter",
        {{"ukf_alpha", [](const Value& v, C& c) { c.ukf.alpha = v.positive(); }},
@@ -84,7 +121,21 @@ const std::map<std::string, Table>& sections() {
            if (!(c.gate.probability > 0.0 && c.gate.probability < 1.0))
              throw io::InputError(v.file, "key '" + v.key + "' must be in (0, 1)", v.line());
          }},
-        {"propagation_interval_s", [](const Value& v, C& c) { c.propagation_interval_s = v.positive(); }}}},
+        {"propagation_interval_s", [](const Value& v, C& c) { c.propagation_interval_s = v.positive(); }},
+        {"recovery", [](const Value& v, C& c) { c.recovery.enabled = v.boolean(); }},
+        {"recovery_rejections", [](const Value& v, C& c) { c.recovery.consecutive_rejections = v.count(); }},
+        {"recovery_span_s", [](const Value& v, C& c) { c.recovery.min_span_s = v.non_negative(); }},
+        {"recovery_nis_window",
+         [](const Value& v, C& c) {
+           const std::int64_t n = v.integer();
+           if (n < 0) throw io::InputError(v.file, "key '" + v.key + "' must not be negative", v.line());
+           c.recovery.nis_window = static_cast<int>(n);
+         }}}},
+      {"vehicle",
+       {{"nhc", [](const Value& v, C& c) { c.land.nhc = v.boolean(); }},
+        {"nhc_sigma_mps", [](const Value& v, C& c) { c.land.nhc_sigma_mps = v.positive(); }},
+        {"nhc_interval_s", [](const Value& v, C& c) { c.land.nhc_interval_s = v.non_negative(); }},
+        {"nhc_lever_arm_body_m", [](const Value& v, C& c) { c.land.lever_arm_b = v.vector3(); }}}},
       {"clock",
        {{"oscillator",
          [](const Value& v, C& c) {
@@ -107,12 +158,7 @@ const std::map<std::string, Table>& sections() {
         {"terrain_sigma_m", [](const Value& v, C& c) { c.height_aiding.terrain_sigma_m = v.positive(); }},
         {"terrain_correlation_s", [](const Value& v, C& c) { c.height_aiding.terrain_correlation_s = v.positive(); }},
         {"height_m", [](const Value& v, C& c) { c.height_aiding.fixed_height_m = v.number(); }},
-        {"interval_s",
-         [](const Value& v, C& c) {
-           c.height_aiding.min_interval_s = v.number();
-           if (!(c.height_aiding.min_interval_s >= 0.0))
-             throw io::InputError(v.file, "key '" + v.key + "' must not be negative", v.line());
-         }}}},
+        {"interval_s", [](const Value& v, C& c) { c.height_aiding.min_interval_s = v.non_negative(); }}}},
       {"output",
        {{"convergence_heading_sigma_deg", [](const Value& v, C& c) { c.convergence_heading_sigma_deg = v.positive(); }}}},
       {"attitude",
@@ -154,7 +200,7 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
     const auto known = sections().find(section);
     const auto* table = section_node.as_table();
     if (known == sections().end() || !table)
-      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, clock, height_aiding, filter, output, attitude)",
+      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, vehicle, clock, height_aiding, filter, output, attitude)",
                            static_cast<int>(section_node.source().begin.line));
     for (const auto& [key_name, node] : *table) {
       const std::string key = section + "." + std::string(key_name.str());

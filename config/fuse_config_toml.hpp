@@ -1,9 +1,19 @@
 // The `fuse` command's TOML configuration (--config). Sections and keys (all optional):
-//   [imu]        preset = "hg1700ae"  (the filter's noise model: fusion::error_model_from_preset)
+//   [imu]        preset = "hg1700ae" (the filter's noise model: fusion::error_model_from_preset; ins/imu_error_model.hpp
+//                names the presets) and datasheet values over it, each optional, the scenario's names
+//                (ins/imu_datasheet.hpp): gyro_bias_dph, accel_bias_mg, gyro_bias_instability_dph,
+//                accel_bias_instability_mg, bias_correlation_time_s, gyro_arw_dpsh, accel_vrw_mpspsh,
+//                gyro_scale_factor_ppm, accel_scale_factor_ppm; max_gap_s = 1 (a longer gap between IMU rows is
+//                an input error)
 //   [initial]    attitude_deg = [roll, pitch, yaw] (needed by --align config), position_deg_m = [lat, lon, h]
 //                (else the first GNSS fix), velocity_ned_mps = [n, e, d] (else the GNSS velocity), sigma_position_m, sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
 //   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2
-//   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z]
+//   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z], update_interval_s = 0
+//                (fixes closer than this to the last one used are skipped: a decorrelating interval for fixes whose
+//                errors are correlated in time; 0: every fix), error_correlation_time_s = 0 (the fixes' position errors
+//                first-order Gauss-Markov with this time: their variance is inflated by 1 + 2 tau / dt; 0: white)
+//   [vehicle]    nhc = false (land vehicles: zero lateral and vertical body velocity, fusion/nhc_measurement.hpp),
+//                nhc_sigma_mps = 0.3, nhc_interval_s = 0.5, nhc_lever_arm_body_m = [x, y, z] (IMU -> rear axle)
 //   [clock]      (tight) oscillator = "tcxo"|"ocxo" (fusion/clock_model presets; default tcxo), h0, h_minus2
 //                (override the preset's Allan coefficients)
 //   [height_aiding] (tight) mode = "off"|"auto" (default off: aircraft; auto: land vehicles, a terrain-height
@@ -12,7 +22,9 @@
 //                terrain about the reference height), height_m (a fixed IMU ellipsoidal reference height instead of
 //                the one held from the last epoch with >= 4 satellites), interval_s = 1 (at most one aid per interval)
 //   [filter]     ukf_alpha = 1, ukf_beta = 2, ukf_kappa = 0, gate = true, gate_probability = 0.9999,
-//                propagation_interval_s = 0.05
+//                propagation_interval_s = 0.05, recovery = true (no gate lock-out: fusion/lockout_recovery.hpp),
+//                recovery_rejections = 5 and recovery_span_s = 2 (a run of rejected fixes / all-rejected epochs at
+//                least this long re-opens the filter), recovery_nis_window = 20 (windowed NIS test; 0: off)
 //   [output]     convergence_heading_sigma_deg = 1
 //   [attitude]   (GPS attitude, --attitude) gps_time_at_imu_zero = [week, tow_s] (GPS time of IMU t_s = 0; the
 //                attitude file is tagged in GPS time), misalignment_deg = [roll, pitch, yaw] (antenna array ->

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <vector>
 
+#include "ins/imu_datasheet.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory.hpp"
 #include "io/input_error.hpp"
@@ -439,10 +440,6 @@ void read_trajectory_key(const Reader& r, const std::string& key, const std::str
 }
 
 void read_imu_key(const Reader& r, const std::string& key, const std::string& name, const toml::node& n, Scenario& s) {
-  auto override_value = [&](std::optional<double>& v, double max) {
-    v = r.number(n, name);
-    r.check(n, name, *v >= 0 && *v <= max, fmt::format("must be within 0..{}", max));
-  };
   if (key == "preset") {
     s.imu_preset = r.string(n, name);
     if (!in_list(ins::imu_preset_names(), s.imu_preset))
@@ -451,16 +448,14 @@ void read_imu_key(const Reader& r, const std::string& key, const std::string& na
     const auto v = r.integer(n, name);
     r.check(n, name, v >= 0, "must be >= 0");
     s.imu_seed = static_cast<std::uint64_t>(v);
-  } else if (key == "gyro_bias_dph") {
-    override_value(s.gyro_bias_dph, 1e5);
-  } else if (key == "accel_bias_mg") {
-    override_value(s.accel_bias_mg, 1e3);
-  } else if (key == "gyro_arw_dpsh") {
-    override_value(s.gyro_arw_dpsh, 1e3);
-  } else if (key == "accel_vrw_mpspsh") {
-    override_value(s.accel_vrw_mpspsh, 1e3);
   } else {
-    r.fail(n, name, "unknown key in [imu]");
+    const auto keys = ins::imu_datasheet_keys();
+    const auto k = std::find_if(keys.begin(), keys.end(), [&](const auto& d) { return d.name == key; });
+    if (k == keys.end()) r.fail(n, name, "unknown key in [imu]");
+    const double v = r.number(n, name);
+    const std::string problem = ins::datasheet_value_problem(*k, v);
+    r.check(n, name, problem.empty(), problem);
+    s.imu_datasheet.*(k->member) = v;
   }
 }
 

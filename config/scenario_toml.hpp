@@ -24,11 +24,12 @@
 //                 duration_s = 120.0 (profiles; must cover [signal] duration_s)  imu_rate_hz = 100.0 (50..1000)
 //                 odometer = false  odometer_scale_factor_error = 0.0   (odometer.csv; the land profile's use)
 //                 The start position is [receiver] llh_deg_m; t = 0 of the trajectory is the [time] start.
-//   [imu]         preset = "ideal" (ideal, hg1700ae, dmu6x, navigation, mems)  seed = 1
-//                 overrides of the preset's 1-sigma values (only when given):
-//                 gyro_bias_dph (turn-on bias, deg/h)  accel_bias_mg (turn-on bias, milli-g of 9.80665 m/s^2)
-//                 gyro_arw_dpsh (angle random walk, deg/sqrt(h))  accel_vrw_mpspsh (velocity random walk,
-//                 m/s/sqrt(h))
+//   [imu]         preset = "ideal" (ideal, hg1700ae, dmu6x, navigation, mems, adis16405, adis16465, bmi088,
+//                 stim300)  seed = 1
+//                 datasheet overrides of the preset's 1-sigma values (only when given; ins/imu_datasheet.hpp):
+//                 gyro_bias_dph, accel_bias_mg (turn-on), gyro_bias_instability_dph, accel_bias_instability_mg,
+//                 bias_correlation_time_s (in-run, Gauss-Markov), gyro_arw_dpsh (deg/sqrt(h)), accel_vrw_mpspsh
+//                 (m/s/sqrt(h)), gyro_scale_factor_ppm, accel_scale_factor_ppm
 //   [[antenna]]   lever_arm_body_m = [x, y, z]   one table per antenna, body axes (x forward, y right,
 //                 z down) from the IMU; the first is the master (antenna0); default one antenna at the IMU
 //   [receiver]    attitude_deg = [roll, pitch, yaw]   with profile = "static": the parked body's attitude

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "config/scenario_toml.hpp"
+#include "ins/imu_datasheet.hpp"
 
 namespace ultratrack::config {
 
@@ -110,13 +111,8 @@ std::string inertial_toml(const Scenario& s) {
   out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                      s.odometer, toml_float(s.odometer_scale_factor_error));
   out += fmt::format("\n[imu]\npreset = {}\nseed = {}\n", toml_string(s.imu_preset), s.imu_seed);
-  const std::pair<const char*, const std::optional<double>*> overrides[] = {
-      {"gyro_bias_dph", &s.gyro_bias_dph},
-      {"accel_bias_mg", &s.accel_bias_mg},
-      {"gyro_arw_dpsh", &s.gyro_arw_dpsh},
-      {"accel_vrw_mpspsh", &s.accel_vrw_mpspsh}};
-  for (const auto& [key, value] : overrides)
-    if (value->has_value()) out += fmt::format("{} = {}\n", key, toml_float(**value));
+  for (const auto& key : ins::imu_datasheet_keys())
+    if (const auto& value = s.imu_datasheet.*(key.member)) out += fmt::format("{} = {}\n", key.name, toml_float(*value));
   for (std::size_t i = 0; i < s.lever_arms_body_m.size(); ++i) {
     const auto& l = s.lever_arms_body_m[i];
     out += fmt::format("\n[[antenna]]\nlever_arm_body_m = [{}, {}, {}]\n", toml_float(l[0]), toml_float(l[1]),

@@ -1,6 +1,8 @@
 #include "fusion/gnss_ins_integration.hpp"
 
 #include <cmath>
+#include <optional>
+#include <string>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -55,6 +57,12 @@ void check_options(const IntegrationOptions& o) {
   if (!(o.propagation_interval_s >= 0.0)) throw std::invalid_argument("integration: negative propagation interval");
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
     throw std::invalid_argument("integration: gate probability must lie in (0, 1)");
+  if (!(o.fix_min_interval_s >= 0.0) || !std::isfinite(o.fix_min_interval_s) || !(o.fix_error_correlation_s >= 0.0) ||
+      !std::isfinite(o.fix_error_correlation_s))
+    throw std::invalid_argument("integration: the fix interval and error correlation time must be >= 0");
+  if (std::string why; !o.recovery.IsValid(&why)) throw std::invalid_argument("integration: " + why);
+  if (o.land.nhc && (!(o.land.nhc_sigma_mps > 0.0) || !(o.land.nhc_interval_s >= 0.0) || !o.land.lever_arm_b.allFinite()))
+    throw std::invalid_argument("integration: non-holonomic constraints need a positive sigma and interval >= 0");
   if (!o.attitude.q_ba.coeffs().allFinite() || std::abs(o.attitude.q_ba.norm() - 1.0) > 1e-6)
     throw std::invalid_argument("integration: attitude mounting q_ba must be a unit quaternion");
   if (!(o.attitude.max_abs_pitch_rad > 0.0 && o.attitude.max_abs_pitch_rad <= 0.5 * std::numbers::pi))
@@ -78,6 +86,7 @@ struct CoreBase {
   IntegrationOutput output;
   IntegrationCounters counters;
   std::vector<UpdateRecord> records;
+  std::vector<RecoveryEvent> recovery_events;
 };
 
 namespace {
@@ -101,7 +110,8 @@ class Core final : public CoreBase {
 
  public:
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
-      : opt_(opt), ins_(initial, opt.strapdown), model_(make_model(opt)), filter_(std::move(filter)) {
+      : opt_(opt), ins_(initial, opt.strapdown), model_(make_model(opt)), filter_(std::move(filter)),
+        monitor_(opt.recovery) {
     nominal_.nav = ins_.state();
     if constexpr (N == 18) {
       if (opt.height_aiding.fixed_height_m) {
@@ -165,6 +175,14 @@ class Core final : public CoreBase {
       apply(node.mapped());
     }
     if (inc.t_s - t > kTimeEpsilon_s) ins_step(dth, dv, inc.t_s - t);
+    if constexpr (N == 15 || N == 17) {
+      if (opt_.land.nhc && nominal_.nav.t_s - last_nhc_t_s_ >= opt_.land.nhc_interval_s - kTimeEpsilon_s) {
+        last_nhc_t_s_ = nominal_.nav.t_s;
+        propagate();
+        ++(update(NhcMeasurement<N>(nominal_, imu_steps_.w_ib_b, opt_.land), -3) ? counters.nhc_accepted
+                                                                                 : counters.nhc_rejected);
+      }
+    }
     fill_output();
   }
 
@@ -226,16 +244,38 @@ class Core final : public CoreBase {
       }
       return;
     }
+    double fix_variance_factor = 1.0;
+    if (const auto* f = std::get_if<PendingFix>(&p)) {
+      const double since_last = f->fix.t_s - last_fix_t_s_;
+      if (opt_.fix_min_interval_s > 0.0 && since_last < opt_.fix_min_interval_s - kTimeEpsilon_s) {
+        ++counters.fixes_skipped;
+        return;
+      }
+      if (opt_.fix_error_correlation_s > 0.0)
+        fix_variance_factor = 1.0 + 2.0 * opt_.fix_error_correlation_s / std::max(since_last, 1e-3);
+      last_fix_t_s_ = f->fix.t_s;
+    }
     ++counters.epochs;
     if (!attitude_since_fix_) ++counters.fixes_without_attitude;
     attitude_since_fix_ = false;
     if (const auto* f = std::get_if<PendingFix>(&p)) {
       if constexpr (N == 15) {
         if (f->fix.has_position || f->fix.has_velocity) {
-          if (update(LooseMeasurement<N>(nominal_, f->fix, opt_.lever_arm_b, imu_steps_.w_ib_b), 0))
-            ++counters.fix_accepted;
-          else
-            ++counters.fix_rejected;
+          GnssFix fix = f->fix;
+          fix.sigma_pos_ned_m *= std::sqrt(fix_variance_factor);
+          const bool accepted = update(LooseMeasurement<N>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b), 0);
+          ++(accepted ? counters.fix_accepted : counters.fix_rejected);
+          const UpdateResult r = records.back().result;
+          if (auto event = monitor_.observe(nominal_.nav.t_s, accepted, r.nis, r.dof)) {
+            const int pos_rows = fix.has_position ? 3 : 0;
+            const Eigen::Vector3d dp = pos_rows ? Eigen::Vector3d(r.innovation.head<3>()) : Eigen::Vector3d::Zero();
+            std::optional<Eigen::Vector3d> dv;
+            if (fix.has_velocity) dv = r.innovation.segment<3>(pos_rows);
+            recover(*event, dp, dv, 0.0);
+            // The fix that tripped the monitor, again through the opened filter (counted as accepted if it passes).
+            if (!accepted && update(LooseMeasurement<N>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b), 0))
+              ++counters.fix_accepted;
+          }
         }
       }
       return;
@@ -260,10 +300,31 @@ class Core final : public CoreBase {
             ++counters.height_rejected;
         }
       }
-      for (const auto& s : sats)
-        update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
-                                                    opt_.tight.use_range_rate)),
-               s.prn);
+      bool any_accepted = false;
+      double nis = 0.0, range_innovation2 = 0.0;
+      int dof = 0;
+      for (const auto& s : sats) {
+        any_accepted |= update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
+                                                                    opt_.tight.use_range_rate)),
+                               s.prn);
+        const UpdateResult& r = records.back().result;
+        nis += std::isfinite(r.nis) ? r.nis : 1e6;
+        dof += r.dof;
+        if (r.innovation.size() > 0) range_innovation2 += r.innovation(0) * r.innovation(0);
+      }
+      if (!sats.empty()) {
+        if (auto event = monitor_.observe(nominal_.nav.t_s, any_accepted, nis, dof)) {
+          const double rms = std::sqrt(range_innovation2 / static_cast<double>(sats.size()));
+          recover(*event, Eigen::Vector3d::Constant(rms), std::nullopt, rms);
+          // This epoch again, through the opened filter (linearised about the current nominal).
+          const auto again = prepare_satellites(e.epoch, e.ephemerides, e.iono,
+                                                antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight, nullptr);
+          for (const auto& s : again)
+            update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
+                                                        opt_.tight.use_range_rate)),
+                   s.prn);
+        }
+      }
       if constexpr (N == 18) {  // full geometry: this epoch's height is the terrain reference from now on
         if (!few && !ha.fixed_height_m) hold_terrain();
       }
@@ -300,6 +361,16 @@ class Core final : public CoreBase {
       return InsErrorModel<N>(o.model);
   }
 
+  // Lock-out recovery: open the covariance of what the measurements observe, log the event.
+  void recover(const RecoveryEvent& event, const Eigen::Vector3d& dp, const std::optional<Eigen::Vector3d>& dv,
+               double clock_innovation_m) {
+    ++counters.recoveries;
+    recovery_events.push_back(event);
+    const double span = opt_.recovery.min_span_s;
+    const Eigen::MatrixXd P = inflate_for_recovery(filter_.P(), dp, dv, span, opt_.recovery, clock_innovation_m);
+    filter_.set_P(P);
+  }
+
   // The INS height becomes the terrain reference; the terrain error is the negative INS down error.
   void hold_terrain() {
     if constexpr (N == 18) {
@@ -320,10 +391,13 @@ class Core final : public CoreBase {
   NominalState nominal_;
   std::multimap<double, Pending> pending_;
   ImuStepAccumulator imu_steps_;
+  LockoutMonitor monitor_;
   bool attitude_since_fix_ = false;
   // Height aiding (18 states): the terrain nominal and its Gauss-Markov mean (the held or configured height).
   double terrain_m_ = 0.0, terrain_ref_m_ = 0.0;
   double last_aid_t_s_ = -1e300;
+  double last_nhc_t_s_ = -1e300;
+  double last_fix_t_s_ = -1e300;
 };
 
 template <int N>
@@ -390,6 +464,7 @@ const IntegrationOutput& GnssInsIntegration::output() const { return impl_->core
 NominalState GnssInsIntegration::nominal() const { return impl_->core->nominal(); }
 Eigen::MatrixXd GnssInsIntegration::covariance() const { return impl_->core->covariance(); }
 const IntegrationCounters& GnssInsIntegration::counters() const { return impl_->core->counters; }
+const std::vector<RecoveryEvent>& GnssInsIntegration::recovery_events() const { return impl_->core->recovery_events; }
 std::vector<UpdateRecord> GnssInsIntegration::take_update_records() {
   std::vector<UpdateRecord> out;
   out.swap(impl_->core->records);

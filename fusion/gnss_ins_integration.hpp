@@ -9,6 +9,8 @@
 // GPS attitude (multi-antenna receiver, seed 003) is a third measurement type in either coupling, applied at
 // its own time: epochs with attitude, position/velocity, or both; without attitude the update falls back to
 // position/velocity only (counted: fixes_without_attitude). At equal times attitude goes first.
+// A filter locked out by its own gate re-opens (fusion/lockout_recovery.hpp): a rejected fix can never make every
+// later fix rejected.
 // Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides; with height aiding 18 (+ the
 // terrain height). EKF or UKF.
@@ -24,7 +26,9 @@
 #include "fusion/ins_error_model.hpp"
 #include "fusion/coupling.hpp"
 #include "fusion/ins_error_state.hpp"
+#include "fusion/lockout_recovery.hpp"
 #include "fusion/loose_measurements.hpp"
+#include "fusion/nhc_measurement.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "fusion/ukf.hpp"
 #include "ins/nav_state.hpp"
@@ -47,6 +51,19 @@ struct IntegrationOptions {
   Eigen::Vector3d sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
   Eigen::Vector3d sigma_att_rad = Eigen::Vector3d::Constant(0.01);
   GateOptions gate;
+  // No gate lock-out: a run of rejected fixes (loose) or of epochs with every satellite rejected (tight), or a
+  // windowed NIS far above its band, re-opens the covariance of position, velocity, attitude (and clock) and
+  // re-applies the measurement (fusion/lockout_recovery.hpp).
+  LockoutRecoveryOptions recovery;
+  // Loose: fixes closer than this to the last fix used are skipped (a decorrelating interval: fixes whose errors
+  // are correlated in time, from receiver smoothing or multipath, are then about independent; 0: every fix).
+  double fix_min_interval_s = 0.0;
+  // Loose: the correlation time of the fixes' position errors (first-order Gauss-Markov; 0: white). Their
+  // variance is inflated by 1 + 2 tau / dt (dt: the time since the previous fix), the factor by which the variance
+  // of a mean of correlated errors exceeds that of white ones, so the filter does not average them down.
+  double fix_error_correlation_s = 0.0;
+  // Land vehicles: non-holonomic constraints (fusion/nhc_measurement.hpp), off by default.
+  LandVehicleOptions land;
   UkfParameters ukf;
   Discretisation discretisation = Discretisation::SecondOrderSeries;
   // The error covariance is propagated over intervals of about this length (F at the interval's end,
@@ -102,12 +119,15 @@ struct IntegrationCounters {
   // pseudo-measurements applied there (accepted / refused by the gate; none before a height is known).
   long long epochs_few_satellites = 0;
   long long height_accepted = 0, height_rejected = 0;
+  long long recoveries = 0;  // lock-out recoveries (recovery_events() says when and why)
+  long long nhc_accepted = 0, nhc_rejected = 0;  // non-holonomic constraint updates
+  long long fixes_skipped = 0;  // loose: within fix_min_interval_s of the last fix used
 };
 
 // Per-update diagnostics (for NIS / consistency logs).
 struct UpdateRecord {
   double t_s = 0.0;
-  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1; height aiding: -2
+  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1; height aiding: -2; non-holonomic: -3
   UpdateResult result;
 };
 
@@ -141,6 +161,8 @@ class GnssInsIntegration {
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;
   const IntegrationCounters& counters() const;
+  // Every lock-out recovery so far, in time order.
+  const std::vector<RecoveryEvent>& recovery_events() const;
   // Updates since the last call (cleared by the call; at most 8192 are kept, the oldest half dropped first).
   std::vector<UpdateRecord> take_update_records();
   const IntegrationOptions& options() const;

@@ -1,6 +1,7 @@
 // IMU error models applied to ideal increments: turn-on bias, bias instability (first-order Gauss-Markov),
 // angle/velocity random walk, white noise on the integrated output, scale factor, misalignment,
-// quantisation. Named presets (`ideal`, `hg1700ae`, `dmu6x`, `navigation`, `mems`); all randomness from a
+// quantisation. Named presets (`ideal`, `hg1700ae`, `dmu6x`, `navigation`, `mems`, and the datasheet parts
+// `adis16405`, `adis16465`, `bmi088`, `stim300`: docs/imu_models.md); all randomness from a
 // seeded std::mt19937_64. Gyro quantities in rad, rad/s, rad/sqrt(s); accelerometer in m/s, m/s^2, m/s/sqrt(s).
 #pragma once
 

@@ -170,7 +170,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   if (gnss.back().t_s <= imu_start || gnss.front().t_s >= imu.back().t_s)
     throw io::InputError("GNSS file", fmt::format("fixes ({:.3f}-{:.3f} s) do not overlap the IMU data ({:.3f}-{:.3f} s)",
                                                   gnss.front().t_s, gnss.back().t_s, imu_start, imu.back().t_s));
-  const ins::ImuErrorSpec preset = ins::imu_preset(c.imu_preset);
+  const ins::ImuErrorSpec preset = imu_error_spec(c);
   const fusion::AttitudeAidingOptions attitude_options = attitude_aiding_options(c);
   const std::vector<TimedAttitude> attitude = timed_attitudes(s, imu_start, imu.back().t_s);
 
@@ -319,6 +319,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   au.after_end = static_cast<long long>(attitude.size() - a);
   result.end_s = integration.output().nav.t_s;
   result.counters = integration.counters();
+  result.recovery_events = integration.recovery_events();
   result.converged_at_s = converged_since;
 
   if (truth_at) {

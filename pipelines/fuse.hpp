@@ -67,6 +67,7 @@ struct FuseResult {
   ins::EulerAngles initial_attitude;
   std::string alignment_note;
   fusion::IntegrationCounters counters;
+  std::vector<fusion::RecoveryEvent> recovery_events;  // lock-out recoveries (fusion/lockout_recovery.hpp)
   long long fixes_used = 0, fixes_before_start = 0, fixes_in_outage = 0;
   std::optional<double> converged_at_s;  // heading 1-sigma below the threshold from here to the end
   NavSigma final_sigma;

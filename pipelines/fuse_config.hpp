@@ -1,5 +1,5 @@
 // The navigation settings shared by `fuse` and `receive --coupling loose|tight|ultra-tight` (the TOML keys of
-// config/fuse_config_toml.hpp fill it): the IMU error preset, the initial state and its 1-sigmas, the alignment spans,
+// config/fuse_config_toml.hpp fill it): the IMU error preset and datasheet values, the initial state and its 1-sigmas, the alignment spans,
 // the GNSS fix weights and lever arm, the filter's UKF and gate parameters, the receiver clock's oscillator and
 // height aiding (tight), and GPS attitude's time origin and misalignment. Units: SI except where the name says deg.
 #pragma once
@@ -10,12 +10,15 @@
 
 #include "fusion/clock_model.hpp"
 #include "fusion/gnss_ins_integration.hpp"
+#include "ins/imu_datasheet.hpp"
 #include "signals/gps_time.hpp"
 
 namespace ultratrack::pipelines {
 
 struct FuseConfig {
   std::string imu_preset = "hg1700ae";
+  ins::ImuDatasheet imu_datasheet;  // [imu] datasheet keys over the preset
+  double imu_max_gap_s = 1.0;       // [imu] max_gap_s: a longer gap between IMU rows is an input error
   std::optional<Eigen::Vector3d> attitude_deg;    // roll, pitch, yaw
   std::optional<Eigen::Vector3d> position_deg_m;  // lat_deg, lon_deg, height_m
   std::optional<Eigen::Vector3d> velocity_ned_mps;  // --align config without GNSS velocity (receive --imu)
@@ -24,10 +27,14 @@ struct FuseConfig {
   double motion_min_speed_mps = 5.0;
   double motion_window_s = 2.0;
   double velocity_sigma_mps = 0.1;
+  double fix_min_interval_s = 0.0;  // [gnss] update_interval_s: a decorrelating interval between fixes used
+  double fix_error_correlation_s = 0.0;  // [gnss] error_correlation_time_s: fixes' errors Gauss-Markov (0: white)
   bool use_velocity = true;
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();
   fusion::UkfParameters ukf;
   fusion::GateOptions gate;
+  fusion::LockoutRecoveryOptions recovery;  // [filter] recovery* keys
+  fusion::LandVehicleOptions land;          // [vehicle] keys
   double propagation_interval_s = 0.05;
   double convergence_heading_sigma_deg = 1.0;
   std::optional<signals::GpsTime> attitude_gps_time_at_imu_zero;
@@ -38,5 +45,11 @@ struct FuseConfig {
   std::optional<double> clock_allan_h0, clock_allan_hm2;  // as given in the file
   fusion::HeightAidingOptions height_aiding;
 };
+
+// The IMU error model the filter assumes: the preset with the configuration's datasheet values put in. Throws
+// io::InputError for an unknown preset.
+inline ins::ImuErrorSpec imu_error_spec(const FuseConfig& config) {
+  return ins::apply_datasheet(ins::imu_preset(config.imu_preset), config.imu_datasheet);
+}
 
 }  // namespace ultratrack::pipelines

@@ -6,6 +6,7 @@
 
 #include "io/json_text.hpp"
 #include "io/units.hpp"
+#include "pipelines/imu_model_json.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
@@ -28,6 +29,7 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", io::json_escape(truth_file));
   j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
                    s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
+  j += "  \"imu_model\": " + imu_model_json(s.config) + ",\n";
   j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
                    "\"yaw_deg\": {:.6f}}},\n",
                    io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / io::kRadPerDeg,
@@ -39,6 +41,15 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
                    r.counters.accepted, r.counters.rejected, r.counters.late);
   j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
                    r.counters.fix_rejected);
+  j += fmt::format("  \"fixes_skipped_by_interval\": {},\n", r.counters.fixes_skipped);
+  if (s.config.land.nhc)
+    j += fmt::format("  \"nhc_updates_accepted\": {},\n  \"nhc_updates_rejected\": {},\n", r.counters.nhc_accepted,
+                     r.counters.nhc_rejected);
+  j += fmt::format("  \"lockout_recoveries\": {},\n  \"recovery_events\": [", r.counters.recoveries);
+  for (std::size_t i = 0; i < r.recovery_events.size(); ++i)
+    j += fmt::format("{}{{\"t_s\": {:.3f}, \"reason\": \"{}\"}}", i ? ", " : "", r.recovery_events[i].t_s,
+                     io::json_escape(r.recovery_events[i].reason));
+  j += "],\n";
   if (!s.attitude.empty()) {
     const AttitudeUse& a = r.attitude;
     const auto& n = r.counters;

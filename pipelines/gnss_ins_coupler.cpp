@@ -20,6 +20,7 @@
 #include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
+#include "pipelines/imu_model_json.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
@@ -197,7 +198,7 @@ struct GnssInsCoupler::Impl {
   // Tries to start the INS + filter at this epoch (time t; fix = this epoch's, if any).
   bool try_start(double t, const receiver::ObservationEpoch& e, const std::optional<fusion::GnssFix>& fix) {
     const FuseConfig& c = settings.navigation;
-    const ins::ImuErrorSpec preset = ins::imu_preset(c.imu_preset);
+    const ins::ImuErrorSpec preset = imu_error_spec(c);
     AttitudeStart start;
     const fusion::GnssFix* pos_fix = nullptr;
     if (settings.align == AlignMode::Config) {
@@ -439,6 +440,7 @@ std::string GnssInsCoupler::summary_json() const {
                    to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align,
                    io::json_escape(m.settings.imu_name), to_string(m.settings.imu_time_origin), io::json_escape(m.settings.navigation.imu_preset),
                    m.integration.has_value());
+  j += ", \"imu_model\": " + imu_model_json(m.settings.navigation);
   if (m.origin)
     j += fmt::format(", \"imu_time_origin_gps\": {{\"week\": {}, \"tow_s\": {:.9f}}}", m.origin->week, m.origin->tow_s);
   j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
@@ -458,6 +460,12 @@ std::string GnssInsCoupler::summary_json() const {
                    "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
                    m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
                    k.satellites_missing_ephemeris);
+  j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": [", k.recoveries);
+  const auto& events = m.integration->recovery_events();
+  for (std::size_t i = 0; i < events.size(); ++i)
+    j += fmt::format("{}{{\"t_s\": {:.3f}, \"reason\": \"{}\"}}", i ? ", " : "", events[i].t_s,
+                     io::json_escape(events[i].reason));
+  j += "]";
   if (m.is_tight())
     j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
                      "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "

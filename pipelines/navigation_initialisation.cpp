@@ -116,12 +116,16 @@ fusion::IntegrationOptions integration_options(const NavigationStart& start, con
   fusion::IntegrationOptions o;
   o.coupling = coupling;
   o.filter = filter;
-  o.model = fusion::error_model_from_preset(ins::imu_preset(c.imu_preset));
+  o.model = fusion::error_model_from_preset(imu_error_spec(c));
   o.lever_arm_b = c.lever_arm_b;
   o.sigma_pos_ned_m = start.sigma_pos_ned_m;
   o.sigma_vel_n_mps = start.sigma_vel_n_mps;
   o.sigma_att_rad = start.sigma_att_rad;
   o.gate = c.gate;
+  o.recovery = c.recovery;
+  o.land = c.land;
+  o.fix_min_interval_s = c.fix_min_interval_s;
+  o.fix_error_correlation_s = c.fix_error_correlation_s;
   o.ukf = c.ukf;
   o.propagation_interval_s = c.propagation_interval_s;
   return o;

@@ -82,7 +82,7 @@ void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) 
   fusion::UltraTightOptions o;
   o.filter = s.filter;
   o.form = s.ut_form;
-  o.model = fusion::error_model_from_preset(ins::imu_preset(c.imu_preset));
+  o.model = fusion::error_model_from_preset(imu_error_spec(c));
   // The tight filter's clock sigmas (its bias is re-expressed below, exactly, from the time line) with margin.
   o.model.clock.bias_sigma_m = 3.0 * out.sigma_clock_bias_m + 1.0;
   o.model.clock.drift_sigma_mps = 3.0 * out.sigma_clock_drift_mps + 0.1;

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "ins/imu_datasheet.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/sample_format.hpp"
 
@@ -76,10 +77,10 @@ struct Scenario {
   bool odometer = false;
   double odometer_scale_factor_error = 0.0;
 
-  // IMU errors: a preset (ins/imu_error_model.hpp) with optional 1-sigma overrides.
+  // IMU errors: a preset (ins/imu_error_model.hpp) with optional datasheet overrides.
   std::string imu_preset = "ideal";
   std::uint64_t imu_seed = 1;
-  std::optional<double> gyro_bias_dph, accel_bias_mg, gyro_arw_dpsh, accel_vrw_mpspsh;
+  ins::ImuDatasheet imu_datasheet;  // the [imu] datasheet keys given (ins/imu_datasheet.hpp)
 
   // Antennas on the body (inertial scenarios; the first is the master) and the parked attitude (static profile).
   std::vector<std::array<double, 3>> lever_arms_body_m = {{0.0, 0.0, 0.0}};

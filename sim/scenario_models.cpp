@@ -60,14 +60,7 @@ ins::ImuErrorSpec imu_error_spec(const Scenario& s) {
   } catch (const InputError& err) {
     throw InputError(s.source.string(), std::string("[imu]: ") + err.what());
   }
-  constexpr double kDph = io::kRadPerDeg / 3600.0;  // deg/h -> rad/s
-  constexpr double kDpsh = io::kRadPerDeg / 60.0;   // deg/sqrt(h) -> rad/sqrt(s)
-  constexpr double kMg = 9.80665e-3;      // milli-g -> m/s^2
-  if (s.gyro_bias_dph) e.gyro.bias_sigma = *s.gyro_bias_dph * kDph;
-  if (s.accel_bias_mg) e.accel.bias_sigma = *s.accel_bias_mg * kMg;
-  if (s.gyro_arw_dpsh) e.gyro.random_walk = *s.gyro_arw_dpsh * kDpsh;
-  if (s.accel_vrw_mpspsh) e.accel.random_walk = *s.accel_vrw_mpspsh / 60.0;  // m/s/sqrt(h) -> m/s/sqrt(s)
-  return e;
+  return ins::apply_datasheet(e, s.imu_datasheet);
 }
 
 std::shared_ptr<const signals::ReceiverMotion> make_motion(const Scenario& s,

@@ -84,7 +84,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.attitude_file = o.attitude_file;
   }
 
-  const auto imu = ins::read_imu_csv(o.imu_file);
+  const auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
   const auto gnss = pipelines::read_gnss_csv(o.gnss_file);
   std::vector<ins::NavState> truth;
   if (!o.truth_file.empty()) truth = sim::read_truth_csv(o.truth_file);

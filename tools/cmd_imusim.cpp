@@ -113,7 +113,7 @@ void add_imusim_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--duration", o->duration_s, "seconds (profiles)");
   cmd->add_option("--rate", o->rate_hz, "IMU rate in Hz (50-1000, default 100)");
-  cmd->add_option("--preset", o->preset, "IMU errors: ideal, hg1700ae, dmu6x, navigation, mems (default ideal)");
+  cmd->add_option("--preset", o->preset, "IMU errors: ideal, hg1700ae, dmu6x, navigation, mems, adis16405, adis16465, bmi088, stim300 (default ideal)");
   cmd->add_option("--seed", o->seed, "random seed of the IMU errors (default 1)");
   cmd->add_option("--lat-deg", o->lat_deg, "start latitude (default 36.37)");
   cmd->add_option("--lon-deg", o->lon_deg, "start longitude (default 127.36)");

@@ -126,10 +126,10 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   }
 }
 
-std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file) {
+std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file, const ins::ImuCsvOptions& options) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw io::InputError(file, "IMU file not found");
-  auto imu = ins::read_imu_csv(file);
+  auto imu = ins::read_imu_csv(file, options);
   if (imu.size() < 2) throw io::InputError(file, "the IMU file needs at least two rows");
   return imu;
 }

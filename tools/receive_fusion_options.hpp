@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "ins/imu_csv.hpp"
 #include "ins/nav_state.hpp"
 #include "pipelines/receive_options.hpp"
 
@@ -27,6 +28,6 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 // GNSS/INS settings); with --coupling scalar or vector no GNSS/INS option may be given.
 void apply_receive_coupling_args(const ReceiveFusionArgs& args, pipelines::ReceiveOptions& options);
 // The IMU file: InputError naming it when missing, malformed, non-finite or shorter than two rows.
-std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file);
+std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file, const ins::ImuCsvOptions& options);
 
 }  // namespace ultratrack::tools

@@ -158,6 +158,7 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   opt.sigma_pos_ned_m = cfg.sigma0_pos_m;
   opt.sigma_vel_n_mps = cfg.sigma0_vel_mps;
   opt.sigma_att_rad = cfg.sigma0_att_rad;
+  opt.recovery = cfg.recovery;
   opt.gps_time_origin = origin;
   opt.tight.sigma_range_zenith_m = cfg.sigma_range_m;
   opt.tight.sigma_rate_zenith_mps = cfg.sigma_rate_mps;
@@ -171,6 +172,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   e0.segment<3>(fusion::ix::kPos) = cfg.sigma0_pos_m.cwiseProduct(gauss3());
   e0.segment<3>(fusion::ix::kVel) = cfg.sigma0_vel_mps.cwiseProduct(gauss3());
   e0.segment<3>(fusion::ix::kAtt) = cfg.sigma0_att_rad.cwiseProduct(gauss3());
+  e0.segment<3>(fusion::ix::kPos) += cfg.initial_offset_pos_m;
+  e0.segment<3>(fusion::ix::kAtt) += cfg.initial_offset_att_rad;
   fusion::NominalState truth0;
   truth0.nav = run.truth[0].nav();
   const ins::NavState initial = fusion::corrected<15>(truth0, fusion::StateVector<15>(-e0)).nav;
@@ -213,7 +216,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
         }
         const ins::EcefMotion ant = interp.antenna(t_true, cfg.lever_arm_b);
         if (!tight) {
-          const Eigen::Vector3d noise = cfg.sigma_pos_ned_m.cwiseProduct(gauss3());
+          Eigen::Vector3d noise = cfg.sigma_pos_ned_m.cwiseProduct(gauss3());
+          if (t_true >= cfg.bias_start_s && t_true < cfg.bias_start_s + cfg.bias_length_s) noise += cfg.bias_offset_ned_m;
           double lat, lon, h;
           geodetic(ant.r_e, lat, lon, h);
           const Eigen::Vector3d r_noisy = ant.r_e + ins::C_en(lat, lon) * noise;

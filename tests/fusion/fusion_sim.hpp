@@ -35,6 +35,14 @@ struct SimConfig {
   Eigen::Vector3d sigma0_pos_m{3.0, 3.0, 5.0};
   Eigen::Vector3d sigma0_vel_mps{0.3, 0.3, 0.3};
   Eigen::Vector3d sigma0_att_rad{1e-3, 1e-3, 1e-2};
+  // Faults (loose): a fixed initial error added to the drawn one (position NED m, attitude psi NED rad), and
+  // fixes offset by bias_offset_ned_m inside [bias_start_s, bias_start_s + bias_length_s).
+  Eigen::Vector3d initial_offset_pos_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d initial_offset_att_rad = Eigen::Vector3d::Zero();
+  double bias_start_s = 1e9, bias_length_s = 0.0;
+  Eigen::Vector3d bias_offset_ned_m = Eigen::Vector3d::Zero();
+  // The filter's lock-out recovery (fusion/lockout_recovery.hpp).
+  fusion::LockoutRecoveryOptions recovery;
   // Tight: satellites kept (all above the mask when 0), from reduce_after_s on.
   int max_satellites = 0;
   std::vector<int> keep_prns;  // from reduce_after_s on: only these satellites (instead of the highest)

@@ -1,6 +1,7 @@
 // IMU and navigation CSV files: exact round trips, and every kind of bad input rejected with a typed
 // error that names the file and the line. Also the segment-file reader of the trajectory description.
 #include <gtest/gtest.h>
+#include <fmt/core.h>
 
 #include <cmath>
 #include <filesystem>
@@ -87,6 +88,46 @@ TEST(ImuCsv, RejectsBadInputNamingFileAndLine) {
   expect_error_at([&] { read_imu_csv(none); }, none, 0, "cannot open");
   const fs::path empty = write_text(dir, "empty.csv", "");
   expect_error_at([&] { read_imu_csv(empty); }, empty, 0, "missing header");
+}
+
+TEST(ImuCsv, RatesFormBecomesTrapezoidalIncrements) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  // Body rate and specific force linear in time: the trapezoidal rule is exact for them.
+  std::string text = "t_s,acc_x_mps2,acc_y_mps2,acc_z_mps2,gyro_x_radps,gyro_y_radps,gyro_z_radps\n";
+  auto f = [](double t) { return Eigen::Vector3d(0.5 + 2.0 * t, -0.1, -9.8 + t); };
+  auto w = [](double t) { return Eigen::Vector3d(0.01, -0.02 * t, 0.3); };
+  for (int k = 0; k <= 200; ++k) {
+    const double t = 10.0 + k * 0.005;
+    const Eigen::Vector3d a = f(t), g = w(t);
+    text += fmt::format("{},{},{},{},{},{},{}\n", t, a.x(), a.y(), a.z(), g.x(), g.y(), g.z());
+  }
+  const fs::path p = write_text(dir, "rates.csv", text);
+  EXPECT_EQ(imu_csv_form(p), ImuCsvForm::Rates);
+  const auto out = read_imu_csv(p);
+  ASSERT_EQ(out.size(), 200u);  // the first sample opens the first interval
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double t1 = 10.0 + (i + 1) * 0.005, t0 = t1 - 0.005;
+    EXPECT_NEAR(out[i].t_s, t1, 1e-12);
+    EXPECT_TRUE(out[i].dv_b.isApprox(0.5 * (f(t0) + f(t1)) * 0.005, 1e-9)) << i;
+    EXPECT_TRUE(out[i].dtheta_b.isApprox(0.5 * (w(t0) + w(t1)) * 0.005, 1e-9)) << i;
+  }
+}
+
+TEST(ImuCsv, RejectsUnknownHeadersGapsAndSingleSamples) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  const fs::path odd = write_text(dir, "odd.csv", "# logger v2\ntime,ax,ay,az,gx,gy,gz\n0,0,0,0,0,0,0\n");
+  expect_error_at([&] { read_imu_csv(odd); }, odd, 2, "expected increments");
+  const fs::path gap = write_text(dir, "gap.csv", std::string(kImuHeader) + "0.01,0,0,0,0,0,0\n2.5,0,0,0,0,0,0\n");
+  expect_error_at([&] { read_imu_csv(gap); }, gap, 3, "gap of 2.490 s");
+  EXPECT_NO_THROW(read_imu_csv(gap, {3.0}));
+  const fs::path one = write_text(dir, "one.csv",
+                                  "t_s,acc_x_mps2,acc_y_mps2,acc_z_mps2,gyro_x_radps,gyro_y_radps,gyro_z_radps\n"
+                                  "0,0,0,-9.8,0,0,0\n");
+  expect_error_at([&] { read_imu_csv(one); }, one, 0, "single rate sample");
+  const fs::path nan = write_text(dir, "nan_rate.csv",
+                                  "t_s,acc_x_mps2,acc_y_mps2,acc_z_mps2,gyro_x_radps,gyro_y_radps,gyro_z_radps\n"
+                                  "0,0,0,-9.8,0,0,0\n0.01,0,nan,-9.8,0,0,0\n");
+  expect_error_at([&] { read_imu_csv(nan); }, nan, 3, "not finite");
 }
 
 TEST(NavCsv, RoundTripKeepsStateToRoundingPrecision) {

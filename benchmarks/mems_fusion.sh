@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Fusion on a datasheet MEMS unit (issue: fusion on a user's own IMU): the ADIS16405-class drive of
+# scenarios/mems_drive_adis16405.toml over several IMU seeds, 5 Hz fixes at non-integer times from `gnsssim`, `fuse`
+# told only the datasheet values (scenarios/mems_datasheet_fuse.toml) with in-motion alignment, and the errors after
+# the first 60 s (benchmarks/nav_error_stats.py). One line per run, then the median and worst of each column.
+#   benchmarks/mems_fusion.sh [--build DIR] [--seeds "1 2 3 4 5"] [--out DIR] [--fixes vel|pos] [--filter ekf|ukf]
+#       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--correlation S] [--interval S] [--told-correlation S]
+# --correlation: the fixes' errors first-order Gauss-Markov with that time (gnsssim); --interval: the filter's
+# decorrelating interval between fixes used ([gnss] update_interval_s); --told-correlation: the correlation
+# time the filter is told ([gnss] error_correlation_time_s).
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+build="$here/build"; seeds="1 2 3 4 5"; out="${TMPDIR:-/tmp}/mems_fusion"; fixes=vel; filter=ekf; nhc=on
+sigma="0.5 0.5 1.0"; correlation=0; interval=0; told=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build) build="$2"; shift 2 ;; --seeds) seeds="$2"; shift 2 ;; --out) out="$2"; shift 2 ;;
+    --fixes) fixes="$2"; shift 2 ;; --filter) filter="$2"; shift 2 ;; --nhc) nhc="$2"; shift 2 ;;
+    --sigma) sigma="$2"; shift 2 ;; --correlation) correlation="$2"; shift 2 ;; --interval) interval="$2"; shift 2 ;;
+    --told-correlation) told="$2"; shift 2 ;;
+    *) echo "unknown option $1" >&2; exit 2 ;;
+  esac
+done
+U="$build/tools/ultratrack"
+mkdir -p "$out"
+cp "$here/scenarios/mems_drive_segments.csv" "$out/"
+config="$out/fuse.toml"
+cp "$here/scenarios/mems_datasheet_fuse.toml" "$config"
+[ "$nhc" = on ] && printf '\n[vehicle]\nnhc = true\n' >> "$config"
+printf '\n[gnss]\nupdate_interval_s = %s\nerror_correlation_time_s = %s\n' "$interval" "$told" >> "$config"
+velocity_flag=""; [ "$fixes" = pos ] && velocity_flag="--no-velocity"
+echo "fixes $fixes ($sigma m, correlation ${correlation} s, used every ${interval} s, filter told ${told} s), filter $filter, nhc $nhc"
+for seed in $seeds; do
+  run="$out/seed$seed"
+  sed "s/^seed = .*/seed = $seed/" "$here/scenarios/mems_drive_adis16405.toml" > "$out/scenario_$seed.toml"
+  "$U" simulate --scenario "$out/scenario_$seed.toml" --out "$run/sim" --quiet >/dev/null
+  # shellcheck disable=SC2086
+  "$U" gnsssim --truth "$run/sim/truth.csv" --rate 5 --first 0.137 --sigma $sigma --correlation "$correlation" \
+      $velocity_flag --seed "$seed" --out "$run/gnss.csv" >/dev/null
+  "$U" fuse --imu "$run/sim/imu.csv" --gnss "$run/gnss.csv" --config "$config" --filter "$filter" --align motion \
+      --out "$run/fuse" --quiet >/dev/null
+  stats=$(python3 "$here/benchmarks/nav_error_stats.py" "$run/fuse/nav.csv" "$run/sim/truth.csv" --from-s 60)
+  extra=$(python3 -c "import json,sys; s=json.load(open('$run/fuse/summary.json')); print(json.dumps({'rejected': s['fix_updates_rejected'], 'used': s['fixes_used'], 'recoveries': s['lockout_recoveries']}))")
+  echo "seed $seed $stats $extra"
+done | tee "$out/runs.txt"
+python3 - "$out/runs.txt" <<'PY'
+import json, statistics, sys
+rows = []
+for line in open(sys.argv[1]):
+    if not line.startswith("seed"):
+        continue
+    parts = line.split(" ", 2)[2]
+    a, b = parts.rsplit("} {", 1)
+    d = json.loads(a + "}")
+    d.update(json.loads("{" + b))
+    rows.append(d)
+keys = ["horizontal_rms_m", "height_rms_m", "roll_rms_deg", "pitch_rms_deg", "yaw_rms_deg", "within_3sigma"]
+print("| | " + " | ".join(keys) + " | rejected fixes | recoveries |")
+print("|---" * (len(keys) + 3) + "|")
+for name, f in (("median", statistics.median), ("worst", max)):
+    vals = [f(r[k] for r in rows) if not (name == "worst" and k == "within_3sigma") else min(r[k] for r in rows) for k in keys]
+    rej = f(r["rejected"] / r["used"] for r in rows)
+    rec = f(r["recoveries"] for r in rows)
+    print(f"| {name} of {len(rows)} | " + " | ".join(f"{v:.3f}" for v in vals) + f" | {100 * rej:.1f} % | {rec} |")
+PY

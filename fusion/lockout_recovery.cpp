@@ -1,0 +1,96 @@
+#include "fusion/lockout_recovery.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "fusion/ins_error_state.hpp"
+#include "receiver/chi_square.hpp"
+
+namespace ultratrack::fusion {
+
+bool LockoutRecoveryOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* w) {
+    if (why) *why = w;
+    return false;
+  };
+  if (consecutive_rejections < 1) return fail("lock-out recovery: consecutive_rejections must be at least 1");
+  if (!(min_span_s >= 0.0) || !std::isfinite(min_span_s)) return fail("lock-out recovery: min_span_s must be >= 0");
+  if (nis_window < 0) return fail("lock-out recovery: nis_window must be >= 0");
+  if (!(nis_window_probability > 0.0 && nis_window_probability < 1.0))
+    return fail("lock-out recovery: nis_window_probability must lie in (0, 1)");
+  if (!(attitude_sigma_rad.array() > 0.0).all() || !attitude_sigma_rad.allFinite())
+    return fail("lock-out recovery: attitude sigmas must be positive");
+  return true;
+}
+
+void LockoutMonitor::reset() {
+  rejections_ = 0;
+  window_.clear();
+  window_nis_ = 0.0;
+  window_dof_ = 0;
+}
+
+std::optional<RecoveryEvent> LockoutMonitor::observe(double t_s, bool accepted, double nis, int dof) {
+  if (!opt_.enabled) return std::nullopt;
+  if (accepted) {
+    rejections_ = 0;
+  } else if (rejections_++ == 0) {
+    first_rejection_t_s_ = t_s;
+  }
+  if (rejections_ >= opt_.consecutive_rejections && t_s - first_rejection_t_s_ >= opt_.min_span_s) {
+    RecoveryEvent e{t_s, fmt::format("{} consecutive rejections over {:.1f} s", rejections_, t_s - first_rejection_t_s_)};
+    reset();
+    return e;
+  }
+  if (opt_.nis_window == 0 || dof <= 0) return std::nullopt;
+  // A rejected update's NIS can be huge: capped so that one outlier alone cannot fill the window's budget.
+  const double capped = std::isfinite(nis) ? std::min(nis, 100.0 * dof) : 100.0 * dof;
+  window_.emplace_back(capped, dof);
+  window_nis_ += capped;
+  window_dof_ += dof;
+  if (static_cast<int>(window_.size()) > opt_.nis_window) {
+    window_nis_ -= window_.front().first;
+    window_dof_ -= window_.front().second;
+    window_.pop_front();
+  }
+  if (static_cast<int>(window_.size()) < opt_.nis_window) return std::nullopt;
+  const double limit = receiver::chi_square_upper_quantile(window_dof_, opt_.nis_window_probability);
+  if (window_nis_ <= limit) return std::nullopt;
+  RecoveryEvent e{t_s, fmt::format("windowed NIS {:.0f} over {} updates (limit {:.0f})", window_nis_,
+                                   static_cast<int>(window_.size()), limit)};
+  reset();
+  return e;
+}
+
+Eigen::MatrixXd inflate_for_recovery(const Eigen::MatrixXd& P_in, const Eigen::Vector3d& dp,
+                                     const std::optional<Eigen::Vector3d>& dv, double span_s,
+                                     const LockoutRecoveryOptions& o, double clock_innovation_m) {
+  Eigen::MatrixXd P = P_in;
+  const int n = static_cast<int>(P.rows());
+  Eigen::VectorXd var = P.diagonal();
+  const double v_from_p = 2.0 * dp.norm() / std::max(span_s, 1.0);
+  for (int i = 0; i < 3; ++i) {
+    var(ix::kPos + i) = std::max(var(ix::kPos + i), 4.0 * dp(i) * dp(i) + 1.0);
+    const double dvi = dv ? (*dv)(i) : v_from_p;
+    var(ix::kVel + i) = std::max(var(ix::kVel + i), 4.0 * dvi * dvi + 1.0);
+    var(ix::kAtt + i) = std::max(var(ix::kAtt + i), o.attitude_sigma_rad(i) * o.attitude_sigma_rad(i));
+  }
+  std::vector<int> opened{ix::kPos, ix::kPos + 1, ix::kPos + 2, ix::kVel, ix::kVel + 1, ix::kVel + 2,
+                          ix::kAtt, ix::kAtt + 1, ix::kAtt + 2};
+  if (n >= 17) {
+    var(ix::kClockBias) = std::max(var(ix::kClockBias), 4.0 * clock_innovation_m * clock_innovation_m + 1.0);
+    var(ix::kClockDrift) = std::max(var(ix::kClockDrift), 4.0 * v_from_p * v_from_p + 1.0);
+    opened.push_back(ix::kClockBias);
+    opened.push_back(ix::kClockDrift);
+  }
+  for (int i : opened) {
+    P.row(i).setZero();
+    P.col(i).setZero();
+  }
+  for (int i : opened) P(i, i) = var(i);
+  return P;
+}
+
+}  // namespace ultratrack::fusion

@@ -1,0 +1,84 @@
+// The fuse configuration's datasheet IMU keys, lock-out recovery and land-vehicle keys: values reach the
+// FuseConfig, the filter's model is the preset with them put in, and bad values name the file, line and key.
+#include "config/fuse_config_toml.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <numbers>
+
+#include "io/input_error.hpp"
+#include "support/test_data.hpp"
+
+namespace ultratrack::config {
+namespace {
+
+std::filesystem::path write(const std::string& name, const std::string& text) {
+  const auto p = test::scratch_dir() / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+TEST(FuseConfigToml, DatasheetKeysOverThePreset) {
+  const auto p = write("datasheet.toml",
+                       "[imu]\npreset = \"mems\"\ngyro_bias_dph = 10800\naccel_vrw_mpspsh = 0.2\n"
+                       "bias_correlation_time_s = 100\nmax_gap_s = 0.2\n");
+  const FuseConfig c = read_fuse_config(p);
+  EXPECT_EQ(c.imu_preset, "mems");
+  ASSERT_TRUE(c.imu_datasheet.gyro_bias_dph);
+  EXPECT_EQ(*c.imu_datasheet.gyro_bias_dph, 10800.0);
+  EXPECT_FALSE(c.imu_datasheet.accel_bias_mg);
+  EXPECT_EQ(c.imu_max_gap_s, 0.2);
+  const ins::ImuErrorSpec spec = pipelines::imu_error_spec(c);
+  EXPECT_NEAR(spec.gyro.bias_sigma, 3.0 * std::numbers::pi / 180.0, 1e-12);  // 3 deg/s
+  EXPECT_NEAR(spec.accel.random_walk, 0.2 / 60.0, 1e-15);
+  EXPECT_EQ(spec.accel.bias_sigma, ins::imu_preset("mems").accel.bias_sigma);  // not given: the preset's
+}
+
+TEST(FuseConfigToml, RecoveryAndVehicleKeys) {
+  const auto p = write("vehicle.toml",
+                       "[filter]\nrecovery = false\nrecovery_rejections = 8\nrecovery_span_s = 4\n"
+                       "recovery_nis_window = 0\n[vehicle]\nnhc = true\nnhc_sigma_mps = 0.5\nnhc_interval_s = 1\n"
+                       "nhc_lever_arm_body_m = [-1.5, 0, 0.5]\n");
+  const FuseConfig c = read_fuse_config(p);
+  EXPECT_FALSE(c.recovery.enabled);
+  EXPECT_EQ(c.recovery.consecutive_rejections, 8);
+  EXPECT_EQ(c.recovery.min_span_s, 4.0);
+  EXPECT_EQ(c.recovery.nis_window, 0);
+  EXPECT_TRUE(c.land.nhc);
+  EXPECT_EQ(c.land.nhc_sigma_mps, 0.5);
+  EXPECT_EQ(c.land.nhc_interval_s, 1.0);
+  EXPECT_EQ(c.land.lever_arm_b, Eigen::Vector3d(-1.5, 0.0, 0.5));
+}
+
+TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
+  struct Case {
+    std::string text, what;
+    int line;
+  };
+  const std::vector<Case> cases{
+      {"[imu]\n\ngyro_bias_dph = -3\n", "imu.gyro_bias_dph", 3},
+      {"[imu]\nbias_correlation_time_s = 0\n", "imu.bias_correlation_time_s", 2},
+      {"[imu]\ngyro_arw_dpsh = \"2\"\n", "must be a number", 2},
+      {"[imu]\npreset = \"adis99\"\n", "unknown preset 'adis99'", 2},
+      {"[imu]\ngyro_bias_dps = 3\n", "unknown key 'imu.gyro_bias_dps'", 2},
+      {"[filter]\nrecovery_rejections = 0\n", "at least 1", 2},
+      {"[filter]\nrecovery_rejections = 2.5\n", "must be an integer", 2},
+      {"[vehicle]\nnhc_sigma_mps = 0\n", "must be positive", 2},
+      {"[vehicle]\nnhc = 1\n", "true or false", 2},
+  };
+  for (const auto& c : cases) {
+    const auto p = write("bad.toml", c.text);
+    try {
+      read_fuse_config(p);
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const io::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      EXPECT_EQ(e.line(), c.line) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ultratrack::config

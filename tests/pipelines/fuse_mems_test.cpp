@@ -1,0 +1,89 @@
+// Fusion on a datasheet MEMS unit through the library: the ADIS16405-class drive of
+// scenarios/mems_drive_adis16405.toml (turn-on gyro bias 3 deg/s, 50 mg), 5 Hz position-only fixes at non-integer
+// times, the filter told only the datasheet values (scenarios/mems_datasheet_fuse.toml) with in-motion alignment
+// and land-vehicle constraints. After the first 60 s: the targets (horizontal and height RMS <= 0.45 m,
+// roll and pitch <= 0.3 deg, yaw <= 1.5 deg). The same run without the constraints is printed beside it (its heading
+// is unobservable on the straight stretches: over 8 seeds benchmarks/mems_fusion.sh --nhc off gives a median yaw RMS
+// of 22 deg, docs/validation.md), not asserted: on this seed it happens to stay within 1.5 deg.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "config/fuse_config_toml.hpp"
+#include "config/scenario_toml.hpp"
+#include "ins/attitude.hpp"
+#include "ins/earth_model.hpp"
+#include "ins/imu_csv.hpp"
+#include "pipelines/fuse.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
+#include "sim/simulation_files.hpp"
+#include "sim/truth_csv.hpp"
+#include "support/test_data.hpp"
+
+namespace ultratrack::pipelines {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct Errors {
+  double horizontal_m = 0.0, height_m = 0.0, roll_deg = 0.0, pitch_deg = 0.0, yaw_deg = 0.0;
+};
+
+double wrapped_deg(double a_rad) { return std::remainder(a_rad, 2.0 * std::numbers::pi) / kDeg; }
+
+Errors run_fuse(bool nhc) {
+  const auto dir = test::scratch_dir();
+  const auto scenario_file = test::scenarios_dir() / "mems_drive_adis16405.toml";
+  const sim::Scenario scenario = config::read_scenario(scenario_file);
+  sim::simulate_to_folder(scenario, dir / "sim", test::read_text_file(scenario_file));
+  const auto imu = ins::read_imu_csv(dir / "sim" / "imu.csv");
+  const ins::TruthInterpolator truth(truth_samples_from_nav(sim::read_truth_csv(dir / "sim" / "truth.csv")));
+  GnssFixSimulationOptions fixes;
+  fixes.rate_hz = 5.0;
+  fixes.first_time_s = 0.137;
+  fixes.sigma_ned_m = Eigen::Vector3d(0.5, 0.5, 1.0);
+  fixes.with_velocity = false;
+  fixes.seed = 1;
+  const std::vector<GnssFixRow> gnss = simulate_gnss_fixes(truth, fixes);
+
+  FuseSettings s;
+  s.config = config::read_fuse_config(test::scenarios_dir() / "mems_datasheet_fuse.toml");
+  s.config.land.nhc = nhc;
+  s.align = AlignMode::Motion;
+  double h2 = 0, v2 = 0, r2 = 0, p2 = 0, y2 = 0;
+  int n = 0;
+  fuse(imu, gnss, {}, s, [&](const ins::NavState& nav, const NavSigma&) {
+    if (nav.t_s < 60.0 || nav.t_s > truth.end_s()) return;
+    const ins::EcefMotion m = truth.antenna(nav.t_s, Eigen::Vector3d::Zero());
+    const Eigen::Vector3d d = ins::C_en(nav.lat_rad, nav.lon_rad).transpose() *
+                              (ins::ecef_from_geodetic(nav.lat_rad, nav.lon_rad, nav.height_m) - m.r_e);
+    const ins::EulerAngles e = ins::euler_from_quaternion(nav.q_nb);
+    const ins::EulerAngles t = ins::euler_from_quaternion(truth.attitude(nav.t_s));
+    h2 += d.head<2>().squaredNorm();
+    v2 += d.z() * d.z();
+    r2 += std::pow(wrapped_deg(e.roll_rad - t.roll_rad), 2);
+    p2 += std::pow(wrapped_deg(e.pitch_rad - t.pitch_rad), 2);
+    y2 += std::pow(wrapped_deg(e.yaw_rad - t.yaw_rad), 2);
+    ++n;
+  });
+  EXPECT_GT(n, 1000);
+  return {std::sqrt(h2 / n), std::sqrt(v2 / n), std::sqrt(r2 / n), std::sqrt(p2 / n), std::sqrt(y2 / n)};
+}
+
+TEST(FuseMems, DatasheetUnitAlignsInMotionAndMeetsTheTargets) {
+  const Errors e = run_fuse(true);
+  std::printf("MEMS drive, land constraints: horizontal %.3f m, height %.3f m, roll %.3f, pitch %.3f, yaw %.3f deg\n",
+              e.horizontal_m, e.height_m, e.roll_deg, e.pitch_deg, e.yaw_deg);
+  EXPECT_LE(e.horizontal_m, 0.45);
+  EXPECT_LE(e.height_m, 0.45);
+  EXPECT_LE(e.roll_deg, 0.3);
+  EXPECT_LE(e.pitch_deg, 0.3);
+  EXPECT_LE(e.yaw_deg, 1.5);
+  const Errors without = run_fuse(false);
+  std::printf("MEMS drive, no constraints: horizontal %.3f m, yaw %.3f deg\n", without.horizontal_m, without.yaw_deg);
+}
+
+}  // namespace
+}  // namespace ultratrack::pipelines
