@@ -236,9 +236,8 @@ std::string substitute(const CampaignFile& c, const std::string& text, const pip
   try {
     return pipelines::substitute_parameters(text, run);
   } catch (const std::invalid_argument& e) {
-    throw io::InputError(where, e.what());
+    throw io::InputError(where, std::string(e.what()) + " (campaign file " + c.source.string() + ")");
   }
-  (void)c;
 }
 
 fs::path resolve(const CampaignFile& c, const std::string& path) {

@@ -8,7 +8,7 @@
 //   [[axis]]     name = "cn0_dbhz"  values = [24.0, 26.0]          (numbers or strings)   or  count = 4 (0..3)
 //                further keys are zipped columns, one value per axis value: seed = [100, 101, 102, 103]
 //                or linear in the axis position: seed = { start = 100, step = 1 }
-//                The first axis varies slowest; run i's parameters are its axis values and their columns.
+//                The first axis varies slowest; a run's parameters are each axis value, then its columns in key order.
 //   [simulate]   scenario = "threshold.scenario.toml"   a scenario file whose text names parameters as {name}
 //                keep_samples = false                   (the IF sample file is deleted after the receive)
 //   [[recording]] instead of [simulate]: name = "a"  input = "a.bin"  format = "i8"  sample_rate_hz = 4e6
