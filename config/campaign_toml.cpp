@@ -33,7 +33,9 @@ struct Table {
     seen.insert(key);
     return table.get(key);
   }
-  std::string key_name(const std::string& key) const { return name.empty() ? key : name + "." + key; }
+  std::string key_name(const std::string& key) const {
+    return name.empty() ? key : key.empty() ? name : name + "." + key;
+  }
   [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& problem) const {
     throw io::InputError(file, "key '" + key_name(key) + "' " + problem, line_of(node));
   }
@@ -135,9 +137,12 @@ pipelines::CampaignAxis read_axis(const std::string& file, const toml::table& t,
       l.check_done();
       const auto is = [](const toml::node* n) { return n->value_exact<std::int64_t>().has_value(); };
       for (std::size_t k = 0; k < axis.values.size(); ++k) {
+        std::int64_t offset = 0, value = 0;
         if (is(start) && is(step)) {
-          column.push_back(std::to_string(*start->value<std::int64_t>() +
-                                          static_cast<std::int64_t>(k) * *step->value<std::int64_t>()));
+          if (__builtin_mul_overflow(static_cast<std::int64_t>(k), *step->value<std::int64_t>(), &offset) ||
+              __builtin_add_overflow(*start->value<std::int64_t>(), offset, &value))
+            l.fail(node, "", "overflows a 64-bit integer");
+          column.push_back(std::to_string(value));
         } else {
           const auto s0 = start->value<double>(), ds = step->value<double>();
           if (!s0 || !ds) l.fail(node, "", "start and step must be numbers");

@@ -1,6 +1,6 @@
-// Campaign files (`ultratrack campaign run C.toml`): the runs as a product of parameter axes, what each run does
-// (simulate a scenario template, or take a recording, then receive in process), what it computes and how the
-// report reduces the results; and the Slurm resources. Read strictly: every key known and of the right type, or
+// Campaign files (`ultratrack campaign run C.toml`): runs, what each does and computes, the report, Slurm resources.
+// The runs are a product of parameter axes; each simulates a scenario template (or takes a recording) and
+// receives in process. Read strictly: every key known and of the right type, or
 // an io::InputError naming the file, the line and the key. Relative paths resolve against the campaign file's
 // folder (or the base folder given: `campaign run` keeps a copy of the file in its output folder).
 //

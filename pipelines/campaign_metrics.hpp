@@ -1,4 +1,5 @@
-// What a campaign run computes from its output files, so that a report can be redone from the run folders alone:
+// What a campaign run computes from its output files (lock outcomes, nav z-scores). Written per run, so that a
+// report can be redone from the run folders alone:
 //   lock outcomes   each simulated satellite of a receive classified from tracking.csv (the tracking threshold);
 //   nav z-scores    the fused nav.csv against the simulation's truth.csv at fixed times, each NED position and
 //                   velocity error divided by nav.csv's own 1-sigma (the filter's consistency).

@@ -24,6 +24,8 @@ std::vector<CampaignRun> expand_campaign(const std::vector<CampaignAxis>& axes) 
         throw std::invalid_argument("campaign column '" + name + "' is not as long as axis '" + axis.name + "'");
       if (!names.insert(name).second) throw std::invalid_argument("campaign parameter '" + name + "' twice");
     }
+    if (axis.values.size() > kMaxCampaignRuns / total)
+      throw std::invalid_argument(fmt::format("the campaign has more than {} runs", kMaxCampaignRuns));
     total *= axis.values.size();
   }
   std::vector<CampaignRun> runs(total);

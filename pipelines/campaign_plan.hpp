@@ -1,10 +1,11 @@
-// A campaign's runs: the product of its parameter axes, in a fixed order (the first axis outermost, the last
-// varying fastest), each run numbered 0..N-1 and carrying one value of every parameter as text. An axis may
+// A campaign's runs: the product of its parameter axes, and its templates filled in per run. The order is fixed
+// (the first axis outermost, the last varying fastest), each run numbered 0..N-1 and carrying one value of every parameter as text. An axis may
 // carry zipped columns (parameters that vary with it, one value per axis value: e.g. a file number with its seed
 // and start time), so that seeds and levels combine without writing every pair. Templates (scenario and
 // configuration text) name parameters as {name}; substitute_parameters fills them in.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -27,8 +28,12 @@ struct CampaignRun {
   const std::string* find(std::string_view name) const;
 };
 
+// At most this many runs (a campaign of more is split into several).
+inline constexpr std::size_t kMaxCampaignRuns = 1000000;
+
 // The runs of the product of `axes` (no axis: one run without parameters). Axes must be non-empty with columns of
-// their own length and unique names (config/campaign_toml.hpp checks that at the edge; std::invalid_argument here).
+// their own length and unique names, at most kMaxCampaignRuns runs (config/campaign_toml.hpp checks that at the
+// edge; std::invalid_argument here).
 std::vector<CampaignRun> expand_campaign(const std::vector<CampaignAxis>& axes);
 
 // `text` with every {name} (letters, digits and _) replaced by the run's value; other braces stay as written (TOML

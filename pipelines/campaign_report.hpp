@@ -1,4 +1,4 @@
-// A campaign's report: what is complete, failed and missing, and the reductions the campaign file asks for, over
+// A campaign's report: what is complete, failed and missing, and the tables the campaign asks for. They reduce
 // whatever runs are complete (pipelines/campaign_run.hpp's folders). The reductions print the tables the
 // benchmark scripts printed (benchmarks/tracking_threshold.sh, ultratight_consistency.sh), in the same format:
 //   lock threshold   per level of a parameter (C/N0, dB-Hz): satellite-runs kept, lost, never locked, not

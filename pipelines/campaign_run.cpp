@@ -76,6 +76,9 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
   }
   date_recording(rx.options.receiver, rx.navigation, fallback_week > 0 ? fallback_week : 2190);
   if (uses_imu(rx.options.coupling)) {
+    if (job.scenario && !job.scenario->trajectory_enabled())
+      throw io::InputError(job.scenario->source.string(), "the " + to_string(rx.options.coupling) +
+                                                              " coupling needs an IMU: the scenario has no [trajectory]");
     rx.imu = ins::read_imu_csv(imu);
     rx.options.imu_name = imu.string();
   }

@@ -1,6 +1,6 @@
-// One campaign run into its own folder: simulate a scenario (or take a recording), receive it in process
-// (pipelines/receive_file.hpp), compute what the campaign asks (pipelines/campaign_metrics.hpp), and write the
-// completion marker last. A run folder holds
+// One campaign run into its own folder, its completion marker written last. It simulates a scenario (or takes a
+// recording), receives it in process (pipelines/receive_file.hpp) and computes what the campaign asks
+// (pipelines/campaign_metrics.hpp). A run folder holds
 //   parameters.csv    the run's parameters (name,value), written first
 //   sim/              the simulation's files (the IF sample file deleted after the receive unless kept)
 //   rx/               the receive's outputs

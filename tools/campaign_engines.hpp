@@ -1,4 +1,4 @@
-// Where a campaign's runs execute (`ultratrack campaign run --engine local|slurm`). The output folder keeps a copy
+// Where a campaign's runs execute (`ultratrack campaign run --engine local|slurm`): threads here, or a Slurm array. The output folder keeps a copy
 // of the campaign file (campaign.toml) and the folder its relative paths resolve against (campaign_base.txt), so
 // that `campaign run-one DIR INDEX` on any node and `campaign report DIR` read the same campaign. Runs already
 // complete are never redone (resume).

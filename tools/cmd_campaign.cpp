@@ -1,4 +1,4 @@
-// `ultratrack campaign`: many runs from one campaign file (config/campaign_toml.hpp) and their report.
+// `ultratrack campaign`: many runs from one campaign file (config/campaign_toml.hpp), and their report.
 //   campaign run C.toml --out DIR [--engine local|slurm] [--jobs N] [--no-wait]   runs what is not complete yet
 //   campaign run-one DIR INDEX                                                    one run (a Slurm array task)
 //   campaign report DIR                                                           the report of what is complete

@@ -13,6 +13,8 @@
 #include "pipelines/campaign_metrics.hpp"
 #include "pipelines/campaign_report.hpp"
 #include "pipelines/campaign_run.hpp"
+#include "config/scenario_toml.hpp"
+#include "sim/simulation_files.hpp"
 #include "support/test_data.hpp"
 
 namespace {
@@ -84,6 +86,44 @@ TEST(CampaignRun, RunsResumesAndReportsFailures) {
   { std::ofstream(pipelines::campaign_run_dir(out, 1) / "sentinel") << "x"; }
   (void)pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
   EXPECT_FALSE(fs::exists(pipelines::campaign_run_dir(out, 1) / "sentinel"));
+}
+
+// A campaign over recordings: each [[recording]] is one value of the axis "recording", received with its flags.
+TEST(CampaignRun, ReceivesRecordings) {
+  const fs::path dir = test::scratch_dir();
+  tiny_campaign(dir);  // s.toml
+  std::string scenario = test::read_text_file(dir / "s.toml");
+  scenario.replace(scenario.find("{seed}"), 6, "9");
+  std::ofstream(dir / "rec.toml") << scenario;
+  const sim::Scenario parsed = config::read_scenario(dir / "rec.toml");
+  const auto simulated = sim::simulate_to_folder(parsed, dir / "rec", config::to_toml(parsed));
+  std::ofstream(dir / "r.toml") << "[[recording]]\nname = \"rec9\"\ninput = \"rec/antenna0.i8.bin\"\nformat = \"i8\"\n"
+                                   "sample_rate_hz = 2.0e6\n[[recording]]\nname = \"absent\"\ninput = \"nothing.bin\"\n"
+                                   "sample_rate_hz = 2.0e6\n[receive]\nnav = \""
+                                << test::shipped_nav_file().string()
+                                << "\"\n[compute]\nlock_outcomes = { lock_deadline_s = 1.5 }\n";
+  const config::CampaignFile campaign = config::read_campaign(dir / "r.toml");
+  const auto runs = pipelines::expand_campaign(campaign.axes);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_EQ(*runs[0].find("input"), (dir / "rec" / "antenna0.i8.bin").string());
+  const fs::path out = dir / "out";
+  const auto status = pipelines::run_campaign_job(config::campaign_job(campaign, runs[0]), pipelines::campaign_run_dir(out, 0));
+  ASSERT_EQ(status.state, CampaignRunState::kComplete) << status.message;
+  EXPECT_TRUE(fs::exists(dir / "rec" / "antenna0.i8.bin")) << "a recording is never deleted";
+  // Without the simulation's list every PRN is classified: the simulated ones kept, the others not acquired.
+  int kept = 0, not_acquired = 0;
+  for (const auto& o : pipelines::read_lock_outcomes_csv(pipelines::campaign_run_dir(out, 0) / "lock_outcomes.csv"))
+    if (o.outcome == "kept") {
+      ++kept;
+    } else if (o.outcome == "not_acquired") {
+      ++not_acquired;
+    }
+  EXPECT_EQ(kept, static_cast<int>(simulated.satellites.size()));
+  EXPECT_EQ(kept + not_acquired, 32);
+  // A missing recording: the run fails naming the file.
+  const auto missing = pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
+  ASSERT_EQ(missing.state, CampaignRunState::kFailed);
+  EXPECT_NE(missing.message.find("nothing.bin"), std::string::npos) << missing.message;
 }
 
 // A run folder made by hand: parameters, lock outcomes, the marker.
