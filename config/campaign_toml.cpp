@@ -1,12 +1,12 @@
 #include "config/campaign_toml.hpp"
 
 #include <fmt/core.h>
+#include <toml++/toml.h>
 
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <stdexcept>
-#include <toml++/toml.h>
 
 #include "config/fuse_config_toml.hpp"
 #include "config/receive_config_toml.hpp"
@@ -161,14 +161,13 @@ pipelines::CampaignAxis read_axis(const std::string& file, const toml::table& t,
 }
 
 // The recordings as the first axis, "recording": their names, and a column per key.
-pipelines::CampaignAxis read_recordings(const std::string& file, const toml::array& list, const fs::path& base) {
+pipelines::CampaignAxis read_recordings(const std::string& file, const std::vector<const toml::table*>& list,
+                                        const fs::path& base) {
   static const char* const kKeys[] = {"input", "format", "sample_rate_hz", "if_hz", "imu", "truth"};
   pipelines::CampaignAxis axis{"recording", {}, {}};
   for (const char* key : kKeys) axis.columns.emplace_back(key, std::vector<std::string>{});
   int i = 0;
-  for (const toml::node& node : list) {
-    const toml::table* t = node.as_table();
-    if (!t) throw io::InputError(file, "[[recording]] must be tables", line_of(node));
+  for (const toml::table* t : list) {
     Table table{file, fmt::format("recording[{}]", i), *t, {}};
     axis.values.push_back(table.text("name", fmt::format("recording{}", i)));
     for (auto& [key, column] : axis.columns) {
@@ -215,9 +214,11 @@ CampaignReduction read_reduction(const std::string& file, const toml::table& t, 
     for (const auto& [name, values] : axis.columns) names.insert(name);
   }
   for (const std::string& g : r.group)
-    if (!names.count(g)) throw io::InputError(file, "key '" + table.key_name("group") + "' names no parameter '" + g + "'", line_of(t));
+    if (!names.count(g))
+      throw io::InputError(file, "key '" + table.key_name("group") + "' names no parameter '" + g + "'", line_of(t));
   if (r.kind == CampaignReduction::Kind::kLockThreshold && !names.count(r.level))
-    throw io::InputError(file, "key '" + table.key_name("level") + "' names no parameter '" + r.level + "'", line_of(t));
+    throw io::InputError(file, "key '" + table.key_name("level") + "' names no parameter '" + r.level + "'",
+                         line_of(t));
   return r;
 }
 
@@ -226,6 +227,20 @@ const toml::table* section(const std::string& file, const toml::table& root, con
   if (!n) return nullptr;
   if (const toml::table* t = n->as_table()) return t;
   throw io::InputError(file, "'" + name + "' must be a table [" + name + "]", line_of(*n));
+}
+
+// The tables of an array of tables ([[name]]); none when absent.
+std::vector<const toml::table*> tables_of(const std::string& file, const toml::table& root, const std::string& name) {
+  std::vector<const toml::table*> tables;
+  const toml::node* n = root.get(name);
+  if (!n) return tables;
+  const toml::array* a = n->as_array();
+  if (!a) throw io::InputError(file, "'" + name + "' must be [[" + name + "]] tables", line_of(*n));
+  for (const toml::node& item : *a) {
+    if (!item.as_table()) throw io::InputError(file, "'" + name + "' must be [[" + name + "]] tables", line_of(item));
+    tables.push_back(item.as_table());
+  }
+  return tables;
 }
 
 std::string read_text(const fs::path& path, const std::string& who) {
@@ -265,7 +280,8 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
   c.source = path;
   c.base_dir = base_dir.empty() ? fs::absolute(path).parent_path() : fs::absolute(base_dir);
   Table top{file, "", root, {}};
-  for (const char* s : {"campaign", "axis", "simulate", "recording", "receive", "compute", "report", "slurm"}) top.get(s);
+  for (const char* s : {"campaign", "axis", "simulate", "recording", "receive", "compute", "report", "slurm"})
+    top.get(s);
   top.check_done();
 
   if (const toml::table* t = section(file, root, "campaign")) {
@@ -274,23 +290,16 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
     c.description = table.text("description", "");
     table.check_done();
   }
-  const toml::array* recordings = root.get("recording") ? root.get("recording")->as_array() : nullptr;
+  const std::vector<const toml::table*> recordings = tables_of(file, root, "recording");
   const toml::table* simulate = section(file, root, "simulate");
-  if ((recordings != nullptr) == (simulate != nullptr))
+  if (recordings.empty() == (simulate == nullptr))
     throw io::InputError(file, "a campaign has either [simulate] or [[recording]] tables");
-  if (recordings) {
+  if (!recordings.empty()) {
     c.recordings = true;
-    c.axes.push_back(read_recordings(file, *recordings, c.base_dir));
+    c.axes.push_back(read_recordings(file, recordings, c.base_dir));
   }
-  if (const toml::node* axes = root.get("axis")) {
-    const toml::array* a = axes->as_array();
-    if (!a) throw io::InputError(file, "'axis' must be [[axis]] tables", line_of(*axes));
-    int i = 0;
-    for (const toml::node& n : *a) {
-      if (!n.as_table()) throw io::InputError(file, "'axis' must be [[axis]] tables", line_of(n));
-      c.axes.push_back(read_axis(file, *n.as_table(), i++));
-    }
-  }
+  int axis_number = 0;
+  for (const toml::table* t : tables_of(file, root, "axis")) c.axes.push_back(read_axis(file, *t, axis_number++));
   try {
     (void)pipelines::expand_campaign(c.axes);
   } catch (const std::invalid_argument& e) {
@@ -316,8 +325,7 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
     r.align = table.text("align", r.align);
     r.threads = table.integer("threads", r.threads, 0);
     const std::string prns = table.text("prns", "simulated");
-    if (prns != "simulated" && prns != "all")
-      table.fail(*t->get("prns"), "prns", "must be \"simulated\" or \"all\"");
+    if (prns != "simulated" && prns != "all") table.fail(*t->get("prns"), "prns", "must be \"simulated\" or \"all\"");
     r.prns_from_simulation = prns == "simulated";
     table.check_done();
   }
@@ -345,15 +353,9 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
     }
     table.check_done();
   }
-  if (const toml::node* reports = root.get("report")) {
-    const toml::array* a = reports->as_array();
-    if (!a) throw io::InputError(file, "'report' must be [[report]] tables", line_of(*reports));
-    int i = 0;
-    for (const toml::node& n : *a) {
-      if (!n.as_table()) throw io::InputError(file, "'report' must be [[report]] tables", line_of(n));
-      c.reductions.push_back(read_reduction(file, *n.as_table(), i++, c));
-    }
-  }
+  int report_number = 0;
+  for (const toml::table* t : tables_of(file, root, "report"))
+    c.reductions.push_back(read_reduction(file, *t, report_number++, c));
   if (const toml::table* t = section(file, root, "slurm")) {
     Table table{file, "slurm", *t, {}};
     SlurmResources& s = c.slurm;
@@ -393,7 +395,8 @@ pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::Camp
     pipelines::ReceiveFileJob& rx = job.receive;
     rx.input = param("input");
     const auto format = signals::parse_sample_format(param("format").empty() ? "i8" : param("format"));
-    if (!format) throw io::InputError(file, "recording " + param("recording") + ": unknown format '" + param("format") + "'");
+    if (!format)
+      throw io::InputError(file, "recording " + param("recording") + ": unknown format '" + param("format") + "'");
     rx.format = *format;
     try {
       rx.source.fs_hz = std::stod(param("sample_rate_hz"));
@@ -411,21 +414,18 @@ pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::Camp
   const std::string where = file + ": [receive]";
   const std::string coupling = substitute(c, c.receive.coupling, run, where);
   const auto parsed = pipelines::coupling_from_string(coupling);
-  if (!parsed) throw io::InputError(where, "coupling must be scalar, vector, loose, tight or ultra-tight, got '" + coupling + "'");
+  if (!parsed)
+    throw io::InputError(where, "coupling must be scalar, vector, loose, tight or ultra-tight, got '" + coupling + "'");
   o.coupling = *parsed;
   const std::string filter = substitute(c, c.receive.filter, run, where);
-  if (filter != "ekf" && filter != "ukf") throw io::InputError(where, "filter must be ekf or ukf, got '" + filter + "'");
+  if (filter != "ekf" && filter != "ukf")
+    throw io::InputError(where, "filter must be ekf or ukf, got '" + filter + "'");
   o.filter = filter == "ukf" ? fusion::FilterKind::Ukf : fusion::FilterKind::Ekf;
   const std::string align = substitute(c, c.receive.align, run, where);
-  if (align == "static") {
-    o.align = pipelines::AlignMode::Static;
-  } else if (align == "motion") {
-    o.align = pipelines::AlignMode::Motion;
-  } else if (align == "config") {
-    o.align = pipelines::AlignMode::Config;
-  } else {
+  const auto mode = pipelines::align_mode_from_string(align);
+  if (!mode || *mode == pipelines::AlignMode::Attitude)  // attitude alignment is `fuse`'s
     throw io::InputError(where, "align must be static, motion or config, got '" + align + "'");
-  }
+  o.align = *mode;
   if (!c.receive.fusion_config.empty()) o.navigation = read_fuse_config(resolve(c, c.receive.fusion_config));
   const std::string nav = substitute(c, c.receive.nav, run, where);
   if (!nav.empty()) job.receive.navigation = signals::read_rinex_nav(resolve(c, nav));

@@ -120,7 +120,8 @@ std::vector<LockOutcome> lock_outcomes(const std::vector<int>& prns, const std::
     const NamedCsv csv = read_named_csv(tracking_csv);
     const std::size_t prn_col = csv.column("prn"), t_col = csv.column("time_s"), state_col = csv.column("state");
     for (std::size_t r = 0; r < csv.rows.size(); ++r)
-      by_prn[static_cast<int>(csv.number(r, prn_col))].push_back({csv.number(r, t_col), is_locked(csv.rows[r][state_col])});
+      by_prn[static_cast<int>(csv.number(r, prn_col))].push_back(
+          {csv.number(r, t_col), is_locked(csv.rows[r][state_col])});
   }
   std::vector<LockOutcome> out;
   for (const int prn : prns) {
@@ -148,7 +149,8 @@ std::vector<LockOutcome> lock_outcomes(const std::vector<int>& prns, const std::
 
 void write_lock_outcomes_csv(const std::filesystem::path& file, const std::vector<LockOutcome>& outcomes) {
   std::string text = "prn,outcome,first_lock_s,lock_end_s\n";
-  for (const LockOutcome& o : outcomes) text += fmt::format("{},{},{},{}\n", o.prn, o.outcome, o.first_lock_s, o.lock_end_s);
+  for (const LockOutcome& o : outcomes)
+    text += fmt::format("{},{},{},{}\n", o.prn, o.outcome, o.first_lock_s, o.lock_end_s);
   io::write_file_atomically(file, text);
 }
 

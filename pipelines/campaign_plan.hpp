@@ -1,8 +1,8 @@
 // A campaign's runs: the product of its parameter axes, and its templates filled in per run. The order is fixed
-// (the first axis outermost, the last varying fastest), each run numbered 0..N-1 and carrying one value of every parameter as text. An axis may
-// carry zipped columns (parameters that vary with it, one value per axis value: e.g. a file number with its seed
-// and start time), so that seeds and levels combine without writing every pair. Templates (scenario and
-// configuration text) name parameters as {name}; substitute_parameters fills them in.
+// (the first axis outermost, the last varying fastest), each run numbered 0..N-1 and carrying one value of every
+// parameter as text. An axis may carry zipped columns (parameters that vary with it, one value per axis value: e.g. a
+// file number with its seed and start time), so that seeds and levels combine without writing every pair. Templates
+// (scenario and configuration text) name parameters as {name}; substitute_parameters fills them in.
 #pragma once
 
 #include <cstddef>
@@ -21,7 +21,7 @@ struct CampaignAxis {
 };
 
 struct CampaignRun {
-  int index = 0;                                              // 0..N-1 in expansion order
+  int index = 0;                                                // 0..N-1 in expansion order
   std::vector<std::pair<std::string, std::string>> parameters;  // axis values and their columns, in axis order
 
   // The parameter's value; nullptr when the run has no such parameter.

@@ -78,7 +78,8 @@ std::string lock_threshold(const std::vector<CompleteRun>& runs, const CampaignR
       const fs::path file = run->dir / "lock_outcomes.csv";
       if (!fs::exists(file)) continue;
       const std::string* level = run->run->find(r.level);
-      if (!level) throw io::InputError("campaign report", "lock threshold: the runs have no parameter '" + r.level + "'");
+      if (!level)
+        throw io::InputError("campaign report", "lock threshold: the runs have no parameter '" + r.level + "'");
       auto& c = count[number(*level, r.level)];
       for (const LockOutcome& o : read_lock_outcomes_csv(file)) {
         ++c[o.outcome];
@@ -87,7 +88,9 @@ std::string lock_threshold(const std::vector<CompleteRun>& runs, const CampaignR
       }
     }
     out += group_title(r.group, key);
-    out += "cn0_dbhz  runs  kept  lost  never_locked  not_acquired  fraction_kept  wilson68        kept_of_locked  wilson68";
+    out +=
+        "cn0_dbhz  runs  kept  lost  never_locked  not_acquired  fraction_kept  wilson68        kept_of_locked  "
+        "wilson68";
     out += step_mode ? "        not_locked_at_step\n" : "\n";
     std::vector<std::pair<double, double>> f_curve, f_hi, f_lo, g_curve, g_hi, g_lo;
     for (auto& [L, c] : count) {
@@ -99,17 +102,19 @@ std::string lock_threshold(const std::vector<CompleteRun>& runs, const CampaignR
       const auto [glo, ghi] = wilson_interval(c["kept"], m, 1.0);
       f_curve.emplace_back(L, f), f_hi.emplace_back(L, hi), f_lo.emplace_back(L, lo);
       g_curve.emplace_back(L, g), g_hi.emplace_back(L, ghi), g_lo.emplace_back(L, glo);
-      out += fmt::format("{:8.1f}  {:4d}  {:4d}  {:4d}  {:12d}  {:12d}  {:13.3f}  [{:.3f}, {:.3f}]  {:14.3f}  [{:.3f}, {:.3f}]",
-                         L, c["runs"], c["kept"], c["lost"], c["never_locked"], c["not_acquired"], f, lo, hi, g, glo,
-                         ghi);
+      out += fmt::format(
+          "{:8.1f}  {:4d}  {:4d}  {:4d}  {:12d}  {:12d}  {:13.3f}  [{:.3f}, {:.3f}]  {:14.3f}  [{:.3f}, {:.3f}]", L,
+          c["runs"], c["kept"], c["lost"], c["never_locked"], c["not_acquired"], f, lo, hi, g, glo, ghi);
       out += step_mode ? fmt::format("  {:18d}\n", c["not_locked_at_step"]) : "\n";
     }
     if (!step_mode)  // in the step protocol both fractions are kept / (kept + lost)
-      out += fmt::format("90 % threshold, of acquired satellites (pull-in included): {} dB-Hz; from the 68 % "
-                         "intervals: {} .. {}\n",
-                         crossing(f_curve), crossing(f_hi), crossing(f_lo));
-    out += fmt::format("90 % threshold, of locked satellites (lock kept): {} dB-Hz; from the 68 % intervals: {} .. {}\n",
-                       crossing(g_curve), crossing(g_hi), crossing(g_lo));
+      out += fmt::format(
+          "90 % threshold, of acquired satellites (pull-in included): {} dB-Hz; from the 68 % "
+          "intervals: {} .. {}\n",
+          crossing(f_curve), crossing(f_hi), crossing(f_lo));
+    out +=
+        fmt::format("90 % threshold, of locked satellites (lock kept): {} dB-Hz; from the 68 % intervals: {} .. {}\n",
+                    crossing(g_curve), crossing(g_hi), crossing(g_lo));
   }
   return out;
 }
@@ -146,12 +151,15 @@ std::string nav_consistency(const std::vector<CompleteRun>& runs, const Campaign
                             : fmt::format("{}: {} runs handed over, hand-over at {:.2f}-{:.2f} s\n", label, used.size(),
                                           *std::min_element(handover.begin(), handover.end()),
                                           *std::max_element(handover.begin(), handover.end()));
-    out += fmt::format("  bands (95 %): mean z +-{:.2f}; mean z^2 per axis [{:.2f}, {:.2f}]; sum of 3 axes [{:.2f}, "
-                       "{:.2f}] (if uncorrelated)\n",
-                       1.96 / std::sqrt(n), chi2_quantile(-1.959964, n) / n, chi2_quantile(1.959964, n) / n,
-                       chi2_quantile(-1.959964, 3 * n) / n, chi2_quantile(1.959964, 3 * n) / n);
-    out += "  t_s   | mean z  pN    pE    pD    vN    vE    vD   | mean z^2 pN   pE   pD   vN   vE   vD  | pos sum vel sum | "
-           "RMS err pos m  vel m/s | RMS sigma pos m vel m/s\n";
+    out += fmt::format(
+        "  bands (95 %): mean z +-{:.2f}; mean z^2 per axis [{:.2f}, {:.2f}]; sum of 3 axes [{:.2f}, "
+        "{:.2f}] (if uncorrelated)\n",
+        1.96 / std::sqrt(n), chi2_quantile(-1.959964, n) / n, chi2_quantile(1.959964, n) / n,
+        chi2_quantile(-1.959964, 3 * n) / n, chi2_quantile(1.959964, 3 * n) / n);
+    out +=
+        "  t_s   | mean z  pN    pE    pD    vN    vE    vD   | mean z^2 pN   pE   pD   vN   vE   vD  | pos sum vel "
+        "sum | "
+        "RMS err pos m  vel m/s | RMS sigma pos m vel m/s\n";
     for (const double t : r.times_s) {
       std::vector<const NavZ*> at;
       for (const auto& rows : used)
@@ -198,8 +206,10 @@ std::string stats(const std::vector<CompleteRun>& runs, const CampaignReduction&
     for (const CompleteRun* run : members) {
       const auto it = run->status.scalars.find(r.value);
       const std::string* p = run->run->find(r.value);
-      if (it != run->status.scalars.end()) v.push_back(number(it->second, r.value));
-      else if (p) v.push_back(number(*p, r.value));
+      if (it != run->status.scalars.end())
+        v.push_back(number(it->second, r.value));
+      else if (p)
+        v.push_back(number(*p, r.value));
     }
     if (v.empty()) continue;
     std::sort(v.begin(), v.end());
@@ -274,9 +284,15 @@ std::string campaign_report(const fs::path& campaign_dir, const std::vector<Camp
   for (const CampaignReduction& r : reductions) {
     out += "\n";
     switch (r.kind) {
-      case CampaignReduction::Kind::kLockThreshold: out += lock_threshold(complete, r); break;
-      case CampaignReduction::Kind::kNavConsistency: out += nav_consistency(complete, r); break;
-      case CampaignReduction::Kind::kStats: out += stats(complete, r); break;
+      case CampaignReduction::Kind::kLockThreshold:
+        out += lock_threshold(complete, r);
+        break;
+      case CampaignReduction::Kind::kNavConsistency:
+        out += nav_consistency(complete, r);
+        break;
+      case CampaignReduction::Kind::kStats:
+        out += stats(complete, r);
+        break;
     }
   }
   return out;

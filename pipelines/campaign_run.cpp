@@ -53,8 +53,7 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
   int fallback_week = 0;
   if (job.scenario) {
     const sim::Scenario& scenario = *job.scenario;
-    const sim::SimulationResult simulated =
-        sim::simulate_to_folder(scenario, run_dir / "sim", job.scenario_echo, stop);
+    const sim::SimulationResult simulated = sim::simulate_to_folder(scenario, run_dir / "sim", job.scenario_echo, stop);
     if (simulated.interrupted) return std::nullopt;
     if (simulated.sample_files.empty())
       throw io::InputError(scenario.source.string(), "a campaign run receives IF samples: the scenario needs [signal]");
@@ -77,8 +76,9 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
   date_recording(rx.options.receiver, rx.navigation, fallback_week > 0 ? fallback_week : 2190);
   if (uses_imu(rx.options.coupling)) {
     if (job.scenario && !job.scenario->trajectory_enabled())
-      throw io::InputError(job.scenario->source.string(), "the " + to_string(rx.options.coupling) +
-                                                              " coupling needs an IMU: the scenario has no [trajectory]");
+      throw io::InputError(
+          job.scenario->source.string(),
+          "the " + to_string(rx.options.coupling) + " coupling needs an IMU: the scenario has no [trajectory]");
     rx.imu = ins::read_imu_csv(imu);
     rx.options.imu_name = imu.string();
   }
@@ -91,8 +91,8 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
     for (int prn = 1; prn <= 32; ++prn) prns.push_back(prn);
 
   if (job.metrics.lock_outcomes)
-    write_lock_outcomes_csv(run_dir / "lock_outcomes.csv",
-                            lock_outcomes(prns, run_dir / "rx" / "tracking.csv", duration_s, *job.metrics.lock_outcomes));
+    write_lock_outcomes_csv(run_dir / "lock_outcomes.csv", lock_outcomes(prns, run_dir / "rx" / "tracking.csv",
+                                                                         duration_s, *job.metrics.lock_outcomes));
   if (job.metrics.nav_z_times_s && s.navigation_started) {
     if (truth.empty()) throw io::InputError("campaign", "nav z-scores need a truth file ([[recording]] truth)");
     write_nav_z_csv(run_dir / "nav_z.csv", nav_z_scores(run_dir / "rx" / "nav.csv", truth, *job.metrics.nav_z_times_s));

@@ -39,9 +39,9 @@ struct CampaignJob {
   // The receive. For a simulated run input, format and source (fs, IF, 2-bit layout) come from the scenario and
   // out is set by the runner; `receive.imu` is read from the simulation's imu.csv for the couplings that use one.
   ReceiveFileJob receive;
-  bool prns_from_simulation = true;   // search only the satellites the simulation put in the signal
-  std::filesystem::path truth_csv;    // recordings: the truth for nav z-scores (simulated runs: sim/truth.csv)
-  std::filesystem::path imu_csv;      // recordings: the IMU file of the GNSS/INS couplings
+  bool prns_from_simulation = true;  // search only the satellites the simulation put in the signal
+  std::filesystem::path truth_csv;   // recordings: the truth for nav z-scores (simulated runs: sim/truth.csv)
+  std::filesystem::path imu_csv;     // recordings: the IMU file of the GNSS/INS couplings
   CampaignMetrics metrics;
 };
 
@@ -49,7 +49,7 @@ enum class CampaignRunState { kMissing, kComplete, kFailed };
 
 struct CampaignRunStatus {
   CampaignRunState state = CampaignRunState::kMissing;
-  std::string message;                        // kFailed: the error
+  std::string message;                         // kFailed: the error
   std::map<std::string, std::string> scalars;  // kComplete: complete.csv
 };
 

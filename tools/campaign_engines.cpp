@@ -115,8 +115,10 @@ int run_campaign_local(const config::CampaignFile& campaign, const fs::path& out
           pipelines::campaign_run_status(pipelines::campaign_run_dir(out, pending[i]));
       std::lock_guard lock(log_mutex);
       fmt::print(log, "campaign: run {} {} ({:.1f} s){}\n", pipelines::campaign_run_folder(pending[i]),
-                 ok ? "complete" : status.state == pipelines::CampaignRunState::kFailed ? "FAILED" : "stopped", wall_s,
-                 status.message.empty() ? "" : ": " + status.message);
+                 ok                                                     ? "complete"
+                 : status.state == pipelines::CampaignRunState::kFailed ? "FAILED"
+                                                                        : "stopped",
+                 wall_s, status.message.empty() ? "" : ": " + status.message);
       std::fflush(log);
     }
   };
@@ -131,12 +133,15 @@ int run_campaign_local(const config::CampaignFile& campaign, const fs::path& out
 std::string slurm_script(const config::CampaignFile& campaign, const fs::path& out, std::size_t pending,
                          const fs::path& program) {
   const config::SlurmResources& s = campaign.slurm;
-  const std::size_t tasks = (pending + static_cast<std::size_t>(s.runs_per_task) - 1) / static_cast<std::size_t>(s.runs_per_task);
+  const std::size_t tasks =
+      (pending + static_cast<std::size_t>(s.runs_per_task) - 1) / static_cast<std::size_t>(s.runs_per_task);
   const fs::path dir = fs::absolute(out).lexically_normal();
   std::string text = "#!/bin/bash\n";
   text += fmt::format("#SBATCH --job-name=ultratrack-{}\n", campaign.name.empty() ? "campaign" : campaign.name);
-  text += fmt::format("#SBATCH --array=0-{}{}\n", tasks - 1, s.max_parallel > 0 ? fmt::format("%{}", s.max_parallel) : "");
-  text += fmt::format("#SBATCH --time={}\n#SBATCH --cpus-per-task={}\n#SBATCH --mem={}\n", s.time, s.cpus_per_task, s.mem);
+  text +=
+      fmt::format("#SBATCH --array=0-{}{}\n", tasks - 1, s.max_parallel > 0 ? fmt::format("%{}", s.max_parallel) : "");
+  text +=
+      fmt::format("#SBATCH --time={}\n#SBATCH --cpus-per-task={}\n#SBATCH --mem={}\n", s.time, s.cpus_per_task, s.mem);
   if (!s.partition.empty()) text += fmt::format("#SBATCH --partition={}\n", s.partition);
   if (!s.account.empty()) text += fmt::format("#SBATCH --account={}\n", s.account);
   text += fmt::format("#SBATCH --output={}/slurm/task_%a.log\n", dir.string());
@@ -151,7 +156,8 @@ std::string slurm_script(const config::CampaignFile& campaign, const fs::path& o
       "  {2} campaign run-one {3} \"$index\" || status=1\n"
       "done\n"
       "exit $status\n",
-      s.runs_per_task, quoted((dir / "slurm" / "pending.txt").string()), quoted(program.string()), quoted(dir.string()));
+      s.runs_per_task, quoted((dir / "slurm" / "pending.txt").string()), quoted(program.string()),
+      quoted(dir.string()));
   return text;
 }
 
@@ -174,7 +180,9 @@ SlurmSubmission run_campaign_slurm(const config::CampaignFile& campaign, const f
   if (status != 0 || id.empty() || id.find_first_not_of("0123456789_") != std::string::npos)
     throw std::runtime_error(fmt::format("sbatch failed (exit status {}): {}", status, answer));
   submission.job_id = id;
-  if (log) fmt::print(log, "campaign: submitted Slurm job {}: {} runs in {} array tasks\n", id, pending.size(), submission.tasks);
+  if (log)
+    fmt::print(log, "campaign: submitted Slurm job {}: {} runs in {} array tasks\n", id, pending.size(),
+               submission.tasks);
   if (no_wait) return submission;
   for (;;) {
     const auto [queue, queue_status] = capture("squeue -h -j " + id + " 2>/dev/null");

@@ -1,7 +1,7 @@
-// Where a campaign's runs execute (`ultratrack campaign run --engine local|slurm`): threads here, or a Slurm array. The output folder keeps a copy
-// of the campaign file (campaign.toml) and the folder its relative paths resolve against (campaign_base.txt), so
-// that `campaign run-one DIR INDEX` on any node and `campaign report DIR` read the same campaign. Runs already
-// complete are never redone (resume).
+// Where a campaign's runs execute (`ultratrack campaign run --engine local|slurm`): threads here, or a Slurm array. The
+// output folder keeps a copy of the campaign file (campaign.toml) and the folder its relative paths resolve against
+// (campaign_base.txt), so that `campaign run-one DIR INDEX` on any node and `campaign report DIR` read the same
+// campaign. Runs already complete are never redone (resume).
 //   local  the pending runs on this machine, `jobs` at a time (threads in this process);
 //   slurm  slurm/campaign.sbatch, an array job whose task k runs pending runs k*R .. k*R+R-1 (slurm/pending.txt,
 //          R = [slurm] runs_per_task) through `ultratrack campaign run-one`, submitted with `sbatch --parsable`;
@@ -32,12 +32,12 @@ bool run_campaign_index(const config::CampaignFile& campaign, const std::filesys
                         std::stop_token stop = {});
 
 // The local engine: returns the number of runs that failed. log: one line per finished run (nullptr: silent).
-int run_campaign_local(const config::CampaignFile& campaign, const std::filesystem::path& out, int jobs,
-                       std::FILE* log, std::stop_token stop = {});
+int run_campaign_local(const config::CampaignFile& campaign, const std::filesystem::path& out, int jobs, std::FILE* log,
+                       std::stop_token stop = {});
 
 // The sbatch script for `pending` runs; program: the ultratrack the tasks run (an absolute path).
-std::string slurm_script(const config::CampaignFile& campaign, const std::filesystem::path& out,
-                         std::size_t pending, const std::filesystem::path& program);
+std::string slurm_script(const config::CampaignFile& campaign, const std::filesystem::path& out, std::size_t pending,
+                         const std::filesystem::path& program);
 
 struct SlurmSubmission {
   std::string job_id;  // empty when nothing was pending
@@ -47,7 +47,6 @@ struct SlurmSubmission {
 // Writes slurm/pending.txt and slurm/campaign.sbatch, submits with sbatch (PATH), and unless no_wait polls squeue
 // every poll_s until the job is gone. Throws std::runtime_error when sbatch fails or says no job id.
 SlurmSubmission run_campaign_slurm(const config::CampaignFile& campaign, const std::filesystem::path& out,
-                                   const std::filesystem::path& program, bool no_wait, double poll_s,
-                                   std::FILE* log);
+                                   const std::filesystem::path& program, bool no_wait, double poll_s, std::FILE* log);
 
 }  // namespace ultratrack::tools

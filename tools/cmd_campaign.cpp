@@ -93,7 +93,8 @@ void run_one(const CampaignArgs& args) {
 }  // namespace
 
 void add_campaign_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("campaign", "Campaigns: many simulate-and-receive runs from one file, locally or on Slurm");
+  auto* cmd =
+      app.add_subcommand("campaign", "Campaigns: many simulate-and-receive runs from one file, locally or on Slurm");
   cmd->require_subcommand(1);
   auto args = std::make_shared<CampaignArgs>();
 
@@ -114,7 +115,8 @@ void add_campaign_command(CLI::App& app) {
   one->add_option("INDEX", args->index, "run index (0-based)")->required();
   one->callback([args] { run_one(*args); });
 
-  auto* rep = cmd->add_subcommand("report", "Report a campaign folder: what is complete, failed, missing, and the tables");
+  auto* rep =
+      cmd->add_subcommand("report", "Report a campaign folder: what is complete, failed, missing, and the tables");
   rep->add_option("DIR", args->out, "campaign output folder")->required();
   rep->callback([args] { fmt::print("{}", report(args->out)); });
 }

@@ -1,6 +1,8 @@
 // Campaign expansion (pipelines/campaign_plan.hpp) and campaign files (config/campaign_toml.hpp): the product's
 // count and order, zipped and linear columns, template substitution, and malformed files as InputErrors naming
 // the file and the key.
+#include "pipelines/campaign_plan.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -10,7 +12,6 @@
 
 #include "config/campaign_toml.hpp"
 #include "io/input_error.hpp"
-#include "pipelines/campaign_plan.hpp"
 #include "support/test_data.hpp"
 
 namespace {

@@ -1,6 +1,8 @@
 // Campaign runs and their report (pipelines/campaign_run.hpp, campaign_report.hpp) on a tiny simulated campaign
 // (2 s static files on the shipped ephemeris): a run writes its folder and marker, a complete run is not redone,
 // a failed run is reported with its message, a missing one is named; the reductions against hand-computed tables.
+#include "pipelines/campaign_run.hpp"
+
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
@@ -9,11 +11,10 @@
 #include <string>
 
 #include "config/campaign_toml.hpp"
+#include "config/scenario_toml.hpp"
 #include "io/atomic_file.hpp"
 #include "pipelines/campaign_metrics.hpp"
 #include "pipelines/campaign_report.hpp"
-#include "pipelines/campaign_run.hpp"
-#include "config/scenario_toml.hpp"
 #include "sim/simulation_files.hpp"
 #include "support/test_data.hpp"
 
@@ -30,12 +31,13 @@ fs::path tiny_campaign(const fs::path& dir) {
                                 << test::shipped_nav_week << "\ntow_s = " << test::shipped_nav_tow_s
                                 << "\n[navigation]\nrinex = \"" << test::shipped_nav_file().string()
                                 << "\"\nelevation_mask_deg = 30.0\n";
-  std::ofstream(dir / "c.toml") << "[[axis]]\nname = \"seed\"\nvalues = [7, 8]\ncoupling = [\"scalar\", \"tight\"]\n"
-                                   "[simulate]\nscenario = \"s.toml\"\n[receive]\nnav = \""
-                                << test::shipped_nav_file().string()
-                                << "\"\ncoupling = \"{coupling}\"\n[compute]\nlock_outcomes = { lock_deadline_s = 1.5 }\n"
-                                   "[[report]]\nkind = \"lock_threshold\"\nlevel = \"seed\"\n"
-                                   "[[report]]\nkind = \"stats\"\nvalue = \"satellites_tracked\"\n";
+  std::ofstream(dir / "c.toml")
+      << "[[axis]]\nname = \"seed\"\nvalues = [7, 8]\ncoupling = [\"scalar\", \"tight\"]\n"
+         "[simulate]\nscenario = \"s.toml\"\n[receive]\nnav = \""
+      << test::shipped_nav_file().string()
+      << "\"\ncoupling = \"{coupling}\"\n[compute]\nlock_outcomes = { lock_deadline_s = 1.5 }\n"
+         "[[report]]\nkind = \"lock_threshold\"\nlevel = \"seed\"\n"
+         "[[report]]\nkind = \"stats\"\nvalue = \"satellites_tracked\"\n";
   return dir / "c.toml";
 }
 
@@ -71,7 +73,8 @@ TEST(CampaignRun, RunsResumesAndReportsFailures) {
   EXPECT_TRUE(fs::exists(run0 / "sentinel"));
 
   // The tight coupling needs an IMU (no [trajectory]): the run fails, recorded with its message.
-  const auto status1 = pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
+  const auto status1 =
+      pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
   ASSERT_EQ(status1.state, CampaignRunState::kFailed);
   EXPECT_FALSE(status1.message.empty());
   report = pipelines::campaign_report(out, runs, campaign.reductions);
@@ -107,7 +110,8 @@ TEST(CampaignRun, ReceivesRecordings) {
   ASSERT_EQ(runs.size(), 2u);
   EXPECT_EQ(*runs[0].find("input"), (dir / "rec" / "antenna0.i8.bin").string());
   const fs::path out = dir / "out";
-  const auto status = pipelines::run_campaign_job(config::campaign_job(campaign, runs[0]), pipelines::campaign_run_dir(out, 0));
+  const auto status =
+      pipelines::run_campaign_job(config::campaign_job(campaign, runs[0]), pipelines::campaign_run_dir(out, 0));
   ASSERT_EQ(status.state, CampaignRunState::kComplete) << status.message;
   EXPECT_TRUE(fs::exists(dir / "rec" / "antenna0.i8.bin")) << "a recording is never deleted";
   // Without the simulation's list every PRN is classified: the simulated ones kept, the others not acquired.
@@ -121,7 +125,8 @@ TEST(CampaignRun, ReceivesRecordings) {
   EXPECT_EQ(kept, static_cast<int>(simulated.satellites.size()));
   EXPECT_EQ(kept + not_acquired, 32);
   // A missing recording: the run fails naming the file.
-  const auto missing = pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
+  const auto missing =
+      pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
   ASSERT_EQ(missing.state, CampaignRunState::kFailed);
   EXPECT_NE(missing.message.find("nothing.bin"), std::string::npos) << missing.message;
 }
@@ -139,8 +144,8 @@ void fake_run(const fs::path& out, int index, const std::string& level, const st
 
 TEST(CampaignReport, LockThresholdTableMatchesHandCounts) {
   const fs::path out = test::scratch_dir();
-  const std::vector<pipelines::CampaignRun> runs{{0, {{"cn0_dbhz", "26.0"}}}, {1, {{"cn0_dbhz", "30.0"}}},
-                                                 {2, {{"cn0_dbhz", "30.0"}}}};
+  const std::vector<pipelines::CampaignRun> runs{
+      {0, {{"cn0_dbhz", "26.0"}}}, {1, {{"cn0_dbhz", "30.0"}}}, {2, {{"cn0_dbhz", "30.0"}}}};
   // 26 dB-Hz: 2 kept, 1 lost, 1 never locked, 1 not acquired; 30 dB-Hz: 10 kept over two runs.
   fake_run(out, 0, "1", {"kept", "kept", "lost", "never_locked", "not_acquired"});
   fake_run(out, 1, "3", {"kept", "kept", "kept", "kept", "kept"});

@@ -24,11 +24,14 @@ fs::path tiny_campaign(const fs::path& dir) {
   const std::string nav = ultratrack::test::shipped_nav_file().string();
   std::ofstream(dir / "s.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 2.0\n"
                                    "cn0_dbhz = 45.0\nseed = {seed}\n[time]\ngps_week = "
-                                << ultratrack::test::shipped_nav_week << "\ntow_s = " << ultratrack::test::shipped_nav_tow_s
-                                << "\n[navigation]\nrinex = \"" << nav << "\"\nelevation_mask_deg = 30.0\n";
+                                << ultratrack::test::shipped_nav_week
+                                << "\ntow_s = " << ultratrack::test::shipped_nav_tow_s << "\n[navigation]\nrinex = \""
+                                << nav << "\"\nelevation_mask_deg = 30.0\n";
   std::ofstream(dir / "c.toml") << "[campaign]\nname = \"tiny\"\n[[axis]]\nname = \"seed\"\nvalues = [7, 8]\n"
                                    "coupling = [\"scalar\", \"tight\"]\n[simulate]\nscenario = \"s.toml\"\n"
-                                   "[receive]\nnav = \"" << nav << "\"\ncoupling = \"{coupling}\"\n"
+                                   "[receive]\nnav = \""
+                                << nav
+                                << "\"\ncoupling = \"{coupling}\"\n"
                                    "[compute]\nlock_outcomes = { lock_deadline_s = 1.5 }\n"
                                    "[[report]]\nkind = \"lock_threshold\"\nlevel = \"seed\"\n"
                                    "[slurm]\ntime = \"00:05:00\"\nmem = \"1G\"\nextra = [\"--qos=test\"]\n";
@@ -94,19 +97,24 @@ TEST(CampaignCommand, MalformedCampaignIsInputErrorNamingFileAndKey) {
 // SLURM_ARRAY_TASK_ID set, and answers a job id; squeue lists the job until every task has ended.
 void install_fake_slurm(const fs::path& bin, const fs::path& state) {
   fs::create_directories(bin);
-  std::ofstream(bin / "sbatch") << "#!/bin/bash\n"
-                                   "[ \"$1\" = --parsable ] || { echo 'expected --parsable' >&2; exit 9; }\n"
-                                   "state=" << state.string() << "\n"
-                                   "n=$(ls \"$state\" | grep -c '^submitted' || true)\n"
-                                   "cp \"$2\" \"$state/submitted_$n.sbatch\"\n"
-                                   "rm -f \"$state/done\"\n"
-                                   "read first last < <(sed -n 's/^#SBATCH --array=\\([0-9]*\\)-\\([0-9]*\\).*/\\1 \\2/p' \"$2\")\n"
-                                   "( sleep 0.3; for ((k = first; k <= last; k++)); do\n"
-                                   "    SLURM_ARRAY_TASK_ID=$k bash \"$2\" > \"$state/task_$k.log\" 2>&1; done\n"
-                                   "  touch \"$state/done\" ) > /dev/null 2>&1 &\n"
-                                   "echo \"424$n;testcluster\"\n";
+  std::ofstream(bin / "sbatch")
+      << "#!/bin/bash\n"
+         "[ \"$1\" = --parsable ] || { echo 'expected --parsable' >&2; exit 9; }\n"
+         "state="
+      << state.string()
+      << "\n"
+         "n=$(ls \"$state\" | grep -c '^submitted' || true)\n"
+         "cp \"$2\" \"$state/submitted_$n.sbatch\"\n"
+         "rm -f \"$state/done\"\n"
+         "read first last < <(sed -n 's/^#SBATCH --array=\\([0-9]*\\)-\\([0-9]*\\).*/\\1 \\2/p' \"$2\")\n"
+         "( sleep 0.3; for ((k = first; k <= last; k++)); do\n"
+         "    SLURM_ARRAY_TASK_ID=$k bash \"$2\" > \"$state/task_$k.log\" 2>&1; done\n"
+         "  touch \"$state/done\" ) > /dev/null 2>&1 &\n"
+         "echo \"424$n;testcluster\"\n";
   std::ofstream(bin / "squeue") << "#!/bin/bash\n"
-                                   "state=" << state.string() << "\n"
+                                   "state="
+                                << state.string()
+                                << "\n"
                                    "echo x >> \"$state/squeue_calls\"\n"
                                    "[ -f \"$state/done\" ] || echo \"$3_0 R\"\n";
   fs::permissions(bin / "sbatch", fs::perms::owner_all);
@@ -120,7 +128,7 @@ TEST(CampaignCommand, SlurmEngineSubmitsAnArrayWaitsAndResumes) {
   install_fake_slurm(dir / "bin", state);
   const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
   setenv("PATH", ((dir / "bin").string() + ":" + path).c_str(), 1);
-  const std::vector<std::string> slurm{"run", campaign.string(), "--out", out.string(), "--engine", "slurm",
+  const std::vector<std::string> slurm{"run",       campaign.string(),  "--out",    out.string(), "--engine", "slurm",
                                        "--program", ULTRATRACK_PROGRAM, "--poll-s", "0.2"};
   EXPECT_EQ(exit_code("campaign", slurm), 1);  // one run fails
   const std::string script = read_text_file(state / "submitted_0.sbatch");
