@@ -9,7 +9,10 @@
 //                    (95 % bands +-1.96/sqrt(N) and chi2(N)/N, Wilson-Hilferty), RMS error and RMS sigma;
 //   stats            a run scalar (complete.csv) or parameter: count, mean with its 95 % Student-t interval,
 //                    median, standard deviation, minimum and maximum.
-// Each reduction may split the runs by parameters (`group`), one table per combination in first-seen order.
+// The step protocol (LockOutcomeOptions::strong_s) adds the not_locked_at_step column when a satellite was not
+// locked at its step; the threshold script's position RMS columns are not computed. Each reduction may split the
+// runs by parameters (`group`): one table per combination, in the sorted order of their values (as the scripts
+// sort couplings and filters).
 #pragma once
 
 #include <filesystem>

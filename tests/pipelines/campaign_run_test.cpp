@@ -72,6 +72,14 @@ TEST(CampaignRun, RunsResumesAndReportsFailures) {
             CampaignRunState::kComplete);
   EXPECT_TRUE(fs::exists(run0 / "sentinel"));
 
+  // A run killed before its marker (folder and outputs there, no complete.csv) is missing, and redone from scratch.
+  fs::remove(run0 / "complete.csv");
+  EXPECT_EQ(pipelines::campaign_run_status(run0).state, CampaignRunState::kMissing);
+  EXPECT_EQ(pipelines::run_campaign_job(config::campaign_job(campaign, runs[0]), run0).state,
+            CampaignRunState::kComplete);
+  EXPECT_FALSE(fs::exists(run0 / "sentinel"));
+  EXPECT_EQ(pipelines::read_lock_outcomes_csv(run0 / "lock_outcomes.csv").size(), outcomes.size());
+
   // The tight coupling needs an IMU (no [trajectory]): the run fails, recorded with its message.
   const auto status1 =
       pipelines::run_campaign_job(config::campaign_job(campaign, runs[1]), pipelines::campaign_run_dir(out, 1));
