@@ -13,7 +13,8 @@
 # fraction kept = kept / (kept + lost + never locked) (the headline: pull-in included), and kept / (kept + lost)
 # (lock kept once locked), each with its Wilson 68 % interval; a 90 % threshold is the lowest C/N0 above which
 # the fraction stays >= 0.9, interpolated linearly between the bracketing levels (its bounds likewise from the
-# interval curves). The report can be redone from runs.csv: --report-only DIR.
+# interval curves). The report can be redone from runs.csv: --report-only DIR. The default protocol is also a
+# campaign file: `ultratrack campaign run campaigns/tracking_threshold.toml --out DIR [--engine slurm]` (docs/usage.md).
 #
 # Acquisition is not what is measured: the receiver searches only the PRNs the file holds, +-4.5 kHz, with a
 # long snapshot (10 ms coherent x 25: it finds every satellite of a 26 dB-Hz file); a lost satellite is not
@@ -79,7 +80,7 @@ while [ $# -gt 0 ]; do
     --keep) keep=1; shift ;;
     --reuse) reuse=1; keep=1; shift ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
-    -h|--help) sed -n '2,51p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,53p' "$0"; exit 0 ;;
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done

@@ -12,6 +12,8 @@
 #   mean z^2 per axis (95 % band chi2(N) / N), and the sums over N/E/D ("NEES" of position and of velocity; their
 #   band chi2(3N) / N holds only if the three axes' errors are uncorrelated, so the per-axis bands are the test).
 #   Times before the hand-over (~11.1 s) read the tight filter's rows, which the ultra-tight filter starts from.
+# The default protocol is also a campaign file: `ultratrack campaign run campaigns/ultratight_consistency.toml
+# --out DIR [--engine slurm]` (docs/usage.md).
 # Usage: benchmarks/ultratight_consistency.sh [--runs 40] [--duration 60] [--times "10.5 11 12 14 16 20 25 30 40 50 59.5"]
 #          [--filters "ekf ukf"] [--cn0 45] [--seed0 1000] [--out DIR] [--receive-args "..."]
 #          [--ultratrack build/tools/ultratrack] [--atmosphere off (neither simulated nor corrected)]
@@ -38,7 +40,7 @@ while [ $# -gt 0 ]; do
     --atmosphere) atmosphere=$2; shift 2 ;;
     --coupling) coupling=$2; shift 2 ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
-    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "ultratight_consistency.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""docs/cli.md from the program itself: `ultratrack --help` and every subcommand's `--help`, so the flag reference
-cannot drift from the code. Run from anywhere:
+"""docs/cli.md from the program itself: `ultratrack --help` and every subcommand's `--help` (and its own
+subcommands'), so the flag reference cannot drift from the code. Run from anywhere:
 
     python3 docs/cli_reference.py build/tools/ultratrack            # print
     python3 docs/cli_reference.py build/tools/ultratrack --write    # rewrite docs/cli.md
@@ -42,7 +42,10 @@ def document(program):
              "",
              "```", top.rstrip(), "```", ""]
     for name in subcommands(top):
-        parts += [f"## {name}", "", "```", help_text(program, name).rstrip(), "```", ""]
+        text = help_text(program, name)
+        parts += [f"## {name}", "", "```", text.rstrip(), "```", ""]
+        for sub in subcommands(text):  # a command with subcommands of its own (campaign run, report, ...)
+            parts += [f"### {name} {sub}", "", "```", help_text(program, name, sub).rstrip(), "```", ""]
     return "\n".join(parts)
 
 

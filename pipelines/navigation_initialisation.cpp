@@ -30,6 +30,12 @@ const char* to_string(AlignMode mode) {
   return "?";
 }
 
+std::optional<AlignMode> align_mode_from_string(std::string_view name) {
+  for (const AlignMode mode : {AlignMode::Static, AlignMode::Motion, AlignMode::Config, AlignMode::Attitude})
+    if (name == to_string(mode)) return mode;
+  return std::nullopt;
+}
+
 std::size_t static_span_end(std::span<const ins::ImuIncrement> imu, double t0_s, const FuseConfig& config,
                             const std::string& imu_name) {
   std::size_t end = 0;

@@ -15,6 +15,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "fusion/fuse_motion_alignment.hpp"
 #include "fusion/gnss_ins_integration.hpp"
@@ -26,6 +27,7 @@ namespace ultratrack::pipelines {
 
 enum class AlignMode { Static, Motion, Config, Attitude };
 const char* to_string(AlignMode mode);  // "static", "motion", "config", "attitude"
+std::optional<AlignMode> align_mode_from_string(std::string_view name);  // to_string's names; nothing otherwise
 
 // An alignment's result: the INS start time, attitude and velocity, their 1-sigmas, and a note for summaries.
 struct AttitudeStart {

@@ -100,15 +100,10 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     throw io::InputError("command line", "--filter must be ekf or ukf, got '" + filter + "'");
   }
   const std::string align = a.align.empty() ? "motion" : a.align;
-  if (align == "static") {
-    s.align = pipelines::AlignMode::Static;
-  } else if (align == "motion") {
-    s.align = pipelines::AlignMode::Motion;
-  } else if (align == "config") {
-    s.align = pipelines::AlignMode::Config;
-  } else {
+  const auto mode = pipelines::align_mode_from_string(align);
+  if (!mode || *mode == pipelines::AlignMode::Attitude)  // attitude alignment is `fuse`'s
     throw io::InputError("command line", "--align must be static, motion or config, got '" + align + "'");
-  }
+  s.align = *mode;
   if (!a.config.empty()) s.navigation = config::read_fuse_config(a.config);
   (void)ins::imu_preset(s.navigation.imu_preset);  // an unknown preset fails here, before any output
   if (s.align == pipelines::AlignMode::Config && !s.navigation.attitude_deg)

@@ -1,0 +1,435 @@
+#include "config/campaign_toml.hpp"
+
+#include <fmt/core.h>
+#include <toml++/toml.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "config/fuse_config_toml.hpp"
+#include "config/receive_config_toml.hpp"
+#include "config/scenario_toml.hpp"
+#include "io/input_error.hpp"
+#include "signals/rinex_nav.hpp"
+
+namespace ultratrack::config {
+namespace {
+
+namespace fs = std::filesystem;
+using pipelines::CampaignReduction;
+
+int line_of(const toml::node& node) { return static_cast<int>(node.source().begin.line); }
+
+// Reading one table strictly: each key asked for once; check_done() rejects any key nobody asked for.
+struct Table {
+  const std::string& file;
+  std::string name;  // "receive", "axis[2]"
+  const toml::table& table;
+  std::set<std::string> seen;
+
+  const toml::node* get(const std::string& key) {
+    seen.insert(key);
+    return table.get(key);
+  }
+  std::string key_name(const std::string& key) const {
+    return name.empty() ? key : key.empty() ? name : name + "." + key;
+  }
+  [[noreturn]] void fail(const toml::node& node, const std::string& key, const std::string& problem) const {
+    throw io::InputError(file, "key '" + key_name(key) + "' " + problem, line_of(node));
+  }
+  std::string text(const std::string& key, std::string fallback) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    if (auto v = n->value<std::string>()) return *v;
+    fail(*n, key, "must be a string");
+  }
+  double number(const std::string& key, double fallback) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    if (auto v = n->value<double>()) return *v;
+    fail(*n, key, "must be a number");
+  }
+  int integer(const std::string& key, int fallback, int min) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    const auto v = n->value<std::int64_t>();
+    if (!v) fail(*n, key, "must be an integer");
+    if (*v < min || *v > 1000000) fail(*n, key, fmt::format("must be in [{}, 1000000]", min));
+    return static_cast<int>(*v);
+  }
+  bool boolean(const std::string& key, bool fallback) {
+    const toml::node* n = get(key);
+    if (!n) return fallback;
+    if (auto v = n->value<bool>()) return *v;
+    fail(*n, key, "must be true or false");
+  }
+  std::vector<std::string> texts(const std::string& key) {
+    std::vector<std::string> out;
+    const toml::node* n = get(key);
+    if (!n) return out;
+    const toml::array* a = n->as_array();
+    if (!a) fail(*n, key, "must be an array of strings");
+    for (const toml::node& item : *a) {
+      const auto v = item.value<std::string>();
+      if (!v) fail(item, key, "must be an array of strings");
+      out.push_back(*v);
+    }
+    return out;
+  }
+  void check_done() const {
+    for (const auto& [key, node] : table)
+      if (!seen.count(std::string(key.str())))
+        throw io::InputError(file, "unknown key '" + key_name(std::string(key.str())) + "'", line_of(node));
+  }
+};
+
+// A parameter value as text: strings as written, integers in decimal, floats with a decimal point or exponent so
+// that a TOML template reads them back as floats.
+std::string value_text(const toml::node& node, Table& where, const std::string& key) {
+  if (auto s = node.value_exact<std::string>()) return *s;
+  if (auto i = node.value_exact<std::int64_t>()) return std::to_string(*i);
+  if (auto d = node.value_exact<double>()) {
+    std::string t = fmt::format("{}", *d);
+    if (t.find_first_of(".eEn") == std::string::npos) t += ".0";
+    return t;
+  }
+  if (auto b = node.value_exact<bool>()) return *b ? "true" : "false";
+  where.fail(node, key, "values must be numbers, strings or booleans");
+}
+
+std::vector<std::string> values_of(const toml::node& node, Table& where, const std::string& key) {
+  const toml::array* a = node.as_array();
+  if (!a || a->empty()) where.fail(node, key, "must be a non-empty array");
+  std::vector<std::string> out;
+  for (const toml::node& item : *a) out.push_back(value_text(item, where, key));
+  return out;
+}
+
+pipelines::CampaignAxis read_axis(const std::string& file, const toml::table& t, int i) {
+  Table table{file, fmt::format("axis[{}]", i), t, {}};
+  pipelines::CampaignAxis axis;
+  const toml::node* name = table.get("name");
+  if (!name || !name->value<std::string>() || name->value<std::string>()->empty())
+    throw io::InputError(file, "key '" + table.key_name("name") + "' must be a non-empty string", line_of(t));
+  axis.name = *name->value<std::string>();
+  const toml::node* values = table.get("values");
+  const toml::node* count = table.get("count");
+  if ((values != nullptr) == (count != nullptr))
+    throw io::InputError(file, "axis '" + axis.name + "' needs either 'values' or 'count'", line_of(t));
+  if (values) {
+    axis.values = values_of(*values, table, "values");
+  } else {
+    const int n = table.integer("count", 0, 1);
+    for (int k = 0; k < n; ++k) axis.values.push_back(std::to_string(k));
+  }
+  for (const auto& [key_view, node] : t) {
+    const std::string key(key_view.str());
+    if (key == "name" || key == "values" || key == "count") continue;
+    table.seen.insert(key);
+    std::vector<std::string> column;
+    if (const toml::table* linear = node.as_table()) {
+      Table l{file, table.key_name(key), *linear, {}};
+      const toml::node* start = l.get("start");
+      const toml::node* step = l.get("step");
+      if (!start || !step) l.fail(node, "", "must have start and step");
+      l.check_done();
+      const auto is = [](const toml::node* n) { return n->value_exact<std::int64_t>().has_value(); };
+      for (std::size_t k = 0; k < axis.values.size(); ++k) {
+        std::int64_t offset = 0, value = 0;
+        if (is(start) && is(step)) {
+          if (__builtin_mul_overflow(static_cast<std::int64_t>(k), *step->value<std::int64_t>(), &offset) ||
+              __builtin_add_overflow(*start->value<std::int64_t>(), offset, &value))
+            l.fail(node, "", "overflows a 64-bit integer");
+          column.push_back(std::to_string(value));
+        } else {
+          const auto s0 = start->value<double>(), ds = step->value<double>();
+          if (!s0 || !ds) l.fail(node, "", "start and step must be numbers");
+          toml::value<double> v(*s0 + static_cast<double>(k) * *ds);
+          column.push_back(value_text(v, table, key));
+        }
+      }
+    } else {
+      column = values_of(node, table, key);
+      if (column.size() != axis.values.size())
+        table.fail(node, key, fmt::format("has {} values, the axis {}", column.size(), axis.values.size()));
+    }
+    axis.columns.emplace_back(key, std::move(column));
+  }
+  return axis;
+}
+
+// The recordings as the first axis, "recording": their names, and a column per key.
+pipelines::CampaignAxis read_recordings(const std::string& file, const std::vector<const toml::table*>& list,
+                                        const fs::path& base) {
+  static const char* const kKeys[] = {"input", "format", "sample_rate_hz", "if_hz", "imu", "truth"};
+  pipelines::CampaignAxis axis{"recording", {}, {}};
+  for (const char* key : kKeys) axis.columns.emplace_back(key, std::vector<std::string>{});
+  int i = 0;
+  for (const toml::table* t : list) {
+    Table table{file, fmt::format("recording[{}]", i), *t, {}};
+    axis.values.push_back(table.text("name", fmt::format("recording{}", i)));
+    for (auto& [key, column] : axis.columns) {
+      const toml::node* n = table.get(key);
+      std::string text = n ? value_text(*n, table, key) : "";
+      if ((key == "input" || key == "imu" || key == "truth") && !text.empty()) text = (base / text).lexically_normal();
+      if ((key == "input" || key == "sample_rate_hz") && text.empty())
+        throw io::InputError(file, "key '" + table.key_name(key) + "' is required", line_of(*t));
+      column.push_back(text);
+    }
+    table.check_done();
+    ++i;
+  }
+  return axis;
+}
+
+CampaignReduction read_reduction(const std::string& file, const toml::table& t, int i, const CampaignFile& c) {
+  Table table{file, fmt::format("report[{}]", i), t, {}};
+  CampaignReduction r;
+  const std::string kind = table.text("kind", "");
+  r.group = table.texts("group");
+  if (kind == "lock_threshold") {
+    r.kind = CampaignReduction::Kind::kLockThreshold;
+    r.level = table.text("level", "cn0_dbhz");
+    if (!c.metrics.lock_outcomes)
+      throw io::InputError(file, "a lock_threshold report needs [compute] lock_outcomes", line_of(t));
+  } else if (kind == "nav_consistency") {
+    r.kind = CampaignReduction::Kind::kNavConsistency;
+    if (!c.metrics.nav_z_times_s)
+      throw io::InputError(file, "a nav_consistency report needs [compute] nav_z_times_s", line_of(t));
+    r.times_s = *c.metrics.nav_z_times_s;
+  } else if (kind == "stats") {
+    r.kind = CampaignReduction::Kind::kStats;
+    r.value = table.text("value", "");
+    if (r.value.empty()) throw io::InputError(file, "key '" + table.key_name("value") + "' is required", line_of(t));
+  } else {
+    throw io::InputError(file, "key '" + table.key_name("kind") + "' must be lock_threshold, nav_consistency or stats",
+                         line_of(t));
+  }
+  table.check_done();
+  std::set<std::string> names;
+  for (const auto& axis : c.axes) {
+    names.insert(axis.name);
+    for (const auto& [name, values] : axis.columns) names.insert(name);
+  }
+  for (const std::string& g : r.group)
+    if (!names.count(g))
+      throw io::InputError(file, "key '" + table.key_name("group") + "' names no parameter '" + g + "'", line_of(t));
+  if (r.kind == CampaignReduction::Kind::kLockThreshold && !names.count(r.level))
+    throw io::InputError(file, "key '" + table.key_name("level") + "' names no parameter '" + r.level + "'",
+                         line_of(t));
+  return r;
+}
+
+const toml::table* section(const std::string& file, const toml::table& root, const std::string& name) {
+  const toml::node* n = root.get(name);
+  if (!n) return nullptr;
+  if (const toml::table* t = n->as_table()) return t;
+  throw io::InputError(file, "'" + name + "' must be a table [" + name + "]", line_of(*n));
+}
+
+// The tables of an array of tables ([[name]]); none when absent.
+std::vector<const toml::table*> tables_of(const std::string& file, const toml::table& root, const std::string& name) {
+  std::vector<const toml::table*> tables;
+  const toml::node* n = root.get(name);
+  if (!n) return tables;
+  const toml::array* a = n->as_array();
+  if (!a) throw io::InputError(file, "'" + name + "' must be [[" + name + "]] tables", line_of(*n));
+  for (const toml::node& item : *a) {
+    if (!item.as_table()) throw io::InputError(file, "'" + name + "' must be [[" + name + "]] tables", line_of(item));
+    tables.push_back(item.as_table());
+  }
+  return tables;
+}
+
+std::string read_text(const fs::path& path, const std::string& who) {
+  std::ifstream in(path);
+  if (!in) throw io::InputError(who, "cannot read the scenario template " + path.string());
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string substitute(const CampaignFile& c, const std::string& text, const pipelines::CampaignRun& run,
+                       const std::string& where) {
+  try {
+    return pipelines::substitute_parameters(text, run);
+  } catch (const std::invalid_argument& e) {
+    throw io::InputError(where, std::string(e.what()) + " (campaign file " + c.source.string() + ")");
+  }
+}
+
+fs::path resolve(const CampaignFile& c, const std::string& path) {
+  return path.empty() ? fs::path() : (c.base_dir / path).lexically_normal();
+}
+
+}  // namespace
+
+CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
+  const std::string file = path.string();
+  toml::table root;
+  try {
+    root = toml::parse_file(file);
+  } catch (const toml::parse_error& e) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw io::InputError(file, "campaign file not found");
+    throw io::InputError(file, std::string(e.description()), static_cast<int>(e.source().begin.line));
+  }
+  CampaignFile c;
+  c.source = path;
+  c.base_dir = base_dir.empty() ? fs::absolute(path).parent_path() : fs::absolute(base_dir);
+  Table top{file, "", root, {}};
+  for (const char* s : {"campaign", "axis", "simulate", "recording", "receive", "compute", "report", "slurm"})
+    top.get(s);
+  top.check_done();
+
+  if (const toml::table* t = section(file, root, "campaign")) {
+    Table table{file, "campaign", *t, {}};
+    c.name = table.text("name", "");
+    c.description = table.text("description", "");
+    table.check_done();
+  }
+  const std::vector<const toml::table*> recordings = tables_of(file, root, "recording");
+  const toml::table* simulate = section(file, root, "simulate");
+  if (recordings.empty() == (simulate == nullptr))
+    throw io::InputError(file, "a campaign has either [simulate] or [[recording]] tables");
+  if (!recordings.empty()) {
+    c.recordings = true;
+    c.axes.push_back(read_recordings(file, recordings, c.base_dir));
+  }
+  int axis_number = 0;
+  for (const toml::table* t : tables_of(file, root, "axis")) c.axes.push_back(read_axis(file, *t, axis_number++));
+  try {
+    (void)pipelines::expand_campaign(c.axes);
+  } catch (const std::invalid_argument& e) {
+    throw io::InputError(file, e.what());
+  }
+  if (simulate) {
+    Table table{file, "simulate", *simulate, {}};
+    const std::string scenario = table.text("scenario", "");
+    if (scenario.empty()) throw io::InputError(file, "key 'simulate.scenario' is required", line_of(*simulate));
+    c.scenario_template = resolve(c, scenario);
+    c.keep_samples = table.boolean("keep_samples", false);
+    table.check_done();
+    c.scenario_text = read_text(c.scenario_template, file);
+  }
+  if (const toml::table* t = section(file, root, "receive")) {
+    Table table{file, "receive", *t, {}};
+    CampaignReceive& r = c.receive;
+    r.nav = table.text("nav", "");
+    r.config = table.text("config", "");
+    r.fusion_config = table.text("fusion_config", "");
+    r.coupling = table.text("coupling", r.coupling);
+    r.filter = table.text("filter", r.filter);
+    r.align = table.text("align", r.align);
+    r.threads = table.integer("threads", r.threads, 0);
+    const std::string prns = table.text("prns", "simulated");
+    if (prns != "simulated" && prns != "all") table.fail(*t->get("prns"), "prns", "must be \"simulated\" or \"all\"");
+    r.prns_from_simulation = prns == "simulated";
+    table.check_done();
+  }
+  if (const toml::table* t = section(file, root, "compute")) {
+    Table table{file, "compute", *t, {}};
+    if (const toml::node* n = table.get("lock_outcomes")) {
+      if (!n->as_table()) table.fail(*n, "lock_outcomes", "must be a table { lock_deadline_s = 5.0, strong_s = 0.0 }");
+      Table l{file, "compute.lock_outcomes", *n->as_table(), {}};
+      pipelines::LockOutcomeOptions o;
+      o.lock_deadline_s = l.number("lock_deadline_s", o.lock_deadline_s);
+      o.strong_s = l.number("strong_s", o.strong_s);
+      l.check_done();
+      c.metrics.lock_outcomes = o;
+    }
+    if (const toml::node* n = table.get("nav_z_times_s")) {
+      const toml::array* a = n->as_array();
+      if (!a || a->empty()) table.fail(*n, "nav_z_times_s", "must be a non-empty array of times (s)");
+      std::vector<double> times;
+      for (const toml::node& item : *a) {
+        const auto v = item.value<double>();
+        if (!v) table.fail(item, "nav_z_times_s", "must be a non-empty array of times (s)");
+        times.push_back(*v);
+      }
+      c.metrics.nav_z_times_s = times;
+    }
+    table.check_done();
+  }
+  int report_number = 0;
+  for (const toml::table* t : tables_of(file, root, "report"))
+    c.reductions.push_back(read_reduction(file, *t, report_number++, c));
+  if (const toml::table* t = section(file, root, "slurm")) {
+    Table table{file, "slurm", *t, {}};
+    SlurmResources& s = c.slurm;
+    s.time = table.text("time", s.time);
+    s.mem = table.text("mem", s.mem);
+    s.partition = table.text("partition", s.partition);
+    s.account = table.text("account", s.account);
+    s.cpus_per_task = table.integer("cpus_per_task", s.cpus_per_task, 1);
+    s.runs_per_task = table.integer("runs_per_task", s.runs_per_task, 1);
+    s.max_parallel = table.integer("max_parallel", s.max_parallel, 0);
+    s.extra = table.texts("extra");
+    table.check_done();
+  }
+  // Every run's templates must fill in: a misspelt {name} fails here, before any run.
+  const std::vector<pipelines::CampaignRun> runs = pipelines::expand_campaign(c.axes);
+  if (!runs.empty()) {
+    if (!c.recordings) (void)substitute(c, c.scenario_text, runs.front(), c.scenario_template.string());
+    for (const std::string* text : {&c.receive.nav, &c.receive.coupling, &c.receive.filter, &c.receive.align})
+      (void)substitute(c, *text, runs.front(), file + ": [receive]");
+  }
+  return c;
+}
+
+pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::CampaignRun& run) {
+  const std::string file = c.source.string();
+  pipelines::CampaignJob job;
+  job.run = run;
+  job.keep_samples = c.keep_samples;
+  job.metrics = c.metrics;
+  job.prns_from_simulation = c.receive.prns_from_simulation;
+  if (!c.recordings) {
+    const std::string text = substitute(c, c.scenario_text, run, c.scenario_template.string());
+    job.scenario = parse_scenario(text, c.scenario_template);
+    job.scenario_echo = to_toml(*job.scenario);
+  } else {
+    const auto param = [&](const char* name) { return run.find(name) ? *run.find(name) : std::string(); };
+    pipelines::ReceiveFileJob& rx = job.receive;
+    rx.input = param("input");
+    const auto format = signals::parse_sample_format(param("format").empty() ? "i8" : param("format"));
+    if (!format)
+      throw io::InputError(file, "recording " + param("recording") + ": unknown format '" + param("format") + "'");
+    rx.format = *format;
+    try {
+      rx.source.fs_hz = std::stod(param("sample_rate_hz"));
+      rx.source.if_hz = param("if_hz").empty() ? 0.0 : std::stod(param("if_hz"));
+    } catch (const std::exception&) {
+      throw io::InputError(file, "recording " + param("recording") + ": sample_rate_hz and if_hz must be numbers");
+    }
+    rx.options.receiver.fs_hz = rx.source.fs_hz;
+    job.truth_csv = param("truth");
+    job.imu_csv = param("imu");
+  }
+  pipelines::ReceiveOptions& o = job.receive.options;
+  if (!c.receive.config.empty()) apply_receive_config(resolve(c, c.receive.config), o.receiver);
+  o.receiver.threads = c.receive.threads;
+  const std::string where = file + ": [receive]";
+  const std::string coupling = substitute(c, c.receive.coupling, run, where);
+  const auto parsed = pipelines::coupling_from_string(coupling);
+  if (!parsed)
+    throw io::InputError(where, "coupling must be scalar, vector, loose, tight or ultra-tight, got '" + coupling + "'");
+  o.coupling = *parsed;
+  const std::string filter = substitute(c, c.receive.filter, run, where);
+  if (filter != "ekf" && filter != "ukf")
+    throw io::InputError(where, "filter must be ekf or ukf, got '" + filter + "'");
+  o.filter = filter == "ukf" ? fusion::FilterKind::Ukf : fusion::FilterKind::Ekf;
+  const std::string align = substitute(c, c.receive.align, run, where);
+  const auto mode = pipelines::align_mode_from_string(align);
+  if (!mode || *mode == pipelines::AlignMode::Attitude)  // attitude alignment is `fuse`'s
+    throw io::InputError(where, "align must be static, motion or config, got '" + align + "'");
+  o.align = *mode;
+  if (!c.receive.fusion_config.empty()) o.navigation = read_fuse_config(resolve(c, c.receive.fusion_config));
+  const std::string nav = substitute(c, c.receive.nav, run, where);
+  if (!nav.empty()) job.receive.navigation = signals::read_rinex_nav(resolve(c, nav));
+  return job;
+}
+
+}  // namespace ultratrack::config

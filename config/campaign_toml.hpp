@@ -1,0 +1,75 @@
+// Campaign files (`ultratrack campaign run C.toml`): runs, what each does and computes, the report, Slurm resources.
+// The runs are a product of parameter axes; each simulates a scenario template (or takes a recording) and
+// receives in process. Read strictly: every key known and of the right type, or
+// an io::InputError naming the file, the line and the key. Relative paths resolve against the campaign file's
+// folder (or the base folder given: `campaign run` keeps a copy of the file in its output folder).
+//
+//   [campaign]   name = "tracking_threshold"  description = "..."
+//   [[axis]]     name = "cn0_dbhz"  values = [24.0, 26.0]          (numbers or strings)   or  count = 4 (0..3)
+//                further keys are zipped columns, one value per axis value: seed = [100, 101, 102, 103]
+//                or linear in the axis position: seed = { start = 100, step = 1 }
+//                The first axis varies slowest; a run's parameters are each axis value, then its columns in key order.
+//   [simulate]   scenario = "threshold.scenario.toml"   a scenario file whose text names parameters as {name}
+//                keep_samples = false                   (the IF sample file is deleted after the receive)
+//   [[recording]] instead of [simulate]: name = "a"  input = "a.bin"  format = "i8"  sample_rate_hz = 4e6
+//                if_hz = 0.0  imu = "imu.csv"  truth = "truth.csv"; the recordings are the first axis, "recording"
+//   [receive]    nav = "brdc0010.22n" (hot start)  config = "receive.toml" (`receive --config`)
+//                fusion_config = "motion.toml"  coupling = "scalar"  filter = "ekf"  align = "motion"
+//                threads = 1  prns = "simulated" (search the simulated satellites) or "all"
+//                (nav, coupling, filter and align may name parameters, e.g. coupling = "{coupling}")
+//   [compute]    lock_outcomes = { lock_deadline_s = 5.0, strong_s = 0.0 }   nav_z_times_s = [10.5, 11.0]
+//   [[report]]   kind = "lock_threshold" (level = "cn0_dbhz")  or "nav_consistency"  or "stats" (value = "fixes")
+//                group = ["coupling"]   (one table per combination of these parameters)
+//   [slurm]      time = "01:00:00"  cpus_per_task = 1  mem = "4G"  partition = ""  account = ""
+//                runs_per_task = 1  max_parallel = 0 (array throttle; 0: none)  extra = ["--qos=normal"]
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "pipelines/campaign_plan.hpp"
+#include "pipelines/campaign_report.hpp"
+#include "pipelines/campaign_run.hpp"
+
+namespace ultratrack::config {
+
+struct CampaignReceive {
+  std::string nav, config, fusion_config;  // paths (nav templated), resolved against the base folder
+  std::string coupling = "scalar", filter = "ekf", align = "motion";
+  int threads = 1;
+  bool prns_from_simulation = true;
+};
+
+struct SlurmResources {
+  std::string time = "01:00:00", mem = "4G", partition, account;
+  int cpus_per_task = 1;
+  int runs_per_task = 1;
+  int max_parallel = 0;
+  std::vector<std::string> extra;
+};
+
+struct CampaignFile {
+  std::filesystem::path source;    // the file read (errors name it)
+  std::filesystem::path base_dir;  // relative paths resolve here
+  std::string name, description;
+  std::vector<pipelines::CampaignAxis> axes;
+  std::filesystem::path scenario_template;  // empty for recordings
+  std::string scenario_text;
+  bool keep_samples = false;
+  bool recordings = false;
+  CampaignReceive receive;
+  pipelines::CampaignMetrics metrics;
+  std::vector<pipelines::CampaignReduction> reductions;
+  SlurmResources slurm;
+};
+
+// Reads and checks a campaign file (and its scenario template: every {name} must be a parameter). base_dir: where
+// relative paths resolve (empty: the file's folder). Throws io::InputError naming the file, the line and the key.
+CampaignFile read_campaign(const std::filesystem::path& file, const std::filesystem::path& base_dir = {});
+
+// What run `run` of the campaign does: the scenario template filled in and parsed, the receive's options.
+// Throws io::InputError naming the campaign file or the template.
+pipelines::CampaignJob campaign_job(const CampaignFile& campaign, const pipelines::CampaignRun& run);
+
+}  // namespace ultratrack::config

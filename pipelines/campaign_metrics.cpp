@@ -1,0 +1,249 @@
+#include "pipelines/campaign_metrics.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "io/atomic_file.hpp"
+#include "io/input_error.hpp"
+#include "io/numeric_csv.hpp"
+
+namespace ultratrack::pipelines {
+namespace {
+
+// A CSV file read by column names (the outputs' later columns do not matter): the header, then rows of as many
+// fields.
+struct NamedCsv {
+  std::string file;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  std::vector<int> lines;
+
+  std::size_t column(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) throw io::InputError(file, "no column '" + name + "'");
+    return static_cast<std::size_t>(it - header.begin());
+  }
+  double number(std::size_t row, std::size_t column) const {
+    const auto v = io::parse_csv_number(file, lines[row], header[column], rows[row][column]);
+    if (!v) throw io::InputError(file, header[column] + " is empty", lines[row]);
+    return *v;
+  }
+};
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> fields;
+  std::stringstream in(line);
+  std::string field;
+  while (std::getline(in, field, ',')) fields.emplace_back(io::trim(field));
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+NamedCsv read_named_csv(const std::filesystem::path& path) {
+  NamedCsv csv;
+  csv.file = path.string();
+  std::ifstream in(path);
+  if (!in) throw io::InputError(csv.file, "cannot open the file");
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (io::trim(line).empty()) continue;
+    std::vector<std::string> fields = split(line);
+    if (csv.header.empty()) {
+      csv.header = std::move(fields);
+      continue;
+    }
+    if (fields.size() != csv.header.size())
+      throw io::InputError(csv.file, fmt::format("{} fields, the header has {}", fields.size(), csv.header.size()),
+                           number);
+    csv.rows.push_back(std::move(fields));
+    csv.lines.push_back(number);
+  }
+  if (csv.header.empty()) throw io::InputError(csv.file, "empty file");
+  return csv;
+}
+
+bool is_locked(const std::string& state) { return state == "phase-locked" || state == "bit-synced"; }
+
+struct Record {
+  double t_s;
+  bool locked;
+};
+
+// From recs[i0] (locked) on: kept while every record is locked and none is more than 0.2 s after the previous.
+void follow_lock(const std::vector<Record>& recs, std::size_t i0, double duration_s, LockOutcome& o) {
+  o.first_lock_s = fmt::format("{:.3f}", recs[i0].t_s);
+  o.outcome = "kept";
+  double end_t = recs.back().t_s, previous = recs[i0].t_s;
+  for (std::size_t i = i0; i < recs.size(); ++i) {
+    if (!recs[i].locked || recs[i].t_s - previous > 0.2) {  // records come every 20 ms
+      o.outcome = "lost";
+      end_t = previous;
+      break;
+    }
+    previous = recs[i].t_s;
+  }
+  if (o.outcome == "kept" && end_t < duration_s - 0.2) o.outcome = "lost";
+  o.lock_end_s = fmt::format("{:.3f}", end_t);
+}
+
+constexpr double kA = 6378137.0, kF = 1.0 / 298.257223563, kE2 = kF * (2.0 - kF);
+
+std::array<double, 3> ecef(double lat_deg, double lon_deg, double h) {
+  const double la = lat_deg * M_PI / 180.0, lo = lon_deg * M_PI / 180.0;
+  const double n = kA / std::sqrt(1.0 - kE2 * std::sin(la) * std::sin(la));
+  return {(n + h) * std::cos(la) * std::cos(lo), (n + h) * std::cos(la) * std::sin(lo),
+          (n * (1.0 - kE2) + h) * std::sin(la)};
+}
+
+std::array<double, 3> ned(double lat_deg, double lon_deg, const std::array<double, 3>& d) {
+  const double la = lat_deg * M_PI / 180.0, lo = lon_deg * M_PI / 180.0;
+  const double sl = std::sin(la), cl = std::cos(la), so = std::sin(lo), co = std::cos(lo);
+  return {-sl * co * d[0] - sl * so * d[1] + cl * d[2], -so * d[0] + co * d[1],
+          -cl * co * d[0] - cl * so * d[1] - sl * d[2]};
+}
+
+}  // namespace
+
+std::vector<LockOutcome> lock_outcomes(const std::vector<int>& prns, const std::filesystem::path& tracking_csv,
+                                       double duration_s, const LockOutcomeOptions& options) {
+  std::map<int, std::vector<Record>> by_prn;
+  std::error_code ec;
+  if (std::filesystem::exists(tracking_csv, ec)) {
+    const NamedCsv csv = read_named_csv(tracking_csv);
+    const std::size_t prn_col = csv.column("prn"), t_col = csv.column("time_s"), state_col = csv.column("state");
+    for (std::size_t r = 0; r < csv.rows.size(); ++r)
+      by_prn[static_cast<int>(csv.number(r, prn_col))].push_back(
+          {csv.number(r, t_col), is_locked(csv.rows[r][state_col])});
+  }
+  std::vector<LockOutcome> out;
+  for (const int prn : prns) {
+    LockOutcome o{prn, "not_acquired", "", ""};
+    const auto it = by_prn.find(prn);
+    if (it != by_prn.end() && !it->second.empty()) {
+      const std::vector<Record>& recs = it->second;
+      if (options.strong_s > 0.0) {
+        o.outcome = "not_locked_at_step";
+        std::size_t last_before = recs.size();
+        for (std::size_t i = 0; i < recs.size(); ++i)
+          if (recs[i].t_s >= options.strong_s - 0.2 && recs[i].t_s <= options.strong_s) last_before = i;
+        if (last_before < recs.size() && recs[last_before].locked) follow_lock(recs, last_before, duration_s, o);
+      } else {
+        o.outcome = "never_locked";
+        const auto lock = std::find_if(recs.begin(), recs.end(), [](const Record& r) { return r.locked; });
+        if (lock != recs.end() && lock->t_s <= options.lock_deadline_s)
+          follow_lock(recs, static_cast<std::size_t>(lock - recs.begin()), duration_s, o);
+      }
+    }
+    out.push_back(std::move(o));
+  }
+  return out;
+}
+
+void write_lock_outcomes_csv(const std::filesystem::path& file, const std::vector<LockOutcome>& outcomes) {
+  std::string text = "prn,outcome,first_lock_s,lock_end_s\n";
+  for (const LockOutcome& o : outcomes)
+    text += fmt::format("{},{},{},{}\n", o.prn, o.outcome, o.first_lock_s, o.lock_end_s);
+  io::write_file_atomically(file, text);
+}
+
+std::vector<LockOutcome> read_lock_outcomes_csv(const std::filesystem::path& file) {
+  const NamedCsv csv = read_named_csv(file);
+  const std::size_t prn = csv.column("prn"), outcome = csv.column("outcome"), first = csv.column("first_lock_s"),
+                    end = csv.column("lock_end_s");
+  std::vector<LockOutcome> out;
+  for (std::size_t r = 0; r < csv.rows.size(); ++r)
+    out.push_back({static_cast<int>(csv.number(r, prn)), csv.rows[r][outcome], csv.rows[r][first], csv.rows[r][end]});
+  return out;
+}
+
+std::vector<NavZ> nav_z_scores(const std::filesystem::path& nav_csv, const std::filesystem::path& truth_csv,
+                               const std::vector<double>& times_s) {
+  const NamedCsv nav = read_named_csv(nav_csv), truth = read_named_csv(truth_csv);
+  if (truth.rows.size() < 2) throw io::InputError(truth.file, "fewer than two rows");
+  std::vector<double> tt, rt;
+  const std::size_t truth_t = truth.column("t_s"), nav_t = nav.column("t_s");
+  for (std::size_t r = 0; r < truth.rows.size(); ++r) tt.push_back(truth.number(r, truth_t));
+  for (std::size_t r = 0; r < nav.rows.size(); ++r) rt.push_back(nav.number(r, nav_t));
+  const std::array<std::size_t, 6> truth_cols{truth.column("ecef_x_m"),  truth.column("ecef_y_m"),
+                                              truth.column("ecef_z_m"),  truth.column("vel_n_mps"),
+                                              truth.column("vel_e_mps"), truth.column("vel_d_mps")};
+  const std::size_t lat = nav.column("lat_deg"), lon = nav.column("lon_deg"), height = nav.column("height_m");
+  const std::array<std::size_t, 3> vel{nav.column("vel_n_mps"), nav.column("vel_e_mps"), nav.column("vel_d_mps")};
+  const std::array<std::size_t, 6> sig{nav.column("sigma_n_m"),    nav.column("sigma_e_m"),
+                                       nav.column("sigma_d_m"),    nav.column("sigma_vn_mps"),
+                                       nav.column("sigma_ve_mps"), nav.column("sigma_vd_mps")};
+  std::vector<NavZ> out;
+  for (const double t : times_s) {
+    const auto after = std::upper_bound(rt.begin(), rt.end(), t);
+    if (after == rt.begin()) continue;
+    const std::size_t j = static_cast<std::size_t>(after - rt.begin()) - 1;
+    const double tr = rt[j];
+    const std::size_t i = std::clamp<std::size_t>(
+        static_cast<std::size_t>(std::lower_bound(tt.begin(), tt.end(), tr) - tt.begin()), 1, tt.size() - 1);
+    const double w = (tr - tt[i - 1]) / (tt[i] - tt[i - 1]);
+    const auto lin = [&](std::size_t c) {
+      return truth.number(i - 1, c) + w * (truth.number(i, c) - truth.number(i - 1, c));
+    };
+    const double lat_deg = nav.number(j, lat), lon_deg = nav.number(j, lon);
+    const std::array<double, 3> q = ecef(lat_deg, lon_deg, nav.number(j, height));
+    const std::array<double, 3> ep =
+        ned(lat_deg, lon_deg, {q[0] - lin(truth_cols[0]), q[1] - lin(truth_cols[1]), q[2] - lin(truth_cols[2])});
+    NavZ row;
+    row.t_s = t;
+    for (int k = 0; k < 3; ++k) {
+      row.error[k] = ep[k];
+      row.error[3 + k] = nav.number(j, vel[k]) - lin(truth_cols[3 + k]);
+    }
+    for (int k = 0; k < 6; ++k) {
+      row.sigma[k] = nav.number(j, sig[k]);
+      row.z[k] = row.error[k] / row.sigma[k];
+    }
+    out.push_back(row);
+  }
+  return out;
+}
+
+namespace {
+const char* const kAxes[6] = {"pn", "pe", "pd", "vn", "ve", "vd"};
+}
+
+void write_nav_z_csv(const std::filesystem::path& file, const std::vector<NavZ>& rows) {
+  std::string text = "t_s";
+  for (const char* prefix : {"z_", "error_", "sigma_"})
+    for (const char* axis : kAxes) text += fmt::format(",{}{}", prefix, axis);
+  text += '\n';
+  for (const NavZ& r : rows) {
+    text += fmt::format("{:.17g}", r.t_s);
+    for (const auto* v : {&r.z, &r.error, &r.sigma})
+      for (const double x : *v) text += fmt::format(",{:.17g}", x);
+    text += '\n';
+  }
+  io::write_file_atomically(file, text);
+}
+
+std::vector<NavZ> read_nav_z_csv(const std::filesystem::path& file) {
+  const NamedCsv csv = read_named_csv(file);
+  std::vector<NavZ> out;
+  const std::size_t t = csv.column("t_s");
+  for (std::size_t r = 0; r < csv.rows.size(); ++r) {
+    NavZ row;
+    row.t_s = csv.number(r, t);
+    for (int k = 0; k < 6; ++k) {
+      row.z[k] = csv.number(r, csv.column(std::string("z_") + kAxes[k]));
+      row.error[k] = csv.number(r, csv.column(std::string("error_") + kAxes[k]));
+      row.sigma[k] = csv.number(r, csv.column(std::string("sigma_") + kAxes[k]));
+    }
+    out.push_back(row);
+  }
+  return out;
+}
+
+}  // namespace ultratrack::pipelines

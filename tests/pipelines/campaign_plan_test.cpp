@@ -1,0 +1,158 @@
+// Campaign expansion (pipelines/campaign_plan.hpp) and campaign files (config/campaign_toml.hpp): the product's
+// count and order, zipped and linear columns, template substitution, and malformed files as InputErrors naming
+// the file and the key.
+#include "pipelines/campaign_plan.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <set>
+#include <stdexcept>
+#include <string>
+
+#include "config/campaign_toml.hpp"
+#include "io/input_error.hpp"
+#include "support/test_data.hpp"
+
+namespace {
+
+using ultratrack::pipelines::CampaignAxis;
+using ultratrack::pipelines::CampaignRun;
+using ultratrack::pipelines::expand_campaign;
+using ultratrack::pipelines::substitute_parameters;
+
+std::string params(const CampaignRun& run) {
+  std::string text;
+  for (const auto& [name, value] : run.parameters) text += name + "=" + value + " ";
+  return text;
+}
+
+TEST(CampaignPlan, ProductHasEveryCombinationFirstAxisSlowest) {
+  const std::vector<CampaignAxis> axes{{"cn0", {"24", "26", "28"}, {}},
+                                       {"file", {"0", "1"}, {{"seed", {"100", "101"}}}},
+                                       {"coupling", {"scalar", "vector"}, {}}};
+  const auto runs = expand_campaign(axes);
+  ASSERT_EQ(runs.size(), 12u);
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].index, static_cast<int>(i));
+  EXPECT_EQ(params(runs[0]), "cn0=24 file=0 seed=100 coupling=scalar ");
+  EXPECT_EQ(params(runs[1]), "cn0=24 file=0 seed=100 coupling=vector ");
+  EXPECT_EQ(params(runs[2]), "cn0=24 file=1 seed=101 coupling=scalar ");
+  EXPECT_EQ(params(runs[4]), "cn0=26 file=0 seed=100 coupling=scalar ");
+  EXPECT_EQ(params(runs[11]), "cn0=28 file=1 seed=101 coupling=vector ");
+  // Every combination exactly once.
+  std::set<std::string> distinct;
+  for (const auto& r : runs) distinct.insert(params(r));
+  EXPECT_EQ(distinct.size(), 12u);
+}
+
+TEST(CampaignPlan, NoAxisIsOneRunAndBadAxesThrow) {
+  EXPECT_EQ(expand_campaign({}).size(), 1u);
+  EXPECT_THROW(expand_campaign({{"a", {}, {}}}), std::invalid_argument);
+  EXPECT_THROW(expand_campaign({{"a", {"1"}, {}}, {"a", {"2"}, {}}}), std::invalid_argument);
+  EXPECT_THROW(expand_campaign({{"a", {"1", "2"}, {{"b", {"1"}}}}}), std::invalid_argument);
+}
+
+TEST(CampaignPlan, SubstitutesNamesAndLeavesOtherBracesAlone) {
+  const CampaignRun run{3, {{"seed", "101"}, {"cn0_dbhz", "26.0"}}};
+  EXPECT_EQ(substitute_parameters("seed = {seed}\ncn0_dbhz = {cn0_dbhz}\n", run), "seed = 101\ncn0_dbhz = 26.0\n");
+  EXPECT_EQ(substitute_parameters("cn0_dbhz_by_prn = { 5 = 40.0 }  x = {}", run),
+            "cn0_dbhz_by_prn = { 5 = 40.0 }  x = {}");
+  try {
+    substitute_parameters("seed = {sed}", run);
+    FAIL() << "no throw";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("{sed}"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(ultratrack::pipelines::campaign_run_folder(7), "0007");
+}
+
+// A campaign file and its scenario template in a scratch folder.
+std::filesystem::path write_campaign(const std::filesystem::path& dir, const std::string& campaign,
+                                     const std::string& scenario = "[signal]\nseed = {seed}\ncn0_dbhz = {cn0_dbhz}\n") {
+  std::ofstream(dir / "s.toml") << scenario;
+  std::ofstream(dir / "c.toml") << campaign;
+  return dir / "c.toml";
+}
+
+const char* const kGood = R"(
+[campaign]
+name = "t"
+[[axis]]
+name = "cn0_dbhz"
+values = [24, 26.5]
+[[axis]]
+name = "file"
+count = 3
+seed = { start = 100, step = 2 }
+tow_s = { start = 518400.0, step = 90.0 }
+label = ["a", "b", "c"]
+[simulate]
+scenario = "s.toml"
+[compute]
+lock_outcomes = { lock_deadline_s = 4.0 }
+[[report]]
+kind = "lock_threshold"
+[slurm]
+runs_per_task = 2
+extra = ["--qos=low"]
+)";
+
+TEST(CampaignToml, ReadsAxesColumnsAndSections) {
+  const auto dir = ultratrack::test::scratch_dir();
+  const auto c = ultratrack::config::read_campaign(write_campaign(dir, kGood));
+  const auto runs = expand_campaign(c.axes);
+  ASSERT_EQ(runs.size(), 6u);
+  EXPECT_EQ(params(runs[0]), "cn0_dbhz=24 file=0 label=a seed=100 tow_s=518400.0 ");
+  EXPECT_EQ(params(runs[5]), "cn0_dbhz=26.5 file=2 label=c seed=104 tow_s=518580.0 ");
+  ASSERT_TRUE(c.metrics.lock_outcomes);
+  EXPECT_EQ(c.metrics.lock_outcomes->lock_deadline_s, 4.0);
+  EXPECT_EQ(c.metrics.lock_outcomes->strong_s, 0.0);
+  EXPECT_EQ(c.slurm.runs_per_task, 2);
+  ASSERT_EQ(c.slurm.extra.size(), 1u);
+  ASSERT_EQ(c.reductions.size(), 1u);
+  EXPECT_EQ(c.scenario_template, dir / "s.toml");
+  // The job of a run is its scenario with the parameters filled in.
+  const auto job = ultratrack::config::campaign_job(c, runs[5]);
+  ASSERT_TRUE(job.scenario);
+  EXPECT_EQ(job.scenario->seed, 104u);
+  EXPECT_EQ(job.scenario->cn0_dbhz, 26.5);
+}
+
+// The InputError of a campaign file, or "no InputError".
+std::string error_of(const std::string& campaign, const std::string& scenario = "[signal]\nseed = {seed}\n") {
+  const auto dir = ultratrack::test::scratch_dir();
+  try {
+    ultratrack::config::read_campaign(write_campaign(dir, campaign, scenario));
+  } catch (const ultratrack::io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find((dir / "c.toml").string()), std::string::npos) << e.what();
+    return e.what();
+  }
+  return "no InputError";
+}
+
+TEST(CampaignToml, MalformedFilesNameTheFileAndTheKey) {
+  const std::string axis = "[[axis]]\nname = \"seed\"\nvalues = [1, 2]\n[simulate]\nscenario = \"s.toml\"\n";
+  EXPECT_NE(error_of(axis + "[receive]\nthreds = 2\n").find("unknown key 'receive.threds'"), std::string::npos);
+  EXPECT_NE(error_of(axis + "[receive]\nthreads = \"two\"\n").find("key 'receive.threads' must be an integer"),
+            std::string::npos);
+  EXPECT_NE(error_of("[[axis]]\nname = \"seed\"\nvalues = [1, 2]\nx = [1]\n[simulate]\nscenario = \"s.toml\"\n")
+                .find("key 'axis[0].x' has 1 values"),
+            std::string::npos);
+  EXPECT_NE(error_of("[[axis]]\nname = \"seed\"\n[simulate]\nscenario = \"s.toml\"\n").find("'values' or 'count'"),
+            std::string::npos);
+  EXPECT_NE(error_of(axis + "[[report]]\nkind = \"median\"\n").find("key 'report[0].kind'"), std::string::npos);
+  EXPECT_NE(error_of(axis + "[[report]]\nkind = \"lock_threshold\"\n").find("needs [compute] lock_outcomes"),
+            std::string::npos);
+  EXPECT_NE(error_of(axis + "[[report]]\nkind = \"stats\"\nvalue = \"fixes\"\ngroup = [\"coupling\"]\n")
+                .find("names no parameter 'coupling'"),
+            std::string::npos);
+  EXPECT_NE(error_of("[[axis]]\nname = \"seed\"\nvalues = [1]\n").find("either [simulate] or [[recording]]"),
+            std::string::npos);
+  EXPECT_NE(error_of("[simulate\n").find("c.toml"), std::string::npos);
+  // A template naming a parameter no axis defines: the template's file and the name.
+  const std::string e = error_of(axis, "[signal]\nseed = {sede}\n");
+  EXPECT_NE(e.find("{sede}"), std::string::npos) << e;
+  EXPECT_NE(e.find("s.toml"), std::string::npos) << e;
+}
+
+}  // namespace
