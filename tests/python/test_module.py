@@ -47,6 +47,21 @@ llh_deg_m = [%r, %r, %r]
 ionosphere = true
 troposphere = true
 """ % ((NAV,) + LLH)
+# IMU and truth only (no [signal]): a 60 s circle with a navigation-grade IMU, simulated in a fraction of a second.
+INERTIAL = """
+[time]
+gps_week = 1823
+tow_s = 518400.0
+[receiver]
+llh_deg_m = [%r, %r, %r]
+[trajectory]
+profile = "circle"
+duration_s = 60.0
+imu_rate_hz = 100.0
+[imu]
+preset = "hg1700ae"
+seed = 3
+""" % LLH
 OUTPUTS = ("solution.csv", "tracking.csv", "observations.rnx", "navigation.rnx", "solution.nmea", "solution.kml")
 
 
@@ -164,6 +179,45 @@ class ModuleTest(unittest.TestCase):
         with self.assertRaises(TypeError) as caught:
             ut.receive(input=self.input, format="i8", fs=2.0e6, out=os.path.join(self.dir, "bad"), no_such_option=1)
         self.assertIn("no_such_option", str(caught.exception))
+
+    def test_fuse_writes_what_the_program_writes(self):
+        folder = os.path.join(self.dir, "inertial")
+        ut.simulate(INERTIAL, folder)
+        truth = ut.read_truth(folder)
+        self.assertIn("yaw_deg", truth.dtype.names)
+        # Fixes at 1 Hz from the truth itself (sigma 1 m): the filter must stay within a few metres of it.
+        step = int(round(1.0 / (truth["t_s"][1] - truth["t_s"][0])))
+        gnss = os.path.join(folder, "gnss.csv")
+        with open(gnss, "w") as f:
+            f.write("t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m\n")
+            for row in truth[::step]:
+                f.write("%.6f,%.10f,%.10f,%.4f,%.5f,%.5f,%.5f,1,1,1\n" % (
+                    row["t_s"], row["lat_deg"], row["lon_deg"], row["height_m"], row["vel_n_mps"], row["vel_e_mps"],
+                    row["vel_d_mps"]))
+        imu, truth_file = os.path.join(folder, "imu.csv"), os.path.join(folder, "truth.csv")
+        summary = ut.fuse(imu, gnss, os.path.join(self.dir, "fuse"), truth=truth_file)
+        self.assertEqual(summary, ut.read_summary(os.path.join(self.dir, "fuse")) | {"out": summary["out"]})
+        nav = ut.read_nav(summary["out"])
+        self.assertGreater(nav.size, 1000)
+        self.assertLess(nav["t_s"][-1], 60.0 + 1e-6)
+        self.assertEqual(summary["fixes_used"] + summary["fixes_before_start"], 61)  # 0..60 s at 1 Hz
+        self.assertLess(summary["rms_all"]["position_3d_m"], 1.0)
+        self.assertGreater(summary["rms_all"]["within_3sigma"], 0.95)
+        if PROGRAM and os.path.exists(PROGRAM):
+            out = os.path.join(self.dir, "fuse_cli")
+            subprocess.run([PROGRAM, "fuse", "--imu", imu, "--gnss", gnss, "--truth", truth_file, "--out", out,
+                            "--quiet"], check=True, stdout=subprocess.DEVNULL)
+            self.assertTrue(same_output(os.path.join(out, "nav.csv"), os.path.join(summary["out"], "nav.csv")))
+            self.assertTrue(same_output(os.path.join(out, "summary.json"),
+                                        os.path.join(summary["out"], "summary.json")))
+        # The report of a fuse run: the GNSS/INS figures, errors against the truth with the filter's 1-sigma.
+        report = os.path.join(self.dir, "fuse_report")
+        self.assertEqual(ultratrack.report.main([summary["out"], "--truth", truth_file, "--out", report]), 0)
+        self.assertEqual({n[:-4] for n in os.listdir(report) if n.endswith(".png")},
+                         {"nav_position_error", "nav_attitude", "nav_velocity"})
+        with self.assertRaises(ut.InputError) as caught:
+            ut.fuse(imu, gnss + ".missing", os.path.join(self.dir, "fuse_missing"))
+        self.assertIn("gnss.csv.missing", str(caught.exception))
 
     def test_report_names_every_figure_it_made(self):
         out = os.path.join(self.dir, "report")
