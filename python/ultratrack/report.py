@@ -3,7 +3,7 @@
 Figures (matplotlib, Agg) from the files the run wrote, each skipped when its file is absent: C/N0 per satellite
 vs time and tracking state with lock/loss events (tracking.csv), position on a local east/north map, errors
 east/north/up vs time against a truth (solution.csv, nav.csv; truth.csv of the simulation), velocity, satellites
-used and DOP (solution.csv), innovations and NIS (ultratight.csv, vector.csv), attitude with 1-sigma (attitude.csv,
+used and DOP (solution.csv), NIS (ultratight.csv) and normalised innovations (vector.csv), attitude with 1-sigma (attitude.csv,
 nav.csv), and the summary table (summary.json). Each figure is written as a PNG into the output folder (default:
 RUN_DIR/report) and embedded in report.html, which therefore stands alone.
 """
@@ -227,20 +227,50 @@ def _nav_figures(page, nav, truth):
 
 
 def _nis_figure(page, rows, name, title):
+    """Each satellite's normalised innovation squared, with its expectation: the measurement's dimension m (the
+    innovation_k columns it fills), E[NIS] = m for a consistent filter."""
     if "nis" not in rows.dtype.names:
         return
+    innovations = [c for c in rows.dtype.names if c.startswith("innovation_")]
     fig, ax = plt.subplots(figsize=(10, 4))
     for prn in np.unique(rows["prn"]):
         r = rows[(rows["prn"] == prn) & np.isfinite(rows["nis"])]
         if r.size:
             ax.plot(r["time_s"], r["nis"], ".", ms=2, label="PRN %d" % prn)
+    updated = rows[np.isfinite(rows["nis"])]
+    if innovations and updated.size:
+        m = np.mean(sum(np.isfinite(updated[c]).astype(int) for c in innovations))
+        ax.axhline(m, color="k", lw=1, label="E[NIS] = m = %.3g" % m)
     ax.set_yscale("log")
     ax.set_xlabel("time since the first sample (s)")
     ax.set_ylabel("NIS")
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
-    ax.legend(ncol=8, fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     page.add(name, title, fig)
+
+
+def _vector_innovation_figure(page, rows):
+    """The vector filter's pseudorange innovations over their predicted 1-sigma, with the +-1 and +-3 bands."""
+    needed = ("pr_used", "pr_innovation_m", "pr_sigma_m")
+    if any(c not in rows.dtype.names for c in needed):
+        return
+    used = rows[(rows["pr_used"] == 1) & (rows["pr_sigma_m"] > 0)]
+    if not used.size:
+        return
+    fig, ax = plt.subplots(figsize=(10, 4))
+    for prn in np.unique(used["prn"]):
+        r = used[used["prn"] == prn]
+        ax.plot(r["time_s"], r["pr_innovation_m"] / r["pr_sigma_m"], ".", ms=2, label="PRN %d" % prn)
+    for k, style in ((1, "--"), (3, ":")):
+        ax.axhline(k, color="k", ls=style, lw=1, label="+-%d sigma" % k)
+        ax.axhline(-k, color="k", ls=style, lw=1)
+    ax.set_xlabel("time since the first sample (s)")
+    ax.set_ylabel("innovation / sigma")
+    ax.set_title("Vector filter pseudorange innovations, normalised")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    page.add("vector_innovations", "Vector filter normalised pseudorange innovations", fig)
 
 
 def _attitude_figure(page, attitude, truth):
@@ -298,7 +328,7 @@ def make_report(run_dir, truth=None, out_dir=None):
         _nis_figure(page, ultratight, "ultratight_nis", "Ultra-tight filter NIS per satellite")
     vector = _optional(readers.read_vector, run_dir)
     if vector is not None:
-        _nis_figure(page, vector, "vector_nis", "Vector filter NIS per satellite")
+        _vector_innovation_figure(page, vector)
     attitude = _optional(readers.read_attitude, run_dir)
     if attitude is not None:
         _attitude_figure(page, attitude, truth_rows)
