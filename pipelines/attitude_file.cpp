@@ -9,6 +9,7 @@
 #include <span>
 
 #include "io/why_invalid.hpp"
+#include "pipelines/receive_file.hpp"
 #include "receiver/multi_sample_source.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
@@ -21,6 +22,9 @@ AttitudeFileResult attitude_file(AttitudeFileJob job, std::stop_token stop, cons
     throw signals::InputError("inputs", fmt::format("{} files for the {} antennas of the array", job.inputs.size(), n_ant));
   receiver::ReceiverOptions& options = job.options;
   options.num_antennas = static_cast<int>(n_ant);
+  if (options.reference_week == 0 && job.navigation.ephemerides.empty())
+    throw signals::InputError("options", "give navigation data or a reference week (the full GPS week of the recording)");
+  date_recording(options, job.navigation, 0);
   if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError("options", why);
   if (job.duration_s < 0.0) throw signals::InputError("options", "duration: must not be negative");
 

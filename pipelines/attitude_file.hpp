@@ -26,7 +26,8 @@ struct AttitudeFileJob {
   std::vector<std::filesystem::path> inputs;  // one per antenna of solver.array, master first
   signals::SampleFormat format = signals::SampleFormat::i8;
   receiver::SampleSourceOptions source;      // fs_hz, if_hz
-  receiver::ReceiverOptions options;         // fs_hz = source.fs_hz; num_antennas is set from inputs
+  // fs_hz = source.fs_hz; num_antennas is set from inputs; reference_week 0: the navigation's (date_recording).
+  receiver::ReceiverOptions options;
   receiver::AttitudeSolverOptions solver;    // the array (lever arms) and the solver's settings
   std::vector<double> line_bias_cycles;      // per antenna
   signals::RinexNavData navigation;          // hot start (may be empty)
@@ -47,7 +48,8 @@ using AttitudeProgressCallback =
     std::function<void(const receiver::ReceiverEngine& engine, const receiver::AttitudeStats& stats)>;
 
 // Runs the job. Throws signals::InputError naming the file or the setting: unreadable or malformed samples, a
-// file count other than the array's antennas, options that do not validate. No attitude is not an error (the
+// file count other than the array's antennas, neither a reference week nor navigation data to date the recording,
+// options that do not validate. No attitude is not an error (the
 // result's stats say so; the files are written).
 AttitudeFileResult attitude_file(AttitudeFileJob job, std::stop_token stop = {},
                                  const AttitudeProgressCallback& progress = {});

@@ -42,14 +42,7 @@ py::dict attitude(const std::vector<std::string>& inputs, const std::string& for
   take_option(options, "interval", r.observation_interval_s);
   take_option(options, "duration", job.duration_s);
   if (!nav.empty()) job.navigation = signals::read_rinex_nav(nav);
-  if (take_option(options, "reference_week", r.reference_week)) {
-    r.reference_week_is_signal_week = true;
-  } else if (!job.navigation.ephemerides.empty()) {
-    r.reference_week = job.navigation.ephemerides.front().week;
-    r.reference_week_is_signal_week = true;
-  } else {
-    throw io::InputError("python", "give nav or reference_week (the full GPS week of the recording)");
-  }
+  if (take_option(options, "reference_week", r.reference_week)) r.reference_week_is_signal_week = true;  // else nav's
   reject_unknown_options(options, "attitude");
 
   PythonInterrupt interrupt;

@@ -59,10 +59,7 @@ void run_attitude(const AttitudeArgs& args) {
   if (!args.reference_week.empty()) {
     options.reference_week = parse_int_option("--reference-week", args.reference_week);
     options.reference_week_is_signal_week = true;
-  } else if (!job.navigation.ephemerides.empty()) {
-    options.reference_week = job.navigation.ephemerides.front().week;
-    options.reference_week_is_signal_week = true;
-  } else {
+  } else if (job.navigation.ephemerides.empty()) {  // else the nav file dates it (pipelines::attitude_file)
     throw signals::InputError("command line", "give --nav or --reference-week (the full GPS week of the recording)");
   }
   if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError("command line", why);

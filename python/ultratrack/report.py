@@ -1,7 +1,7 @@
-"""A run's results on one HTML page: python3 -m ultratrack.report RUN_DIR [--truth truth.csv] [--out DIR]
+"""A run's results on one HTML page: python3 -m ultratrack.report RUN_DIR [--truth truth.csv] [--out DIR] [--prn N]
 
 Figures (matplotlib, Agg) from the files the run wrote, each skipped when its file is absent: C/N0 per satellite
-vs time and tracking state with lock/loss events (tracking.csv), position on a local east/north map, errors
+vs time, tracking state with lock/loss events and one satellite's prompt I/Q (tracking.csv), position on a local east/north map, errors
 east/north/up vs time against a truth (solution.csv, nav.csv; truth.csv of the simulation), velocity, satellites
 used and DOP (solution.csv), NIS (ultratight.csv) and normalised innovations (vector.csv), attitude with 1-sigma (attitude.csv,
 nav.csv), and the summary table (summary.json). Each figure is written as a PNG into the output folder (default:
@@ -68,6 +68,19 @@ class _Page:
         self.figures.append((name, title, png))
 
 
+def _time_series(page, name, title, t, series, xlabel, ylabel):
+    """One figure of curves against time: series is a list of (values, label)."""
+    fig, ax = plt.subplots(figsize=(10, 4))
+    for values, label in series:
+        ax.plot(t, values, lw=0.8, label=label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    page.add(name, title, fig)
+
+
 def _tracking_figures(page, tracking):
     prns = np.unique(tracking["prn"])
     fig, ax = plt.subplots(figsize=(10, 4.5))
@@ -109,6 +122,32 @@ def _tracking_figures(page, tracking):
     page.add("tracking_state", "Tracking state and lock/loss events", fig)
 
 
+def _iq_figure(page, tracking, prn):
+    """Prompt I/Q of one satellite (the one with most rows when prn is None): a phase-locked channel's points lie
+    along I, split by the data bit; bit-synced rows only when there are any (one integration length)."""
+    if not all(c in tracking.dtype.names for c in ("prompt_i", "prompt_q")):
+        return
+    if prn is None:
+        prns, counts = np.unique(tracking["prn"], return_counts=True)
+        prn = int(prns[np.argmax(counts)])
+    rows = tracking[tracking["prn"] == prn]
+    if not rows.size:
+        return
+    if "state" in rows.dtype.names and (rows["state"] == "bit-synced").any():
+        rows = rows[rows["state"] == "bit-synced"]
+    fig, ax = plt.subplots(figsize=(5.5, 5.5))
+    ax.plot(rows["prompt_i"], rows["prompt_q"], ".", ms=2)
+    limit = 1.05 * np.nanmax(np.abs(np.concatenate([rows["prompt_i"], rows["prompt_q"]])))
+    ax.set_xlim(-limit, limit)
+    ax.set_ylim(-limit, limit)
+    ax.set_aspect("equal")
+    ax.set_xlabel("prompt I")
+    ax.set_ylabel("prompt Q")
+    ax.set_title("Prompt I/Q of PRN %d (%d epochs)" % (prn, rows.size))
+    ax.grid(True, alpha=0.3)
+    page.add("prompt_iq", "Prompt I/Q of PRN %d" % prn, fig)
+
+
 def _truth_ecef_at(truth, tow_s):
     """The truth's ECEF position interpolated at GPS times of week (nan outside it)."""
     order = np.argsort(truth["tow_s"])
@@ -144,25 +183,14 @@ def _solution_figures(page, solution, truth):
         truth_at = _truth_ecef_at(truth, solution["tow_s"])
         errors = np.array([_enu_rotation(la, lo) @ d for la, lo, d in
                            zip(solution["lat_deg"], solution["lon_deg"], ecef - truth_at)])
-        fig, ax = plt.subplots(figsize=(10, 4))
-        for k, axis in enumerate(("east", "north", "up")):
-            ax.plot(t, errors[:, k], lw=0.8, label="%s (RMS %.2f m)" % (axis, np.sqrt(np.nanmean(errors[:, k] ** 2))))
-        ax.set_xlabel("time since the first fix (s)")
-        ax.set_ylabel("error (m)")
-        ax.set_title("Position error of solution.csv against the truth")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-        page.add("position_error", "Position error (east, north, up) against the truth", fig)
+        _time_series(page, "position_error", "Position error of solution.csv against the truth", t,
+                     [(errors[:, k], "%s (RMS %.2f m)" % (axis, np.sqrt(np.nanmean(errors[:, k] ** 2))))
+                      for k, axis in enumerate(("east", "north", "up"))], "time since the first fix (s)", "error (m)")
 
-    fig, ax = plt.subplots(figsize=(10, 4))
-    for c, label in (("vel_e_mps", "east"), ("vel_n_mps", "north"), ("vel_u_mps", "up")):
-        ax.plot(t, solution[c], lw=0.8, label=label)
-    ax.set_xlabel("time since the first fix (s)")
-    ax.set_ylabel("velocity (m/s)")
-    ax.set_title("Velocity of solution.csv")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    page.add("velocity", "Velocity (east, north, up)", fig)
+    _time_series(page, "velocity", "Velocity of solution.csv (east, north, up)", t,
+                 [(solution[c], label) for c, label in (("vel_e_mps", "east"), ("vel_n_mps", "north"),
+                                                        ("vel_u_mps", "up"))],
+                 "time since the first fix (s)", "velocity (m/s)")
 
     fig, ax = plt.subplots(figsize=(10, 4))
     ax.step(t, solution["num_sats"], where="post", color="k", label="satellites used")
@@ -215,15 +243,8 @@ def _nav_figures(page, nav, truth):
     axes[-1].set_xlabel("t_s (s)")
     page.add("nav_attitude", "GNSS/INS attitude with 1-sigma", fig)
 
-    fig, ax = plt.subplots(figsize=(10, 4))
-    for c in ("vel_n_mps", "vel_e_mps", "vel_d_mps"):
-        ax.plot(t, nav[c], lw=0.8, label=c)
-    ax.set_xlabel("t_s (s)")
-    ax.set_ylabel("velocity (m/s)")
-    ax.set_title("GNSS/INS velocity (nav.csv, NED)")
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
-    page.add("nav_velocity", "GNSS/INS velocity", fig)
+    _time_series(page, "nav_velocity", "GNSS/INS velocity (nav.csv, NED)", t,
+                 [(nav[c], c) for c in ("vel_n_mps", "vel_e_mps", "vel_d_mps")], "t_s (s)", "velocity (m/s)")
 
 
 def _nis_figure(page, rows, name, title):
@@ -304,8 +325,9 @@ def _summary_rows(summary, prefix=""):
     return rows
 
 
-def make_report(run_dir, truth=None, out_dir=None):
-    """Writes report.html and its PNG figures into out_dir (default RUN_DIR/report); returns the HTML's path."""
+def make_report(run_dir, truth=None, out_dir=None, prn=None):
+    """Writes report.html and its PNG figures into out_dir (default RUN_DIR/report); returns the HTML's path.
+    prn: the satellite of the prompt I/Q figure (default: the one tracked longest)."""
     run_dir = os.fspath(run_dir)
     if not os.path.isdir(run_dir):
         raise InputError(run_dir + ": not a folder")
@@ -317,6 +339,7 @@ def make_report(run_dir, truth=None, out_dir=None):
     tracking = _optional(readers.read_tracking, run_dir)
     if tracking is not None:
         _tracking_figures(page, tracking)
+        _iq_figure(page, tracking, prn)
     solution = _optional(readers.read_solution, run_dir)
     if solution is not None:
         _solution_figures(page, solution, truth_rows)
@@ -367,9 +390,10 @@ def main(argv=None):
     parser.add_argument("run_dir", help="the output folder of a run (receive, fuse, attitude, ...)")
     parser.add_argument("--truth", help="truth.csv of the simulation: position errors against it")
     parser.add_argument("--out", help="folder for report.html and its figures (default RUN_DIR/report)")
+    parser.add_argument("--prn", type=int, help="satellite of the prompt I/Q figure (default: tracked longest)")
     args = parser.parse_args(argv)
     try:
-        path = make_report(args.run_dir, args.truth, args.out)
+        path = make_report(args.run_dir, args.truth, args.out, args.prn)
     except InputError as e:
         print("ultratrack.report: %s" % e, file=sys.stderr)
         return 2

@@ -169,6 +169,15 @@ class ModuleTest(unittest.TestCase):
             ut.read_solution(os.path.join(self.dir, "missing_run"))
         self.assertIn("solution.csv", str(caught.exception))
 
+    def test_attitude_checks_its_files_against_the_array(self):
+        antennas = os.path.join(SOURCE, "scenarios", "attitude_antennas.toml")  # three antennas
+        with self.assertRaises(ut.InputError) as caught:
+            ut.attitude([self.input], "i8", 2.0e6, antennas, os.path.join(self.dir, "attitude"), nav=NAV)
+        self.assertIn("1 files for the 3 antennas of " + antennas, str(caught.exception))
+        with self.assertRaises(ut.InputError) as caught:
+            ut.attitude([self.input] * 3, "i8", 2.0e6, antennas, os.path.join(self.dir, "attitude"))
+        self.assertIn("reference week", str(caught.exception))
+
     def test_bad_settings_raise_the_librarys_messages(self):
         with self.assertRaises(ut.InputError) as caught:
             ut.receive(input=self.input, format="i9", fs=2.0e6, out=os.path.join(self.dir, "bad"))
@@ -222,12 +231,12 @@ class ModuleTest(unittest.TestCase):
     def test_report_names_every_figure_it_made(self):
         out = os.path.join(self.dir, "report")
         truth = os.path.join(self.dir, "sim", "truth.csv")
-        code = ultratrack.report.main([self.rx["out"], "--truth", truth, "--out", out])
+        code = ultratrack.report.main([self.rx["out"], "--truth", truth, "--out", out, "--prn", "3"])
         self.assertEqual(code, 0)
         with open(os.path.join(out, "report.html")) as f:
             page = f.read()
         figures = sorted(n for n in os.listdir(out) if n.endswith(".png"))
-        expected = {"cn0", "tracking_state", "position_map", "position_error", "velocity", "satellites_dop"}
+        expected = {"cn0", "tracking_state", "prompt_iq", "position_map", "position_error", "velocity", "satellites_dop"}
         self.assertEqual({n[:-4] for n in figures}, expected)
         for name in figures:
             self.assertGreater(os.path.getsize(os.path.join(out, name)), 1000, name)
@@ -235,6 +244,7 @@ class ModuleTest(unittest.TestCase):
             self.assertIn('alt="%s"' % name, page)
         self.assertIn("summary.json", page)
         self.assertIn("<td>fixes</td>", page)
+        self.assertIn("Prompt I/Q of PRN 3", page)
         # As a command: python3 -m ultratrack.report, on a folder with no files to plot, still a page.
         empty = os.path.join(self.dir, "empty_run")
         os.makedirs(empty)
