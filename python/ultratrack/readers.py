@@ -22,7 +22,7 @@ _SNIFF_ROWS = 500
 
 
 def _column_type(values):
-    values = [v for v in values]
+    values = list(values)
     if values and all(_INT.match(v) for v in values):
         return "i8"
     try:
@@ -31,7 +31,7 @@ def _column_type(values):
         return "f8"
     except ValueError:
         width = max([len(v) for v in values] + [1])
-        return "U%d" % max(16, 2 * width)
+        return "U%d" % max(64, 4 * width)  # room for longer text in rows after the sniffed ones
 
 
 def _read_slow(path, names):

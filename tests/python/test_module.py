@@ -6,7 +6,6 @@ file's samples against the file, bad input against its message, and the report a
 Environment: PYTHONPATH holding build/python, ULTRATRACK_PROGRAM (the `ultratrack` program; its comparison is
 skipped without it), ULTRATRACK_SOURCE_DIR (the checkout). Exits 77 (ctest: skipped) when the module was not built.
 """
-import json
 import math
 import os
 import shutil
