@@ -4,7 +4,8 @@
 # it links: the dependency rule is enforced by the compiler, not by discipline. Installed, the headers are
 # include/ultratrack/<layer>/*.hpp under one include root, and the library is Ultratrack::<layer> of the
 # exported package (every layer is listed in the global property ULTRATRACK_LAYERS, which
-# cmake/UltratrackInstall.cmake installs).
+# cmake/UltratrackInstall.cmake installs). With ULTRATRACK_LAYERS_PIC the libraries are position-independent (the
+# Python module links them).
 function(ultratrack_layer name)
   cmake_parse_arguments(ARG "" "" "DEPS;EXTERNAL" ${ARGN})
   set(include_root "${CMAKE_BINARY_DIR}/layer_include/${name}")
@@ -26,6 +27,9 @@ function(ultratrack_layer name)
     target_link_libraries(ultratrack_${name} INTERFACE ${ARG_DEPS} ${ARG_EXTERNAL})
   endif()
   set_target_properties(ultratrack_${name} PROPERTIES EXPORT_NAME ${name})
+  if(ULTRATRACK_LAYERS_PIC AND sources)  # linked into the Python extension module (python/)
+    set_target_properties(ultratrack_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  endif()
   add_library(ultratrack::${name} ALIAS ultratrack_${name})
   set_property(GLOBAL APPEND PROPERTY ULTRATRACK_LAYERS ${name})
   set_property(GLOBAL PROPERTY ULTRATRACK_LAYER_HEADERS_${name} "${headers}")

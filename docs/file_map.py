@@ -11,7 +11,7 @@ import os
 import re
 import sys
 
-LAYERS = ["io", "signals", "ins", "sim", "receiver", "fusion", "pipelines", "config", "tools"]
+LAYERS = ["io", "signals", "ins", "sim", "receiver", "fusion", "pipelines", "config", "tools", "python"]
 DOC = "docs/architecture.md"
 
 

@@ -1,27 +1,23 @@
-// `ultratrack attitude`: the multi-antenna receiver end to end. N IF files recorded on one clock (antenna 0 the
-// master) are read sample-synchronously (receiver/multi_sample_source.hpp); the scalar receiver acquires and
-// tracks each satellite on the master and correlates every antenna against the master's replica
-// (ReceiverOptions::num_antennas), each antenna's phase follows from the between-antenna prompt phase
-// (receiver/antenna_phase_tracker.hpp), and the AttitudeSolver turns each epoch into roll, pitch and yaw.
+// `ultratrack attitude`: the multi-antenna receiver end to end (pipelines/attitude_file.hpp). N IF files recorded on
+// one clock (antenna 0 the master); the scalar receiver acquires and tracks each satellite on the master and
+// correlates every antenna against the master's replica (ReceiverOptions::num_antennas), each antenna's phase
+// follows from the between-antenna prompt phase (receiver/antenna_phase_tracker.hpp), and the AttitudeSolver turns
+// each epoch into roll, pitch and yaw.
 // Outputs (receiver/attitude_outputs.hpp): attitude.csv, antenna_phases.csv, summary.json, position/ (as `receive`).
 // Exit: 0 with at least one attitude; 2 for bad input; 3 when the signal ended before an attitude (outputs written).
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
-#include <chrono>
-#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "config/antenna_config_toml.hpp"
-#include "receiver/attitude_outputs.hpp"
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "interrupt_guard.hpp"
-#include "receiver/multi_sample_source.hpp"
-#include "receiver/receiver_engine.hpp"
+#include "pipelines/attitude_file.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
@@ -44,84 +40,49 @@ void run_attitude(const AttitudeArgs& args) {
   if (args.inputs.size() != n_ant)
     throw signals::InputError("command line", fmt::format("--input: {} files for the {} antennas of {}",
                                                           args.inputs.size(), n_ant, args.antennas));
-  receiver::SampleSourceOptions source_options;
-  source_options.fs_hz = parse_double_option("--fs", args.fs);
-  source_options.if_hz = parse_double_option("--if", args.if_hz);
+  pipelines::AttitudeFileJob job;
+  job.inputs.assign(args.inputs.begin(), args.inputs.end());
+  job.format = *format;
+  job.solver = antennas.solver;
+  job.line_bias_cycles = antennas.line_bias_cycles;
+  job.out = args.out;
+  job.source.fs_hz = parse_double_option("--fs", args.fs);
+  job.source.if_hz = parse_double_option("--if", args.if_hz);
 
-  receiver::ReceiverOptions options;
-  options.fs_hz = source_options.fs_hz;
+  receiver::ReceiverOptions& options = job.options;
+  options.fs_hz = job.source.fs_hz;
   options.num_antennas = static_cast<int>(n_ant);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.interval.empty()) options.observation_interval_s = parse_double_option("--interval", args.interval);
-  signals::RinexNavData nav;
-  if (!args.nav.empty()) nav = signals::read_rinex_nav(args.nav);
+  if (!args.nav.empty()) job.navigation = signals::read_rinex_nav(args.nav);
   if (!args.reference_week.empty()) {
     options.reference_week = parse_int_option("--reference-week", args.reference_week);
     options.reference_week_is_signal_week = true;
-  } else if (!nav.ephemerides.empty()) {
-    options.reference_week = nav.ephemerides.front().week;
-    options.reference_week_is_signal_week = true;
-  } else {
+  } else if (job.navigation.ephemerides.empty()) {  // else the nav file dates it (pipelines::attitude_file)
     throw signals::InputError("command line", "give --nav or --reference-week (the full GPS week of the recording)");
   }
   if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError("command line", why);
-  const double duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
-  if (duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
-
-  std::vector<std::filesystem::path> paths(args.inputs.begin(), args.inputs.end());
-  receiver::MultiSampleSource source(paths, *format, source_options);
-  std::int64_t to_process = source.total_samples();
-  if (duration_s > 0.0) to_process = std::min<std::int64_t>(to_process, std::llround(duration_s * options.fs_hz));
-
-  receiver::AttitudeOutputs outputs(args.out, options.fs_hz, options.observation_interval_s, antennas.solver,
-                          antennas.line_bias_cycles);
-  receiver::ReceiverEngine engine(options, outputs);
-  if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
+  job.duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
+  if (job.duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
 
   InterruptGuard interrupt;  // Ctrl-C ends the loop; the outputs are still finished
-  const auto block_size = static_cast<std::size_t>(std::max<std::int64_t>(1, std::llround(0.05 * options.fs_hz)));
-  std::vector<std::vector<std::complex<float>>> blocks(n_ant, std::vector<std::complex<float>>(block_size));
-  std::vector<std::span<std::complex<float>>> out(n_ant);
-  std::vector<std::span<const std::complex<float>>> in(n_ant);
-  const auto wall_start = std::chrono::steady_clock::now();
-  std::int64_t done = 0;
   double next_progress_s = 10.0;
-  while (done < to_process && !interrupt.interrupted()) {
-    const auto want = static_cast<std::size_t>(std::min<std::int64_t>(block_size, to_process - done));
-    for (std::size_t a = 0; a < n_ant; ++a) out[a] = std::span(blocks[a].data(), want);
-    const receiver::SampleBlock got = source.read(out);
-    if (got.count == 0) break;
-    for (std::size_t a = 0; a < n_ant; ++a) in[a] = std::span<const std::complex<float>>(blocks[a].data(), got.count);
-    engine.process(std::span<const std::span<const std::complex<float>>>(in), got.first_sample);
-    done += static_cast<std::int64_t>(got.count);
-    const double t = receiver::processed_seconds(engine);
-    if (!args.quiet && t >= next_progress_s) {
-      next_progress_s += 10.0;
-      const auto& s = outputs.stats();
-      fmt::print(stderr, "attitude: {:.0f} s, tracking {}, attitude epochs {} (fixed {})\n", t,
-                 engine.channels_in_use(), s.attitude_epochs, s.fixed_epochs);
-    }
-  }
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-
-  receiver::RunDescription run;
-  run.input = args.inputs.front();
-  run.format = args.format;
-  run.fs_hz = options.fs_hz;
-  run.if_hz = source_options.if_hz;
-  run.wall_time_s = wall_s;
-  run.interrupted = interrupt.interrupted();
-  outputs.finish(engine, run, args.inputs);
-
-  const double t = receiver::processed_seconds(engine);
-  const auto& s = outputs.stats();
-  fmt::print("attitude: {:.1f} s of signal, {} antennas, in {:.1f} s ({:.1f}x real time, {} threads)\n", t, n_ant,
-             wall_s, wall_s > 0 ? t / wall_s : 0.0, engine.threads());
+  const pipelines::AttitudeFileResult r = pipelines::attitude_file(
+      std::move(job), interrupt.token(), [&](const receiver::ReceiverEngine& engine, const receiver::AttitudeStats& s) {
+        const double t = receiver::processed_seconds(engine);
+        if (args.quiet || t < next_progress_s) return;
+        next_progress_s += 10.0;
+        fmt::print(stderr, "attitude: {:.0f} s, tracking {}, attitude epochs {} (fixed {})\n", t,
+                   engine.channels_in_use(), s.attitude_epochs, s.fixed_epochs);
+      });
+  const auto& s = r.stats;
+  fmt::print("attitude: {:.1f} s of signal, {} antennas, in {:.1f} s ({:.1f}x real time, {} threads)\n", r.processed_s,
+             n_ant, r.wall_s, r.wall_s > 0 ? r.processed_s / r.wall_s : 0.0, r.threads);
   fmt::print("attitude: epochs {}, with attitude {}, fixed {} ({:.1f} %); outputs in {}\n", s.epochs, s.attitude_epochs,
              s.fixed_epochs, s.epochs ? 100.0 * s.fixed_epochs / s.epochs : 0.0, args.out);
   if (s.attitude_epochs == 0)
-    throw CommandExit(3, fmt::format("no attitude in {:.1f} s of signal (outputs in {})", t, args.out));
+    throw CommandExit(3, fmt::format("no attitude in {:.1f} s of signal (outputs in {})", r.processed_s, args.out));
 }
 
 }  // namespace

@@ -10,8 +10,9 @@ cd "$(dirname "$0")/.."
 packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-dev libcli11-dev
           libtomlplusplus-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev)
 # The test suite also runs RTKLIB (convbin, rnx2rtkp) on our RINEX output as an independent reader.
-# python3: ctest docs.file_map checks docs/architecture.md's module tables against the code.
-[[ "${1:-build}" == test ]] && packages+=(rtklib python3)
+# python3: ctest docs.file_map checks docs/architecture.md's module tables against the code; pybind11-dev,
+# python3-dev, python3-numpy and python3-matplotlib: the Python package (python/) and its tests (python.module).
+[[ "${1:-build}" == test ]] && packages+=(rtklib python3 pybind11-dev python3-dev python3-numpy python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
