@@ -189,10 +189,15 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
     const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
     const auto a = align_moving(imu, gnss_velocities(gnss), c, window, position_only);
-    if (!a)
-      throw io::InputError("GNSS file", fmt::format("no in-motion alignment: the fixes never show {} m/s for {} s "
-                                                    "within the IMU data",
-                                                    c.motion_min_speed_mps, c.motion_window_s));
+    if (!a) {
+      double fastest = 0.0;
+      for (const auto& v : gnss_velocities(gnss)) fastest = std::max(fastest, v.v_n.head<2>().norm());
+      throw AlignmentUnavailable(fmt::format(
+          "no in-motion alignment: the fixes never show {} m/s for {} s within the IMU data (fastest {:.2f} m/s); "
+          "for a slower platform lower [alignment] motion_min_speed_mps (the heading then comes from a shorter, "
+          "noisier track), or align with --align static, config or attitude",
+          c.motion_min_speed_mps, window, fastest));
+    }
     start = *a;
   } else if (s.align == AlignMode::Attitude) {
     if (attitude.empty()) throw io::InputError("command line", "--align attitude needs --attitude FILE");
@@ -201,7 +206,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       return a.t_s >= from && a.t_s < imu.back().t_s && fusion::attitude_usable(a.attitude, attitude_options);
     });
     if (it == attitude.end())
-      throw io::InputError(s.attitude_file, fmt::format("--align attitude: no fixed attitude within the IMU and GNSS "
+      throw AlignmentUnavailable(s.attitude_file + ": " + fmt::format("--align attitude: no fixed attitude within the IMU and GNSS "
                                                         "data ({:.3f}-{:.3f} s)",
                                                         from, imu.back().t_s));
     start.t_s = it->t_s;
@@ -275,6 +280,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     }
     result.final_sigma = sig;
     result.final_nav = out.nav;
+    result.accel_bias_b = out.accel_bias_b;
+    result.gyro_bias_b = out.gyro_bias_b;
+    result.sigma_accel_bias_b = out.sigma_accel_bias_b;
+    result.sigma_gyro_bias_b = out.sigma_gyro_bias_b;
   };
   emit(integration.output());
   for (; k < imu.size() && !stop.stop_requested(); ++k) {

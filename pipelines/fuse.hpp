@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <stop_token>
 #include <string>
 #include <utility>
@@ -28,6 +29,12 @@
 #include "pipelines/navigation_initialisation.hpp"
 
 namespace ultratrack::pipelines {
+
+// The data hold no window the chosen alignment can use (the platform never reaches the in-motion alignment's speed,
+// no fixed GPS attitude, ...): not bad input but a run without a solution, with what to change in the message.
+struct AlignmentUnavailable : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 struct FuseSettings {
   fusion::FilterKind filter = fusion::FilterKind::Ekf;
@@ -72,6 +79,9 @@ struct FuseResult {
   std::optional<double> converged_at_s;  // heading 1-sigma below the threshold from here to the end
   NavSigma final_sigma;
   ins::NavState final_nav;
+  // The IMU bias estimates at the end and their 1-sigma (body axes, m/s^2 and rad/s).
+  Eigen::Vector3d accel_bias_b = Eigen::Vector3d::Zero(), gyro_bias_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sigma_accel_bias_b = Eigen::Vector3d::Zero(), sigma_gyro_bias_b = Eigen::Vector3d::Zero();
   std::optional<ErrorRms> rms_all, rms_converged;  // against truth
   std::optional<ErrorRms> gnss_rms;                // the fixes themselves against truth (antenna)
   std::vector<OutageResult> outages;
@@ -80,8 +90,8 @@ struct FuseResult {
 
 // Every solution row (after each IMU interval) goes to on_row. truth: a trajectory on the IMU time line for the
 // RMS statistics (empty: none). A stop request ends the run after the current IMU interval (the result then covers
-// the rows so far). Throws io::InputError for inputs that do not fit together (no overlap in time, no alignment
-// window, unknown preset, ...).
+// the rows so far). Throws io::InputError for inputs that do not fit together (no overlap in time, unknown preset,
+// ...) and AlignmentUnavailable when the data hold no window the chosen alignment can use.
 FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssFixRow>& gnss,
                 const std::vector<ins::TruthSample>& truth, const FuseSettings& settings,
                 const std::function<void(const ins::NavState&, const NavSigma&)>& on_row = {},

@@ -71,6 +71,14 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
                    "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
                    g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
                    g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg, g.attitude_ned_rad.z() / io::kRadPerDeg);
+  constexpr double kMg = 9.80665e-3, kDph = io::kRadPerDeg / 3600.0;
+  auto triple = [](const Eigen::Vector3d& v, double unit) {
+    return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x() / unit, v.y() / unit, v.z() / unit);
+  };
+  j += fmt::format("  \"bias_estimates\": {{\"accel_mg\": {}, \"sigma_accel_mg\": {}, \"gyro_dph\": {}, "
+                   "\"sigma_gyro_dph\": {}}},\n",
+                   triple(r.accel_bias_b, kMg), triple(r.sigma_accel_bias_b, kMg), triple(r.gyro_bias_b, kDph),
+                   triple(r.sigma_gyro_bias_b, kDph));
   if (r.rms_all) j += "  \"rms_all\": " + rms_json(*r.rms_all) + ",\n";
   if (r.rms_converged) j += "  \"rms_converged\": " + rms_json(*r.rms_converged) + ",\n";
   if (r.gnss_rms) j += "  \"gnss_only_rms\": " + rms_json(*r.gnss_rms) + ",\n";

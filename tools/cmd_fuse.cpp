@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "command_exit.hpp"
 #include "commands.hpp"
 #include "io/units.hpp"
 #include "pipelines/gps_attitude_csv.hpp"
@@ -98,15 +99,21 @@ void run_fuse_command(const FuseCommandOptions& o) {
   long long rows = 0;
   const auto t0 = std::chrono::steady_clock::now();
   InterruptGuard interrupt;  // Ctrl-C ends the run early; nav.csv and summary.json cover it so far
-  const pipelines::FuseResult r = pipelines::fuse(
-      imu, gnss, pipelines::truth_samples_from_nav(truth), s,
-      [&](const ins::NavState& state, const pipelines::NavSigma& sigma) {
-        if (rows++ % o.decimate == 0) nav.write(state, sigma);
-      },
-      [&](double fraction) {
-        if (!o.quiet) fmt::print("fuse: {:3.0f} %\n", 100.0 * fraction);
-      },
-      interrupt.token());
+  const pipelines::FuseResult r = [&] {
+    try {
+      return pipelines::fuse(
+          imu, gnss, pipelines::truth_samples_from_nav(truth), s,
+          [&](const ins::NavState& state, const pipelines::NavSigma& sigma) {
+            if (rows++ % o.decimate == 0) nav.write(state, sigma);
+          },
+          [&](double fraction) {
+            if (!o.quiet) fmt::print("fuse: {:3.0f} %\n", 100.0 * fraction);
+          },
+          interrupt.token());
+    } catch (const pipelines::AlignmentUnavailable& e) {
+      throw CommandExit(3, std::string("fuse: no solution: ") + e.what());  // nav.csv is not left behind
+    }
+  }();
   nav.commit();
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   io::write_file_atomically(fs::path(o.out_dir) / "summary.json",

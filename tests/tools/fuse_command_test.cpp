@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "command_exit.hpp"
 #include "commands.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
@@ -155,10 +156,16 @@ TEST(FuseCommand, BadInputIsOneInputError) {
   EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--filter", "kf", "--out", out}), InputError);
   EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--coupling", "tight", "--out", out}), InputError);
   EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--align", "config", "--out", out}), InputError);
-  // never faster than 5 m/s for 2 s within 12 s of data
+  // Never 500 m/s: not bad input but no solution (exit 3), with the speed the data show and what to change.
   std::ofstream(dir / "short.toml") << "[alignment]\nmotion_min_speed_mps = 500.0\n";
-  EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--config", (dir / "short.toml").string(), "--out", out}),
-               InputError);
+  try {
+    run({"fuse", "--imu", imu, "--gnss", gnss, "--config", (dir / "short.toml").string(), "--out", out});
+    ADD_FAILURE() << "aligned at 500 m/s";
+  } catch (const ultratrack::tools::CommandExit& e) {
+    EXPECT_EQ(e.code, 3);
+    EXPECT_NE(std::string(e.what()).find("fastest"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("motion_min_speed_mps"), std::string::npos) << e.what();
+  }
   std::ofstream(dir / "bad.toml") << "[filter]\nukf_alpha = -1.0\n";
   EXPECT_THROW(run({"fuse", "--imu", imu, "--gnss", gnss, "--config", (dir / "bad.toml").string(), "--out", out}),
                InputError);
