@@ -4,6 +4,8 @@
 # told only the datasheet values (scenarios/mems_datasheet_fuse.toml) with in-motion alignment, and the errors after
 # the first 60 s (benchmarks/nav_error_stats.py). One line per run, then the median and worst of each column.
 #   benchmarks/mems_fusion.sh [--build DIR] [--seeds "1 2 3 4 5"] [--out DIR] [--fixes vel|pos] [--filter ekf|ukf]
+#       [--scenario S.toml (default scenarios/mems_drive_adis16405.toml)] [--fuse-config C.toml (default
+#       scenarios/mems_datasheet_fuse.toml)] [--from-s 60]
 #       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--correlation S] [--interval S] [--told-correlation S]
 # --correlation: the fixes' errors first-order Gauss-Markov with that time (gnsssim); --interval: the filter's
 # decorrelating interval between fixes used ([gnss] update_interval_s); --told-correlation: the correlation
@@ -12,34 +14,42 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="$here/build"; seeds="1 2 3 4 5"; out="${TMPDIR:-/tmp}/mems_fusion"; fixes=vel; filter=ekf; nhc=on
 sigma="0.5 0.5 1.0"; correlation=0; interval=0; told=0
+scenario="$here/scenarios/mems_drive_adis16405.toml"; fuse_config="$here/scenarios/mems_datasheet_fuse.toml"; from_s=60
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build="$2"; shift 2 ;; --seeds) seeds="$2"; shift 2 ;; --out) out="$2"; shift 2 ;;
     --fixes) fixes="$2"; shift 2 ;; --filter) filter="$2"; shift 2 ;; --nhc) nhc="$2"; shift 2 ;;
     --sigma) sigma="$2"; shift 2 ;; --correlation) correlation="$2"; shift 2 ;; --interval) interval="$2"; shift 2 ;;
     --told-correlation) told="$2"; shift 2 ;;
+    --scenario) scenario="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+    --fuse-config) fuse_config="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+    --from-s) from_s="$2"; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
 U="$build/tools/ultratrack"
 mkdir -p "$out"
-cp "$here/scenarios/mems_drive_segments.csv" "$out/"
+segments=$(sed -n 's/^file = "\(.*\)"/\1/p' "$scenario")
+[ -n "$segments" ] && cp "$(dirname "$scenario")/$segments" "$out/"
 config="$out/fuse.toml"
-cp "$here/scenarios/mems_datasheet_fuse.toml" "$config"
-[ "$nhc" = on ] && printf '\n[vehicle]\nnhc = true\n' >> "$config"
+grep -v '^nhc = ' "$fuse_config" > "$config"
+if [ "$nhc" = on ]; then
+  if grep -q '^\[vehicle\]' "$config"; then sed -i 's/^\[vehicle\]/[vehicle]\nnhc = true/' "$config"
+  else printf '\n[vehicle]\nnhc = true\n' >> "$config"; fi
+fi
 printf '\n[gnss]\nupdate_interval_s = %s\nerror_correlation_time_s = %s\n' "$interval" "$told" >> "$config"
 velocity_flag=""; [ "$fixes" = pos ] && velocity_flag="--no-velocity"
 echo "fixes $fixes ($sigma m, correlation ${correlation} s, used every ${interval} s, filter told ${told} s), filter $filter, nhc $nhc"
 for seed in $seeds; do
   run="$out/seed$seed"
-  sed "s/^seed = .*/seed = $seed/" "$here/scenarios/mems_drive_adis16405.toml" > "$out/scenario_$seed.toml"
+  sed "s/^seed = .*/seed = $seed/" "$scenario" > "$out/scenario_$seed.toml"
   "$U" simulate --scenario "$out/scenario_$seed.toml" --out "$run/sim" --quiet >/dev/null
   # shellcheck disable=SC2086
   "$U" gnsssim --truth "$run/sim/truth.csv" --rate 5 --first 0.137 --sigma $sigma --correlation "$correlation" \
       $velocity_flag --seed "$seed" --out "$run/gnss.csv" >/dev/null
   "$U" fuse --imu "$run/sim/imu.csv" --gnss "$run/gnss.csv" --config "$config" --filter "$filter" --align motion \
       --out "$run/fuse" --quiet >/dev/null
-  stats=$(python3 "$here/benchmarks/nav_error_stats.py" "$run/fuse/nav.csv" "$run/sim/truth.csv" --from-s 60)
+  stats=$(python3 "$here/benchmarks/nav_error_stats.py" "$run/fuse/nav.csv" "$run/sim/truth.csv" --from-s "$from_s")
   extra=$(python3 -c "import json,sys; s=json.load(open('$run/fuse/summary.json')); print(json.dumps({'rejected': s['fix_updates_rejected'], 'used': s['fixes_used'], 'recoveries': s['lockout_recoveries']}))")
   echo "seed $seed $stats $extra"
 done | tee "$out/runs.txt"
