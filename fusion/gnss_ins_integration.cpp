@@ -300,29 +300,14 @@ class Core final : public CoreBase {
             ++counters.height_rejected;
         }
       }
-      bool any_accepted = false;
-      double nis = 0.0, range_innovation2 = 0.0;
-      int dof = 0;
-      for (const auto& s : sats) {
-        any_accepted |= update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
-                                                                    opt_.tight.use_range_rate)),
-                               s.prn);
-        const UpdateResult& r = records.back().result;
-        nis += std::isfinite(r.nis) ? r.nis : 1e6;
-        dof += r.dof;
-        if (r.innovation.size() > 0) range_innovation2 += r.innovation(0) * r.innovation(0);
-      }
+      const EpochUpdates u = update_satellites(sats);
       if (!sats.empty()) {
-        if (auto event = monitor_.observe(nominal_.nav.t_s, any_accepted, nis, dof)) {
-          const double rms = std::sqrt(range_innovation2 / static_cast<double>(sats.size()));
+        if (auto event = monitor_.observe(nominal_.nav.t_s, u.any_accepted, u.nis, u.dof)) {
+          const double rms = std::sqrt(u.range_innovation2 / static_cast<double>(sats.size()));
           recover(*event, Eigen::Vector3d::Constant(rms), std::nullopt, rms);
           // This epoch again, through the opened filter (linearised about the current nominal).
-          const auto again = prepare_satellites(e.epoch, e.ephemerides, e.iono,
-                                                antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight, nullptr);
-          for (const auto& s : again)
-            update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
-                                                        opt_.tight.use_range_rate)),
-                   s.prn);
+          update_satellites(prepare_satellites(e.epoch, e.ephemerides, e.iono,
+                                               antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight));
         }
       }
       if constexpr (N == 18) {  // full geometry: this epoch's height is the terrain reference from now on
@@ -359,6 +344,26 @@ class Core final : public CoreBase {
       return TerrainAugmentedModel(o.model, o.height_aiding);
     else
       return InsErrorModel<N>(o.model);
+  }
+
+  // One epoch's satellite updates, and what the lock-out monitor needs of them.
+  struct EpochUpdates {
+    bool any_accepted = false;
+    double nis = 0.0, range_innovation2 = 0.0;
+    int dof = 0;
+  };
+  EpochUpdates update_satellites(const std::vector<SatelliteObservable>& sats) {
+    EpochUpdates u;
+    for (const auto& s : sats) {
+      u.any_accepted |= update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
+                                                                    opt_.tight.use_range_rate)),
+                               s.prn);
+      const UpdateResult& r = records.back().result;
+      u.nis += std::isfinite(r.nis) ? r.nis : 1e6;
+      u.dof += r.dof;
+      if (r.innovation.size() > 0) u.range_innovation2 += r.innovation(0) * r.innovation(0);
+    }
+    return u;
   }
 
   // Lock-out recovery: open the covariance of what the measurements observe, log the event.

@@ -14,6 +14,14 @@ namespace {
 
 }  // namespace
 
+std::string recovery_events_json(const std::vector<fusion::RecoveryEvent>& events) {
+  std::string j = "[";
+  for (std::size_t i = 0; i < events.size(); ++i)
+    j += fmt::format("{}{{\"t_s\": {:.3f}, \"reason\": \"{}\"}}", i ? ", " : "", events[i].t_s,
+                     io::json_escape(events[i].reason));
+  return j + "]";
+}
+
 std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
                               const std::string& gnss_file, const std::string& truth_file) {
   auto rms_json = [](const ErrorRms& e) {
@@ -45,11 +53,8 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   if (s.config.land.nhc)
     j += fmt::format("  \"nhc_updates_accepted\": {},\n  \"nhc_updates_rejected\": {},\n", r.counters.nhc_accepted,
                      r.counters.nhc_rejected);
-  j += fmt::format("  \"lockout_recoveries\": {},\n  \"recovery_events\": [", r.counters.recoveries);
-  for (std::size_t i = 0; i < r.recovery_events.size(); ++i)
-    j += fmt::format("{}{{\"t_s\": {:.3f}, \"reason\": \"{}\"}}", i ? ", " : "", r.recovery_events[i].t_s,
-                     io::json_escape(r.recovery_events[i].reason));
-  j += "],\n";
+  j += fmt::format("  \"lockout_recoveries\": {},\n  \"recovery_events\": {},\n", r.counters.recoveries,
+                   recovery_events_json(r.recovery_events));
   if (!s.attitude.empty()) {
     const AttitudeUse& a = r.attitude;
     const auto& n = r.counters;

@@ -20,6 +20,7 @@
 #include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
+#include "pipelines/fuse_summary.hpp"
 #include "pipelines/imu_model_json.hpp"
 
 namespace ultratrack::pipelines {
@@ -460,12 +461,8 @@ std::string GnssInsCoupler::summary_json() const {
                    "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
                    m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
                    k.satellites_missing_ephemeris);
-  j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": [", k.recoveries);
-  const auto& events = m.integration->recovery_events();
-  for (std::size_t i = 0; i < events.size(); ++i)
-    j += fmt::format("{}{{\"t_s\": {:.3f}, \"reason\": \"{}\"}}", i ? ", " : "", events[i].t_s,
-                     io::json_escape(events[i].reason));
-  j += "]";
+  j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": {}", k.recoveries,
+                   recovery_events_json(m.integration->recovery_events()));
   if (m.is_tight())
     j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
                      "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "
