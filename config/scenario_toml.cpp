@@ -16,6 +16,8 @@
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory.hpp"
 #include "io/input_error.hpp"
+#include "signals/gps_constants.hpp"
+#include "signals/oscillator_allan.hpp"
 
 namespace ultratrack::config {
 namespace {
@@ -70,6 +72,7 @@ struct GivenKeys {
   bool llh = false, rinex = false, constellation = false, offsets = false;
   bool signal = false, trajectory = false, antennas = false, attitude = false;
   bool duration = false, start_state = false;
+  bool oscillator = false, clock_noise = false;
 };
 
 bool in_list(const std::vector<std::string>& names, const std::string& v) {
@@ -351,7 +354,7 @@ bool read_receiver_position_key(const Reader& r, const std::string& key, const s
 
 // [receiver]: the clock model's keys.
 void read_receiver_clock_key(const Reader& r, const std::string& key, const std::string& name, const toml::node& n,
-                             Scenario& s) {
+                             Scenario& s, GivenKeys& given) {
   if (key == "clock_bias_m") {
     s.clock_bias_m = r.number(n, name);
     r.check(n, name, std::abs(s.clock_bias_m) < 3e8, "must be below 1 light-second");
@@ -361,9 +364,19 @@ void read_receiver_clock_key(const Reader& r, const std::string& key, const std:
   } else if (key == "clock_bias_noise_m_per_sqrt_s") {
     s.clock_bias_noise_m_per_sqrt_s = r.number(n, name);
     r.check(n, name, s.clock_bias_noise_m_per_sqrt_s >= 0, "must be >= 0");
+    given.clock_noise = true;
   } else if (key == "clock_drift_noise_mps_per_sqrt_s") {
     s.clock_drift_noise_mps_per_sqrt_s = r.number(n, name);
     r.check(n, name, s.clock_drift_noise_mps_per_sqrt_s >= 0, "must be >= 0");
+    given.clock_noise = true;
+  } else if (key == "oscillator") {
+    // A named oscillator sets both random walks from its Allan coefficients (signals/oscillator_allan.hpp).
+    const auto allan = signals::oscillator_preset(r.string(n, name));
+    if (!allan) r.fail(n, name, "unknown oscillator (" + joined(signals::oscillator_preset_names()) + ")");
+    const signals::ReceiverClockModel noise = signals::receiver_clock_from_allan(*allan);
+    s.clock_bias_noise_m_per_sqrt_s = noise.bias_noise_s_per_sqrt_s * signals::kSpeedOfLight_mps;
+    s.clock_drift_noise_mps_per_sqrt_s = noise.drift_noise_sps_per_sqrt_s * signals::kSpeedOfLight_mps;
+    given.oscillator = true;
   } else {
     r.fail(n, name, "unknown key in [receiver]");
   }
@@ -371,7 +384,9 @@ void read_receiver_clock_key(const Reader& r, const std::string& key, const std:
 
 void read_receiver_key(const Reader& r, const std::string& key, const std::string& name, const toml::node& n,
                        Scenario& s, GivenKeys& given) {
-  if (!read_receiver_position_key(r, key, name, n, s, given)) read_receiver_clock_key(r, key, name, n, s);
+  if (!read_receiver_position_key(r, key, name, n, s, given)) read_receiver_clock_key(r, key, name, n, s, given);
+  if (given.oscillator && given.clock_noise)
+    r.fail(n, name, "give either oscillator or the clock noise keys (clock_*_noise_*), not both");
   if (given.llh && !s.trajectory.empty()) r.fail(n, name, "give either llh_deg_m or trajectory, not both");
   if (given.offsets && !s.trajectory.empty())
     r.fail(n, name, "antenna_offsets_enu_m needs a static receiver (llh_deg_m), not a trajectory");

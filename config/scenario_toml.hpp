@@ -12,6 +12,8 @@
 //                 antenna_offsets_enu_m = [[0, 0, 0], [1.0, 0, 0]]   (static receiver: one file per antenna)
 //                 clock_bias_m = 0.0  clock_drift_mps = 0.0
 //                 clock_bias_noise_m_per_sqrt_s = 0.0  clock_drift_noise_mps_per_sqrt_s = 0.0
+//                 or  oscillator = "tcxo" | "ocxo"   (both random walks from the oscillator's Allan coefficients,
+//                 signals/oscillator_allan.hpp; the written scenario carries the two noise values)
 //   [atmosphere]  ionosphere = true  troposphere = false
 //   [output]      truth_rate_hz = 10.0
 //

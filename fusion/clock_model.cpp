@@ -6,12 +6,6 @@
 
 namespace ultratrack::fusion {
 
-std::optional<OscillatorAllan> oscillator_preset(const std::string& name) {
-  if (name == "tcxo") return OscillatorAllan{2e-19, 2e-20};
-  if (name == "ocxo") return OscillatorAllan{8e-20, 4e-23};
-  return std::nullopt;
-}
-
 ClockNoiseModel clock_noise_from_allan(const OscillatorAllan& allan, const ClockNoiseModel& base) {
   constexpr double c2 = signals::kSpeedOfLight_mps * signals::kSpeedOfLight_mps;
   ClockNoiseModel out = base;

@@ -10,17 +10,14 @@
 #include <string>
 
 #include "fusion/ins_error_model.hpp"
+#include "signals/oscillator_allan.hpp"
 
 namespace ultratrack::fusion {
 
-struct OscillatorAllan {
-  double h0 = 2e-19;       // white frequency
-  double h_minus2 = 2e-20;  // random-walk frequency
-};
-
-// Brown & Hwang's table of typical oscillators: "tcxo" (compensated crystal: h0 2e-19, h-2 2e-20) and
-// "ocxo" (oven-controlled: h0 8e-20, h-2 4e-23). Nothing for another name.
-std::optional<OscillatorAllan> oscillator_preset(const std::string& name);
+// The oscillator and its presets are the signal layer's (signals/oscillator_allan.hpp): the simulator's clock
+// and the filters' clock model come from the same coefficients.
+using signals::OscillatorAllan;
+using signals::oscillator_preset;
 
 // The clock part of the error model (PSDs from h0, h-2; initial sigmas kept from `base`).
 ClockNoiseModel clock_noise_from_allan(const OscillatorAllan& allan, const ClockNoiseModel& base = {});
