@@ -284,6 +284,11 @@ void read_signal_key(const Reader& r, const std::string& key, const std::string&
     s.nav_data = r.boolean(n, name);
   } else if (key == "noise") {
     s.noise = r.boolean(n, name);
+  } else if (key == "parameter_update_s") {
+    s.parameter_update_s = r.number(n, name);
+    const double ms = s.parameter_update_s * 1e3;
+    r.check(n, name, ms >= 1.0 - 1e-9 && ms <= 1000.0 + 1e-9 && std::abs(ms - std::round(ms)) < 1e-6,
+            "must be a whole number of milliseconds within 0.001..1 s");
   } else {
     r.fail(n, name, "unknown key in [signal]");
   }
@@ -316,6 +321,14 @@ void read_navigation_key(const Reader& r, const std::string& key, const std::str
     r.check(n, name, s.elevation_mask_deg >= -90 && s.elevation_mask_deg <= 90, "must be within -90..90");
   } else if (key == "include_unhealthy") {
     s.include_unhealthy = r.boolean(n, name);
+  } else if (key == "field_rounding") {
+    const std::string v = r.string(n, name);
+    if (v != "nearest" && v != "toward_zero") r.fail(n, name, "must be \"nearest\" or \"toward_zero\"");
+    s.nav_field_rounding = v == "nearest" ? signals::FieldRounding::nearest : signals::FieldRounding::toward_zero;
+  } else if (key == "pages") {
+    const std::string v = r.string(n, name);
+    if (v != "almanac" && v != "random") r.fail(n, name, "must be \"almanac\" or \"random\"");
+    s.nav_random_pages = v == "random";
   } else {
     r.fail(n, name, "unknown key in [navigation]");
   }
@@ -463,6 +476,9 @@ void read_imu_key(const Reader& r, const std::string& key, const std::string& na
     const auto v = r.integer(n, name);
     r.check(n, name, v >= 0, "must be >= 0");
     s.imu_seed = static_cast<std::uint64_t>(v);
+  } else if (key == "time_offset_s") {
+    s.imu_time_offset_s = r.number(n, name);
+    r.check(n, name, std::abs(s.imu_time_offset_s) <= 0.1, "must be within +-0.1 s");
   } else {
     const auto keys = ins::imu_datasheet_keys();
     const auto k = std::find_if(keys.begin(), keys.end(), [&](const auto& d) { return d.name == key; });

@@ -15,6 +15,10 @@
 //                 or  oscillator = "tcxo" | "ocxo"   (both random walks from the oscillator's Allan coefficients,
 //                 signals/oscillator_allan.hpp; the written scenario carries the two noise values)
 //   [atmosphere]  ionosphere = true  troposphere = false
+//   Another generator's conventions (signals/if_synthesiser.hpp, lnav_transmitter.hpp), all off by default:
+//   [signal] parameter_update_s = 0.001 (0.1: exact parameters every 0.1 s, rates held between)
+//   [navigation] field_rounding = "nearest" | "toward_zero"   pages = "almanac" | "random"
+//   [imu] time_offset_s = 0.0 (the IMU's stamps read true time + this, within +-0.1 s)
 //   [output]      truth_rate_hz = 10.0
 //
 // Inertial scenarios (one trajectory drives the IMU data, the truth and the IF synthesiser's antennas):

@@ -51,6 +51,8 @@ std::string signal_toml(const Scenario& s) {
   }
   out += first ? "}\n" : " }\n";
   out += fmt::format("nav_data = {}\nnoise = {}\n", s.nav_data, s.noise);
+  // The other-generator conventions are written only when set, so that other echoes stay as they were.
+  if (s.parameter_update_s != 1e-3) out += fmt::format("parameter_update_s = {}\n", toml_float(s.parameter_update_s));
   if (signals::is_two_bit(s.format))
     out += fmt::format("two_bit_coding = \"{}\"\ntwo_bit_order = \"{}\"\n", signals::to_string(s.two_bit.coding),
                        signals::to_string(s.two_bit.order));
@@ -68,6 +70,8 @@ std::string static_toml(const Scenario& s) {
   }
   out += fmt::format("elevation_mask_deg = {}\ninclude_unhealthy = {}\n", toml_float(s.elevation_mask_deg),
                      s.include_unhealthy);
+  if (s.nav_field_rounding == signals::FieldRounding::toward_zero) out += "field_rounding = \"toward_zero\"\n";
+  if (s.nav_random_pages) out += "pages = \"random\"\n";
   out += "\n[receiver]\n";
   if (!s.trajectory.empty()) {
     out += "trajectory = " + absolute_toml_path(s, s.trajectory) + "\n";
@@ -111,6 +115,7 @@ std::string inertial_toml(const Scenario& s) {
   out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                      s.odometer, toml_float(s.odometer_scale_factor_error));
   out += fmt::format("\n[imu]\npreset = {}\nseed = {}\n", toml_string(s.imu_preset), s.imu_seed);
+  if (s.imu_time_offset_s != 0.0) out += fmt::format("time_offset_s = {}\n", toml_float(s.imu_time_offset_s));
   for (const auto& key : ins::imu_datasheet_keys())
     if (const auto& value = s.imu_datasheet.*(key.member)) out += fmt::format("{} = {}\n", key.name, toml_float(*value));
   for (std::size_t i = 0; i < s.lever_arms_body_m.size(); ++i) {

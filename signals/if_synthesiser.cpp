@@ -76,6 +76,12 @@ struct IfSynthesiser::Impl {
     double noise_m = 0.0;
     bool noise_started = false;
     std::mt19937_64 rng;
+    // Held parameters (parameter_update_s > 1 ms): code and carrier advance per block, and the carrier
+    // offset (line bias, slips, extra noise) at the last update.
+    bool held = false;
+    double code_step_chips = 0.0;
+    double carrier_step_cycles = 0.0;
+    double offset_cycles = 0.0;
   };
 
   const SynthesiserOptions& opt;
@@ -86,6 +92,7 @@ struct IfSynthesiser::Impl {
   std::vector<synth::GaussianNoise> noise;
   std::vector<std::int64_t> step_samples;  // every C/N0 step's first sample, sorted, unique
   std::int64_t block_samples = 1;
+  std::int64_t update_blocks = 1;  // blocks per parameter update (1: exact nodes at every block)
   std::int64_t visibility_blocks = 1000;
   std::int64_t current_block = -1;
   double frac20_s = 0.0;          // start.tow_s modulo 20 ms: aligns code epochs and data bits with GPS time
@@ -173,17 +180,25 @@ struct IfSynthesiser::Impl {
     return s;
   }
 
-  Node node_at(std::size_t k, int antenna, const RxGeo& rx, std::int64_t sample) {
+  // The exact node without the carrier offsets.
+  Node geometric_node(std::size_t k, int antenna, const RxGeo& rx, std::int64_t sample) {
     Track& tr = tracks[static_cast<std::size_t>(antenna) * sats.size() + k];
     const Solution s = solve(sats[k], rx, tr.travel_guess_s, tr.d_guess_s);
     tr.travel_guess_s = s.travel_s;
     tr.d_guess_s = s.d_code_s;
-    return {sample, s.code_chips, s.carrier_cycles - carrier_offset_cycles(tr, sats[k].eph.prn, antenna, sample)};
+    return {sample, s.code_chips, s.carrier_cycles};
+  }
+
+  Node node_at(std::size_t k, int antenna, const RxGeo& rx, std::int64_t sample) {
+    Track& tr = tracks[static_cast<std::size_t>(antenna) * sats.size() + k];
+    Node n = geometric_node(k, antenna, rx, sample);
+    n.carrier_cycles -= carrier_offset_cycles(tr, sats[k].eph.prn, antenna, sample, kNodeInterval_s);
+    return n;
   }
 
   // Line bias + slips + extra noise of a track at a node, cycles, RINEX sense (the synthesised phase falls
-  // with range, so the caller subtracts it).
-  double carrier_offset_cycles(Track& tr, int prn, int antenna, std::int64_t sample) {
+  // with range, so the caller subtracts it); dt_s since the track's previous node (the noise's step).
+  double carrier_offset_cycles(Track& tr, int prn, int antenna, std::int64_t sample, double dt_s) {
     double cycles = 0.0;
     if (antenna < static_cast<int>(opt.antenna_impairments.size())) {
       const AntennaImpairment& imp = opt.antenna_impairments[static_cast<std::size_t>(antenna)];
@@ -194,7 +209,7 @@ struct IfSynthesiser::Impl {
           tr.noise_m = imp.phase_noise_m * gauss(tr.rng);
           tr.noise_started = true;
         } else {
-          const double phi = std::exp(-kNodeInterval_s / opt.phase_noise_correlation_s);
+          const double phi = std::exp(-dt_s / opt.phase_noise_correlation_s);
           tr.noise_m = phi * tr.noise_m + std::sqrt(1.0 - phi * phi) * imp.phase_noise_m * gauss(tr.rng);
         }
         cycles += tr.noise_m / kL1Wavelength_m;
@@ -230,10 +245,14 @@ struct IfSynthesiser::Impl {
     for (auto& sat : sats) sat.active = solve(sat, rx, 0.075, 0.0).timing.elevation_rad >= opt.elevation_mask_rad;
   }
 
-  // Makes n0/n1 of every active track the exact nodes of block b.
+  // Makes n0/n1 of every active track the exact nodes of block b (or the held ones).
   void enter_block(std::int64_t b) {
     if (b % visibility_blocks == 0 || current_block < 0) update_visibility(b * block_samples);
     current_block = b;
+    if (update_blocks > 1) {
+      enter_held_block(b);
+      return;
+    }
     const std::int64_t s0 = b * block_samples, s1 = s0 + block_samples;
     for (int a = 0; a < static_cast<int>(geo0.size()); ++a) {
       bool need0 = false;
@@ -250,6 +269,45 @@ struct IfSynthesiser::Impl {
         Track& tr = tracks[static_cast<std::size_t>(a) * sats.size() + k];
         if (tr.n0.sample != s0) tr.n0 = node_at(k, a, geo0[a], s0);
         tr.n1 = node_at(k, a, geo1[a], s1);
+      }
+    }
+  }
+
+  // Held parameters: at an update block (or a track's first) the exact nodes at its two ends give the code
+  // and carrier advance per block, kept until the next update; the code restarts from its exact value there,
+  // the carrier continues from where it was, stepping only by the change of its offsets (slips, line bias).
+  void enter_held_block(std::int64_t b) {
+    const std::int64_t s0 = b * block_samples, s1 = s0 + block_samples;
+    const bool update = b % update_blocks == 0;
+    for (int a = 0; a < static_cast<int>(geo0.size()); ++a) {
+      bool geo_done = false;
+      for (std::size_t k = 0; k < sats.size(); ++k) {
+        Track& tr = tracks[static_cast<std::size_t>(a) * sats.size() + k];
+        if (!sats[k].active) {
+          tr.held = false;
+          continue;
+        }
+        if (update || !tr.held) {
+          if (!geo_done) {
+            geo0[a] = rx_geo(a, tau_of(s0));
+            geo1[a] = rx_geo(a, tau_of(s1));
+            geo_done = true;
+          }
+          const Node e0 = geometric_node(k, a, geo0[a], s0);
+          const Node e1 = geometric_node(k, a, geo1[a], s1);
+          const double dt = tr.held ? static_cast<double>(update_blocks) * kNodeInterval_s : kNodeInterval_s;
+          const double offset = carrier_offset_cycles(tr, sats[k].eph.prn, a, s0, dt);
+          const double carrier0 =
+              tr.held ? tr.n1.carrier_cycles - (offset - tr.offset_cycles) : e0.carrier_cycles - offset;
+          tr.n0 = {s0, e0.code_chips, carrier0};
+          tr.code_step_chips = e1.code_chips - e0.code_chips;
+          tr.carrier_step_cycles = e1.carrier_cycles - e0.carrier_cycles;
+          tr.offset_cycles = offset;
+          tr.held = true;
+        } else {
+          tr.n0 = tr.n1;
+        }
+        tr.n1 = {s1, tr.n0.code_chips + tr.code_step_chips, tr.n0.carrier_cycles + tr.carrier_step_cycles};
       }
     }
   }
@@ -307,6 +365,9 @@ bool SynthesiserOptions::IsValid(std::string* why) const {
     if (!(std::abs(o.clock.drift_sps) < 1e-3)) return "clock drift must be below 1e-3 s/s (300 km/s)";
     if (!std::isfinite(o.clock.bias_s) || std::abs(o.clock.bias_s) > 1.0) return "clock bias must be below 1 s";
     if (!(o.phase_noise_correlation_s > 0.0)) return "phase noise correlation time must be positive";
+    if (!(o.parameter_update_s >= kNodeInterval_s - 1e-12 && o.parameter_update_s <= 1.0) ||
+        std::abs(o.parameter_update_s / kNodeInterval_s - std::round(o.parameter_update_s / kNodeInterval_s)) > 1e-6)
+      return "parameter update interval must be a whole number of milliseconds within 1 ms..1 s";
     for (const auto& imp : o.antenna_impairments) {
       if (!std::isfinite(imp.line_bias_cycles)) return "line bias must be finite";
       if (!(imp.phase_noise_m >= 0.0 && imp.phase_noise_m < 1.0)) return "phase noise must be within [0, 1) m";
@@ -357,6 +418,7 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
   impl_ = std::make_unique<Impl>(options_, *motion_);
   Impl& m = *impl_;
   m.block_samples = std::max<std::int64_t>(1, std::llround(options_.sample_rate_hz * kNodeInterval_s));
+  m.update_blocks = std::max<std::int64_t>(1, std::llround(options_.parameter_update_s / kNodeInterval_s));
   m.visibility_blocks =
       std::max<std::int64_t>(1, std::llround(kVisibilityInterval_s * options_.sample_rate_hz / m.block_samples));
   m.frac20_s = floor_mod(options_.start.tow_s, kTwentyMs_s);
@@ -386,7 +448,8 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
       tr.rng.seed(options_.seed * 1000003ULL + 7919ULL * static_cast<std::uint64_t>(a) +
                   static_cast<std::uint64_t>(m.sats[k].eph.prn));
       if (options_.nav_data)
-        tr.lnav = std::make_unique<LnavTransmitter>(m.sats[k].eph, options_.klobuchar, options_.utc, ephemerides);
+        tr.lnav = std::make_unique<LnavTransmitter>(m.sats[k].eph, options_.klobuchar, options_.utc, ephemerides,
+                                                    options_.lnav);
     }
   }
   // C/N0 steps: per track, in sample order (a later entry wins a tie, as it comes later in the list).

@@ -100,6 +100,15 @@ struct SynthesiserOptions {
   bool noise = true;     // add the receiver noise (false: signals only, same gain)
   ReceiverClockModel clock;
   std::uint64_t seed = 1;  // every random number comes from it
+  // Another generator's conventions (a receiver must not depend on ours): the navigation message's encoding
+  // (lnav_transmitter.hpp), and how often the exact signal parameters are computed. parameter_update_s = 1 ms
+  // (ours) interpolates exact nodes every millisecond; a longer interval (e.g. 0.1 s, as gps-sdr-sim does)
+  // computes them only at multiples of it and holds the code rate and the carrier frequency of the interval's
+  // first millisecond until the next: the code phase is reset to the exact value at each update, the carrier
+  // phase runs on continuously (integrated Doppler), so under acceleration it lags the geometry by half an
+  // interval's frequency change. A multiple of 1 ms, 1 ms .. 1 s.
+  LnavConventions lnav;
+  double parameter_update_s = 1e-3;
   // Multi-antenna impairments. Event times are resolved to the 1 ms synthesis blocks.
   std::vector<AntennaImpairment> antenna_impairments;  // index = antenna
   double phase_noise_correlation_s = 0.1;              // > 0

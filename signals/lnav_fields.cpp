@@ -53,10 +53,16 @@ std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_
   return (get_lnav_field(words, msb_first, msb_length) << lsb_length) | get_lnav_field(words, lsb_first, lsb_length);
 }
 
-std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_view what) {
+namespace {
+double quantised(double scaled, FieldRounding rounding) {
+  return rounding == FieldRounding::nearest ? std::nearbyint(scaled) : std::trunc(scaled);
+}
+}  // namespace
+
+std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_view what, FieldRounding rounding) {
   const double scaled = std::ldexp(value, -scale_log2);
   const double half_range = std::ldexp(1.0, bits - 1);
-  const double r = std::nearbyint(scaled);
+  const double r = quantised(scaled, rounding);
   if (!std::isfinite(scaled) || r < -half_range || r >= half_range) {
     throw_lnav_encoding_error(
         fmt::format("{} = {} does not fit {} signed bits of 2^{}", what, value, bits, scale_log2));
@@ -64,9 +70,9 @@ std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_vi
   return static_cast<std::uint32_t>(static_cast<std::int64_t>(r)) & low_mask(bits);
 }
 
-std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_view what) {
+std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_view what, FieldRounding rounding) {
   const double scaled = std::ldexp(value, -scale_log2);
-  const double r = std::nearbyint(scaled);
+  const double r = quantised(scaled, rounding);
   if (!std::isfinite(scaled) || r < 0.0 || r >= std::ldexp(1.0, bits)) {
     throw_lnav_encoding_error(
         fmt::format("{} = {} does not fit {} unsigned bits of 2^{}", what, value, bits, scale_log2));
@@ -74,10 +80,11 @@ std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_
   return static_cast<std::uint32_t>(static_cast<std::int64_t>(r));
 }
 
-std::uint32_t lnav_angle(double radians, int scale_log2, int bits) {
+std::uint32_t lnav_angle(double radians, int scale_log2, int bits, FieldRounding rounding) {
   double sc = radians / kPi;
   sc -= 2.0 * std::floor((sc + 1.0) / 2.0);  // [-1, 1)
-  const std::int64_t r = std::llround(std::ldexp(sc, -scale_log2));
+  const double scaled = std::ldexp(sc, -scale_log2);
+  const auto r = static_cast<std::int64_t>(rounding == FieldRounding::nearest ? std::round(scaled) : std::trunc(scaled));
   // +1 semicircle after rounding is the same angle as -1: the mask wraps it.
   return static_cast<std::uint32_t>(r) & low_mask(bits);
 }

@@ -22,12 +22,18 @@ void put_lnav_split(LnavDataWords& words, int msb_first, int msb_length, int lsb
                     std::uint32_t value);
 std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_length, int lsb_first, int lsb_length);
 
+// How a value becomes a whole number of LSBs: to nearest (our encoder, and what recovers the RINEX value best),
+// or toward zero (a C cast, as some other generators quantise: a different last bit in ~half the fields).
+enum class FieldRounding { nearest, toward_zero };
+
 // Fixed-point encoding of value (in units of the scale factor 2^scale_log2) to an n-bit two's complement
-// or unsigned field, rounded to nearest. Throws InputError naming `what` when it does not fit.
-std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_view what);
-std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_view what);
+// or unsigned field. Throws InputError naming `what` when it does not fit.
+std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_view what,
+                          FieldRounding rounding = FieldRounding::nearest);
+std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_view what,
+                            FieldRounding rounding = FieldRounding::nearest);
 // An angle in radians as a two's complement semicircle field, wrapped into [-1, 1) semicircles first.
-std::uint32_t lnav_angle(double radians, int scale_log2, int bits);
+std::uint32_t lnav_angle(double radians, int scale_log2, int bits, FieldRounding rounding = FieldRounding::nearest);
 
 // Throws InputError("LNAV encoder", problem): a value that cannot be broadcast.
 [[noreturn]] void throw_lnav_encoding_error(const std::string& problem);

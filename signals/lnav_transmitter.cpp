@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 
 #include "signals/gps_constants.hpp"
@@ -18,16 +19,21 @@ void put(LnavDataWords& w, Field f, std::uint32_t v) { put_lnav_field(w, f.first
 void put(LnavDataWords& w, SplitField f, std::uint32_t v) {
   put_lnav_split(w, f.msb_first, f.msb_length, f.lsb_first, f.lsb_length, v);
 }
-std::uint32_t sgn(double v, int scale, Field f, const char* what) { return lnav_signed(v, scale, f.length, what); }
-std::uint32_t sgn(double v, int scale, SplitField f, const char* what) {
-  return lnav_signed(v, scale, f.msb_length + f.lsb_length, what);
+int bits_of(Field f) { return f.length; }
+int bits_of(SplitField f) { return f.msb_length + f.lsb_length; }
+// Fields of the ephemeris subframes take the transmitter's rounding convention; the pages round to nearest.
+template <class F>
+std::uint32_t sgn(double v, int scale, F f, const char* what, FieldRounding r = FieldRounding::nearest) {
+  return lnav_signed(v, scale, bits_of(f), what, r);
 }
-std::uint32_t uns(double v, int scale, Field f, const char* what) { return lnav_unsigned(v, scale, f.length, what); }
-std::uint32_t uns(double v, int scale, SplitField f, const char* what) {
-  return lnav_unsigned(v, scale, f.msb_length + f.lsb_length, what);
+template <class F>
+std::uint32_t uns(double v, int scale, F f, const char* what, FieldRounding r = FieldRounding::nearest) {
+  return lnav_unsigned(v, scale, bits_of(f), what, r);
 }
-std::uint32_t ang(double rad, int scale, SplitField f) { return lnav_angle(rad, scale, f.msb_length + f.lsb_length); }
-std::uint32_t ang(double rad, int scale, Field f) { return lnav_angle(rad, scale, f.length); }
+template <class F>
+std::uint32_t ang(double rad, int scale, F f, FieldRounding r = FieldRounding::nearest) {
+  return lnav_angle(rad, scale, bits_of(f), r);
+}
 
 // Alternating 1010... in every data bit from subframe bit `first` to the end of word 10's bit 22
 // (IS-GPS-200 20.3.2: fill of pages without meaningful data and of dummy-SV almanacs).
@@ -74,8 +80,12 @@ int lnav_page_at(double tow_s) {
 }
 
 LnavTransmitter::LnavTransmitter(Ephemeris ephemeris, KlobucharParameters iono, UtcParameters utc,
-                                 std::vector<Ephemeris> almanac_source)
-    : ephemeris_(std::move(ephemeris)), iono_(iono), utc_(utc), almanac_source_(std::move(almanac_source)) {
+                                 std::vector<Ephemeris> almanac_source, LnavConventions conventions)
+    : ephemeris_(std::move(ephemeris)),
+      iono_(iono),
+      utc_(utc),
+      almanac_source_(std::move(almanac_source)),
+      conventions_(conventions) {
   // Fail at construction, not in the middle of a synthesis run, when a field does not fit.
   const auto check = [&](int value, int bits, const char* what) {
     if (value < 0 || value >= (1 << bits))
@@ -128,6 +138,7 @@ LnavDataWords LnavTransmitter::subframe_data(const GpsTime& start_in) const {
       w = subframe5(lnav_page_at(start.tow_s));
       break;
   }
+  if (conventions_.random_pages && id >= 4) randomise_page(w, start);
   // TLM: preamble, TLM message 0, integrity status 0 (legacy accuracy), reserved 0.
   put(w, kPreamble, kLnavPreamble);
   const auto tow_count = static_cast<std::uint32_t>(
@@ -163,33 +174,35 @@ int LnavTransmitter::data_symbol_at(const GpsTime& t_in) {
 LnavDataWords LnavTransmitter::subframe1(int transmit_week) const {
   const Ephemeris& e = ephemeris_;
   LnavDataWords w{};
+  const FieldRounding r = conventions_.field_rounding;
   put(w, kWeek, static_cast<std::uint32_t>(((transmit_week % 1024) + 1024) % 1024));
   put(w, kCodeOnL2, static_cast<std::uint32_t>(e.code_on_l2));
   put(w, kUra, static_cast<std::uint32_t>(e.ura_index));
   put(w, kHealth, static_cast<std::uint32_t>(e.health));
   put(w, kIodcMsb, static_cast<std::uint32_t>(e.iodc >> 8));
   put(w, kL2pFlag, static_cast<std::uint32_t>(e.l2p_data_flag));
-  put(w, kTgd, sgn(e.tgd_s, kTgdScale, kTgd, "TGD"));
+  put(w, kTgd, sgn(e.tgd_s, kTgdScale, kTgd, "TGD", r));
   put(w, kIodcLsb, static_cast<std::uint32_t>(e.iodc));
-  put(w, kToc, uns(e.toc_s, kTocScale, kToc, "toc"));
-  put(w, kAf2, sgn(e.af2_sps2, kAf2Scale, kAf2, "af2"));
-  put(w, kAf1, sgn(e.af1_sps, kAf1Scale, kAf1, "af1"));
-  put(w, kAf0, sgn(e.af0_s, kAf0Scale, kAf0, "af0"));
+  put(w, kToc, uns(e.toc_s, kTocScale, kToc, "toc", r));
+  put(w, kAf2, sgn(e.af2_sps2, kAf2Scale, kAf2, "af2", r));
+  put(w, kAf1, sgn(e.af1_sps, kAf1Scale, kAf1, "af1", r));
+  put(w, kAf0, sgn(e.af0_s, kAf0Scale, kAf0, "af0", r));
   return w;
 }
 
 LnavDataWords LnavTransmitter::subframe2() const {
   const Ephemeris& e = ephemeris_;
   LnavDataWords w{};
+  const FieldRounding r = conventions_.field_rounding;
   put(w, kIode2, static_cast<std::uint32_t>(e.iode));
-  put(w, kCrs, sgn(e.crs_m, kCrsScale, kCrs, "Crs"));
-  put(w, kDeltaN, sgn(e.delta_n_radps / kPi, kDeltaNScale, kDeltaN, "delta n"));
-  put(w, kM0, ang(e.m0_rad, kM0Scale, kM0));
-  put(w, kCuc, sgn(e.cuc_rad, kCucScale, kCuc, "Cuc"));
-  put(w, kE, uns(e.e, kEScale, kE, "e"));
-  put(w, kCus, sgn(e.cus_rad, kCusScale, kCus, "Cus"));
-  put(w, kSqrtA, uns(e.sqrt_a_sqrtm, kSqrtAScale, kSqrtA, "sqrt A"));
-  put(w, kToe, uns(e.toe_s, kToeScale, kToe, "toe"));
+  put(w, kCrs, sgn(e.crs_m, kCrsScale, kCrs, "Crs", r));
+  put(w, kDeltaN, sgn(e.delta_n_radps / kPi, kDeltaNScale, kDeltaN, "delta n", r));
+  put(w, kM0, ang(e.m0_rad, kM0Scale, kM0, r));
+  put(w, kCuc, sgn(e.cuc_rad, kCucScale, kCuc, "Cuc", r));
+  put(w, kE, uns(e.e, kEScale, kE, "e", r));
+  put(w, kCus, sgn(e.cus_rad, kCusScale, kCus, "Cus", r));
+  put(w, kSqrtA, uns(e.sqrt_a_sqrtm, kSqrtAScale, kSqrtA, "sqrt A", r));
+  put(w, kToe, uns(e.toe_s, kToeScale, kToe, "toe", r));
   put(w, kFitFlag, static_cast<std::uint32_t>(e.fit_interval_flag));
   put(w, kAodo, static_cast<std::uint32_t>(e.aodo));
   return w;
@@ -198,15 +211,16 @@ LnavDataWords LnavTransmitter::subframe2() const {
 LnavDataWords LnavTransmitter::subframe3() const {
   const Ephemeris& e = ephemeris_;
   LnavDataWords w{};
-  put(w, kCic, sgn(e.cic_rad, kCicScale, kCic, "Cic"));
-  put(w, kOmega0, ang(e.omega0_rad, kOmega0Scale, kOmega0));
-  put(w, kCis, sgn(e.cis_rad, kCisScale, kCis, "Cis"));
-  put(w, kI0, ang(e.i0_rad, kI0Scale, kI0));
-  put(w, kCrc, sgn(e.crc_m, kCrcScale, kCrc, "Crc"));
-  put(w, kOmega, ang(e.omega_rad, kOmegaScale, kOmega));
-  put(w, kOmegaDot, sgn(e.omega_dot_radps / kPi, kOmegaDotScale, kOmegaDot, "Omega dot"));
+  const FieldRounding r = conventions_.field_rounding;
+  put(w, kCic, sgn(e.cic_rad, kCicScale, kCic, "Cic", r));
+  put(w, kOmega0, ang(e.omega0_rad, kOmega0Scale, kOmega0, r));
+  put(w, kCis, sgn(e.cis_rad, kCisScale, kCis, "Cis", r));
+  put(w, kI0, ang(e.i0_rad, kI0Scale, kI0, r));
+  put(w, kCrc, sgn(e.crc_m, kCrcScale, kCrc, "Crc", r));
+  put(w, kOmega, ang(e.omega_rad, kOmegaScale, kOmega, r));
+  put(w, kOmegaDot, sgn(e.omega_dot_radps / kPi, kOmegaDotScale, kOmegaDot, "Omega dot", r));
   put(w, kIode3, static_cast<std::uint32_t>(e.iode));
-  put(w, kIdot, sgn(e.idot_radps / kPi, kIdotScale, kIdot, "IDOT"));
+  put(w, kIdot, sgn(e.idot_radps / kPi, kIdotScale, kIdot, "IDOT", r));
   return w;
 }
 
@@ -239,6 +253,22 @@ void LnavTransmitter::almanac_page(LnavDataWords& w, int prn) const {
   put(w, kAlmM0, ang(a->m0_rad + n * dt, kAlmAngleScale, kAlmM0));
   put(w, kAlmAf0, sgn(a->af0_s + a->af1_sps * dtc, kAlmAf0Scale, kAlmAf0, "almanac af0"));
   put(w, kAlmAf1, sgn(a->af1_sps, kAlmAf1Scale, kAlmAf1, "almanac af1"));
+}
+
+// Words 3-10 after the data ID and SV ID (subframe bits 69..292, parity positions skipped) become random and
+// the SV ID 0 (a dummy SV, whose page a decoder skips: random almanac or health bits must not be taken for
+// broadcast ones), except page 18's ionosphere and UTC (SV ID 56).
+void LnavTransmitter::randomise_page(LnavDataWords& w, const GpsTime& start) const {
+  if (get_lnav_field(w, kPageSvId.first, kPageSvId.length) == static_cast<std::uint32_t>(kIonoUtcSvId)) return;
+  put(w, kPageSvId, 0);
+  const auto subframe_count = static_cast<std::uint64_t>(std::llround(start.tow_s / kSubframeDuration_s)) +
+                              static_cast<std::uint64_t>(start.week) * 100800u;
+  std::seed_seq seq{conventions_.page_seed, static_cast<std::uint64_t>(ephemeris_.prn), subframe_count};
+  std::mt19937_64 rng(seq);
+  for (int bit = 69; bit <= 292; ++bit) {
+    if ((bit - 1) % 30 >= 24) continue;  // parity positions
+    put_lnav_field(w, bit, 1, static_cast<std::uint32_t>(rng() >> 63));
+  }
 }
 
 LnavDataWords LnavTransmitter::subframe4(int page) const {

@@ -28,12 +28,23 @@ SubframeBits encode_lnav_subframe(const LnavDataWords& data);
 int lnav_subframe_id_at(double tow_s);
 int lnav_page_at(double tow_s);
 
+// Choices another generator may make differently from ours (a receiver must not depend on ours):
+// - field_rounding: ephemeris and clock fields of subframes 1-3 rounded to nearest (ours) or toward zero;
+// - random_pages: subframe 4/5 words 3-10 carry seeded random bits instead of almanac and health pages (what a
+//   receiver cannot predict from any nav file), marked as dummy-SV pages (SV ID 0) so that no decoder takes
+//   them for almanacs or health; page 18 (ionosphere and UTC, SV ID 56) keeps its content.
+struct LnavConventions {
+  FieldRounding field_rounding = FieldRounding::nearest;
+  bool random_pages = false;
+  std::uint64_t page_seed = 0;  // random_pages: with the PRN and the subframe's time, fixes the bits
+};
+
 class LnavTransmitter {
  public:
   // almanac_source: ephemerides of the whole constellation for subframe 4/5 almanac pages (may be empty:
   // the pages then carry dummy-satellite almanacs as IS-GPS-200 allows).
   LnavTransmitter(Ephemeris ephemeris, KlobucharParameters iono, UtcParameters utc,
-                  std::vector<Ephemeris> almanac_source = {});
+                  std::vector<Ephemeris> almanac_source = {}, LnavConventions conventions = {});
 
   // The subframe whose first bit starts at GPS time (week, tow) where tow is a multiple of 6 s (any other
   // start is taken back to the multiple of 6 s at or before it). WN is transmitted as start.week mod 1024,
@@ -58,11 +69,13 @@ class LnavTransmitter {
   LnavDataWords subframe5(int page) const;
   void almanac_page(LnavDataWords& w, int prn) const;
   const Ephemeris* almanac_of(int prn) const;
+  void randomise_page(LnavDataWords& w, const GpsTime& start) const;
 
   Ephemeris ephemeris_;
   KlobucharParameters iono_;
   UtcParameters utc_;
   std::vector<Ephemeris> almanac_source_;
+  LnavConventions conventions_;
   GpsTime cached_start_{-1, 0.0};
   SubframeBits cached_bits_{};
 };

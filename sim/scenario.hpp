@@ -37,6 +37,9 @@ struct Scenario {
   std::map<int, double> cn0_dbhz_by_prn;
   bool nav_data = true;
   bool noise = true;
+  // Another generator's conventions (signals/if_synthesiser.hpp): exact parameters every parameter_update_s
+  // (1 ms ours, 0.1 s as gps-sdr-sim) with the rates held in between.
+  double parameter_update_s = 1e-3;
 
   // True GPS time of the first sample (full weeks).
   int gps_week = 2190;
@@ -47,6 +50,10 @@ struct Scenario {
   std::string constellation = "nominal";
   double elevation_mask_deg = 5.0;
   bool include_unhealthy = false;
+  // How the LNAV message is made (signals/lnav_transmitter.hpp): ephemeris fields rounded to nearest or toward
+  // zero; subframe 4/5 pages with almanacs or with random content no nav file predicts.
+  signals::FieldRounding nav_field_rounding = signals::FieldRounding::nearest;
+  bool nav_random_pages = false;
 
   // Receiver: a static position (with optional extra antennas, one file each) or a trajectory CSV.
   std::array<double, 3> llh_deg_m = {35.274016, 137.013759, 100.0};
@@ -80,6 +87,7 @@ struct Scenario {
   // IMU errors: a preset (ins/imu_error_model.hpp) with optional datasheet overrides.
   std::string imu_preset = "ideal";
   std::uint64_t imu_seed = 1;
+  double imu_time_offset_s = 0.0;   // the IMU's time stamps read true time + this (a mis-synchronised IMU)
   ins::ImuDatasheet imu_datasheet;  // the [imu] datasheet keys given (ins/imu_datasheet.hpp)
 
   // Antennas on the body (inertial scenarios; the first is the master) and the parked attitude (static profile).

@@ -116,6 +116,10 @@ signals::SynthesiserOptions synthesiser_options(const Scenario& s, const Navigat
   o.clock.bias_noise_s_per_sqrt_s = s.clock_bias_noise_m_per_sqrt_s / signals::kSpeedOfLight_mps;
   o.clock.drift_noise_sps_per_sqrt_s = s.clock_drift_noise_mps_per_sqrt_s / signals::kSpeedOfLight_mps;
   o.seed = s.seed;
+  o.parameter_update_s = s.parameter_update_s;
+  o.lnav.field_rounding = s.nav_field_rounding;
+  o.lnav.random_pages = s.nav_random_pages;
+  o.lnav.page_seed = s.seed;
   o.antenna_impairments = s.antenna_impairments;
   o.cycle_slips = s.cycle_slips;
   o.blockages = s.blockages;

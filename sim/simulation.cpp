@@ -34,7 +34,11 @@ std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, Si
   std::vector<ins::TruthSample> samples;
   samples.reserve(static_cast<std::size_t>(std::llround(spec.duration_s() * s.imu_rate_hz)) + 1);
   ImuSimulationCallbacks callbacks;
-  callbacks.on_imu = [&](const ins::ImuIncrement& inc) { sink.imu(inc); };
+  callbacks.on_imu = [&](const ins::ImuIncrement& inc) {
+    ins::ImuIncrement stamped = inc;
+    stamped.t_s += s.imu_time_offset_s;  // the IMU's clock, not true time
+    sink.imu(stamped);
+  };
   callbacks.on_truth = [&](const ins::TruthSample& t) { samples.push_back(t); };
   callbacks.on_progress = [&](int percent) {
     sink.progress({SimulationProgress::Stage::Imu, percent, 0.0, 0.0, 0.0});

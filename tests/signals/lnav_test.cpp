@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <optional>
 #include <set>
@@ -474,4 +475,84 @@ TEST(LnavDecoder, AlmanacRoundTripOfAWholeMasterFrame) {
     const bool present = std::any_of(all.begin(), all.end(), [prn](const auto& e) { return e.prn == prn; });
     EXPECT_EQ(decoder.almanacs()[static_cast<std::size_t>(prn)].has_value(), present) << prn;
   }
+}
+
+// Another generator's quantisation: fields rounded toward zero decode within one LSB of the broadcast value,
+// never farther from zero than it (|decoded| <= |value|), and differ from our round-to-nearest encoding in
+// about half of the fields (the half whose remainder is >= LSB/2).
+TEST(LnavTransmitter, TowardZeroRoundingDecodesWithinOneLsbTowardZero) {
+  LnavConventions truncating;
+  truncating.field_rounding = FieldRounding::toward_zero;
+  int differing_words = 0, words = 0;
+  for (const Ephemeris& e : brdc_2022_001_ephemerides()) {
+    const LnavTransmitter nearest = make_transmitter(e);
+    const LnavTransmitter toward_zero(e, brdc_2022_001_klobuchar(), brdc_2022_001_utc(), brdc_2022_001_ephemerides(),
+                                      truncating);
+    LnavDecoder decoder(e.prn, kWeek);
+    feed(decoder, toward_zero, {kWeek, kToe}, 3);
+    ASSERT_TRUE(decoder.ephemeris().has_value()) << e.prn;
+    const Ephemeris& d = *decoder.ephemeris();
+    const auto check = [&](double decoded, double value, double lsb, const char* what) {
+      const double ulps = 4.0 * std::numeric_limits<double>::epsilon() * std::abs(value);
+      EXPECT_LE(std::abs(decoded - value), lsb + ulps) << what << " PRN " << e.prn;
+      EXPECT_LE(std::abs(decoded), std::abs(value) + ulps) << what << " PRN " << e.prn;
+    };
+    check(d.af0_s, e.af0_s, std::ldexp(1.0, -31), "af0");
+    check(d.af1_sps, e.af1_sps, std::ldexp(1.0, -43), "af1");
+    check(d.crs_m, e.crs_m, std::ldexp(1.0, -5), "Crs");
+    check(d.e, e.e, std::ldexp(1.0, -33), "e");
+    check(d.sqrt_a_sqrtm, e.sqrt_a_sqrtm, std::ldexp(1.0, -19), "sqrt A");
+    check(d.m0_rad, e.m0_rad, std::ldexp(kPi, -31), "M0");
+    check(d.i0_rad, e.i0_rad, std::ldexp(kPi, -31), "i0");
+    check(d.idot_radps, e.idot_radps, std::ldexp(kPi, -43), "IDOT");
+    for (int k = 0; k < 3; ++k) {
+      const GpsTime start = add_seconds({kWeek, kToe}, 6.0 * k);
+      const LnavDataWords a = nearest.subframe_data(start), b = toward_zero.subframe_data(start);
+      for (int w = 2; w < 10; ++w) {
+        ++words;
+        differing_words += a[static_cast<std::size_t>(w)] != b[static_cast<std::size_t>(w)];
+      }
+    }
+  }
+  // Words 3-10 of subframes 1-3 hold 1-3 rounded fields each: with a remainder uniform in [0, 1) LSB, a word
+  // keeps its bits only when each of its fields' remainders is below LSB/2, so ~25-50 % of words stay.
+  std::printf("toward-zero rounding changes %d of %d words 3-10 of subframes 1-3\n", differing_words, words);
+  EXPECT_GT(differing_words, words / 3) << differing_words << " of " << words;
+  EXPECT_LT(differing_words, words) << differing_words << " of " << words;
+}
+
+// Random subframe 4/5 pages: valid parity, dummy-SV pages (nothing decoded from them), page 18 intact, the bits
+// fixed by the seed and changed by another seed; subframes 1-3 unchanged.
+TEST(LnavTransmitter, RandomPagesKeepParityAndPage18AndDependOnTheSeed) {
+  const Ephemeris e = brdc_2022_001_ephemerides()[3];
+  LnavConventions random_pages;
+  random_pages.random_pages = true;
+  random_pages.page_seed = 11;
+  LnavConventions other_seed = random_pages;
+  other_seed.page_seed = 12;
+  const LnavTransmitter ours = make_transmitter(e);
+  const auto tx = [&](const LnavConventions& c) {
+    return LnavTransmitter(e, brdc_2022_001_klobuchar(), brdc_2022_001_utc(), brdc_2022_001_ephemerides(), c);
+  };
+  const LnavTransmitter random = tx(random_pages), random_again = tx(random_pages), other = tx(other_seed);
+  LnavDecoder decoder(e.prn, kWeek);
+  feed(decoder, random, {kWeek, kToe}, 5 * 25);  // a whole master frame: every page once, parity checked in feed
+  EXPECT_EQ(decoder.counters().parity_errors, 0);
+  EXPECT_TRUE(decoder.klobuchar().valid);  // page 18 decoded
+  for (int prn = 1; prn <= 32; ++prn) EXPECT_FALSE(decoder.almanacs()[static_cast<std::size_t>(prn)].has_value());
+  int differing = 0;
+  for (int k = 0; k < 5 * 25; ++k) {
+    const GpsTime start = add_seconds({kWeek, kToe}, 6.0 * k);
+    const int id = lnav_subframe_id_at(start.tow_s);
+    const LnavDataWords a = ours.subframe_data(start), b = random.subframe_data(start);
+    EXPECT_EQ(b, random_again.subframe_data(start));
+    const bool page18 = id == 4 && lnav_page_at(start.tow_s) == 18;
+    if (id <= 3 || page18) {
+      EXPECT_EQ(a, b) << "subframe " << id;
+      continue;
+    }
+    EXPECT_NE(b, other.subframe_data(start));
+    differing += a != b;
+  }
+  EXPECT_EQ(differing, 2 * 25 - 1);
 }
