@@ -111,6 +111,31 @@ TEST(Scenario, OscillatorSetsTheClockRandomWalks) {
   EXPECT_NE(e.find("not both"), std::string::npos) << e;
 }
 
+// Other generators' conventions parse, echo only when set, and reject values outside their meaning.
+TEST(Scenario, OtherGeneratorConventionsParseAndEcho) {
+  const Scenario s = parse_scenario(
+      "[signal]\nparameter_update_s = 0.1\n[navigation]\nfield_rounding = \"toward_zero\"\npages = \"random\"\n",
+      "/data/s.toml");
+  EXPECT_DOUBLE_EQ(s.parameter_update_s, 0.1);
+  EXPECT_EQ(s.nav_field_rounding, signals::FieldRounding::toward_zero);
+  EXPECT_TRUE(s.nav_random_pages);
+  const Scenario back = parse_scenario(to_toml(s), "/data/s.toml");
+  EXPECT_DOUBLE_EQ(back.parameter_update_s, 0.1);
+  EXPECT_EQ(back.nav_field_rounding, signals::FieldRounding::toward_zero);
+  EXPECT_TRUE(back.nav_random_pages);
+  const std::string plain = to_toml(parse_scenario("[signal]\nduration_s = 2\n", "/data/s.toml"));
+  EXPECT_EQ(plain.find("parameter_update_s"), std::string::npos);
+  EXPECT_EQ(plain.find("field_rounding"), std::string::npos);
+  auto e = error_of("[signal]\nparameter_update_s = 0.0005\n");
+  EXPECT_NE(e.find("signal.parameter_update_s"), std::string::npos) << e;
+  e = error_of("[signal]\nparameter_update_s = 0.0015\n");
+  EXPECT_NE(e.find("whole number of milliseconds"), std::string::npos) << e;
+  e = error_of("[navigation]\nfield_rounding = \"up\"\n");
+  EXPECT_NE(e.find("navigation.field_rounding"), std::string::npos) << e;
+  e = error_of("[navigation]\npages = \"none\"\n");
+  EXPECT_NE(e.find("navigation.pages"), std::string::npos) << e;
+}
+
 TEST(Scenario, EchoReadsBackTheSameScenario) {
   Scenario s = parse_scenario(R"(
 [signal]

@@ -331,6 +331,31 @@ preset = "ideal"
   EXPECT_LT(worst_att, 1e-4);
 }
 
+// A mis-synchronised IMU ([imu] time_offset_s): its stamps read true time + the offset, the truth does not move.
+TEST(SimulateIns, ImuTimeOffsetShiftsOnlyTheImuStamps) {
+  const auto dir = test::scratch_dir();
+  const std::string text = scenario_head("") + R"(
+[trajectory]
+profile = "circle"
+duration_s = 2.0
+imu_rate_hz = 100.0
+[imu]
+preset = "ideal"
+time_offset_s = 0.003
+)";
+  { std::ofstream(dir / "offset.toml") << text; }
+  const Scenario s = read_scenario(dir / "offset.toml");
+  EXPECT_DOUBLE_EQ(s.imu_time_offset_s, 0.003);
+  const auto out = dir / "out";
+  run_simulation(s, out);
+  EXPECT_EQ(to_toml(read_scenario(out / "scenario.toml")), to_toml(s));
+  const auto imu = ins::read_imu_csv(out / "imu.csv");
+  ASSERT_EQ(imu.size(), 200u);
+  for (std::size_t k = 0; k < imu.size(); ++k) EXPECT_NEAR(imu[k].t_s, 0.01 * static_cast<double>(k + 1) + 0.003, 1e-9);
+  const auto truth = read_rows(out / "truth.csv");
+  EXPECT_NEAR(truth[1][0], 0.1, 1e-9);
+}
+
 TEST(SimulateIns, LandProfileWritesTheOdometer) {
   const auto dir = test::scratch_dir();
   const std::string text = scenario_head("") + R"(
