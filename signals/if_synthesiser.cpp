@@ -76,11 +76,14 @@ struct IfSynthesiser::Impl {
     double noise_m = 0.0;
     bool noise_started = false;
     std::mt19937_64 rng;
-    // Held parameters (parameter_update_s > 1 ms): code and carrier advance per block, and the carrier
-    // offset (line bias, slips, extra noise) at the last update.
+    // Held parameters (parameter_update_s > 1 ms): code and carrier advance per block, the held code and
+    // carrier at the next block's start (before the clock noise), and the carrier offset (line bias, slips,
+    // extra noise) at the last update.
     bool held = false;
     double code_step_chips = 0.0;
     double carrier_step_cycles = 0.0;
+    double held_code_chips = 0.0;
+    double held_carrier_cycles = 0.0;
     double offset_cycles = 0.0;
   };
 
@@ -102,10 +105,12 @@ struct IfSynthesiser::Impl {
 
   double tau_of(std::int64_t sample) const { return static_cast<double>(sample) / opt.sample_rate_hz; }
 
-  RxGeo rx_geo(int antenna, double tau_s) {
+  // noisy_clock false: the clock's deterministic part only (bias + drift tau), for held parameters.
+  RxGeo rx_geo(int antenna, double tau_s, bool noisy_clock = true) {
     RxGeo g;
     g.tau_s = tau_s;
-    g.clock = clock.at(tau_s);
+    g.clock = noisy_clock ? clock.at(tau_s) : ReceiverClockState{opt.clock.bias_s + opt.clock.drift_sps * tau_s,
+                                                                    opt.clock.drift_sps};
     g.t_r_s = tau_s - (g.clock.bias_s - opt.clock.bias_s);
     g.state = motion.antenna_state(antenna, g.t_r_s);
     double lat_deg = 0, lon_deg = 0, h = 0;
@@ -276,9 +281,17 @@ struct IfSynthesiser::Impl {
   // Held parameters: at an update block (or a track's first) the exact nodes at its two ends give the code
   // and carrier advance per block, kept until the next update; the code restarts from its exact value there,
   // the carrier continues from where it was, stepping only by the change of its offsets (slips, line bias).
+  // What is held is the generator's geometry on the clock's deterministic part: the oscillator's noise is the
+  // front end's, so it stays on every block (as a time shift of the whole signal: -db chips and cycles at the
+  // code and carrier rates, to 1e-5 of db, the Doppler's share).
   void enter_held_block(std::int64_t b) {
     const std::int64_t s0 = b * block_samples, s1 = s0 + block_samples;
     const bool update = b % update_blocks == 0;
+    const auto clock_noise_s = [&](std::int64_t sample) {
+      const double tau = tau_of(sample);
+      return clock.at(tau).bias_s - (opt.clock.bias_s + opt.clock.drift_sps * tau);
+    };
+    const double db0 = clock_noise_s(s0), db1 = clock_noise_s(s1);
     for (int a = 0; a < static_cast<int>(geo0.size()); ++a) {
       bool geo_done = false;
       for (std::size_t k = 0; k < sats.size(); ++k) {
@@ -289,25 +302,26 @@ struct IfSynthesiser::Impl {
         }
         if (update || !tr.held) {
           if (!geo_done) {
-            geo0[a] = rx_geo(a, tau_of(s0));
-            geo1[a] = rx_geo(a, tau_of(s1));
+            geo0[a] = rx_geo(a, tau_of(s0), false);
+            geo1[a] = rx_geo(a, tau_of(s1), false);
             geo_done = true;
           }
           const Node e0 = geometric_node(k, a, geo0[a], s0);
           const Node e1 = geometric_node(k, a, geo1[a], s1);
           const double dt = tr.held ? static_cast<double>(update_blocks) * kNodeInterval_s : kNodeInterval_s;
           const double offset = carrier_offset_cycles(tr, sats[k].eph.prn, a, s0, dt);
-          const double carrier0 =
-              tr.held ? tr.n1.carrier_cycles - (offset - tr.offset_cycles) : e0.carrier_cycles - offset;
-          tr.n0 = {s0, e0.code_chips, carrier0};
+          tr.held_carrier_cycles =
+              tr.held ? tr.held_carrier_cycles - (offset - tr.offset_cycles) : e0.carrier_cycles - offset;
+          tr.held_code_chips = e0.code_chips;
           tr.code_step_chips = e1.code_chips - e0.code_chips;
           tr.carrier_step_cycles = e1.carrier_cycles - e0.carrier_cycles;
           tr.offset_cycles = offset;
           tr.held = true;
-        } else {
-          tr.n0 = tr.n1;
         }
-        tr.n1 = {s1, tr.n0.code_chips + tr.code_step_chips, tr.n0.carrier_cycles + tr.carrier_step_cycles};
+        tr.n0 = {s0, tr.held_code_chips - kCaChipRate_hz * db0, tr.held_carrier_cycles - kL1Frequency_hz * db0};
+        tr.held_code_chips += tr.code_step_chips;
+        tr.held_carrier_cycles += tr.carrier_step_cycles;
+        tr.n1 = {s1, tr.held_code_chips - kCaChipRate_hz * db1, tr.held_carrier_cycles - kL1Frequency_hz * db1};
       }
     }
   }
