@@ -383,8 +383,9 @@ void read_receiver_clock_key(const Reader& r, const std::string& key, const std:
     r.check(n, name, s.clock_drift_noise_mps_per_sqrt_s >= 0, "must be >= 0");
     given.clock_noise = true;
   } else if (key == "oscillator") {
-    // A named oscillator sets both random walks from its Allan coefficients (signals/oscillator_allan.hpp).
-    const auto allan = signals::oscillator_preset(r.string(n, name));
+    // A named oscillator sets both random walks from its Allan coefficients as a signal sees them
+    // (signals/oscillator_allan.hpp: datasheet phase noise for the white frequency noise).
+    const auto allan = signals::oscillator_signal_preset(r.string(n, name));
     if (!allan) r.fail(n, name, "unknown oscillator (" + joined(signals::oscillator_preset_names()) + ")");
     const signals::ReceiverClockModel noise = signals::receiver_clock_from_allan(*allan);
     s.clock_bias_noise_m_per_sqrt_s = noise.bias_noise_s_per_sqrt_s * signals::kSpeedOfLight_mps;

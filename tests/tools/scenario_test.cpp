@@ -98,11 +98,12 @@ TEST(Scenario, UnknownKeysWrongTypesAndConflictsNameFileKeyAndLine) {
   EXPECT_NE(e.find("/data/s.toml:1"), std::string::npos) << e;  // a syntax error, with its line
 }
 
-// A named oscillator sets the clock's two random walks from Brown & Hwang's Allan coefficients: TCXO h0 2e-19,
-// h-2 2e-20 give c sqrt(h0 / 2) = 0.0948 m/sqrt(s) and c sqrt(2 pi^2 h-2) = 0.1884 m/s/sqrt(s).
+// A named oscillator sets the clock's two random walks: a 26 MHz TCXO at -135 dBc/Hz (1 kHz) has h0 =
+// 2 (1e3)^2 10^-13.5 / (26e6)^2 = 9.355e-23, so c sqrt(h0 / 2) = 0.002050 m/sqrt(s); Brown & Hwang's h-2 2e-20
+// gives c sqrt(2 pi^2 h-2) = 0.1884 m/s/sqrt(s).
 TEST(Scenario, OscillatorSetsTheClockRandomWalks) {
   const Scenario s = parse_scenario("[receiver]\noscillator = \"tcxo\"\n", "/data/s.toml");
-  EXPECT_NEAR(s.clock_bias_noise_m_per_sqrt_s, 0.09480, 0.00001);
+  EXPECT_NEAR(s.clock_bias_noise_m_per_sqrt_s, 0.002050, 0.000001);
   EXPECT_NEAR(s.clock_drift_noise_mps_per_sqrt_s, 0.18837, 0.00001);
   auto e = error_of("[receiver]\noscillator = \"rubidium\"\n");
   EXPECT_NE(e.find("receiver.oscillator"), std::string::npos) << e;
