@@ -7,6 +7,7 @@
 
 #include "io/units.hpp"
 #include "signals/input_error.hpp"
+#include "signals/oscillator_allan.hpp"
 
 namespace ultratrack::config {
 namespace {
@@ -97,6 +98,22 @@ const std::map<std::string, Table>& sections() {
         {"coherent_jitter_deg", [](const Setter& v, O& o) { o.tracking.coherent_jitter_deg = v.number(); }},
         {"coherent_hysteresis_db", [](const Setter& v, O& o) { o.tracking.coherent_hysteresis_db = v.number(); }},
         {"coherent_max_bn_t", [](const Setter& v, O& o) { o.tracking.coherent_max_bn_t = v.number(); }},
+        {"oscillator", [](const Setter& v, O& o) {
+           // The front end's oscillator class as a tracking loop sees it (signals/oscillator_allan.hpp).
+           const std::string name = v.node.value<std::string>().value_or("");
+           if (name == "none") {
+             o.tracking.oscillator_h0 = o.tracking.oscillator_h_minus2 = 0.0;
+             return;
+           }
+           const auto allan = signals::oscillator_signal_preset(name);
+           if (!allan)
+             throw signals::InputError(v.file, "key '" + v.key + "' must be \"tcxo\", \"ocxo\" or \"none\"",
+                                       static_cast<int>(v.node.source().begin.line));
+           o.tracking.oscillator_h0 = allan->h0;
+           o.tracking.oscillator_h_minus2 = allan->h_minus2;
+         }},
+        {"oscillator_h0", [](const Setter& v, O& o) { o.tracking.oscillator_h0 = v.number(); }},
+        {"oscillator_h_minus2", [](const Setter& v, O& o) { o.tracking.oscillator_h_minus2 = v.number(); }},
         {"presence_window_s", [](const Setter& v, O& o) { o.tracking.presence_window_s = v.number(); }},
         {"presence_threshold_dbhz", [](const Setter& v, O& o) { o.tracking.presence_threshold_dbhz = v.number(); }},
         {"presence_max_windows", [](const Setter& v, O& o) { o.tracking.presence_max_windows = v.integer(); }},

@@ -3,6 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <utility>
+#include <vector>
+
+#include "signals/gps_constants.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -24,21 +29,51 @@ double pll_thermal_jitter_rad(double bn_hz, double t_s, double cn0_dbhz) {
   return std::sqrt(bn_hz / c * (1.0 + 1.0 / (2.0 * t_s * c)));
 }
 
+double pll_oscillator_jitter_rad(double bn_hz, int pll_order, double h0, double h_minus2) {
+  constexpr double kTwoPiL1 = 2.0 * std::numbers::pi * signals::kL1Frequency_hz;
+  const double q_w = kTwoPiL1 * kTwoPiL1 * h0 / 2.0;
+  const double q_rw = kTwoPiL1 * kTwoPiL1 * 2.0 * std::numbers::pi * std::numbers::pi * h_minus2;
+  double w0 = 0.0, i_w = 0.0, i_rw = 0.0;
+  if (pll_order == 2) {
+    w0 = bn_hz / kSecondOrderBnPerW0;
+    i_w = i_rw = 1.0 / (2.0 * std::numbers::sqrt2);
+  } else {
+    w0 = bn_hz / kThirdOrderBnPerW0;
+    constexpr double kB3 = 2.4, kA3 = 1.1;  // loop_filters.cpp's third-order coefficients
+    i_w = kA3 / (2.0 * (kB3 * kA3 - 1.0));
+    i_rw = 1.0 / (2.0 * (kB3 * kA3 - 1.0));
+  }
+  return std::sqrt(q_w * i_w / w0 + q_rw * i_rw / (w0 * w0 * w0));
+}
+
 double long_coherent_pll_bw_hz(const ScalarTrackingOptions& o, int epochs) {
   return std::min(o.pll_bw_coherent_hz, o.coherent_max_bn_t / (epochs * kBitPeriod_s));
 }
 
 int choose_coherent_epochs(const ScalarTrackingOptions& o, double cn0_dbhz, int current) {
   const int max_epochs = std::max(1, o.max_coherent_ms / 20);
+  const auto jitter_rad = [&](int n, double cn0) {
+    const double bn = long_coherent_pll_bw_hz(o, n);
+    const double thermal = pll_thermal_jitter_rad(bn, n * kBitPeriod_s, cn0);
+    const double clock = pll_oscillator_jitter_rad(bn, o.pll_order, o.oscillator_h0, o.oscillator_h_minus2);
+    return std::sqrt(thermal * thermal + clock * clock);
+  };
   const auto shortest = [&](double cn0) {
-    int chosen = 1;
+    std::vector<std::pair<int, double>> jitters;
     for (const int n : kCoherentEpochChoices) {
       if (n > max_epochs) break;
-      chosen = n;
-      if (pll_thermal_jitter_rad(long_coherent_pll_bw_hz(o, n), n * kBitPeriod_s, cn0) <= o.coherent_jitter_deg * io::kRadPerDeg)
-        break;
+      const double j = jitter_rad(n, cn0);
+      if (j <= o.coherent_jitter_deg * io::kRadPerDeg) return n;
+      jitters.emplace_back(n, j);
     }
-    return chosen;
+    // None within the bound. Without an oscillator the longest (thermal jitter falls with T); with one the
+    // shortest within 5 % of the least total jitter (a longer block that gains less is not worth its bits).
+    if (!(o.oscillator_h0 > 0.0 || o.oscillator_h_minus2 > 0.0)) return jitters.back().first;
+    double least = jitters.front().second;
+    for (const auto& [n, j] : jitters) least = std::min(least, j);
+    for (const auto& [n, j] : jitters)
+      if (j <= 1.05 * least) return n;
+    return jitters.back().first;
   };
   if (!o.adaptive_coherent) return max_epochs;
   const int longer = shortest(cn0_dbhz);

@@ -17,10 +17,18 @@ namespace ultratrack::receiver {
 
 // Thermal phase jitter of a Costas PLL, radians: sqrt(Bn / c (1 + 1 / (2 T c))), c = 10^(cn0_dbhz / 10).
 double pll_thermal_jitter_rad(double bn_hz, double t_s, double cn0_dbhz);
+// Phase jitter an oscillator puts into a PLL of noise bandwidth bn_hz and order 2 or 3 at L1, radians (linear
+// theory, the analogue loop of loop_filters.hpp): the loop's error response to the clock's phase integrated
+// in closed form, sigma^2 = q_w I_w / w0 + q_rw I_rw / w0^3 with q_w = (2 pi f_L1)^2 h0 / 2 (white frequency,
+// rad^2/s), q_rw = (2 pi f_L1)^2 2 pi^2 h-2 (random-walk frequency, rad^2/s^3), w0 = Bn / (Bn per w0) and, for
+// D(s) = s^3 + 2.4 s^2 + 1.1 s + 1, I_w = 1.1 / (2 (2.4 x 1.1 - 1)) = 0.3354 and I_rw = 1 / (2 (2.4 x 1.1 - 1)) =
+// 0.3049 (for s^2 + sqrt(2) s + 1 both 1 / (2 sqrt(2))).
+double pll_oscillator_jitter_rad(double bn_hz, int pll_order, double h0, double h_minus2);
 // The PLL noise bandwidth long coherent integration uses at T = epochs x 20 ms (see ScalarTrackingOptions).
 double long_coherent_pll_bw_hz(const ScalarTrackingOptions& options, int epochs);
 // The number of 20 ms epochs (1, 2, 5, 10, 20) to integrate coherently at cn0_dbhz, with hysteresis around the
-// current number (see ScalarTrackingOptions).
+// current number (see ScalarTrackingOptions): the shortest whose jitter (thermal and the configured oscillator's)
+// is within coherent_jitter_deg, else the one with the least jitter.
 int choose_coherent_epochs(const ScalarTrackingOptions& options, double cn0_dbhz, int current_epochs);
 
 // The sums of one completed block: its length in epochs and seconds and the sign-corrected E, P, L taps.

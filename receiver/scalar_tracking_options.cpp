@@ -75,6 +75,9 @@ bool ScalarTrackingOptions::IsValid(std::string* why) const {
     c.check(o.coherent_hysteresis_db >= 0 && o.coherent_hysteresis_db <= 10, "coherent_hysteresis_db",
             o.coherent_hysteresis_db, "[0, 10] dB");
     c.check(o.coherent_max_bn_t > 0 && o.coherent_max_bn_t <= 0.25, "coherent_max_bn_t", o.coherent_max_bn_t, "(0, 0.25]");
+    c.check(o.oscillator_h0 >= 0 && o.oscillator_h0 <= 1e-17, "oscillator_h0", o.oscillator_h0, "[0, 1e-17] s");
+    c.check(o.oscillator_h_minus2 >= 0 && o.oscillator_h_minus2 <= 1e-17, "oscillator_h_minus2", o.oscillator_h_minus2,
+            "[0, 1e-17] 1/s");
     c.check(o.presence_window_s >= 0.1 && o.presence_window_s <= 5, "presence_window_s", o.presence_window_s, "[0.1, 5] s");
     c.check(o.presence_threshold_dbhz >= 0 && o.presence_threshold_dbhz <= 30, "presence_threshold_dbhz",
             o.presence_threshold_dbhz, "[0, 30] dB-Hz");

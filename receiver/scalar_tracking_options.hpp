@@ -93,6 +93,12 @@ struct ScalarTrackingOptions {
   // hence 0.2. adaptive_coherent = false: always max_coherent_ms while bits are known.
   int max_coherent_ms = 100;           // 20 (off), 40, 100, 200 or 400
   bool adaptive_coherent = true;
+  // The front end's oscillator (Allan coefficients, signals/oscillator_allan.hpp; 0 = a perfect clock): its phase
+  // noise passes a PLL as jitter that grows as the bandwidth narrows (receiver/long_coherent.hpp), so with it the
+  // choice of N minimises the total jitter, thermal and oscillator: a TCXO's random-walk frequency (Brown & Hwang,
+  // h-2 2e-20) puts 48 deg into the 2 Hz loop of 100 ms integration and 12 deg into the 5 Hz one of 20 ms.
+  double oscillator_h0 = 0.0;          // white frequency, s; [0, 1e-17]
+  double oscillator_h_minus2 = 0.0;    // random-walk frequency, 1/s; [0, 1e-17]
   double coherent_jitter_deg = 4.0;    // (0, 30]
   double coherent_hysteresis_db = 2.0; // [0, 10]
   double coherent_max_bn_t = 0.2;      // (0, 0.25]

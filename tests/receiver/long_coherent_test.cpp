@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -183,6 +184,55 @@ TEST(LongCoherent, ChoiceFollowsTheJitterThresholdsWithHysteresis) {
   o.max_coherent_ms = 20;
   EXPECT_EQ(choose_coherent_epochs(o, 10.0, 1), 1);
   o.max_coherent_ms = 60;
+  EXPECT_NE(io::why_invalid(o), "");
+}
+
+// The oscillator's jitter in closed form against a numerical integration of the analogue loop's error response
+// (trapezoid on a log grid, independent of the closed form), for both loop orders; and a TCXO's figures.
+TEST(LongCoherent, OscillatorJitterMatchesTheLoopsErrorResponse) {
+  constexpr double kTwoPiL1 = 2.0 * M_PI * 1575.42e6;
+  for (const int order : {2, 3}) {
+    for (const double bn : {2.0, 5.0, 15.0}) {
+      const double w0 = bn / (order == 2 ? 0.53 : 0.7845);
+      // |E(jw) / (clock phase driver)|^2 for white frequency (phase = W / s) and random-walk frequency (W / s^2).
+      const auto response = [&](double w, int driver_order) {
+        const std::complex<double> s(0.0, w);
+        const std::complex<double> d = order == 2 ? s * s + std::sqrt(2.0) * w0 * s + w0 * w0
+                                                  : s * s * s + 2.4 * w0 * s * s + 1.1 * w0 * w0 * s + w0 * w0 * w0;
+        const std::complex<double> e = (order == 2 ? s * s : s * s * s) / d;  // error / phase
+        return std::norm(e / std::pow(s, driver_order));
+      };
+      const auto integral = [&](int driver_order) {
+        double sum = 0.0;
+        for (double w = 1e-5 * w0; w < 1e5 * w0; w *= 1.001) sum += 0.5 * (response(w, driver_order) + response(w * 1.001, driver_order)) * w * 0.001;
+        return 2.0 * sum / (2.0 * M_PI);  // both signs of w
+      };
+      const double h0 = 2e-19, h2 = 2e-20;
+      const double q_w = kTwoPiL1 * kTwoPiL1 * h0 / 2.0, q_rw = kTwoPiL1 * kTwoPiL1 * 2.0 * M_PI * M_PI * h2;
+      const double numeric = std::sqrt(q_w * integral(1) + q_rw * integral(2));
+      EXPECT_NEAR(pll_oscillator_jitter_rad(bn, order, h0, h2) / numeric, 1.0, 2e-3) << order << " " << bn;
+    }
+  }
+  // Brown & Hwang's TCXO random-walk frequency alone: 48 deg in a 2 Hz third-order loop, 12 deg at 5 Hz.
+  EXPECT_NEAR(pll_oscillator_jitter_rad(2.0, 3, 0.0, 2e-20) * 180 / M_PI, 48.4, 0.2);
+  EXPECT_NEAR(pll_oscillator_jitter_rad(5.0, 3, 0.0, 2e-20) * 180 / M_PI, 12.2, 0.1);
+}
+
+// With the oscillator known, N minimises the total jitter: a TCXO keeps the 5 Hz loop of 20 ms at any C/N0, its
+// clock jitter (12 deg at 5 Hz, 48 deg at 2 Hz) growing faster than the thermal falls as the loop narrows (40 ms at
+// 5 Hz gains < 5 %: not worth its bits); an OCXO (2.3 deg at 2 Hz) leaves the thermal choice.
+TEST(LongCoherent, ChoiceWithAnOscillatorMinimisesTheTotalJitter) {
+  ScalarTrackingOptions o;
+  o.oscillator_h0 = 9.4e-23;
+  o.oscillator_h_minus2 = 2e-20;
+  EXPECT_EQ(choose_coherent_epochs(o, 45.0, 1), 1);
+  EXPECT_EQ(choose_coherent_epochs(o, 29.0, 1), 1);
+  EXPECT_EQ(choose_coherent_epochs(o, 20.0, 1), 1);
+  EXPECT_EQ(choose_coherent_epochs(o, 29.0, 5), 1);
+  o.oscillator_h0 = 2e-23;
+  o.oscillator_h_minus2 = 4e-23;  // OCXO
+  EXPECT_EQ(choose_coherent_epochs(o, 29.0, 1), 5);
+  o.oscillator_h_minus2 = 1e-16;
   EXPECT_NE(io::why_invalid(o), "");
 }
 

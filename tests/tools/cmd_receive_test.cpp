@@ -135,6 +135,20 @@ TEST(ReceiveConfig, UnknownKeysAndBadTypesNameTheFileAndKey) {
   const auto bad_section = dir / "bad_section.toml";
   std::ofstream(bad_section) << "[receivr]\nchannels = 4\n";
   EXPECT_THROW(ultratrack::config::apply_receive_config(bad_section, o), InputError);
+  // The front end's oscillator for the tracking loops: a named class or explicit coefficients.
+  const auto tcxo = dir / "tcxo.toml";
+  std::ofstream(tcxo) << "[tracking]\noscillator = \"tcxo\"\n";
+  ultratrack::config::apply_receive_config(tcxo, o);
+  EXPECT_NEAR(o.tracking.oscillator_h0, 9.355e-23, 0.001e-23);
+  EXPECT_DOUBLE_EQ(o.tracking.oscillator_h_minus2, 2e-20);
+  const auto bad_oscillator = dir / "bad_oscillator.toml";
+  std::ofstream(bad_oscillator) << "[tracking]\noscillator = \"rubidium\"\n";
+  try {
+    ultratrack::config::apply_receive_config(bad_oscillator, o);
+    FAIL() << "unknown oscillator accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("\"tcxo\", \"ocxo\" or \"none\""), std::string::npos) << e.what();
+  }
 }
 
 namespace {
