@@ -49,7 +49,8 @@ StationaryAlignmentResult run(Filter& filter, std::span<const ins::ImuIncrement>
     filter.predict(StationaryAlignmentModel(C_nb, model_options), s.t_s - last_epoch);
     last_epoch = s.t_s;
     next_epoch += o.filter_interval_s;
-    if (filter.update(ZeroVelocityMeasurement(s.v_n, zupt_sigma)).accepted) ++r.zero_velocity_updates;
+    filter.update(ZeroVelocityMeasurement(s.v_n, zupt_sigma)).accepted ? ++r.zero_velocity_updates
+                                                                      : ++r.zero_velocity_rejected;
     const GnssAttitude* latest = nullptr;
     while (a < attitudes.size() && attitudes[a].t_s <= s.t_s) {
       if (attitude_usable(attitudes[a], usable))

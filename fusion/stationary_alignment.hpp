@@ -52,7 +52,7 @@ struct StationaryAlignmentResult {
   AlignmentMatrix P = AlignmentMatrix::Zero();  // of the (reset) error state at end_s
   Eigen::Vector3d sigma_euler_rad = Eigen::Vector3d::Zero();
   std::vector<AlignmentEpoch> history;
-  long long zero_velocity_updates = 0, attitude_updates = 0, attitude_rejected = 0, attitude_unusable = 0;
+  long long zero_velocity_updates = 0, zero_velocity_rejected = 0, attitude_updates = 0, attitude_rejected = 0, attitude_unusable = 0;
 };
 
 // Throws std::invalid_argument when no usable GPS attitude lies inside the IMU data, or the IMU holds fewer than
