@@ -1,8 +1,9 @@
-// Time synchronisation of an IMU stamped by a free-running local clock (seed 003: the IMU and the GPS receiver's
-// 1 PPS): a PPS record gives the local time of each pulse edge with the GPS time it marks (a whole GPS second);
-// a straight line local -> GPS time (offset and drift) is fitted robustly (least squares, then pulses whose residual
-// exceeds max(outlier_floor_s, 5 x 1.4826 x the median absolute residual) are dropped and the line refitted, until
-// nothing changes), so a missing pulse or one jittered far off changes nothing. The file `pps.csv`:
+// Time synchronisation of an IMU stamped by a free-running local clock, through the GPS receiver's PPS record (seed
+// 003's synchronisation of the IMU and the 1 PPS). The record gives the local time of each pulse edge with the GPS
+// time it marks (a whole GPS second); a straight line local -> GPS time (offset and drift) is fitted robustly (least
+// squares, then pulses whose residual exceeds max(outlier_floor_s, 5 x 1.4826 x the median absolute residual) are
+// dropped and the line refitted, until nothing changes), so a missing pulse or one jittered far off changes nothing.
+// The file `pps.csv`:
 //   local_s,gps_week,gps_tow_s      (local clock seconds; GPS week; GPS seconds of week of the edge, whole)
 // Times strictly increasing; a gap between edges longer than max_gap_s, fewer than 3 edges, or a tow that is not a
 // whole second is an InputError naming the file (and line). Units: s.
