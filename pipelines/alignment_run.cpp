@@ -112,12 +112,20 @@ AlignRunResult run_alignment(const std::vector<ins::ImuIncrement>& imu, const st
                                                tilt * std::tan(o.lat_rad)),
                                     noise.z());
   r.reference_sigma_rad = {tilt, tilt, heading};
+  Eigen::Quaterniond q_nb_ref = ref.q_nb;
+  Eigen::Matrix3d P_ref = r.reference_sigma_rad.cwiseAbs2().asDiagonal();
+  if (s.reference_attitude) {
+    r.reference_attitude = *s.reference_attitude;
+    r.reference_sigma_rad = s.reference_sigma_rad;
+    q_nb_ref = ins::quaternion_from_euler(*s.reference_attitude);
+    const Eigen::Matrix3d M = fusion::euler_rate_to_rotation_n(*s.reference_attitude);
+    P_ref = M * s.reference_sigma_rad.cwiseAbs2().asDiagonal() * M.transpose();
+  }
   std::vector<fusion::GnssAttitude> in_span;
   for (const auto& ga : gps)
     if (ga.t_s >= a.start_s - 1e-9 && ga.t_s <= a.end_s + 1e-9) in_span.push_back(ga);
   r.rows_in_span = static_cast<long long>(in_span.size());
-  r.mounting = fusion::estimate_mounting(in_span, ref.q_nb,
-                                         Eigen::Matrix3d(r.reference_sigma_rad.cwiseAbs2().asDiagonal()));
+  r.mounting = fusion::estimate_mounting(in_span, q_nb_ref, P_ref);
   // A mounting the configuration does not know: the GPS level disagrees with the accelerometers' by more than the
   // IMU's bias explains. Small, it shows as horizontal accelerometer biases beyond the IMU's; large, the velocity
   // the INS then builds up fails the zero-velocity gate (as it would if the vehicle moved).
@@ -167,10 +175,11 @@ std::string alignment_json(const AlignRunResult& r, const AlignSettings& s) {
   j += "  \"mounting_assumed_deg\": " + vec(assumed, 1.0) + ",\n";
   j += fmt::format("  \"mounting\": {{\"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": {:.6f}, "
                    "\"sigma_roll_deg\": {:.6f}, \"sigma_pitch_deg\": {:.6f}, \"sigma_yaw_deg\": {:.6f}, "
-                   "\"samples\": {}, \"reference\": \"IMU levelling and gyrocompassing\", "
+                   "\"samples\": {}, \"reference\": \"{}\", "
                    "\"reference_deg\": [{:.6f}, {:.6f}, {:.6f}], \"reference_sigma_deg\": {}}},\n",
                    m.angles.roll_rad / kDeg, m.angles.pitch_rad / kDeg, m.angles.yaw_rad / kDeg,
                    m.sigma_rad.x() / kDeg, m.sigma_rad.y() / kDeg, m.sigma_rad.z() / kDeg, m.samples,
+                   s.reference_attitude ? "given reference attitude" : "IMU levelling and gyrocompassing",
                    r.reference_attitude.roll_rad / kDeg, r.reference_attitude.pitch_rad / kDeg,
                    r.reference_attitude.yaw_rad / kDeg, vec(r.reference_sigma_rad, kDeg));
   j += fmt::format("  \"observability_rank\": {},\n  \"observability_singular_values\": [{}],\n",

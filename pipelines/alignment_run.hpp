@@ -2,7 +2,7 @@
 // through seed 000's stationary alignment (fusion/stationary_alignment.hpp), with the observability of the final
 // attitude (fusion/alignment_observability.hpp, a warning near pitch 90 deg), the array's mounting on the IMU
 // (fusion/mounting_misalignment.hpp: mean GPS attitude against the IMU's own levelling and gyrocompassing over the
-// same span), and the files: alignment.json (the result) and alignment.csv (one row per filter epoch).
+// same span, or against a given reference attitude), and the files: alignment.json (the result) and alignment.csv (one row per filter epoch).
 // The settings come from `fuse`'s configuration keys: [imu] (the filter's error model), [initial] position_deg_m
 // (needed: latitude and gravity), [attitude] gps_time_at_imu_zero, misalignment_deg (the mounting assumed),
 // max_pitch_deg, [filter] ukf_* and gate keys. Times on the IMU time line (s); angles rad inside, deg in files.
@@ -29,13 +29,17 @@ struct AlignSettings {
   double filter_interval_s = 1.0;
   std::string imu_file = "IMU file", attitude_file = "attitude file";  // for messages
   std::string time_note;  // how the IMU was put on GPS time (PPS), for the json
+  // The body's attitude from a reference (an INS aligned to the vehicle, as seed 000's MAPS) and its 1-sigma (roll,
+  // pitch, yaw): the mounting is then measured against it instead of the IMU's own levelling and gyrocompassing.
+  std::optional<ins::EulerAngles> reference_attitude;
+  Eigen::Vector3d reference_sigma_rad = Eigen::Vector3d::Zero();
 };
 
 struct AlignRunResult {
   fusion::StationaryAlignmentResult alignment;
   fusion::ObservabilityReport observability;
   fusion::MountingEstimate mounting;
-  ins::EulerAngles reference_attitude;               // the IMU's own levelling + gyrocompassing
+  ins::EulerAngles reference_attitude;               // the IMU's own levelling + gyrocompassing, or the given one
   Eigen::Vector3d reference_sigma_rad = Eigen::Vector3d::Zero();
   std::vector<std::string> warnings;
   long long attitude_rows = 0, fixed_rows = 0, rows_in_span = 0;

@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 
 struct AlignCommandOptions {
   std::string imu_file, attitude_file, config_file, out_dir, pps_file, filter = "ekf";
-  std::vector<double> attitude_origin, position;
+  std::vector<double> attitude_origin, position, reference;
   double duration_s = 100.0, interval_s = 1.0;
   bool quiet = false;
 };
@@ -62,6 +62,15 @@ void run_align_command(const AlignCommandOptions& o) {
     s.config.position_deg_m = Eigen::Vector3d(o.position[0], o.position[1], o.position[2]);
   }
   if (!o.attitude_origin.empty()) s.config.attitude_gps_time_at_imu_zero = origin_from(o.attitude_origin);
+  if (!o.reference.empty()) {
+    const double d = io::kRadPerDeg;
+    const auto& v = o.reference;
+    if (!(std::abs(v[0]) <= 180.0 && std::abs(v[1]) < 90.0 && std::abs(v[2]) <= 360.0 && v[3] > 0.0 && v[4] > 0.0 &&
+          v[5] > 0.0 && std::isfinite(v[3] + v[4] + v[5])))
+      throw io::InputError("command line", "--reference-attitude takes ROLL PITCH YAW and their positive 1-sigmas, deg");
+    s.reference_attitude = ins::EulerAngles{v[0] * d, v[1] * d, v[2] * d};
+    s.reference_sigma_rad = Eigen::Vector3d(v[3], v[4], v[5]) * d;
+  }
 
   const auto attitude = pipelines::read_attitude_csv(o.attitude_file);
   auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
@@ -95,9 +104,9 @@ void run_align_command(const AlignCommandOptions& o) {
              a.start_s, a.end_s, e.roll_rad / d, e.pitch_rad / d, e.yaw_rad / d, a.sigma_euler_rad.x() / d,
              a.sigma_euler_rad.y() / d, a.sigma_euler_rad.z() / d, a.attitude_updates, a.attitude_rejected,
              r.observability.rank);
-  fmt::print("align: array mounting (GPS mean - IMU levelling/gyrocompassing) roll {:.3f} pitch {:.3f} yaw {:.3f} "
+  fmt::print("align: array mounting (GPS mean against {}) roll {:.3f} pitch {:.3f} yaw {:.3f} "
              "deg, 1-sigma {:.3f} / {:.3f} / {:.3f} deg\n",
-             r.mounting.angles.roll_rad / d, r.mounting.angles.pitch_rad / d, r.mounting.angles.yaw_rad / d,
+             s.reference_attitude ? "the reference attitude" : "the IMU's levelling/gyrocompassing", r.mounting.angles.roll_rad / d, r.mounting.angles.pitch_rad / d, r.mounting.angles.yaw_rad / d,
              r.mounting.sigma_rad.x() / d, r.mounting.sigma_rad.y() / d, r.mounting.sigma_rad.z() / d);
   for (const auto& w : r.warnings) fmt::print("align: warning: {}\n", w);
   fmt::print("align: wrote {}/alignment.json and alignment.csv\n", o.out_dir);
@@ -119,6 +128,10 @@ void add_align_command(CLI::App& app) {
                   "PPS CSV (local_s,gps_week,gps_tow_s): IMU stamps are a local clock, mapped to GPS time")
       ->check(CLI::ExistingFile);
   cmd->add_option("--position", o->position, "LAT_DEG LON_DEG HEIGHT_M (else [initial] position_deg_m)")->expected(3);
+  cmd->add_option("--reference-attitude", o->reference,
+                  "R P Y SR SP SY (deg): the body's attitude from a reference and its 1-sigma, for the mounting estimate "
+                  "(else the IMU's own levelling and gyrocompassing)")
+      ->expected(6);
   cmd->add_option("--duration", o->duration_s, "seconds of alignment from the first GPS attitude (default 100; 0: all)");
   cmd->add_option("--filter-interval", o->interval_s, "seconds between filter updates (default 1)");
   cmd->add_option("--config", o->config_file, "TOML with `fuse`'s keys ([imu] [initial] [attitude] [filter])")
