@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "commands.hpp"
 #include "config/fuse_config_toml.hpp"
 #include "ins/imu_csv.hpp"
@@ -33,22 +34,9 @@ struct AlignCommandOptions {
   bool quiet = false;
 };
 
-signals::GpsTime origin_from(const std::vector<double>& o) {
-  const double week = o[0], tow = o[1];
-  if (week < 0.0 || week != std::floor(week) || !(tow >= 0.0 && tow < 604800.0))
-    throw io::InputError("command line", "--attitude-origin takes WEEK (integer) TOW (seconds in [0, 604800))");
-  return {static_cast<int>(week), tow};
-}
-
 void run_align_command(const AlignCommandOptions& o) {
   pipelines::AlignSettings s;
-  if (o.filter == "ekf") {
-    s.filter = fusion::FilterKind::Ekf;
-  } else if (o.filter == "ukf") {
-    s.filter = fusion::FilterKind::Ukf;
-  } else {
-    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + o.filter + "'");
-  }
+  s.filter = parse_filter_option(o.filter);
   if (!(o.duration_s >= 0.0)) throw io::InputError("command line", "--duration must be >= 0 (0: all the data)");
   if (!(o.interval_s > 0.0)) throw io::InputError("command line", "--filter-interval must be positive");
   s.duration_s = o.duration_s;
@@ -61,7 +49,7 @@ void run_align_command(const AlignCommandOptions& o) {
       throw io::InputError("command line", "--position takes LAT_DEG LON_DEG HEIGHT_M");
     s.config.position_deg_m = Eigen::Vector3d(o.position[0], o.position[1], o.position[2]);
   }
-  if (!o.attitude_origin.empty()) s.config.attitude_gps_time_at_imu_zero = origin_from(o.attitude_origin);
+  if (!o.attitude_origin.empty()) s.config.attitude_gps_time_at_imu_zero = parse_gps_time_option("--attitude-origin", o.attitude_origin);
   if (!o.reference.empty()) {
     const double d = io::kRadPerDeg;
     const auto& v = o.reference;

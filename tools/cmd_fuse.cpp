@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "io/units.hpp"
@@ -50,13 +51,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
                                              ": fuse takes external position/velocity fixes, only 'loose' applies "
                                              "(tight coupling runs from observables: ultratrack receive --imu)");
   pipelines::FuseSettings s;
-  if (o.filter == "ekf") {
-    s.filter = fusion::FilterKind::Ekf;
-  } else if (o.filter == "ukf") {
-    s.filter = fusion::FilterKind::Ukf;
-  } else {
-    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + o.filter + "'");
-  }
+  s.filter = parse_filter_option(o.filter);
   if (o.align == "static") {
     s.align = AlignMode::Static;
   } else if (o.align == "motion") {
@@ -78,12 +73,8 @@ void run_fuse_command(const FuseCommandOptions& o) {
   }
   if (!o.config_file.empty()) s.config = config::read_fuse_config(o.config_file);
   if (o.align.starts_with("file:")) pipelines::apply_alignment_file(s.config, o.align.substr(5));
-  if (!o.attitude_origin.empty()) {
-    const double week = o.attitude_origin[0], tow = o.attitude_origin[1];
-    if (week < 0.0 || week != std::floor(week) || !(tow >= 0.0 && tow < 604800.0))
-      throw io::InputError("command line", "--attitude-origin takes WEEK (integer) TOW (seconds in [0, 604800))");
-    s.config.attitude_gps_time_at_imu_zero = signals::GpsTime{static_cast<int>(week), tow};
-  }
+  if (!o.attitude_origin.empty())
+    s.config.attitude_gps_time_at_imu_zero = parse_gps_time_option("--attitude-origin", o.attitude_origin);
   if (!o.attitude_file.empty()) {
     s.attitude = pipelines::read_attitude_csv(o.attitude_file);
     s.attitude_file = o.attitude_file;
