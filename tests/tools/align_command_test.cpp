@@ -19,6 +19,7 @@
 #include "pipelines/alignment_monte_carlo.hpp"
 #include "pipelines/alignment_run.hpp"
 #include "pipelines/pps_time_sync.hpp"
+#include "receive_fusion_options.hpp"
 #include "run_command.hpp"
 #include "support/test_data.hpp"
 
@@ -138,6 +139,18 @@ TEST(AlignCommand, AlignsInsideSigmaAndWritesItsFiles) {
   ASSERT_NE(at, std::string::npos);
   EXPECT_NEAR(json_number(fj, "yaw_deg", at), json_number(j, "yaw_deg"), 1e-5);
   EXPECT_NEAR(json_number(fj, "roll_deg", at), json_number(j, "roll_deg"), 1e-5);
+  // `receive --imu --coupling loose --align file:` reads it into the configured start.
+  ultratrack::tools::ReceiveFusionArgs ra;
+  ra.coupling = "loose";
+  ra.imu = c.imu.string();
+  ra.align = "file:" + (c.dir / "out" / "alignment.json").string();
+  ultratrack::pipelines::ReceiveOptions ro;
+  ultratrack::tools::apply_receive_coupling_args(ra, ro);
+  EXPECT_EQ(ro.align, pl::AlignMode::Config);
+  ASSERT_TRUE(ro.navigation.attitude_deg.has_value());
+  EXPECT_NEAR(ro.navigation.attitude_deg->z(), json_number(j, "yaw_deg"), 1e-9);
+  ra.align = "file:" + (c.dir / "missing.json").string();
+  EXPECT_THROW(ultratrack::tools::apply_receive_coupling_args(ra, ro), InputError);
   // The UKF agrees.
   std::vector<std::string> ukf = base_args(c, "ukf");
   ukf.insert(ukf.end(), {"--filter", "ukf"});
