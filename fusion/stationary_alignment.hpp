@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <numbers>
 #include <span>
 #include <vector>
 
@@ -32,7 +33,7 @@ struct StationaryAlignmentOptions {
   double zero_velocity_sigma_mps = 0.0;  // 0: the accelerometer's output white noise, at least 1 mm/s
   double initial_velocity_sigma_mps = 0.01;
   Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();  // antenna array -> IMU body (known mounting)
-  double max_abs_pitch_rad = 80.0 * 3.14159265358979323846 / 180.0;  // GPS attitudes beyond are not used
+  double max_abs_pitch_rad = 80.0 * std::numbers::pi / 180.0;  // GPS attitudes beyond are not used
 };
 
 // The state after one filter epoch (after feedback).
