@@ -68,4 +68,17 @@ int build_gps_week() {
   return signals::gps_time_from_calendar(c).week;
 }
 
+fusion::FilterKind parse_filter_option(const std::string& value) {
+  if (value == "ekf") return fusion::FilterKind::Ekf;
+  if (value == "ukf") return fusion::FilterKind::Ukf;
+  throw signals::InputError("command line", "--filter must be ekf or ukf, got '" + value + "'");
+}
+
+signals::GpsTime parse_gps_time_option(const std::string& option, const std::vector<double>& week_tow) {
+  const double week = week_tow.at(0), tow = week_tow.at(1);
+  if (week < 0.0 || week != std::floor(week) || !(tow >= 0.0 && tow < 604800.0))
+    throw signals::InputError("command line", option + " takes WEEK (integer) TOW (seconds in [0, 604800))");
+  return {static_cast<int>(week), tow};
+}
+
 }  // namespace ultratrack::tools

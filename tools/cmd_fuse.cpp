@@ -12,9 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "io/units.hpp"
+#include "pipelines/alignment_run.hpp"
 #include "pipelines/gps_attitude_csv.hpp"
 #include "config/fuse_config_toml.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
@@ -49,13 +51,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
                                              ": fuse takes external position/velocity fixes, only 'loose' applies "
                                              "(tight coupling runs from observables: ultratrack receive --imu)");
   pipelines::FuseSettings s;
-  if (o.filter == "ekf") {
-    s.filter = fusion::FilterKind::Ekf;
-  } else if (o.filter == "ukf") {
-    s.filter = fusion::FilterKind::Ukf;
-  } else {
-    throw io::InputError("command line", "--filter must be ekf or ukf, got '" + o.filter + "'");
-  }
+  s.filter = parse_filter_option(o.filter);
   if (o.align == "static") {
     s.align = AlignMode::Static;
   } else if (o.align == "motion") {
@@ -64,8 +60,10 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.align = AlignMode::Config;
   } else if (o.align == "attitude") {
     s.align = AlignMode::Attitude;
+  } else if (o.align.starts_with("file:")) {  // `ultratrack align`'s result, applied after --config below
+    s.align = AlignMode::Config;
   } else {
-    throw io::InputError("command line", "--align must be static, motion, config or attitude, got '" + o.align + "'");
+    throw io::InputError("command line", "--align must be static, motion, config, attitude or file:ALIGNMENT.json, got '" + o.align + "'");
   }
   if (o.decimate < 1) throw io::InputError("command line", "--decimate must be at least 1");
   if (o.outage.size() % 2 != 0) throw io::InputError("command line", "--outage takes START DURATION pairs");
@@ -74,12 +72,9 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.outages.emplace_back(o.outage[i], o.outage[i + 1]);
   }
   if (!o.config_file.empty()) s.config = config::read_fuse_config(o.config_file);
-  if (!o.attitude_origin.empty()) {
-    const double week = o.attitude_origin[0], tow = o.attitude_origin[1];
-    if (week < 0.0 || week != std::floor(week) || !(tow >= 0.0 && tow < 604800.0))
-      throw io::InputError("command line", "--attitude-origin takes WEEK (integer) TOW (seconds in [0, 604800))");
-    s.config.attitude_gps_time_at_imu_zero = signals::GpsTime{static_cast<int>(week), tow};
-  }
+  if (o.align.starts_with("file:")) pipelines::apply_alignment_file(s.config, o.align.substr(5));
+  if (!o.attitude_origin.empty())
+    s.config.attitude_gps_time_at_imu_zero = parse_gps_time_option("--attitude-origin", o.attitude_origin);
   if (!o.attitude_file.empty()) {
     s.attitude = pipelines::read_attitude_csv(o.attitude_file);
     s.attitude_file = o.attitude_file;
@@ -162,7 +157,7 @@ void add_fuse_command(CLI::App& app) {
   cmd->add_option("--filter", o->filter, "ekf or ukf (default ekf)");
   cmd->add_option("--config", o->config_file, "TOML: [imu] [initial] [alignment] [gnss] [filter] [output]")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--align", o->align, "static, motion (default), config or attitude (first fixed GPS attitude)");
+  cmd->add_option("--align", o->align, "static, motion (default), config, attitude (first fixed GPS attitude) or file:ALIGNMENT.json (`ultratrack align`)");
   cmd->add_option("--attitude", o->attitude_file,
                   "GPS attitude CSV of `ultratrack attitude` (gps_week,tow_s,roll_deg,...,fixed,ratio): attitude "
                   "updates, unfixed rows skipped")

@@ -16,6 +16,7 @@ void add_all_commands(CLI::App& app) {
   add_gnsssim_command(app);
   add_compare_command(app);
   add_attitude_command(app);
+  add_align_command(app);
   add_campaign_command(app);
 }
 

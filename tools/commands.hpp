@@ -21,6 +21,7 @@ void add_compare_command(CLI::App& app);
 void add_attitude_command(CLI::App& app);
 void add_snapshot_command(CLI::App& app);
 void add_campaign_command(CLI::App& app);
+void add_align_command(CLI::App& app);
 
 // Every subcommand above, in the order `--help` lists them: the program and the tests build the same app.
 void add_all_commands(CLI::App& app);

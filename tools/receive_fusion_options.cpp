@@ -7,6 +7,7 @@
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
 #include "io/input_error.hpp"
+#include "pipelines/alignment_run.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -23,7 +24,7 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
                   "GNSS/INS integration with --imu: loose (PVT fixes), tight (pseudoranges and rates) or "
                   "ultra-tight (the INS-predicted replica drives the channels, the filter updates from correlations)");
   cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
-  cmd->add_option("--align", a.align, "with --coupling: static, motion (default) or config");
+  cmd->add_option("--align", a.align, "with --coupling: static, motion (default), config or file:ALIGNMENT.json (`ultratrack align`)");
   cmd->add_option("--fusion-config", a.config,
                   "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
   cmd->add_option("--imu-time-origin", a.time_origin,
@@ -100,11 +101,13 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     throw io::InputError("command line", "--filter must be ekf or ukf, got '" + filter + "'");
   }
   const std::string align = a.align.empty() ? "motion" : a.align;
-  const auto mode = pipelines::align_mode_from_string(align);
+  const bool from_file = align.starts_with("file:");  // `ultratrack align`'s result: a configured attitude
+  const auto mode = from_file ? std::optional(pipelines::AlignMode::Config) : pipelines::align_mode_from_string(align);
   if (!mode || *mode == pipelines::AlignMode::Attitude)  // attitude alignment is `fuse`'s
-    throw io::InputError("command line", "--align must be static, motion or config, got '" + align + "'");
+    throw io::InputError("command line", "--align must be static, motion, config or file:ALIGNMENT.json, got '" + align + "'");
   s.align = *mode;
   if (!a.config.empty()) s.navigation = config::read_fuse_config(a.config);
+  if (from_file) pipelines::apply_alignment_file(s.navigation, align.substr(5));
   (void)ins::imu_preset(s.navigation.imu_preset);  // an unknown preset fails here, before any output
   if (s.align == pipelines::AlignMode::Config && !s.navigation.attitude_deg)
     throw io::InputError(a.config.empty() ? "command line" : a.config,
