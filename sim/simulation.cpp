@@ -9,6 +9,7 @@
 
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "sim/imu_simulation.hpp"
 #include "sim/navigation_source.hpp"
@@ -36,6 +37,25 @@ std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, Si
   ImuSimulationCallbacks callbacks;
   callbacks.on_imu = [&](const ins::ImuIncrement& inc) { sink.imu(inc); };
   callbacks.on_truth = [&](const ins::TruthSample& t) { samples.push_back(t); };
+  if (s.odometer_misalignment_pitch_deg != 0.0 || s.odometer_misalignment_yaw_deg != 0.0) {
+    // The IMU mounted rotated from the vehicle (whose frame the trajectory moves): its increments and attitude
+    // are the trajectory's rotated into the IMU frame (no lever arm between them).
+    const Eigen::Matrix3d C_bv = ins::C_bv_from_misalignment(s.odometer_misalignment_pitch_deg * io::kRadPerDeg,
+                                                             s.odometer_misalignment_yaw_deg * io::kRadPerDeg);
+    const Eigen::Quaterniond q_vb(C_bv.transpose());
+    callbacks.on_imu = [&sink, C_bv](const ins::ImuIncrement& inc) {
+      ins::ImuIncrement r = inc;
+      r.dtheta_b = C_bv * inc.dtheta_b;
+      r.dv_b = C_bv * inc.dv_b;
+      sink.imu(r);
+    };
+    callbacks.on_truth = [&samples, q_vb, C_bv](const ins::TruthSample& t) {
+      samples.push_back(t);
+      samples.back().q_nb = (t.q_nb * q_vb).normalized();
+      samples.back().w_ib_b = C_bv * t.w_ib_b;
+      samples.back().f_b = C_bv * t.f_b;
+    };
+  }
   callbacks.on_progress = [&](int percent) {
     sink.progress({SimulationProgress::Stage::Imu, percent, 0.0, 0.0, 0.0});
   };
@@ -43,6 +63,8 @@ std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, Si
   if (s.odometer) {
     ins::OdometerOptions odo;
     odo.scale_factor_error = s.odometer_scale_factor_error;
+    odo.delay_s = s.odometer_delay_s;
+    odo.slips = s.odometer_slips;
     sink.odometer(ins::simulate_odometer(samples, odo));
   }
   result.imu_rows = imu.imu_rows;
