@@ -461,6 +461,9 @@ void read_trajectory_key(const Reader& r, const std::string& key, const std::str
   } else if (key == "odometer_scale_factor_error") {
     s.odometer_scale_factor_error = r.number(n, name);
     r.check(n, name, std::abs(s.odometer_scale_factor_error) < 0.5, "must be within +-0.5");
+  } else if (key == "sideslip_deg_per_mps2") {
+    s.sideslip_deg_per_mps2 = r.number(n, name);
+    r.check(n, name, std::abs(s.sideslip_deg_per_mps2) <= 2, "must be within +-2 deg per m/s^2");
   } else if (key == "odometer_delay_s") {
     s.odometer_delay_s = r.number(n, name);
     r.check(n, name, s.odometer_delay_s >= 0 && s.odometer_delay_s <= 1, "must be within 0..1 s");

@@ -111,6 +111,7 @@ std::string inertial_toml(const Scenario& s) {
   out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                      s.odometer, toml_float(s.odometer_scale_factor_error));
   // Written only when set, so that the echo of a scenario without them stays as it was.
+  if (s.sideslip_deg_per_mps2 != 0.0) out += fmt::format("sideslip_deg_per_mps2 = {}\n", toml_float(s.sideslip_deg_per_mps2));
   if (s.odometer_delay_s != 0.0) out += fmt::format("odometer_delay_s = {}\n", toml_float(s.odometer_delay_s));
   if (s.odometer_misalignment_pitch_deg != 0.0 || s.odometer_misalignment_yaw_deg != 0.0)
     out += fmt::format("odometer_misalignment_pitch_deg = {}\nodometer_misalignment_yaw_deg = {}\n",

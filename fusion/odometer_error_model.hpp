@@ -93,23 +93,4 @@ class OdometerAugmentedModel {
   mutable StateMatrix<19> cached_phi_ = StateMatrix<19>::Identity();
 };
 
-// A measurement written for NIn states used in a filter of NOut > NIn states: the extra states do not enter it.
-template <class M, int NIn, int NOut>
-class PaddedMeasurement {
- public:
-  explicit PaddedMeasurement(M m) : m_(std::move(m)) {}
-  Eigen::VectorXd z() const { return m_.z(); }
-  Eigen::VectorXd h(const StateVector<NOut>& dx) const { return m_.h(dx.template head<NIn>()); }
-  MeasurementJacobian<NOut> H(const StateVector<NOut>& dx) const {
-    const MeasurementJacobian<NIn> hin = m_.H(dx.template head<NIn>());
-    MeasurementJacobian<NOut> out = MeasurementJacobian<NOut>::Zero(hin.rows(), NOut);
-    out.leftCols(NIn) = hin;
-    return out;
-  }
-  Eigen::MatrixXd R() const { return m_.R(); }
-
- private:
-  M m_;
-};
-
 }  // namespace ultratrack::fusion

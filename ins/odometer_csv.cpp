@@ -18,8 +18,8 @@ OdometerRecord read_odometer_csv(const std::filesystem::path& file, const Odomet
   if (options.rate_hz) period_s = 1.0 / *options.rate_hz;
   io::read_numeric_csv(file, "odometer file", {"t_s", "pulses", "distance_m"}, [&](int line, std::span<const double> v) {
     const double t = v[0], pulses = v[1], distance = v[2];
-    if (pulses < 0.0 || pulses != std::floor(pulses))
-      throw io::InputError(name, fmt::format("pulses must be a whole number >= 0, got {}", pulses), line);
+    if (pulses < 0.0 || pulses != std::floor(pulses) || pulses > 1e15)
+      throw io::InputError(name, fmt::format("pulses must be a whole number in 0..1e15, got {}", pulses), line);
     if (distance < 0.0) throw io::InputError(name, fmt::format("negative distance_m {}", distance), line);
     if (!r.samples.empty()) {
       const double dt = t - r.samples.back().t_s;

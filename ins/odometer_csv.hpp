@@ -1,8 +1,8 @@
 // Reading odometer.csv (`t_s,pulses,distance_m`, as sim/simulation_files writes it): one row per counting
 // interval ending at t_s, at a constant rate. The reader rejects (io::InputError naming the file and line) a
-// missing or other header, an empty file, NaN/inf or malformed fields, time that does not increase, negative or
-// fractional pulses, a negative distance, and an interval that is not the rate's: the declared rate when one is
-// given (fuse config `[odometer] rate_hz`), else the file's first interval (tolerance 1 % of the interval).
+// missing or other header, an empty file, NaN/inf or malformed fields, time that does not increase, negative,
+// fractional or absurd (> 1e15) pulses, a negative distance, and an interval that is not the rate's: the declared
+// rate when one is given (fuse config `[odometer] rate_hz`), else the file's first interval (tolerance 1 %).
 #pragma once
 
 #include <filesystem>

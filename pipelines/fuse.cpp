@@ -229,7 +229,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
     const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
     const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
-    const auto a = align_moving(imu, gnss_velocities(gnss), c, window, position_only);
+    std::vector<fusion::GnssVelocitySample> velocities = gnss_velocities(gnss);
+    if (s.gnss_until_s)  // the alignment too uses GNSS only until then
+      std::erase_if(velocities, [&](const fusion::GnssVelocitySample& v) { return v.t_s > *s.gnss_until_s; });
+    const auto a = align_moving(imu, velocities, c, window, position_only);
     if (!a) {
       double fastest = 0.0;
       for (const auto& v : gnss_velocities(gnss)) fastest = std::max(fastest, v.v_n.head<2>().norm());
