@@ -9,6 +9,7 @@
 
 #include "ins/imu_datasheet.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 
 namespace ultratrack::config {
 namespace {
@@ -136,6 +137,28 @@ const std::map<std::string, Table>& sections() {
         {"nhc_sigma_mps", [](const Value& v, C& c) { c.land.nhc_sigma_mps = v.positive(); }},
         {"nhc_interval_s", [](const Value& v, C& c) { c.land.nhc_interval_s = v.non_negative(); }},
         {"nhc_lever_arm_body_m", [](const Value& v, C& c) { c.land.lever_arm_b = v.vector3(); }}}},
+      {"odometer",
+       {{"mode",
+         [](const Value& v, C& c) {
+           const std::string m = v.text();
+           if (m != "gated" && m != "always")
+             throw io::InputError(v.file, "key '" + v.key + "' must be \"gated\" or \"always\"", v.line());
+           c.odometer.mode = m == "gated" ? fusion::OdometerMode::kGated : fusion::OdometerMode::kAlways;
+         }},
+        {"yaw_rate_threshold_dps",
+         [](const Value& v, C& c) { c.odometer.yaw_rate_threshold_rad_s = v.positive() * io::kRadPerDeg; }},
+        {"min_speed_mps", [](const Value& v, C& c) { c.odometer.min_speed_mps = v.non_negative(); }},
+        {"update_rate_hz", [](const Value& v, C& c) { c.odometer.update_rate_hz = v.positive(); }},
+        {"rate_hz", [](const Value& v, C& c) { c.odometer_rate_hz = v.positive(); }},
+        {"lever_arm_body_m", [](const Value& v, C& c) { c.odometer.lever_arm_b = v.vector3(); }},
+        {"sigma_scale_factor", [](const Value& v, C& c) { c.odometer.sigma_scale_factor = v.positive(); }},
+        {"sigma_misalignment_deg",
+         [](const Value& v, C& c) { c.odometer.sigma_misalignment_rad = v.positive() * io::kRadPerDeg; }},
+        {"sigma_delay_s", [](const Value& v, C& c) { c.odometer.sigma_delay_s = v.positive(); }},
+        {"scale_factor_psd", [](const Value& v, C& c) { c.odometer.scale_factor_psd = v.non_negative(); }},
+        {"sigma_forward_mps", [](const Value& v, C& c) { c.odometer.sigma_forward_mps = v.positive(); }},
+        {"sigma_lateral_mps", [](const Value& v, C& c) { c.odometer.sigma_lateral_mps = v.positive(); }},
+        {"sigma_vertical_mps", [](const Value& v, C& c) { c.odometer.sigma_vertical_mps = v.positive(); }}}},
       {"clock",
        {{"oscillator",
          [](const Value& v, C& c) {
@@ -200,7 +223,7 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
     const auto known = sections().find(section);
     const auto* table = section_node.as_table();
     if (known == sections().end() || !table)
-      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, vehicle, clock, height_aiding, filter, output, attitude)",
+      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, vehicle, odometer, clock, height_aiding, filter, output, attitude)",
                            static_cast<int>(section_node.source().begin.line));
     for (const auto& [key_name, node] : *table) {
       const std::string key = section + "." + std::string(key_name.str());

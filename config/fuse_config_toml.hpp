@@ -14,6 +14,13 @@
 //                first-order Gauss-Markov with this time: their variance is inflated by 1 + 2 tau / dt; 0: white)
 //   [vehicle]    nhc = false (land vehicles: zero lateral and vertical body velocity, fusion/nhc_measurement.hpp),
 //                nhc_sigma_mps = 0.3, nhc_interval_s = 0.5, nhc_lever_arm_body_m = [x, y, z] (IMU -> rear axle)
+//   [odometer]   (fuse --odometer; seed 004, fusion/vms_measurement.hpp) mode = "gated"|"always" (gated: update only
+//                while |heading change| per second < yaw_rate_threshold_dps = 1.5 and the VMS speed > min_speed_mps
+//                = 5; always: every window), update_rate_hz = 1, rate_hz (the odometer file's declared rate; else
+//                its first interval), lever_arm_body_m = [x, y, z] (IMU -> wheels' non-holonomic point),
+//                sigma_scale_factor = 0.01, sigma_misalignment_deg = 0.5, sigma_delay_s = 0.05 (initial 1-sigmas),
+//                scale_factor_psd = 1e-12 (random walk, 1/s), sigma_forward_mps = 0.05, sigma_lateral_mps = 0.1,
+//                sigma_vertical_mps = 0.1 (measurement 1-sigmas)
 //   [clock]      (tight) oscillator = "tcxo"|"ocxo" (fusion/clock_model presets; default tcxo), h0, h_minus2
 //                (override the preset's Allan coefficients)
 //   [height_aiding] (tight) mode = "off"|"auto" (default off: aircraft; auto: land vehicles, a terrain-height

@@ -234,6 +234,35 @@ void read_blockages(const Reader& r, const toml::node& section_node, Scenario& s
   }
 }
 
+void read_odometer_slips(const Reader& r, const toml::node& section_node, Scenario& s) {
+  for (const auto& e : tables_of(r, section_node, "odometer_slip", "expected [[odometer_slip]] tables")) {
+    const auto* t = e.as_table();
+    if (!t) r.fail(e, "odometer_slip", "expected a table");
+    ins::OdometerSlip ev;
+    bool start = false, duration = false, ratio = false;
+    for (auto&& [k, n] : *t) {
+      const std::string key(k.str()), name = "odometer_slip." + key;
+      if (key == "start_s") {
+        ev.start_s = r.number(n, name);
+        r.check(n, name, ev.start_s >= 0, "must be >= 0");
+        start = true;
+      } else if (key == "duration_s") {
+        ev.duration_s = r.number(n, name);
+        r.check(n, name, ev.duration_s > 0 && ev.duration_s <= 3600, "must be within (0, 3600] s");
+        duration = true;
+      } else if (key == "ratio") {
+        ev.ratio = r.number(n, name);
+        r.check(n, name, ev.ratio >= -1 && ev.ratio <= 10, "must be within -1..10 (-1: a locked wheel)");
+        ratio = true;
+      } else {
+        r.fail(n, name, "unknown key in [[odometer_slip]] (start_s, duration_s, ratio)");
+      }
+    }
+    if (!start || !duration || !ratio) r.fail(e, "odometer_slip", "needs start_s, duration_s and ratio");
+    s.odometer_slips.push_back(ev);
+  }
+}
+
 // [signal] cn0_dbhz_by_prn = { 5 = 40.0 }
 void read_cn0_by_prn(const Reader& r, const toml::node& n, const std::string& name, Scenario& s) {
   const auto* t = n.as_table();
@@ -461,6 +490,16 @@ void read_trajectory_key(const Reader& r, const std::string& key, const std::str
   } else if (key == "odometer_scale_factor_error") {
     s.odometer_scale_factor_error = r.number(n, name);
     r.check(n, name, std::abs(s.odometer_scale_factor_error) < 0.5, "must be within +-0.5");
+  } else if (key == "sideslip_deg_per_mps2") {
+    s.sideslip_deg_per_mps2 = r.number(n, name);
+    r.check(n, name, std::abs(s.sideslip_deg_per_mps2) <= 2, "must be within +-2 deg per m/s^2");
+  } else if (key == "odometer_delay_s") {
+    s.odometer_delay_s = r.number(n, name);
+    r.check(n, name, s.odometer_delay_s >= 0 && s.odometer_delay_s <= 1, "must be within 0..1 s");
+  } else if (key == "odometer_misalignment_pitch_deg" || key == "odometer_misalignment_yaw_deg") {
+    double& m = key == "odometer_misalignment_pitch_deg" ? s.odometer_misalignment_pitch_deg : s.odometer_misalignment_yaw_deg;
+    m = r.number(n, name);
+    r.check(n, name, std::abs(m) <= 10, "must be within +-10 deg");
   } else {
     r.fail(n, name, "unknown key in [trajectory]");
   }
@@ -525,7 +564,7 @@ void read_table_key(const Reader& r, const std::string& section, const toml::nod
   } else {
     r.fail(section_node, section,
            "unknown section (signal, time, navigation, receiver, atmosphere, output, trajectory, imu, "
-           "[[antenna]], [[cycle_slip]], [[blockage]], [[cn0_step]])");
+           "[[antenna]], [[cycle_slip]], [[blockage]], [[cn0_step]], [[odometer_slip]])");
   }
 }
 
@@ -540,6 +579,8 @@ void read_section(const Reader& r, const std::string& section, const toml::node&
     read_cycle_slips(r, section_node, s);
   } else if (section == "blockage") {
     read_blockages(r, section_node, s);
+  } else if (section == "odometer_slip") {
+    read_odometer_slips(r, section_node, s);
   } else {
     const auto* tbl = section_node.as_table();
     if (!tbl) r.fail(section_node, section, "expected a table [" + section + "]");

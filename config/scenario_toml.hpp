@@ -29,6 +29,13 @@
 //                 blend, so the peak jerk of a step da in acceleration is 15/8 da / ramp_s)
 //                 duration_s = 120.0 (profiles; must cover [signal] duration_s)  imu_rate_hz = 100.0 (50..1000)
 //                 odometer = false  odometer_scale_factor_error = 0.0   (odometer.csv; the land profile's use)
+//                 odometer_delay_s = 0.0 (0..1)  odometer_misalignment_pitch_deg = 0.0  odometer_misalignment_yaw_deg
+//                 = 0.0 (+-10: the IMU mounted rotated from the vehicle, C_bv = Rz(yaw) Ry(pitch); the IMU data and
+//                 truth attitude are then the IMU's, the trajectory the vehicle's; ins/odometer.hpp)
+//                 sideslip_deg_per_mps2 = 0.0 (+-2: a land vehicle's body yaws from its track by this times the
+//                 lateral acceleration, breaking the non-holonomic constraints in turns as real tyres do)
+//   [[odometer_slip]] start_s = 100.0  duration_s = 2.0  ratio = -1.0   (wheel slip / skid: pulses scaled by
+//                 1 + ratio over the event; -1 a locked wheel, > 0 a spinning one)
 //                 The start position is [receiver] llh_deg_m; t = 0 of the trajectory is the [time] start.
 //   [imu]         preset = "ideal" (ideal, hg1700ae, dmu6x, navigation, mems, adis16405, adis16465, bmi088,
 //                 stim300)  seed = 1

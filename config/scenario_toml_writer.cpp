@@ -114,6 +114,12 @@ std::string inertial_toml(const Scenario& s) {
   }
   out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                      s.odometer, toml_float(s.odometer_scale_factor_error));
+  // Written only when set, so that the echo of a scenario without them stays as it was.
+  if (s.sideslip_deg_per_mps2 != 0.0) out += fmt::format("sideslip_deg_per_mps2 = {}\n", toml_float(s.sideslip_deg_per_mps2));
+  if (s.odometer_delay_s != 0.0) out += fmt::format("odometer_delay_s = {}\n", toml_float(s.odometer_delay_s));
+  if (s.odometer_misalignment_pitch_deg != 0.0 || s.odometer_misalignment_yaw_deg != 0.0)
+    out += fmt::format("odometer_misalignment_pitch_deg = {}\nodometer_misalignment_yaw_deg = {}\n",
+                       toml_float(s.odometer_misalignment_pitch_deg), toml_float(s.odometer_misalignment_yaw_deg));
   out += fmt::format("\n[imu]\npreset = {}\nseed = {}\n", toml_string(s.imu_preset), s.imu_seed);
   if (s.imu_time_offset_s != 0.0) out += fmt::format("time_offset_s = {}\n", toml_float(s.imu_time_offset_s));
   for (const auto& key : ins::imu_datasheet_keys())
@@ -136,6 +142,9 @@ std::string events_toml(const Scenario& s) {
   for (const auto& e : s.cycle_slips)
     out += fmt::format("\n[[cycle_slip]]\nantenna = {}\nprn = {}\ntime_s = {}\ncycles = {}\nfade_s = {}\n", e.antenna,
                        e.prn, toml_float(e.time_s), toml_float(e.cycles), toml_float(e.fade_s));
+  for (const auto& o : s.odometer_slips)
+    out += fmt::format("\n[[odometer_slip]]\nstart_s = {}\nduration_s = {}\nratio = {}\n", toml_float(o.start_s),
+                       toml_float(o.duration_s), toml_float(o.ratio));
   for (const auto& b : s.blockages)
     out += fmt::format("\n[[blockage]]\nantenna = {}\nstart_s = {}\nduration_s = {}\n", b.antenna, toml_float(b.start_s),
                        toml_float(b.duration_s));

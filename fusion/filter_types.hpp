@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <concepts>
+#include <utility>
 
 namespace ultratrack::fusion {
 
@@ -75,6 +76,25 @@ struct UpdateResult {
   double threshold = 0.0;  // gate threshold used (infinity when gating is off)
   int dof = 0;             // measurement size k
   Eigen::VectorXd innovation;  // z - predicted (EKF: h(x); UKF: weighted mean of h at the sigma points)
+};
+
+// A measurement written for NIn states used in a filter of NOut > NIn states: the extra states do not enter it.
+template <class M, int NIn, int NOut>
+class PaddedMeasurement {
+ public:
+  explicit PaddedMeasurement(M m) : m_(std::move(m)) {}
+  Eigen::VectorXd z() const { return m_.z(); }
+  Eigen::VectorXd h(const StateVector<NOut>& dx) const { return m_.h(dx.template head<NIn>()); }
+  MeasurementJacobian<NOut> H(const StateVector<NOut>& dx) const {
+    const MeasurementJacobian<NIn> hin = m_.H(dx.template head<NIn>());
+    MeasurementJacobian<NOut> out = MeasurementJacobian<NOut>::Zero(hin.rows(), NOut);
+    out.leftCols(NIn) = hin;
+    return out;
+  }
+  Eigen::MatrixXd R() const { return m_.R(); }
+
+ private:
+  M m_;
 };
 
 struct FilterCounters {

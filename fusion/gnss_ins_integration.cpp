@@ -1,6 +1,7 @@
 #include "fusion/gnss_ins_integration.hpp"
 
 #include <cmath>
+#include <deque>
 #include <optional>
 #include <string>
 #include <map>
@@ -9,6 +10,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "ins/attitude.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::fusion {
@@ -28,7 +30,10 @@ struct PendingEpoch {
 struct PendingAttitude {
   GnssAttitude attitude;
 };
-using Pending = std::variant<PendingFix, PendingEpoch, PendingAttitude>;
+struct PendingOdometer {
+  OdometerSpeed speed;
+};
+using Pending = std::variant<PendingFix, PendingEpoch, PendingAttitude, PendingOdometer>;
 
 bool finite(const Pending& p) {
   if (const auto* f = std::get_if<PendingFix>(&p)) {
@@ -45,6 +50,8 @@ bool finite(const Pending& p) {
     return std::isfinite(x.euler_a.roll_rad) && std::isfinite(x.euler_a.pitch_rad) && std::isfinite(x.euler_a.yaw_rad) &&
            x.sigma_euler_rad.allFinite() && (x.sigma_euler_rad.array() > 0.0).all();
   }
+  if (const auto* o = std::get_if<PendingOdometer>(&p))
+    return std::isfinite(o->speed.speed_mps) && std::isfinite(o->speed.window_s) && o->speed.window_s > 0.0;
   return true;  // observation epochs: prepare_satellites skips non-finite pseudoranges
 }
 
@@ -61,6 +68,10 @@ void check_options(const IntegrationOptions& o) {
       !std::isfinite(o.fix_error_correlation_s))
     throw std::invalid_argument("integration: the fix interval and error correlation time must be >= 0");
   if (std::string why; !o.recovery.IsValid(&why)) throw std::invalid_argument("integration: " + why);
+  if (std::string why; o.odometer.enabled && !o.odometer.IsValid(&why))
+    throw std::invalid_argument("integration: " + why);
+  if (o.odometer.enabled && o.coupling != Coupling::kLoose)
+    throw std::invalid_argument("integration: odometer aiding is implemented for the loose coupling only");
   if (o.land.nhc && (!(o.land.nhc_sigma_mps > 0.0) || !(o.land.nhc_interval_s >= 0.0) || !o.land.lever_arm_b.allFinite()))
     throw std::invalid_argument("integration: non-holonomic constraints need a positive sigma and interval >= 0");
   if (!o.attitude.q_ba.coeffs().allFinite() || std::abs(o.attitude.q_ba.norm() - 1.0) > 1e-6)
@@ -91,22 +102,28 @@ struct CoreBase {
 
 namespace {
 
-// 15: loose; 17: tight (clock bias, drift); 18: tight with height aiding (+ terrain height, height_aiding.hpp).
+// 15: loose; 17: tight (clock bias, drift); 18: tight with height aiding (+ terrain height, height_aiding.hpp);
+// 19: loose with odometer aiding (+ VMS delay, misalignment, scale factor; odometer_error_model.hpp).
 template <int N>
-using ProcessModelFor = std::conditional_t<N == 18, TerrainAugmentedModel, InsErrorModel<N>>;
+using ProcessModelFor =
+    std::conditional_t<N == 18, TerrainAugmentedModel,
+                       std::conditional_t<N == 19, OdometerAugmentedModel, InsErrorModel<N>>>;
 
 // A measurement model written for 15 or 17 states, as the filter of N states takes it.
 template <int N, class M>
 auto for_filter(M m) {
   if constexpr (N == 18)
     return TerrainPadded<M>(std::move(m));
+  else if constexpr (N == 19)
+    return PaddedMeasurement<M, 15, 19>(std::move(m));
   else
     return m;
 }
 
 template <int N, class Filter>
 class Core final : public CoreBase {
-  static constexpr int kNav = N == 18 ? 17 : N;  // states of the INS/clock error model (no terrain)
+  static constexpr int kNav = N == 18 ? 17 : N == 19 ? 15 : N;  // INS/clock error states (no terrain, odometer)
+  static constexpr bool kClock = N == 17 || N == 18;
 
  public:
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
@@ -120,7 +137,7 @@ class Core final : public CoreBase {
         hold_terrain();
       }
     }
-    if constexpr (N >= 17) {
+    if constexpr (kClock) {
       nominal_.clock_bias_m = opt.initial_clock_bias_m;
       nominal_.clock_drift_mps = opt.initial_clock_drift_mps;
     }
@@ -175,12 +192,13 @@ class Core final : public CoreBase {
       apply(node.mapped());
     }
     if (inc.t_s - t > kTimeEpsilon_s) ins_step(dth, dv, inc.t_s - t);
-    if constexpr (N == 15 || N == 17) {
+    if constexpr (N == 15 || N == 17 || N == 19) {
       if (opt_.land.nhc && nominal_.nav.t_s - last_nhc_t_s_ >= opt_.land.nhc_interval_s - kTimeEpsilon_s) {
         last_nhc_t_s_ = nominal_.nav.t_s;
         propagate();
-        ++(update(NhcMeasurement<N>(nominal_, imu_steps_.w_ib_b, opt_.land), -3) ? counters.nhc_accepted
-                                                                                 : counters.nhc_rejected);
+        ++(update(for_filter<N>(NhcMeasurement<kNav>(nominal_, imu_steps_.w_ib_b, opt_.land)), -3)
+               ? counters.nhc_accepted
+               : counters.nhc_rejected);
       }
     }
     fill_output();
@@ -196,10 +214,11 @@ class Core final : public CoreBase {
     const Eigen::Quaterniond q0 = ins_.state().q_nb;
     ins_.step(dth, dv, dt);
     nominal_.nav = ins_.state();
-    if constexpr (N >= 17) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
+    if constexpr (kClock) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
     if constexpr (N == 18)  // the nominal terrain follows the Gauss-Markov mean back to the reference
       terrain_m_ = terrain_ref_m_ + (terrain_m_ - terrain_ref_m_) * std::exp(-dt / opt_.height_aiding.terrain_correlation_s);
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
+    if constexpr (N == 19) record_history();
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
 
@@ -223,6 +242,7 @@ class Core final : public CoreBase {
     // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock, terrain), reset.
     nominal_ = corrected<kNav>(nominal_, filter_.x().template head<kNav>());
     if constexpr (N == 18) terrain_m_ -= filter_.x()(ix::kTerrain);
+    if constexpr (N == 19) odometer_ = corrected(odometer_, filter_.x());
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<N>::Zero());
     return true;
@@ -230,6 +250,10 @@ class Core final : public CoreBase {
 
   void apply(const Pending& p) {
     propagate();  // covariance up to the measurement time
+    if (const auto* o = std::get_if<PendingOdometer>(&p)) {
+      if constexpr (N == 19) apply_odometer(o->speed);
+      return;
+    }
     if (const auto* a = std::get_if<PendingAttitude>(&p)) {
       ++counters.attitude_epochs;
       if (!attitude_usable(a->attitude, opt_.attitude)) {
@@ -259,11 +283,12 @@ class Core final : public CoreBase {
     if (!attitude_since_fix_) ++counters.fixes_without_attitude;
     attitude_since_fix_ = false;
     if (const auto* f = std::get_if<PendingFix>(&p)) {
-      if constexpr (N == 15) {
+      if constexpr (N == 15 || N == 19) {
         if (f->fix.has_position || f->fix.has_velocity) {
           GnssFix fix = f->fix;
           fix.sigma_pos_ned_m *= std::sqrt(fix_variance_factor);
-          const bool accepted = update(LooseMeasurement<N>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b), 0);
+          const bool accepted =
+              update(for_filter<N>(LooseMeasurement<kNav>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b)), 0);
           ++(accepted ? counters.fix_accepted : counters.fix_rejected);
           const UpdateResult r = records.back().result;
           if (auto event = monitor_.observe(nominal_.nav.t_s, accepted, r.nis, r.dof)) {
@@ -273,14 +298,15 @@ class Core final : public CoreBase {
             if (fix.has_velocity) dv = r.innovation.segment<3>(pos_rows);
             recover(*event, dp, dv, 0.0);
             // The fix that tripped the monitor, again through the opened filter (counted as accepted if it passes).
-            if (!accepted && update(LooseMeasurement<N>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b), 0))
+            if (!accepted &&
+                update(for_filter<N>(LooseMeasurement<kNav>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b)), 0))
               ++counters.fix_accepted;
           }
         }
       }
       return;
     }
-    if constexpr (N >= 17) {
+    if constexpr (kClock) {
       const auto& e = std::get<PendingEpoch>(p);
       PrepareStats stats;
       const auto sats = prepare_satellites(e.epoch, e.ephemerides, e.iono,
@@ -331,7 +357,11 @@ class Core final : public CoreBase {
       o.terrain_height_m = terrain_m_;
       o.sigma_terrain_height_m = sd(ix::kTerrain);
     }
-    if constexpr (N >= 17) {
+    if constexpr (N == 19) {
+      o.odometer.value = odometer_;
+      o.odometer.sigma = {sd(ix::kOdoDelay), sd(ix::kOdoPitch), sd(ix::kOdoYaw), sd(ix::kOdoScale)};
+    }
+    if constexpr (kClock) {
       o.clock_bias_m = nominal_.clock_bias_m;
       o.clock_drift_mps = nominal_.clock_drift_mps;
       o.sigma_clock_bias_m = sd(ix::kClockBias);
@@ -342,6 +372,8 @@ class Core final : public CoreBase {
   static ProcessModelFor<N> make_model(const IntegrationOptions& o) {
     if constexpr (N == 18)
       return TerrainAugmentedModel(o.model, o.height_aiding);
+    else if constexpr (N == 19)
+      return OdometerAugmentedModel(o.model, o.odometer);
     else
       return InsErrorModel<N>(o.model);
   }
@@ -389,6 +421,42 @@ class Core final : public CoreBase {
     }
   }
 
+  // Odometer aiding (19 states): the INS heading and velocity after each IMU step over the last windows.
+  struct HistoryPoint {
+    double t_s, yaw_rad;
+    Eigen::Vector3d v_n;
+  };
+  void record_history() {
+    const double yaw = ins::euler_from_quaternion(nominal_.nav.q_nb).yaw_rad;
+    history_.push_back({nominal_.nav.t_s, yaw, nominal_.nav.v_n});
+    const double keep_s = 1.0 / opt_.odometer.update_rate_hz + 1.0;
+    while (history_.size() > 2 && history_[1].t_s < nominal_.nav.t_s - keep_s) history_.pop_front();
+  }
+
+  // One odometer window (seed 004 eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
+  void apply_odometer(const OdometerSpeed& speed) {
+    if constexpr (N == 19) {
+      const double t0 = nominal_.nav.t_s - speed.window_s;
+      if (history_.empty() || history_.front().t_s > t0 + 1e-6) {
+        ++counters.odometer_unusable;
+        return;
+      }
+      auto it = history_.begin();  // the last point at or before the window's start
+      while (std::next(it) != history_.end() && std::next(it)->t_s <= t0 + 1e-9) ++it;
+      const double yaw_now = ins::euler_from_quaternion(nominal_.nav.q_nb).yaw_rad;
+      const OdometerGate gate = odometer_gate(opt_.odometer, yaw_now - it->yaw_rad, speed.window_s, speed.speed_mps);
+      if (!gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
+      if (!gate.speed_ok) ++counters.odometer_gated_speed;
+      if (!gate.update()) return;
+      const double span = nominal_.nav.t_s - it->t_s;
+      const Eigen::Vector3d a_n = span > 0.0 ? Eigen::Vector3d((nominal_.nav.v_n - it->v_n) / span) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d a_b = nominal_.nav.q_nb.conjugate() * a_n;
+      ++(update(VmsMeasurement(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer), -4)
+             ? counters.odometer_accepted
+             : counters.odometer_rejected);
+    }
+  }
+
   IntegrationOptions opt_;
   ins::Strapdown ins_;
   ProcessModelFor<N> model_;
@@ -403,6 +471,8 @@ class Core final : public CoreBase {
   double last_aid_t_s_ = -1e300;
   double last_nhc_t_s_ = -1e300;
   double last_fix_t_s_ = -1e300;
+  OdometerNominal odometer_;
+  std::deque<HistoryPoint> history_;
 };
 
 template <int N>
@@ -414,6 +484,8 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
   StateMatrix<N> P0;
   if constexpr (N == 18)
     P0 = TerrainAugmentedModel(mo, o.height_aiding).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  else if constexpr (N == 19)
+    P0 = OdometerAugmentedModel(mo, o.odometer).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else
     P0 = InsErrorModel<N>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   const StateVector<N> x0 = StateVector<N>::Zero();
@@ -433,7 +505,9 @@ GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const Integ
     : impl_(std::make_unique<Impl>()) {
   check_options(options);
   impl_->options = options;
-  if (options.coupling == Coupling::kLoose)
+  if (options.coupling == Coupling::kLoose && options.odometer.enabled)
+    impl_->core = make_core<19>(initial, options);
+  else if (options.coupling == Coupling::kLoose)
     impl_->core = make_core<15>(initial, options);
   else if (options.height_aiding.enabled)
     impl_->core = make_core<18>(initial, options);
@@ -462,6 +536,11 @@ void GnssInsIntegration::add_observations(const receiver::ObservationEpoch& epoc
 
 void GnssInsIntegration::add_attitude(const GnssAttitude& attitude) {
   impl_->core->add_pending(attitude.t_s, PendingAttitude{attitude});
+}
+
+void GnssInsIntegration::add_odometer(const OdometerSpeed& speed) {
+  if (!impl_->options.odometer.enabled) throw std::logic_error("add_odometer: odometer aiding is not enabled");
+  impl_->core->add_pending(speed.t_s, PendingOdometer{speed});
 }
 
 void GnssInsIntegration::add_imu(const ins::ImuIncrement& inc) { impl_->core->add_imu(inc); }

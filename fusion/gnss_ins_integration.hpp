@@ -13,7 +13,8 @@
 // later fix rejected.
 // Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides; with height aiding 18 (+ the
-// terrain height). EKF or UKF.
+// terrain height). Loose with odometer aiding: 19 (+ VMS delay, misalignment, scale factor; seed 004), odometer
+// speeds through add_odometer, gated by fusion/vms_measurement.hpp's rule. EKF or UKF.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,8 +30,10 @@
 #include "fusion/lockout_recovery.hpp"
 #include "fusion/loose_measurements.hpp"
 #include "fusion/nhc_measurement.hpp"
+#include "fusion/odometer_error_model.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "fusion/ukf.hpp"
+#include "fusion/vms_measurement.hpp"
 #include "ins/nav_state.hpp"
 #include "ins/strapdown.hpp"
 #include "receiver/observables.hpp"
@@ -64,6 +67,8 @@ struct IntegrationOptions {
   double fix_error_correlation_s = 0.0;
   // Land vehicles: non-holonomic constraints (fusion/nhc_measurement.hpp), off by default.
   LandVehicleOptions land;
+  // Land vehicles: odometer (VMS) aiding, seed 004 (loose coupling only; off by default).
+  OdometerAidingOptions odometer;
   UkfParameters ukf;
   Discretisation discretisation = Discretisation::SecondOrderSeries;
   // The error covariance is propagated over intervals of about this length (F at the interval's end,
@@ -96,6 +101,7 @@ struct IntegrationOutput {
   double clock_bias_m = 0.0, clock_drift_mps = 0.0;  // tight mode (else 0)
   double sigma_clock_bias_m = 0.0, sigma_clock_drift_mps = 0.0;
   double terrain_height_m = 0.0, sigma_terrain_height_m = 0.0;  // tight with height aiding (else 0)
+  OdometerEstimate odometer;  // odometer aiding (else 0)
 };
 
 struct IntegrationCounters {
@@ -122,12 +128,16 @@ struct IntegrationCounters {
   long long recoveries = 0;  // lock-out recoveries (recovery_events() says when and why)
   long long nhc_accepted = 0, nhc_rejected = 0;  // non-holonomic constraint updates
   long long fixes_skipped = 0;  // loose: within fix_min_interval_s of the last fix used
+  // Odometer windows: updates accepted / refused by the innovation gate; gated out by the heading-rate rule and
+  // by the speed rule (a window failing both counts in both); unusable (no INS history over the window yet).
+  long long odometer_accepted = 0, odometer_rejected = 0;
+  long long odometer_gated_yaw_rate = 0, odometer_gated_speed = 0, odometer_unusable = 0;
 };
 
 // Per-update diagnostics (for NIS / consistency logs).
 struct UpdateRecord {
   double t_s = 0.0;
-  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1; height aiding: -2; non-holonomic: -3
+  int prn = 0;  // tight: satellite; loose: 0; GPS attitude: -1; height aiding: -2; non-holonomic: -3; odometer: -4
   UpdateResult result;
 };
 
@@ -149,6 +159,9 @@ class GnssInsIntegration {
   // Either coupling: a GPS attitude (array frame, options().attitude.q_ba to the IMU) at attitude.t_s.
   // Non-finite values or non-positive sigmas: ignored and counted (counters().invalid).
   void add_attitude(const GnssAttitude& attitude);
+  // Odometer aiding only (options().odometer.enabled; else std::logic_error): the VMS speed over
+  // (speed.t_s - speed.window_s, speed.t_s], applied at speed.t_s. Non-finite values: ignored (counters().invalid).
+  void add_odometer(const OdometerSpeed& speed);
 
   // One raw IMU increment covering (output().nav.t_s, inc.t_s]. Pending GNSS data with times inside the
   // interval are applied at their exact times. Increments not later than the current time, or with non-finite
@@ -157,7 +170,7 @@ class GnssInsIntegration {
 
   const IntegrationOutput& output() const;
   // Current nominal (nav + bias estimates + clock) and the error covariance (15 x 15 or 17 x 17; with height
-  // aiding the terrain state is left out: output().sigma_terrain_height_m).
+  // aiding the terrain state is left out: output().sigma_terrain_height_m; with the odometer the odometer states).
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;
   const IntegrationCounters& counters() const;

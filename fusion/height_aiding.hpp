@@ -60,22 +60,7 @@ class TerrainAugmentedModel {
 
 // A 17-state measurement used in the 18-state filter: the terrain state does not enter it.
 template <class M>
-class TerrainPadded {
- public:
-  explicit TerrainPadded(M m) : m_(std::move(m)) {}
-  Eigen::VectorXd z() const { return m_.z(); }
-  Eigen::VectorXd h(const StateVector<18>& dx) const { return m_.h(dx.template head<17>()); }
-  MeasurementJacobian<18> H(const StateVector<18>& dx) const {
-    const MeasurementJacobian<17> h17 = m_.H(dx.template head<17>());
-    MeasurementJacobian<18> out = MeasurementJacobian<18>::Zero(h17.rows(), 18);
-    out.leftCols(17) = h17;
-    return out;
-  }
-  Eigen::MatrixXd R() const { return m_.R(); }
-
- private:
-  M m_;
-};
+using TerrainPadded = PaddedMeasurement<M, 17, 18>;
 
 // The aid: z = the nominal terrain height; h(dx) = height of the corrected INS nominal + terrain error state
 // (IMU truth height = nominal + dx_d; terrain truth = terrain nominal - dx_t; their difference is the white

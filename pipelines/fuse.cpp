@@ -88,7 +88,43 @@ struct RowError {
   Eigen::Vector3d pos_ned_m, sigma_pos_m;
   double vel_mps;
   Eigen::Vector3d att_rad;
+  double distance_m = 0.0;  // truth path length from the first row
 };
+
+// The odometer rows as speed windows of about `window_s` (whole rows; each window ends at a row's time).
+std::vector<fusion::OdometerSpeed> odometer_windows(const std::vector<ins::OdometerSample>& rows, double window_s) {
+  std::vector<fusion::OdometerSpeed> out;
+  if (rows.size() < 2) return out;
+  double start = rows[0].t_s - (rows[1].t_s - rows[0].t_s), distance = 0.0;
+  const double period = rows[1].t_s - rows[0].t_s;
+  for (const auto& r : rows) {
+    distance += r.distance_m;
+    const double span = r.t_s - start;
+    if (span >= window_s - 0.5 * period) {
+      out.push_back({r.t_s, distance / span, span});
+      start = r.t_s;
+      distance = 0.0;
+    }
+  }
+  return out;
+}
+
+// The odometer's part of the result against truth: from the last GNSS use to the end.
+void odometer_errors(const std::vector<RowError>& errors, OdometerUse& u) {
+  const RowError* first = nullptr;
+  double h_max = 0.0, v_max = 0.0;
+  for (const auto& e : errors) {
+    if (e.t_s < u.gnss_last_used_s - 1e-9) continue;
+    if (!first) first = &e;
+    h_max = std::max(h_max, e.pos_ned_m.head<2>().norm());
+    v_max = std::max(v_max, std::abs(e.pos_ned_m.z()));
+  }
+  if (!first || errors.back().distance_m - first->distance_m <= 0.0) return;
+  u.distance_travelled_m = errors.back().distance_m - first->distance_m;
+  u.horizontal_error_max_m = h_max;
+  u.horizontal_error_end_m = errors.back().pos_ned_m.head<2>().norm();
+  u.altitude_error_max_m = v_max;
+}
 
 ErrorRms rms_of(const std::vector<RowError>& e, double from_t) {
   ErrorRms r;
@@ -165,9 +201,13 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
                 const std::function<void(double)>& on_progress, std::stop_token stop) {
   const FuseConfig& c = s.config;
   if (imu.size() < 2) throw io::InputError("IMU file", "fewer than 2 IMU rows");
-  if (gnss.empty()) throw io::InputError("GNSS file", "no fixes");
+  const bool odometer_only = gnss.empty() && !s.odometer.empty();
+  if (gnss.empty() && !odometer_only) throw io::InputError("GNSS file", "no fixes");
+  if (odometer_only && (s.align != AlignMode::Config || !c.position_deg_m))
+    throw io::InputError("command line", "without --gnss the start is the configuration's: --align config with "
+                                         "[initial] attitude_deg, position_deg_m (and velocity_ned_mps)");
   const double imu_start = imu[0].t_s - (imu[1].t_s - imu[0].t_s);  // the first row's interval start
-  if (gnss.back().t_s <= imu_start || gnss.front().t_s >= imu.back().t_s)
+  if (!odometer_only && (gnss.back().t_s <= imu_start || gnss.front().t_s >= imu.back().t_s))
     throw io::InputError("GNSS file", fmt::format("fixes ({:.3f}-{:.3f} s) do not overlap the IMU data ({:.3f}-{:.3f} s)",
                                                   gnss.front().t_s, gnss.back().t_s, imu_start, imu.back().t_s));
   const ins::ImuErrorSpec preset = imu_error_spec(c);
@@ -178,6 +218,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   FuseResult result;
   AttitudeStart start;
   const double lat_hint = c.position_deg_m ? c.position_deg_m->x() * io::kRadPerDeg : gnss.front().lat_rad;
+  std::optional<NavigationStart> config_start;  // odometer only: everything from the configuration
   if (s.align == AlignMode::Static) {
     const std::size_t end = static_span_end(imu, imu_start, c, "IMU file");
     start = align_static(std::span(imu).first(end), imu_start, lat_hint, preset);
@@ -188,7 +229,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
     const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
     const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
-    const auto a = align_moving(imu, gnss_velocities(gnss), c, window, position_only);
+    std::vector<fusion::GnssVelocitySample> velocities = gnss_velocities(gnss);
+    if (s.gnss_until_s)  // the alignment too uses GNSS only until then
+      std::erase_if(velocities, [&](const fusion::GnssVelocitySample& v) { return v.t_s > *s.gnss_until_s; });
+    const auto a = align_moving(imu, velocities, c, window, position_only);
     if (!a) {
       double fastest = 0.0;
       for (const auto& v : gnss_velocities(gnss)) fastest = std::max(fastest, v.v_n.head<2>().norm());
@@ -219,22 +263,40 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     start.note = fmt::format("GPS attitude at {:.3f} s (line {})", it->t_s, it->line);
   } else {
     if (!c.attitude_deg) throw io::InputError("configuration", "--align config needs [initial] attitude_deg");
-    auto it = std::find_if(gnss.begin(), gnss.end(), [&](const GnssFixRow& r) { return r.t_s >= imu_start; });
-    start = align_from_config(it->t_s, c);
+    if (odometer_only) {
+      start = align_from_config(imu_start, c);
+      if (c.velocity_ned_mps) start.v_n = *c.velocity_ned_mps;
+      config_start = initialise_navigation(start, nullptr, c, Eigen::Vector3d::Ones());
+    } else {
+      auto it = std::find_if(gnss.begin(), gnss.end(), [&](const GnssFixRow& r) { return r.t_s >= imu_start; });
+      start = align_from_config(it->t_s, c);
+    }
   }
   result.alignment_note = start.note;
-  const GnssState g0 = gnss_at(gnss, start.t_s);
-  if ((s.align == AlignMode::Config || s.align == AlignMode::Attitude) && g0.has_velocity) start.v_n = g0.v_n;
-  if (s.align == AlignMode::Config && c.velocity_ned_mps) start.v_n = *c.velocity_ned_mps;
-  const GnssPosition position{g0.lat_rad, g0.lon_rad, g0.height_m, g0.sigma_ned_m};
-  const NavigationStart n = initialise_navigation(start, &position, c, g0.sigma_ned_m);
+  const NavigationStart n = config_start ? *config_start : [&] {
+    const GnssState g0 = gnss_at(gnss, start.t_s);
+    if ((s.align == AlignMode::Config || s.align == AlignMode::Attitude) && g0.has_velocity) start.v_n = g0.v_n;
+    if (s.align == AlignMode::Config && c.velocity_ned_mps) start.v_n = *c.velocity_ned_mps;
+    const GnssPosition position{g0.lat_rad, g0.lon_rad, g0.height_m, g0.sigma_ned_m};
+    return initialise_navigation(start, &position, c, g0.sigma_ned_m);
+  }();
   const ins::NavState& init = n.nav;
   result.initial_attitude = ins::euler_from_quaternion(init.q_nb);
   result.start_s = init.t_s;
 
   fusion::IntegrationOptions o = integration_options(n, c, fusion::Coupling::kLoose, s.filter);
   o.attitude = attitude_options;
+  std::vector<fusion::OdometerSpeed> odometer;
+  if (!s.odometer.empty()) {
+    o.odometer = c.odometer;
+    o.odometer.enabled = true;
+    if (std::string why; !o.odometer.IsValid(&why)) throw io::InputError("configuration", why);
+    odometer = odometer_windows(s.odometer, 1.0 / c.odometer.update_rate_hz);
+    result.odometer.emplace().gnss_last_used_s = init.t_s;
+  }
   fusion::GnssInsIntegration integration(init, o);
+  std::size_t od = 0;
+  while (od < odometer.size() && odometer[od].t_s <= init.t_s) ++od;
 
   // --- run ---
   std::optional<ins::TruthInterpolator> truth_at;
@@ -263,6 +325,8 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   while (k < imu.size() && imu[k].t_s <= init.t_s) ++k;
   const std::size_t k_first = k;
   const double progress_step = std::max<std::size_t>(1, (imu.size() - k_first) / 10);
+  std::optional<Eigen::Vector3d> last_truth_r_e;
+  double truth_distance_m = 0.0;
   auto emit = [&](const fusion::IntegrationOutput& out) {
     NavSigma sig{out.sigma_pos_ned_m, out.sigma_vel_n_mps, out.sigma_att_rad};
     if (on_row) on_row(out.nav, sig);
@@ -275,8 +339,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       const ins::EcefMotion m = truth_at->antenna(t, Eigen::Vector3d::Zero());
       const Eigen::Vector3d r_nav = ins::ecef_from_geodetic(out.nav.lat_rad, out.nav.lon_rad, out.nav.height_m);
       const Eigen::Matrix3d C_ne = ins::C_en(out.nav.lat_rad, out.nav.lon_rad).transpose();
+      if (last_truth_r_e) truth_distance_m += (m.r_e - *last_truth_r_e).norm();
+      last_truth_r_e = m.r_e;
       errors.push_back({t, C_ne * (r_nav - m.r_e), sig.position_ned_m, (out.nav.v_n - C_ne * m.v_e).norm(),
-                        ins::attitude_error_n(out.nav.q_nb, truth_at->attitude(t))});
+                        ins::attitude_error_n(out.nav.q_nb, truth_at->attitude(t)), truth_distance_m});
     }
     result.final_sigma = sig;
     result.final_nav = out.nav;
@@ -284,6 +350,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     result.gyro_bias_b = out.gyro_bias_b;
     result.sigma_accel_bias_b = out.sigma_accel_bias_b;
     result.sigma_gyro_bias_b = out.sigma_gyro_bias_b;
+    if (result.odometer) result.odometer->estimate = out.odometer;
   };
   emit(integration.output());
   for (; k < imu.size() && !stop.stop_requested(); ++k) {
@@ -293,6 +360,11 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
         ++result.fixes_in_outage;
         continue;
       }
+      if (s.gnss_until_s && r.t_s > *s.gnss_until_s) {
+        ++result.fixes_after_gnss_until;
+        continue;
+      }
+      if (result.odometer) result.odometer->gnss_last_used_s = r.t_s;
       fusion::GnssFix f;
       f.t_s = r.t_s;
       f.lat_rad = r.lat_rad;
@@ -312,6 +384,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       }
       integration.add_attitude(attitude[a].attitude);
       ++au.used;
+    }
+    for (; od < odometer.size() && odometer[od].t_s <= imu[k].t_s; ++od) {
+      integration.add_odometer(odometer[od]);
+      ++result.odometer->windows;
     }
     ins::ImuIncrement inc = imu[k];
     const double t_prev = k > 0 ? imu[k - 1].t_s : imu_start;
@@ -333,6 +409,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
 
   if (truth_at) {
     result.rms_all = rms_of(errors, -1e300);
+    if (result.odometer && !errors.empty()) odometer_errors(errors, *result.odometer);
     if (result.converged_at_s) result.rms_converged = rms_of(errors, *result.converged_at_s);
     for (const auto& [start, duration] : s.outages) {
       OutageResult oo{start, start + duration};

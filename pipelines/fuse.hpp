@@ -7,6 +7,10 @@
 // their own times (GPS time -> IMU time by [attitude] gps_time_at_imu_zero), unfixed rows are skipped and the
 // filter falls back to position/velocity; `attitude` alignment takes the first fixed attitude (a MEMS IMU cannot
 // gyrocompass, seed 000). Attitudes inside --outage spans are dropped with the fixes.
+// Optional odometer (seed 004, fusion/vms_measurement.hpp): the odometer rows summed into windows of
+// 1 / [odometer] update_rate_hz, each a VMS/NHC update at its end, gated by heading rate and speed; with
+// gnss_until_s the fixes after that time are dropped (GNSS for the alignment and until then, odometer only after);
+// without fixes the start is the configuration's (--align config with [initial] position_deg_m).
 // Units SI inside; times on the IMU file's time line.
 #pragma once
 
@@ -20,6 +24,7 @@
 #include <vector>
 
 #include "fusion/gnss_ins_integration.hpp"
+#include "ins/odometer.hpp"
 #include "ins/attitude.hpp"
 #include "ins/nav_state.hpp"
 #include "ins/truth_interpolator.hpp"
@@ -44,6 +49,19 @@ struct FuseSettings {
   // GPS attitude (empty: none). attitude_file names it in messages and the summary.
   std::vector<GpsAttitudeRow> attitude;
   std::string attitude_file;
+  // Odometer rows (empty: no odometer aiding) and the file's name for messages and the summary.
+  std::vector<ins::OdometerSample> odometer;
+  std::string odometer_file;
+  std::optional<double> gnss_until_s;  // fixes after this time are dropped
+};
+
+// Odometer aiding's account (seed 004's metric: error / distance travelled since GNSS was last used, in %).
+struct OdometerUse {
+  long long windows = 0;  // odometer windows handed to the filter
+  fusion::OdometerEstimate estimate;  // at the end
+  double gnss_last_used_s = 0.0;      // the last fix handed to the filter (else the navigation start)
+  // Against truth, from gnss_last_used_s to the end (nothing without truth or without distance travelled):
+  std::optional<double> distance_travelled_m, horizontal_error_max_m, horizontal_error_end_m, altitude_error_max_m;
 };
 
 // What happened to the attitude rows (all zero without --attitude).
@@ -86,6 +104,8 @@ struct FuseResult {
   std::optional<ErrorRms> gnss_rms;                // the fixes themselves against truth (antenna)
   std::vector<OutageResult> outages;
   AttitudeUse attitude;
+  long long fixes_after_gnss_until = 0;
+  std::optional<OdometerUse> odometer;  // with odometer rows
 };
 
 // Every solution row (after each IMU interval) goes to on_row. truth: a trajectory on the IMU time line for the

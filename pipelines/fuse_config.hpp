@@ -35,6 +35,8 @@ struct FuseConfig {
   fusion::GateOptions gate;
   fusion::LockoutRecoveryOptions recovery;  // [filter] recovery* keys
   fusion::LandVehicleOptions land;          // [vehicle] keys
+  fusion::OdometerAidingOptions odometer;   // [odometer] keys (enabled by fuse --odometer)
+  std::optional<double> odometer_rate_hz;   // [odometer] rate_hz: the odometer file's declared rate
   double propagation_interval_s = 0.05;
   double convergence_heading_sigma_deg = 1.0;
   std::optional<signals::GpsTime> attitude_gps_time_at_imu_zero;

@@ -11,6 +11,39 @@
 namespace ultratrack::pipelines {
 namespace {
 
+// The "odometer" object: settings, update counts by rule, the odometer estimates with their 1-sigma and, against
+// truth, seed 004's errors as % of the distance travelled since GNSS was last used (DT).
+std::string odometer_json(const OdometerUse& u, const FuseResult& r, const FuseSettings& s) {
+  const fusion::OdometerAidingOptions& o = s.config.odometer;
+  const auto& n = r.counters;
+  const fusion::OdometerNominal &v = u.estimate.value, &sd = u.estimate.sigma;
+  auto opt = [](const std::optional<double>& x) { return x ? fmt::format("{:.6g}", *x) : std::string("null"); };
+  auto pct = [&](const std::optional<double>& e) -> std::optional<double> {
+    if (!e || !u.distance_travelled_m) return std::nullopt;
+    return 100.0 * *e / *u.distance_travelled_m;
+  };
+  std::string j = fmt::format(
+      "{{\"file\": \"{}\", \"mode\": \"{}\", \"yaw_rate_threshold_dps\": {:.6g}, \"min_speed_mps\": {:.6g}, "
+      "\"update_rate_hz\": {:.6g}, \"windows\": {}, \"updates_accepted\": {}, \"updates_rejected\": {}, "
+      "\"gated_yaw_rate\": {}, \"gated_speed\": {}, \"unusable\": {}, ",
+      io::json_escape(s.odometer_file), o.mode == fusion::OdometerMode::kGated ? "gated" : "always",
+      o.yaw_rate_threshold_rad_s / io::kRadPerDeg, o.min_speed_mps, o.update_rate_hz, u.windows, n.odometer_accepted,
+      n.odometer_rejected, n.odometer_gated_yaw_rate, n.odometer_gated_speed, n.odometer_unusable);
+  j += fmt::format(
+      "\"scale_factor\": {:.6g}, \"sigma_scale_factor\": {:.6g}, \"misalignment_pitch_deg\": {:.6g}, "
+      "\"sigma_misalignment_pitch_deg\": {:.6g}, \"misalignment_yaw_deg\": {:.6g}, \"sigma_misalignment_yaw_deg\": {:.6g}, "
+      "\"delay_s\": {:.6g}, \"sigma_delay_s\": {:.6g}, ",
+      v.scale_factor, sd.scale_factor, v.pitch_rad / io::kRadPerDeg, sd.pitch_rad / io::kRadPerDeg,
+      v.yaw_rad / io::kRadPerDeg, sd.yaw_rad / io::kRadPerDeg, v.delay_s, sd.delay_s);
+  j += fmt::format(
+      "\"gnss_last_used_s\": {:.3f}, \"distance_travelled_m\": {}, \"horizontal_error_max_m\": {}, "
+      "\"horizontal_error_end_m\": {}, \"altitude_error_max_m\": {}, \"horizontal_error_max_pct_dt\": {}, "
+      "\"horizontal_error_end_pct_dt\": {}, \"altitude_error_max_pct_dt\": {}}}",
+      u.gnss_last_used_s, opt(u.distance_travelled_m), opt(u.horizontal_error_max_m), opt(u.horizontal_error_end_m),
+      opt(u.altitude_error_max_m), opt(pct(u.horizontal_error_max_m)), opt(pct(u.horizontal_error_end_m)),
+      opt(pct(u.altitude_error_max_m)));
+  return j;
+}
 
 }  // namespace
 
@@ -50,6 +83,10 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
                    r.counters.fix_rejected);
   j += fmt::format("  \"fixes_skipped_by_interval\": {},\n", r.counters.fixes_skipped);
+  if (s.gnss_until_s)
+    j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,
+                     r.fixes_after_gnss_until);
+  if (r.odometer) j += "  \"odometer\": " + odometer_json(*r.odometer, r, s) + ",\n";
   if (s.config.land.nhc)
     j += fmt::format("  \"nhc_updates_accepted\": {},\n  \"nhc_updates_rejected\": {},\n", r.counters.nhc_accepted,
                      r.counters.nhc_rejected);

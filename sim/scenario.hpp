@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "ins/odometer.hpp"
 #include "ins/imu_datasheet.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/sample_format.hpp"
@@ -83,6 +84,11 @@ struct Scenario {
   double ramp_s = 1.0;                 // segment files only: command blend time at segment starts
   bool odometer = false;
   double odometer_scale_factor_error = 0.0;
+  double odometer_delay_s = 0.0;                  // pulses lag the motion (ins/odometer.hpp)
+  double odometer_misalignment_pitch_deg = 0.0;   // IMU mounting relative to the vehicle: the IMU data and the
+  double odometer_misalignment_yaw_deg = 0.0;     // truth attitude are the trajectory's rotated by C_bv
+  std::vector<ins::OdometerSlip> odometer_slips;  // [[odometer_slip]]
+  double sideslip_deg_per_mps2 = 0.0;  // the vehicle yaws from its track by this times the lateral acceleration
 
   // IMU errors: a preset (ins/imu_error_model.hpp) with optional datasheet overrides.
   std::string imu_preset = "ideal";

@@ -6,9 +6,12 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 
+#include "ins/earth_model.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "sim/imu_simulation.hpp"
 #include "sim/navigation_source.hpp"
@@ -40,6 +43,43 @@ std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, Si
     sink.imu(stamped);
   };
   callbacks.on_truth = [&](const ins::TruthSample& t) { samples.push_back(t); };
+  std::optional<ins::ImuIncrement> pending_imu;  // held until the next truth sample gives the sideslip
+  double previous_sideslip_rad = 0.0;
+  if (s.odometer_misalignment_pitch_deg != 0.0 || s.odometer_misalignment_yaw_deg != 0.0 ||
+      s.sideslip_deg_per_mps2 != 0.0) {
+    // The trajectory moves a track frame (x along the velocity). The vehicle yaws from it by its sideslip
+    // beta = gradient * lateral acceleration (positive: the nose right of the track), and the IMU is
+    // mounted rotated from the vehicle: C_bt = C_bv Rz(beta)'. The increments and the truth attitude are the
+    // track's rotated into the IMU frame, the gyro's also turning with beta (no lever arm between the frames).
+    const Eigen::Matrix3d C_bv = ins::C_bv_from_misalignment(s.odometer_misalignment_pitch_deg * io::kRadPerDeg,
+                                                             s.odometer_misalignment_yaw_deg * io::kRadPerDeg);
+    const double gradient = s.sideslip_deg_per_mps2 * io::kRadPerDeg;
+    auto C_bt = [C_bv](double beta) {
+      return Eigen::Matrix3d(C_bv * Eigen::AngleAxisd(beta, Eigen::Vector3d::UnitZ()).toRotationMatrix().transpose());
+    };
+    callbacks.on_imu = [&pending_imu](const ins::ImuIncrement& inc) { pending_imu = inc; };
+    callbacks.on_truth = [&, C_bv, C_bt, gradient](const ins::TruthSample& t) {
+      // The track's turn rate about the vertical (the body rate in NED less the earth rate's down part).
+      const double turn_rate = (t.q_nb * t.w_ib_b).z() + ins::kEarthRate_rps * std::sin(t.lat_rad);
+      const double lateral_accel = t.v_n.head<2>().norm() * turn_rate;
+      const double beta = gradient * lateral_accel;
+      if (pending_imu) {
+        const Eigen::Matrix3d C = C_bt(0.5 * (beta + previous_sideslip_rad));
+        ins::ImuIncrement r = *pending_imu;
+        r.dtheta_b = C * pending_imu->dtheta_b + C_bv * Eigen::Vector3d(0.0, 0.0, beta - previous_sideslip_rad);
+        r.dv_b = C * pending_imu->dv_b;
+        r.t_s += s.imu_time_offset_s;  // the IMU's clock, not true time
+        sink.imu(r);
+        pending_imu.reset();
+      }
+      previous_sideslip_rad = beta;
+      const Eigen::Matrix3d C = C_bt(beta);
+      samples.push_back(t);
+      samples.back().q_nb = (t.q_nb * Eigen::Quaterniond(C.transpose())).normalized();
+      samples.back().w_ib_b = C * t.w_ib_b;
+      samples.back().f_b = C * t.f_b;
+    };
+  }
   callbacks.on_progress = [&](int percent) {
     sink.progress({SimulationProgress::Stage::Imu, percent, 0.0, 0.0, 0.0});
   };
@@ -47,6 +87,8 @@ std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, Si
   if (s.odometer) {
     ins::OdometerOptions odo;
     odo.scale_factor_error = s.odometer_scale_factor_error;
+    odo.delay_s = s.odometer_delay_s;
+    odo.slips = s.odometer_slips;
     sink.odometer(ins::simulate_odometer(samples, odo));
   }
   result.imu_rows = imu.imu_rows;

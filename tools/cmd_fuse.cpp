@@ -1,7 +1,8 @@
 // `ultratrack fuse`: loosely coupled GNSS/INS from an IMU CSV and a GNSS fix CSV (EKF or UKF, closed loop),
 // after a static, in-motion or configured alignment. Writes DIR/nav.csv (nav columns + 1-sigma) and
 // DIR/summary.json (update counts, convergence, RMS against --truth); progress and a summary on stdout.
-// --attitude adds a multi-antenna receiver's GPS attitude (attitude.csv) as a measurement (seed 003).
+// --attitude adds a multi-antenna receiver's GPS attitude (attitude.csv) as a measurement (seed 003);
+// --odometer an odometer's pulses (odometer.csv) as VMS/non-holonomic updates (seed 004), with or without --gnss.
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,7 @@
 #include "pipelines/fuse_summary.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "ins/imu_csv.hpp"
+#include "ins/odometer_csv.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "sim/truth_csv.hpp"
@@ -37,7 +40,8 @@ namespace fs = std::filesystem;
 using pipelines::AlignMode;
 
 struct FuseCommandOptions {
-  std::string imu_file, gnss_file, truth_file, config_file, out_dir, attitude_file;
+  std::string imu_file, gnss_file, truth_file, config_file, out_dir, attitude_file, odometer_file;
+  std::optional<double> gnss_until_s;
   std::vector<double> attitude_origin;  // WEEK TOW
   std::string coupling = "loose", filter = "ekf", align = "motion";
   std::vector<double> outage;  // START DURATION pairs
@@ -80,14 +84,21 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.attitude_file = o.attitude_file;
   }
 
+  if (o.gnss_file.empty() && o.odometer_file.empty())
+    throw io::InputError("command line", "fuse needs --gnss, --odometer or both");
+  if (!o.odometer_file.empty()) {
+    s.odometer = ins::read_odometer_csv(o.odometer_file, {s.config.odometer_rate_hz}).samples;
+    s.odometer_file = o.odometer_file;
+  }
+  s.gnss_until_s = o.gnss_until_s;
   const auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
-  const auto gnss = pipelines::read_gnss_csv(o.gnss_file);
+  const auto gnss = o.gnss_file.empty() ? std::vector<pipelines::GnssFixRow>{} : pipelines::read_gnss_csv(o.gnss_file);
   std::vector<ins::NavState> truth;
   if (!o.truth_file.empty()) truth = sim::read_truth_csv(o.truth_file);
   if (!o.quiet)
     fmt::print("fuse: {} IMU rows ({:.3f}-{:.3f} s), {} GNSS fixes ({:.3f}-{:.3f} s), loose {}, align {}\n",
-               imu.size(), imu.front().t_s, imu.back().t_s, gnss.size(), gnss.front().t_s, gnss.back().t_s, o.filter,
-               o.align);
+               imu.size(), imu.front().t_s, imu.back().t_s, gnss.size(), gnss.empty() ? 0.0 : gnss.front().t_s,
+               gnss.empty() ? 0.0 : gnss.back().t_s, o.filter, o.align);
 
   fs::create_directories(o.out_dir);
   pipelines::FusedNavCsvWriter nav(fs::path(o.out_dir) / "nav.csv");
@@ -136,6 +147,21 @@ void run_fuse_command(const FuseCommandOptions& o) {
                "{} (gate) + {} (near vertical); {} fixes without attitude\n",
                r.attitude.rows, r.attitude.fixed_rows, r.attitude.unfixed_skipped, r.counters.attitude_accepted,
                r.counters.attitude_rejected, r.counters.attitude_unusable, r.counters.fixes_without_attitude);
+  if (const auto& u = r.odometer) {
+    const auto& n = r.counters;
+    fmt::print("fuse: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading rate {}, by "
+               "speed {}; scale factor {:.5f} +- {:.5f}, misalignment pitch {:.3f} yaw {:.3f} deg, delay {:.3f} s\n",
+               u->windows, n.odometer_accepted, n.odometer_rejected, n.odometer_gated_yaw_rate, n.odometer_gated_speed,
+               u->estimate.value.scale_factor, u->estimate.sigma.scale_factor,
+               u->estimate.value.pitch_rad / io::kRadPerDeg, u->estimate.value.yaw_rad / io::kRadPerDeg,
+               u->estimate.value.delay_s);
+    if (u->distance_travelled_m)
+      fmt::print("fuse: odometer: since GNSS at {:.1f} s: {:.0f} m travelled, horizontal error max {:.2f} m ({:.3f} % "
+                 "DT), end {:.2f} m, altitude max {:.2f} m ({:.3f} % DT)\n",
+                 u->gnss_last_used_s, *u->distance_travelled_m, *u->horizontal_error_max_m,
+                 100.0 * *u->horizontal_error_max_m / *u->distance_travelled_m, *u->horizontal_error_end_m,
+                 *u->altitude_error_max_m, 100.0 * *u->altitude_error_max_m / *u->distance_travelled_m);
+  }
   for (const auto& oo : r.outages)
     fmt::print("fuse: outage {:.1f}-{:.1f} s: horizontal error at its end {:.3f} m (1-sigma {:.3f} m)\n", oo.start_s,
                oo.end_s, oo.horizontal_error_m, oo.sigma_horizontal_m);
@@ -150,9 +176,13 @@ void add_fuse_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("fuse", "Loosely coupled GNSS/INS (EKF or UKF) from IMU and GNSS fix CSV files");
   cmd->add_option("--imu", o->imu_file, "IMU CSV (t_s,dtheta_x_rad,...,dv_z_mps)")->required()->check(CLI::ExistingFile);
   cmd->add_option("--gnss", o->gnss_file,
-                  "GNSS CSV (t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m)")
-      ->required()
+                  "GNSS CSV (t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m); "
+                  "needed unless --odometer")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--odometer", o->odometer_file,
+                  "odometer CSV (t_s,pulses,distance_m): VMS speed and non-holonomic updates, [odometer] keys")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--gnss-until", o->gnss_until_s, "T: use GNSS fixes up to T s only (then odometer only)");
   cmd->add_option("--coupling", o->coupling, "loose (external fixes)");
   cmd->add_option("--filter", o->filter, "ekf or ukf (default ekf)");
   cmd->add_option("--config", o->config_file, "TOML: [imu] [initial] [alignment] [gnss] [filter] [output]")

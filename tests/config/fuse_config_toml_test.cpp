@@ -51,6 +51,26 @@ TEST(FuseConfigToml, RecoveryAndVehicleKeys) {
   EXPECT_EQ(c.land.lever_arm_b, Eigen::Vector3d(-1.5, 0.0, 0.5));
 }
 
+TEST(FuseConfigToml, OdometerKeys) {
+  const auto p = write("odometer.toml",
+                       "[odometer]\nmode = \"always\"\nyaw_rate_threshold_dps = 1.25\nmin_speed_mps = 4\n"
+                       "update_rate_hz = 2\nrate_hz = 10\nlever_arm_body_m = [-1.2, 0, 0.6]\nsigma_scale_factor = 0.02\n"
+                       "sigma_misalignment_deg = 2\nsigma_delay_s = 0.1\nsigma_forward_mps = 0.08\n");
+  const FuseConfig c = read_fuse_config(p);
+  EXPECT_EQ(c.odometer.mode, fusion::OdometerMode::kAlways);
+  EXPECT_NEAR(c.odometer.yaw_rate_threshold_rad_s, 1.25 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_EQ(c.odometer.min_speed_mps, 4.0);
+  EXPECT_EQ(c.odometer.update_rate_hz, 2.0);
+  ASSERT_TRUE(c.odometer_rate_hz);
+  EXPECT_EQ(*c.odometer_rate_hz, 10.0);
+  EXPECT_EQ(c.odometer.lever_arm_b, Eigen::Vector3d(-1.2, 0.0, 0.6));
+  EXPECT_EQ(c.odometer.sigma_scale_factor, 0.02);
+  EXPECT_NEAR(c.odometer.sigma_misalignment_rad, 2.0 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_EQ(c.odometer.sigma_delay_s, 0.1);
+  EXPECT_EQ(c.odometer.sigma_forward_mps, 0.08);
+  EXPECT_FALSE(c.odometer.enabled);  // fuse --odometer turns it on
+}
+
 TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
   struct Case {
     std::string text, what;
@@ -66,6 +86,11 @@ TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
       {"[filter]\nrecovery_rejections = 2.5\n", "must be an integer", 2},
       {"[vehicle]\nnhc_sigma_mps = 0\n", "must be positive", 2},
       {"[vehicle]\nnhc = 1\n", "true or false", 2},
+      {"[odometer]\nmode = \"sometimes\"\n", "odometer.mode", 2},
+      {"[odometer]\nyaw_rate_threshold_dps = -1\n", "odometer.yaw_rate_threshold_dps", 2},
+      {"[odometer]\n\nupdate_rate_hz = 0\n", "odometer.update_rate_hz", 3},
+      {"[odometer]\nlever_arm_body_m = [1, 2]\n", "odometer.lever_arm_body_m", 2},
+      {"[odometer]\nyaw_rate_dps = 1\n", "unknown key 'odometer.yaw_rate_dps'", 2},
   };
   for (const auto& c : cases) {
     const auto p = write("bad.toml", c.text);

@@ -1,9 +1,11 @@
 // libFuzzer target: every CSV a command reads: imu.csv, gnss.csv (fuse), attitude.csv (fuse --attitude), truth and
-// nav CSVs (ins --init), solution.csv and truth.csv (compare), trajectory segment and motion files (scenarios).
+// nav CSVs (ins --init), solution.csv and truth.csv (compare), trajectory segment and motion files (scenarios),
+// odometer.csv (fuse --odometer).
 // The first byte picks the reader.
 #include "fuzz_input.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/nav_csv.hpp"
+#include "ins/odometer_csv.hpp"
 #include "ins/trajectory.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
 #include "pipelines/gps_attitude_csv.hpp"
@@ -16,7 +18,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   const auto file = fuzz::as_file(data + 1, size - 1, "input.csv");
   fuzz::expect_input_error_or_success([&] {
-    switch (data[0] % 9) {
+    switch (data[0] % 10) {
       case 0: ins::read_imu_csv(file); break;
       case 1: pipelines::read_gnss_csv(file); break;
       case 2: pipelines::read_attitude_csv(file); break;
@@ -25,7 +27,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       case 5: pipelines::read_solution_csv(file); break;
       case 6: pipelines::read_simulation_truth_csv(file); break;
       case 7: ins::read_segments_csv(file, ins::TrajectorySpec{}); break;
-      default: signals::read_trajectory_csv(file);
+      case 9: ins::read_odometer_csv(file); break;
+      default: signals::read_trajectory_csv(file); break;
     }
   });
   return 0;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <GeographicLib/Geocentric.hpp>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -109,6 +110,41 @@ TEST(Simulate, InertialRunHandsOneImuRowPerInterval) {
   ASSERT_EQ(memory.truth_rows.size(), 21u);  // 10 Hz over 2 s, both ends
   EXPECT_TRUE(memory.truth_rows.back().q_nb.has_value());
   EXPECT_NEAR(memory.truth_rows.back().t_s, 2.0, 1e-12);
+}
+
+TEST(Simulate, SideslipTurnsTheBodyFromItsTrackByTheGradientTimesLateralAcceleration) {
+  Scenario s;
+  s.signal = false;
+  s.trajectory_profile = "circle";
+  s.trajectory_duration_s = 20.0;
+  s.imu_rate_hz = 100.0;
+  s.sideslip_deg_per_mps2 = 0.5;
+  MemorySink memory;
+  simulate(s, memory);
+  ASSERT_GT(memory.truth_rows.size(), 150u);
+  // In the steady turn: the track's rate from the velocity's direction, and the body's lateral velocity.
+  const GeographicLib::Geocentric& earth = GeographicLib::Geocentric::WGS84();
+  auto body_velocity = [&](const TruthRow& row, Eigen::Vector3d* v_n) {
+    double lat = 0, lon = 0, h = 0;
+    earth.Reverse(row.r_e_m.x(), row.r_e_m.y(), row.r_e_m.z(), lat, lon, h);
+    const double sl = std::sin(lat * M_PI / 180), cl = std::cos(lat * M_PI / 180);
+    const double so = std::sin(lon * M_PI / 180), co = std::cos(lon * M_PI / 180);
+    Eigen::Matrix3d C_ne;
+    C_ne << -sl * co, -sl * so, cl, -so, co, 0.0, -cl * co, -cl * so, -sl;
+    *v_n = C_ne * row.v_e_mps;
+    return Eigen::Vector3d(row.q_nb->conjugate() * *v_n);
+  };
+  for (std::size_t i : {100u, 150u}) {
+    Eigen::Vector3d v0, v1;
+    body_velocity(memory.truth_rows[i - 1], &v0);
+    const Eigen::Vector3d v_b = body_velocity(memory.truth_rows[i + 1], &v1);
+    const double dt = memory.truth_rows[i + 1].t_s - memory.truth_rows[i - 1].t_s;
+    const double track_rate = std::remainder(std::atan2(v1.y(), v1.x()) - std::atan2(v0.y(), v0.x()), 2 * M_PI) / dt;
+    const double speed = v_b.head<2>().norm();
+    const double beta = 0.5 * M_PI / 180 * speed * track_rate;  // rad: the gradient times the lateral acceleration
+    ASSERT_GT(std::abs(beta), 0.01);
+    EXPECT_NEAR(v_b.y() / speed, -std::sin(beta), 2e-3 * std::abs(beta)) << "row " << i;
+  }
 }
 
 TEST(Simulate, StopRequestEndsTheRun) {

@@ -203,3 +203,35 @@ TEST(FuseCommand, PositionOnlyFixesAlignFromPositionDifferences) {
             0.7 * json_number(summary, "horizontal_m", "gnss_only_rms"));
   EXPECT_LT(json_number(summary, "heading_deg", "rms_converged"), 1.0);
 }
+
+// --odometer (seed 004): with GNSS until a time, the summary's "odometer" object; without GNSS the configured
+// start; a bad odometer file or no measurement at all is one InputError.
+TEST(FuseCommand, OdometerWithAndWithoutGnss) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  run({"imusim", "--profile", "land", "--duration", "60", "--rate", "100", "--preset", "hg1700ae", "--seed", "3",
+       "--odometer", "--odometer-sf", "0.01", "--out", (dir / "sim").string()});
+  run({"gnsssim", "--truth", (dir / "sim/truth.csv").string(), "--rate", "1", "--seed", "5", "--out",
+       (dir / "gnss.csv").string()});
+  const std::string imu = (dir / "sim/imu.csv").string(), gnss = (dir / "gnss.csv").string();
+  const std::string odo = (dir / "sim/odometer.csv").string(), truth = (dir / "sim/truth.csv").string();
+  run({"fuse", "--imu", imu, "--gnss", gnss, "--odometer", odo, "--gnss-until", "30", "--truth", truth, "--out",
+       (dir / "with").string(), "--quiet"});
+  const fs::path summary = dir / "with/summary.json";
+  EXPECT_GT(json_number(summary, "windows", "odometer"), 40.0);
+  EXPECT_GT(json_number(summary, "updates_accepted", "odometer"), 10.0);
+  EXPECT_LE(json_number(summary, "gnss_last_used_s", "odometer"), 30.0);
+  EXPECT_GT(json_number(summary, "distance_travelled_m", "odometer"), 100.0);
+  EXPECT_GT(json_number(summary, "fixes_after_gnss_until"), 25.0);
+
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--out", (dir / "none").string()}), InputError);
+  EXPECT_THROW(run({"fuse", "--imu", imu, "--odometer", odo, "--out", (dir / "none").string()}), InputError);
+  std::ofstream(dir / "odo_bad.csv") << "t_s,pulses,distance_m\n0.1,5,0.1\n0.2,5,0.1\n0.15,5,0.1\n";
+  try {
+    run({"fuse", "--imu", imu, "--gnss", gnss, "--odometer", (dir / "odo_bad.csv").string(), "--out",
+         (dir / "bad").string()});
+    ADD_FAILURE() << "time going back accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.line(), 4);
+    EXPECT_NE(std::string(e.what()).find("odo_bad.csv"), std::string::npos) << e.what();
+  }
+}
