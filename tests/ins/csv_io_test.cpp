@@ -14,12 +14,15 @@
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
 #include "ins/trajectory.hpp"
+#include "support/expect_input_error.hpp"
 #include "support/test_data.hpp"
 
 using namespace ultratrack::ins;
 namespace fs = std::filesystem;
 
 namespace {
+
+using ultratrack::test::expect_error_at;
 
 constexpr char kImuHeader[] = "t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps\n";
 constexpr char kNavHeader[] = "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg\n";
@@ -30,18 +33,6 @@ fs::path write_text(const fs::path& dir, const std::string& name, const std::str
   return p;
 }
 
-// Expects InputError naming this file and line.
-template <typename F>
-void expect_error_at(F&& f, const fs::path& file, int line, const std::string& what_part) {
-  try {
-    f();
-    ADD_FAILURE() << "no error for " << file << " line " << line;
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), file.string());
-    EXPECT_EQ(e.line(), line) << e.what();
-    EXPECT_NE(std::string(e.what()).find(what_part), std::string::npos) << e.what();
-  }
-}
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "ins/ins_error.hpp"
 #include "ins/odometer.hpp"
 #include "ins/odometer_csv.hpp"
+#include "support/expect_input_error.hpp"
 #include "support/test_data.hpp"
 
 using namespace ultratrack::ins;
@@ -18,23 +19,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using ultratrack::test::expect_error_at;
+
 fs::path write_text(const std::string& name, const std::string& text) {
   const fs::path p = ultratrack::test::scratch_dir() / name;
   std::ofstream(p) << text;
   return p;
 }
 
-template <typename F>
-void expect_error_at(F&& f, const fs::path& file, int line, const std::string& what_part) {
-  try {
-    f();
-    ADD_FAILURE() << "no error for " << file << " line " << line;
-  } catch (const InputError& e) {
-    EXPECT_EQ(e.file(), file.string());
-    EXPECT_EQ(e.line(), line) << e.what();
-    EXPECT_NE(std::string(e.what()).find(what_part), std::string::npos) << e.what();
-  }
-}
 
 // 20 s at a constant 10 m/s, truth at 100 Hz.
 std::vector<TruthSample> straight_truth() {

@@ -375,6 +375,31 @@ TEST(IfSynthesiser, SamplesFollowTheExactTimingOnEveryAntenna) {
   }
 }
 
+// The synthesised carrier phase minus the exact timing's, cycles, at the middle of each of the first `count`
+// milliseconds (moved off chip edges, where the chip is unknown), unwrapped. Noise-free, one satellite.
+std::vector<double> carrier_error_per_ms(IfSynthesiser& synth, const std::vector<std::complex<float>>& x, int prn,
+                                         double fs, std::size_t count) {
+  const auto& code = ca_code(prn);
+  const auto half_ms = static_cast<std::size_t>(fs * 0.5e-3);
+  std::vector<double> error;
+  double unwrapped = 0.0;
+  for (std::size_t ms = 0; ms < count; ++ms) {
+    std::size_t i = (2 * ms + 1) * half_ms;
+    SignalTiming t = synth.timing(prn, 0, static_cast<std::int64_t>(i));
+    for (int tries = 0; tries < 20; ++tries) {
+      const double frac = t.code_phase_chips - std::floor(t.code_phase_chips);
+      if (frac > 0.05 && frac < 0.95) break;
+      t = synth.timing(prn, 0, static_cast<std::int64_t>(++i));
+    }
+    const double chip = code[static_cast<int>(t.code_phase_chips)];
+    double d = std::arg(std::complex<double>(x[i]) * chip) / (2 * std::numbers::pi) - t.carrier_phase_cycles;
+    d -= std::round(d - unwrapped);
+    unwrapped = d;
+    error.push_back(d);
+  }
+  return error;
+}
+
 // Another generator's convention: exact parameters every 0.1 s, the code rate and carrier frequency of each
 // interval's first millisecond held until the next. Under a constant carrier acceleration fdot (cycles/s^2)
 // the integrated carrier then falls behind the geometry by fdot U (h - U) / 2 per interval (U = 0.1 s, h = 1 ms):
@@ -408,25 +433,7 @@ TEST(IfSynthesiser, HeldParametersLagTheGeometryByTheClosedForm) {
   const std::vector<std::complex<float>> x = synthesise(synth, n);
   const auto carrier = [&](double t) { return synth.timing(prn, 0, std::llround(t * fs)).carrier_phase_cycles; };
   const double fdot = (carrier(0.6 + 0.1) - 2.0 * carrier(0.6) + carrier(0.6 - 0.1)) / 0.01;
-  const auto& code = ca_code(prn);
-  // Phase error (synthesised minus exact) every millisecond, unwrapped.
-  std::vector<double> error_ms;
-  double unwrapped = 0.0;
-  for (std::size_t ms = 0; ms < 1200; ++ms) {
-    std::size_t i = ms * 500 + 250;
-    SignalTiming t = synth.timing(prn, 0, static_cast<std::int64_t>(i));
-    for (int tries = 0; tries < 20; ++tries) {  // away from a chip edge, so the chip is known
-      const double frac = t.code_phase_chips - std::floor(t.code_phase_chips);
-      if (frac > 0.05 && frac < 0.95) break;
-      t = synth.timing(prn, 0, static_cast<std::int64_t>(++i));
-    }
-    const double chip = code[static_cast<int>(t.code_phase_chips)];
-    const double got = std::arg(std::complex<double>(x[i]) * chip) / (2 * std::numbers::pi);
-    double d = got - t.carrier_phase_cycles;
-    d -= std::round(d - unwrapped);
-    unwrapped = d;
-    error_ms.push_back(d);
-  }
+  const std::vector<double> error_ms = carrier_error_per_ms(synth, x, prn, fs, 1200);
   const double per_interval = 0.5 * fdot * 0.1 * (1e-3 - 0.1);
   std::printf("held parameters: PRN %d, carrier acceleration %.2f Hz/s, lag %.4f cycles per 0.1 s\n", prn, fdot,
               per_interval);
@@ -460,23 +467,11 @@ TEST(IfSynthesiser, HeldParametersKeepTheOscillatorNoiseOnEveryBlock) {
   o.clock.drift_noise_sps_per_sqrt_s = std::sqrt(2.0 * std::numbers::pi * std::numbers::pi * 2e-20);  // h-2
   IfSynthesiser synth(o, {eph[static_cast<std::size_t>(prn - 1)]}, static_receiver());
   const std::vector<std::complex<float>> x = synthesise(synth, static_cast<std::size_t>(1.05 * fs));
-  const auto& code = ca_code(prn);
-  double unwrapped = 0.0, first = 0.0, worst = 0.0;
-  for (std::size_t ms = 0; ms <= 1000; ++ms) {
-    std::size_t i = ms * 500 + 250;
-    SignalTiming t = synth.timing(prn, 0, static_cast<std::int64_t>(i));
-    for (int tries = 0; tries < 20; ++tries) {
-      const double frac = t.code_phase_chips - std::floor(t.code_phase_chips);
-      if (frac > 0.05 && frac < 0.95) break;
-      t = synth.timing(prn, 0, static_cast<std::int64_t>(++i));
-    }
-    const double chip = code[static_cast<int>(t.code_phase_chips)];
-    double d = std::arg(std::complex<double>(x[i]) * chip) / (2 * std::numbers::pi) - t.carrier_phase_cycles;
-    d -= std::round(d - unwrapped);
-    unwrapped = d;
-    if (ms == 0) first = d;
+  const std::vector<double> error = carrier_error_per_ms(synth, x, prn, fs, 1001);
+  double worst = 0.0;
+  for (std::size_t ms = 0; ms < error.size(); ++ms) {
     const double lag = 0.5 * fdot * 0.1 * (1e-3 - 0.1) * (static_cast<double>(ms) / 100.0);  // at most one interval off
-    worst = std::max(worst, std::abs(d - first - lag));
+    worst = std::max(worst, std::abs(error[ms] - error[0] - lag));
   }
   std::printf("held parameters with a TCXO clock: worst carrier error beyond the hold lag %.4f cycles\n", worst);
   // Within an interval the linear lag model is off by at most |fdot| U^2 / 2 (~0.01 cycles here).
