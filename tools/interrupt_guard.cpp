@@ -23,7 +23,8 @@ struct Registry {
   std::mutex mutex;
   std::vector<std::stop_source*> sources;
   std::thread watcher;
-  void (*previous)(int) = SIG_DFL;
+  void (*previous_int)(int) = SIG_DFL;
+  void (*previous_term)(int) = SIG_DFL;
 };
 
 Registry& registry() {
@@ -52,7 +53,8 @@ InterruptGuard::InterruptGuard() {
   sem_init(&g_posted, 0, 0);
   g_closing = 0;
   r.watcher = std::thread(watch);
-  r.previous = std::signal(SIGINT, ultratrack_interrupt_guard_sigint);
+  r.previous_int = std::signal(SIGINT, ultratrack_interrupt_guard_sigint);
+  r.previous_term = std::signal(SIGTERM, ultratrack_interrupt_guard_sigint);
 }
 
 InterruptGuard::~InterruptGuard() {
@@ -62,7 +64,8 @@ InterruptGuard::~InterruptGuard() {
     const std::lock_guard lock(r.mutex);
     r.sources.erase(std::find(r.sources.begin(), r.sources.end(), &source_));
     if (!r.sources.empty()) return;
-    std::signal(SIGINT, r.previous == SIG_ERR ? SIG_DFL : r.previous);
+    std::signal(SIGINT, r.previous_int == SIG_ERR ? SIG_DFL : r.previous_int);
+    std::signal(SIGTERM, r.previous_term == SIG_ERR ? SIG_DFL : r.previous_term);
     g_closing = 1;
     sem_post(&g_posted);
     watcher = std::move(r.watcher);

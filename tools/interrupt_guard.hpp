@@ -1,7 +1,8 @@
-// The one SIGINT handler of the program: while an InterruptGuard lives, Ctrl-C requests a stop on its
-// std::stop_token instead of killing the process, so that a command's loop (a pipeline's, the simulator's) can end
-// early and still finish every output. Guards may nest (a command run inside another): a Ctrl-C stops them all.
-// The previous handler is restored when the last guard goes.
+// The one SIGINT and SIGTERM handler of the program: while an InterruptGuard lives, Ctrl-C (or a scheduler's
+// SIGTERM, as Slurm sends at a time limit) requests a stop on its std::stop_token instead of killing the process,
+// so that a command's loop (a pipeline's, the simulator's) can end early and still finish every output. Guards may
+// nest (a command run inside another): a signal stops them all. The previous handlers are restored when the last
+// guard goes.
 #pragma once
 
 #include <stop_token>
@@ -15,7 +16,7 @@ class InterruptGuard {
   InterruptGuard(const InterruptGuard&) = delete;
   InterruptGuard& operator=(const InterruptGuard&) = delete;
 
-  // Stop requested by SIGINT (or by request_stop()).
+  // Stop requested by SIGINT or SIGTERM (or by request_stop()).
   std::stop_token token() const { return source_.get_token(); }
   bool interrupted() const { return source_.stop_requested(); }
   void request_stop() { source_.request_stop(); }

@@ -1,5 +1,5 @@
-// tools::InterruptGuard: SIGINT becomes a stop request on every live guard's token (nested guards too), and the
-// handler that was there before comes back when the last guard goes.
+// tools::InterruptGuard: SIGINT and SIGTERM become a stop request on every live guard's token (nested guards too),
+// and the handlers that were there before come back when the last guard goes.
 #include "interrupt_guard.hpp"
 
 #include <gtest/gtest.h>
@@ -42,4 +42,18 @@ TEST(InterruptGuard, SigintStopsEveryLiveGuardAndThePreviousHandlerReturns) {
   std::raise(SIGINT);
   EXPECT_EQ(g_previous_called, 1);
   std::signal(SIGINT, before);
+}
+
+TEST(InterruptGuard, SigtermStopsTheGuardAndThePreviousHandlerReturns) {
+  g_previous_called = 0;
+  const auto before = std::signal(SIGTERM, previous_handler);
+  {
+    ultratrack::tools::InterruptGuard guard;
+    std::raise(SIGTERM);
+    EXPECT_TRUE(stopped_soon(guard));
+    EXPECT_EQ(g_previous_called, 0);
+  }
+  std::raise(SIGTERM);
+  EXPECT_EQ(g_previous_called, 1);
+  std::signal(SIGTERM, before);
 }
