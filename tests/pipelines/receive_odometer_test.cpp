@@ -62,13 +62,8 @@ const Sim& simulated() {
         << "\n";
     const auto scenario = config::read_scenario(r.dir / "tunnel.toml");
     sim::simulate_to_folder(scenario, r.sim, "");
-    const sim::NavigationSource nav = sim::load_navigation(scenario);
-    signals::RinexNavData data;
-    data.ephemerides = nav.ephemerides;
-    data.klobuchar = nav.klobuchar;
-    data.utc = nav.utc;
-    r.nav = r.dir / "nominal.rnx";
-    signals::write_rinex_nav_304(r.nav, data);
+    r.nav = r.dir / "nominal.rnx";  // the scenario's own broadcast data: the receiver's hot start
+    signals::write_rinex_nav_304(r.nav, sim::to_rinex_nav(sim::load_navigation(scenario)));
     r.truth = sim::read_truth_csv(r.sim / "truth.csv");
     return r;
   }();
