@@ -80,7 +80,8 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   if (s.gnss_until_s)
     j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,
                      r.fixes_after_gnss_until);
-  if (r.odometer) j += "  \"odometer\": " + odometer_json(*r.odometer, r.counters, s.config.odometer, s.odometer_file) + ",\n";
+  if (r.odometer)
+    j += "  \"odometer\": " + odometer_json(*r.odometer, r.counters, s.config.odometer, s.odometer_file) + ",\n";
   if (s.config.land.nhc)
     j += fmt::format("  \"nhc_updates_accepted\": {},\n  \"nhc_updates_rejected\": {},\n", r.counters.nhc_accepted,
                      r.counters.nhc_rejected);

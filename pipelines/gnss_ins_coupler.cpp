@@ -518,7 +518,8 @@ std::string GnssInsCoupler::summary_json() const {
   j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": {}", k.recoveries,
                    recovery_events_json(m.integration->recovery_events()));
   if (m.odometer_use)
-    j += ", \"odometer\": " + odometer_json(*m.odometer_use, k, m.settings.navigation.odometer, m.settings.odometer_name);
+    j += ", \"odometer\": " +
+         odometer_json(*m.odometer_use, k, m.settings.navigation.odometer, m.settings.odometer_name);
   if (m.is_tight())
     j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
                      "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "

@@ -29,8 +29,9 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   cmd->add_option("--fusion-config", a.config,
                   "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
   cmd->add_option("--odometer", a.odometer,
-                  "with --coupling loose: odometer CSV (t_s,pulses,distance_m) as VMS speed and non-holonomic "
-                  "updates ([odometer] keys in --fusion-config), as `fuse --odometer`; bridges signal blockages");
+                  "with --coupling loose: odometer CSV (t_s,pulses,distance_m; t_s on the IMU's time line) as VMS "
+                  "speed and non-holonomic updates ([odometer] keys in --fusion-config), as `fuse --odometer`; "
+                  "bridges signal blockages");
   cmd->add_option("--imu-time-origin", a.time_origin,
                   "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
                   "the GPS time of week) or a GPS time of week in seconds");

@@ -131,7 +131,8 @@ TEST(ReceiveOdometer, LooseCouplingWithTheOdometerBridgesATunnel) {
   const auto with = pipelines::read_fused_nav_csv(s.dir / "rx_with" / "nav.csv");
   ASSERT_FALSE(without.empty());
   ASSERT_FALSE(with.empty());
-  const Horizontal entry_without = horizontal_at(without, kBlockStart_s), end_without = horizontal_at(without, kBlockEnd_s);
+  const Horizontal entry_without = horizontal_at(without, kBlockStart_s);
+  const Horizontal end_without = horizontal_at(without, kBlockEnd_s);
   const Horizontal entry_with = horizontal_at(with, kBlockStart_s), end_with = horizontal_at(with, kBlockEnd_s);
   constexpr double kRadPerDeg = M_PI / 180.0;
   const double distance_m = kSpeed_mps * (kBlockEnd_s - kBlockStart_s);
