@@ -91,24 +91,6 @@ struct RowError {
   double distance_m = 0.0;  // truth path length from the first row
 };
 
-// The odometer rows as speed windows of about `window_s` (whole rows; each window ends at a row's time).
-std::vector<fusion::OdometerSpeed> odometer_windows(const std::vector<ins::OdometerSample>& rows, double window_s) {
-  std::vector<fusion::OdometerSpeed> out;
-  if (rows.size() < 2) return out;
-  double start = rows[0].t_s - (rows[1].t_s - rows[0].t_s), distance = 0.0;
-  const double period = rows[1].t_s - rows[0].t_s;
-  for (const auto& r : rows) {
-    distance += r.distance_m;
-    const double span = r.t_s - start;
-    if (span >= window_s - 0.5 * period) {
-      out.push_back({r.t_s, distance / span, span});
-      start = r.t_s;
-      distance = 0.0;
-    }
-  }
-  return out;
-}
-
 // The odometer's part of the result against truth: from the last GNSS use to the end.
 void odometer_errors(const std::vector<RowError>& errors, OdometerUse& u) {
   const RowError* first = nullptr;
@@ -434,6 +416,23 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     if (!ge.empty()) result.gnss_rms = rms_of(ge, -1e300);
   }
   return result;
+}
+
+std::vector<fusion::OdometerSpeed> odometer_windows(const std::vector<ins::OdometerSample>& rows, double window_s) {
+  std::vector<fusion::OdometerSpeed> out;
+  if (rows.size() < 2) return out;
+  double start = rows[0].t_s - (rows[1].t_s - rows[0].t_s), distance = 0.0;
+  const double period = rows[1].t_s - rows[0].t_s;
+  for (const auto& r : rows) {
+    distance += r.distance_m;
+    const double span = r.t_s - start;
+    if (span >= window_s - 0.5 * period) {
+      out.push_back({r.t_s, distance / span, span});
+      start = r.t_s;
+      distance = 0.0;
+    }
+  }
+  return out;
 }
 
 }  // namespace ultratrack::pipelines

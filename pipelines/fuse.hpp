@@ -108,6 +108,10 @@ struct FuseResult {
   std::optional<OdometerUse> odometer;  // with odometer rows
 };
 
+// The odometer rows as speed windows of about window_s (whole rows; each window ends at a row's time): what fuse
+// and receive (pipelines/gnss_ins_coupler.hpp) hand to GnssInsIntegration::add_odometer.
+std::vector<fusion::OdometerSpeed> odometer_windows(const std::vector<ins::OdometerSample>& rows, double window_s);
+
 // Every solution row (after each IMU interval) goes to on_row. truth: a trajectory on the IMU time line for the
 // RMS statistics (empty: none). A stop request ends the run after the current IMU interval (the result then covers
 // the rows so far). Throws io::InputError for inputs that do not fit together (no overlap in time, unknown preset,

@@ -9,13 +9,9 @@
 #include "pipelines/imu_model_json.hpp"
 
 namespace ultratrack::pipelines {
-namespace {
 
-// The "odometer" object: settings, update counts by rule, the odometer estimates with their 1-sigma and, against
-// truth, seed 004's errors as % of the distance travelled since GNSS was last used (DT).
-std::string odometer_json(const OdometerUse& u, const FuseResult& r, const FuseSettings& s) {
-  const fusion::OdometerAidingOptions& o = s.config.odometer;
-  const auto& n = r.counters;
+std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounters& n,
+                          const fusion::OdometerAidingOptions& o, const std::string& file) {
   const fusion::OdometerNominal &v = u.estimate.value, &sd = u.estimate.sigma;
   auto opt = [](const std::optional<double>& x) { return x ? fmt::format("{:.6g}", *x) : std::string("null"); };
   auto pct = [&](const std::optional<double>& e) -> std::optional<double> {
@@ -26,7 +22,7 @@ std::string odometer_json(const OdometerUse& u, const FuseResult& r, const FuseS
       "{{\"file\": \"{}\", \"mode\": \"{}\", \"yaw_rate_threshold_dps\": {:.6g}, \"min_speed_mps\": {:.6g}, "
       "\"update_rate_hz\": {:.6g}, \"windows\": {}, \"updates_accepted\": {}, \"updates_rejected\": {}, "
       "\"gated_yaw_rate\": {}, \"gated_speed\": {}, \"unusable\": {}, ",
-      io::json_escape(s.odometer_file), o.mode == fusion::OdometerMode::kGated ? "gated" : "always",
+      io::json_escape(file), o.mode == fusion::OdometerMode::kGated ? "gated" : "always",
       o.yaw_rate_threshold_rad_s / io::kRadPerDeg, o.min_speed_mps, o.update_rate_hz, u.windows, n.odometer_accepted,
       n.odometer_rejected, n.odometer_gated_yaw_rate, n.odometer_gated_speed, n.odometer_unusable);
   j += fmt::format(
@@ -44,8 +40,6 @@ std::string odometer_json(const OdometerUse& u, const FuseResult& r, const FuseS
       opt(pct(u.altitude_error_max_m)));
   return j;
 }
-
-}  // namespace
 
 std::string recovery_events_json(const std::vector<fusion::RecoveryEvent>& events) {
   std::string j = "[";
@@ -86,7 +80,8 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   if (s.gnss_until_s)
     j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,
                      r.fixes_after_gnss_until);
-  if (r.odometer) j += "  \"odometer\": " + odometer_json(*r.odometer, r, s) + ",\n";
+  if (r.odometer)
+    j += "  \"odometer\": " + odometer_json(*r.odometer, r.counters, s.config.odometer, s.odometer_file) + ",\n";
   if (s.config.land.nhc)
     j += fmt::format("  \"nhc_updates_accepted\": {},\n  \"nhc_updates_rejected\": {},\n", r.counters.nhc_accepted,
                      r.counters.nhc_rejected);

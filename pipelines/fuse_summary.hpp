@@ -11,6 +11,12 @@ namespace ultratrack::pipelines {
 // `[{"t_s": ..., "reason": "..."}, ...]`: the lock-out recoveries (fusion/lockout_recovery.hpp) of a run.
 std::string recovery_events_json(const std::vector<fusion::RecoveryEvent>& events);
 
+// The "odometer" object: settings, update counts by rule, the odometer estimates with their 1-sigma and, against
+// truth, seed 004's errors as % of the distance travelled since GNSS was last used (DT; null without truth).
+// file names the odometer data. `fuse` and `receive` (pipelines/gnss_ins_coupler.hpp) write it.
+std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounters& counters,
+                          const fusion::OdometerAidingOptions& options, const std::string& file);
+
 std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,
                               const std::string& gnss_file, const std::string& truth_file);
 

@@ -90,6 +90,11 @@ struct GnssInsCoupler::Impl {
   std::optional<receiver::ObservationEpoch> held;  // waits for its fix (on_fix follows on_observations)
   std::optional<ins::NavState> previous_nav, last_nav;  // the driving filter's last two rows, after the hand-over
 
+  // Odometer aiding (loose, settings.odometer given): the speed windows and the next one to hand over.
+  std::vector<fusion::OdometerSpeed> odometer;
+  std::size_t next_odometer = 0;
+  std::optional<OdometerUse> odometer_use;
+
   // Counts.
   long long epochs_seen = 0, fixes_seen = 0, before_start = 0, used = 0, nav_rows = 0;
   long long unused = 0;  // after the start: loose epochs without a fix, tight epochs without ephemerides
@@ -171,6 +176,7 @@ struct GnssInsCoupler::Impl {
     final_sigma = NavSigma{out.sigma_pos_ned_m, out.sigma_vel_n_mps, out.sigma_att_rad};
     if (nav_rows > 0 && !(out.nav.t_s > last_row_t_s)) return;  // an increment too short to step
     last_row_t_s = out.nav.t_s;
+    if (odometer_use) odometer_use->estimate = out.odometer;
     sink->on_navigation(out.nav, final_sigma);
     ++nav_rows;
   }
@@ -184,6 +190,10 @@ struct GnssInsCoupler::Impl {
         inc.dtheta_b *= first_share;
         inc.dv_b *= first_share;
         first_share = 1.0;
+      }
+      for (; next_odometer < odometer.size() && odometer[next_odometer].t_s <= inc.t_s; ++next_odometer) {
+        integration->add_odometer(odometer[next_odometer]);
+        ++odometer_use->windows;
       }
       integration->add_imu(inc);
       emit();
@@ -273,6 +283,14 @@ struct GnssInsCoupler::Impl {
       o.model.clock = fusion::clock_noise_from_allan(c.clock_allan, o.model.clock);
       o.height_aiding = c.height_aiding;
     }
+    if (!settings.odometer.empty()) {  // as fuse (pipelines/fuse.hpp): windows of 1 / update_rate_hz
+      o.odometer = c.odometer;
+      o.odometer.enabled = true;
+      if (std::string why; !o.odometer.IsValid(&why)) throw io::InputError("configuration", why);
+      odometer = odometer_windows(settings.odometer, 1.0 / c.odometer.update_rate_hz);
+      while (next_odometer < odometer.size() && odometer[next_odometer].t_s <= init.t_s) ++next_odometer;
+      odometer_use.emplace().gnss_last_used_s = init.t_s;
+    }
     integration.emplace(init, o);
     initial_attitude = ins::euler_from_quaternion(init.q_nb);
     start_s = init.t_s;
@@ -349,6 +367,7 @@ struct GnssInsCoupler::Impl {
       }
     } else if (f) {
       integration->add_fix(*f);
+      if (odometer_use) odometer_use->gnss_last_used_s = t;
       ++used;
     } else {
       ++unused;
@@ -498,6 +517,9 @@ std::string GnssInsCoupler::summary_json() const {
                    k.satellites_missing_ephemeris);
   j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": {}", k.recoveries,
                    recovery_events_json(m.integration->recovery_events()));
+  if (m.odometer_use)
+    j += ", \"odometer\": " +
+         odometer_json(*m.odometer_use, k, m.settings.navigation.odometer, m.settings.odometer_name);
   if (m.is_tight())
     j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
                      "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "
@@ -518,12 +540,18 @@ std::string GnssInsCoupler::report() const {
   if (!m.integration)
     return fmt::format("receive: {} integration not started: {}", to_string(m.settings.coupling), m.not_started);
   const auto& k = m.integration->counters();
-  return fmt::format(
+  std::string r = fmt::format(
       "receive: {} {} integration, aligned {} at {:.3f} s; {} epochs used ({} before the start), updates accepted "
       "{}, rejected {}; final 1-sigma horizontal {:.2f} m, vertical {:.2f} m; {} nav rows",
       to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "EKF" : "UKF", m.alignment_note,
       m.start_s, m.used, m.before_start, k.accepted, k.rejected, m.final_sigma.position_ned_m.head<2>().norm(),
       m.final_sigma.position_ned_m.z(), m.nav_rows);
+  if (m.odometer_use)
+    r += fmt::format("\nreceive: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading "
+                     "rate {}, by speed {}",
+                     m.odometer_use->windows, k.odometer_accepted, k.odometer_rejected, k.odometer_gated_yaw_rate,
+                     k.odometer_gated_speed);
+  return r;
 }
 
 }  // namespace ultratrack::pipelines

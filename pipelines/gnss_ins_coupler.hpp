@@ -3,7 +3,9 @@
 // fusion::GnssInsIntegration: loose: each PVT fix (position and Doppler velocity with the PVT's a-priori
 // covariance) -> GnssFix; tight: each observation epoch (raw pseudoranges and Doppler; ephemerides from the
 // navigation file and the decoded ones; the PVT's elevation mask, atmosphere switches and elevation/C/N0 sigma
-// model) -> pseudorange and rate updates, also with fewer than four satellites. The INS starts after the alignment
+// model) -> pseudorange and rate updates, also with fewer than four satellites. Loose with odometer rows
+// (ReceiveOptions::odometer): their speed windows as `fuse --odometer`'s VMS/NHC updates (pipelines/fuse.hpp), which
+// bridge signal blockages; summary.json's fusion object then has fuse's "odometer" object. The INS starts after the alignment
 // (static: levelling + gyrocompassing over the first seconds; motion: from the fixes' velocities; config: the
 // configuration's attitude, position and velocity) and hands each solution (IMU position) to the sink's
 // on_navigation. Time: IMU t_s on the time line of pipelines/imu_time_line.hpp; receiver clock jumps are taken out

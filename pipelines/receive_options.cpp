@@ -20,6 +20,9 @@ bool ReceiveOptions::IsValid(std::string* error) const {
   const auto& names = ins::imu_preset_names();
   if (std::find(names.begin(), names.end(), navigation.imu_preset) == names.end())
     return fail("unknown IMU preset '" + navigation.imu_preset + "'");
+  if (!odometer.empty() && coupling != Coupling::kLoose)
+    return fail("--odometer works with --coupling loose only (the odometer states are not in the tight and "
+                "ultra-tight filters yet)");
   if (align == AlignMode::Attitude) return fail("--align attitude is `fuse`'s (GPS attitude rows)");
   if (align == AlignMode::Config && !navigation.attitude_deg)
     return fail("--align config needs [initial] attitude_deg in --fusion-config");

@@ -5,10 +5,12 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "fusion/gnss_ins_integration.hpp"
 #include "fusion/ultratight_integration.hpp"
 #include "fusion/vector_tracking.hpp"
+#include "ins/odometer.hpp"
 #include "pipelines/coupling.hpp"
 #include "pipelines/fuse_config.hpp"
 #include "pipelines/imu_time_line.hpp"
@@ -29,6 +31,10 @@ struct ReceiveOptions {
   FuseConfig navigation;                // `fuse`'s configuration keys
   ImuTimeOrigin imu_time_origin;
   std::string imu_name = "IMU data";  // names the IMU data in errors and summary.json (the file's path)
+  // kLoose: odometer rows (empty: no odometer aiding; `fuse --odometer`'s VMS/NHC updates, [odometer] keys) and the
+  // name of their file for errors and summary.json.
+  std::vector<ins::OdometerSample> odometer;
+  std::string odometer_name = "odometer data";
 
   // kUltraTight. Pipelined (the default): the loop runs beside the next block's correlation
   // (receiver::ReceiverEngine::set_vector_loop), its commands one 20 ms vector epoch later, as a real-time

@@ -6,6 +6,7 @@
 #include "config/fuse_config_toml.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
+#include "ins/odometer_csv.hpp"
 #include "io/input_error.hpp"
 #include "pipelines/alignment_run.hpp"
 
@@ -27,6 +28,10 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   cmd->add_option("--align", a.align, "with --coupling: static, motion (default), config or file:ALIGNMENT.json (`ultratrack align`)");
   cmd->add_option("--fusion-config", a.config,
                   "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
+  cmd->add_option("--odometer", a.odometer,
+                  "with --coupling loose: odometer CSV (t_s,pulses,distance_m; t_s on the IMU's time line) as VMS "
+                  "speed and non-holonomic updates ([odometer] keys in --fusion-config), as `fuse --odometer`; "
+                  "bridges signal blockages");
   cmd->add_option("--imu-time-origin", a.time_origin,
                   "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
                   "the GPS time of week) or a GPS time of week in seconds");
@@ -70,10 +75,14 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
       throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
                                            "--coupling loose, tight or ultra-tight");
     if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
+    if (!a.odometer.empty()) throw io::InputError("command line", "--odometer needs --coupling loose and --imu");
     if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
     if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
     return;
   }
+  if (!a.odometer.empty() && s.coupling != Coupling::kLoose)
+    throw io::InputError("command line", "--odometer works with --coupling loose only (tight and ultra-tight do not "
+                                         "carry the odometer states yet); got --coupling " + a.coupling);
   if (!a.ut_measurement.empty() && s.coupling != Coupling::kUltraTight)
     throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
   if (a.ut_serial && s.coupling != Coupling::kUltraTight)
@@ -112,6 +121,12 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   if (s.align == pipelines::AlignMode::Config && !s.navigation.attitude_deg)
     throw io::InputError(a.config.empty() ? "command line" : a.config,
                          "--align config needs [initial] attitude_deg in --fusion-config");
+  if (!a.odometer.empty()) {
+    s.odometer = ins::read_odometer_csv(a.odometer, {s.navigation.odometer_rate_hz}).samples;
+    s.odometer_name = a.odometer;
+    if (std::string why; !s.navigation.odometer.IsValid(&why))
+      throw io::InputError(a.config.empty() ? "command line" : a.config, why);
+  }
   if (a.time_origin.empty() || a.time_origin == "sample0") {
     s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::Sample0;
   } else if (a.time_origin == "tow") {

@@ -1,7 +1,7 @@
 // The command-line options of `receive` that choose the coupling and its GNSS/INS settings (--coupling, --imu,
 // --filter, --align, --fusion-config, --imu-time-origin, --ut-measurement, --ut-serial, --ut-pipelined,
-// --vector-carrier), parsed into pipelines::ReceiveOptions, and the IMU file's reader. Errors are io::InputError
-// naming the option or the file.
+// --vector-carrier, --odometer), parsed into pipelines::ReceiveOptions, and the IMU file's reader. Errors are
+// io::InputError naming the option or the file.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -17,6 +17,7 @@ namespace ultratrack::tools {
 // The command-line text of the coupling options (parsed by apply_receive_coupling_args).
 struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement, vector_carrier;
+  std::string odometer;  // --odometer FILE (loose)
   bool ut_serial = false;  // --ut-serial
   // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
   bool ut_pipelined = true;
@@ -25,7 +26,8 @@ struct ReceiveFusionArgs {
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 
 // Checks and parses the options into options (coupling, vector carrier and, for loose, tight and ultra-tight, the
-// GNSS/INS settings); with --coupling scalar or vector no GNSS/INS option may be given.
+// GNSS/INS settings; with --odometer the odometer file is read); with --coupling scalar or vector no GNSS/INS
+// option may be given.
 void apply_receive_coupling_args(const ReceiveFusionArgs& args, pipelines::ReceiveOptions& options);
 // The IMU file: InputError naming it when missing, malformed, non-finite or shorter than two rows.
 std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file, const ins::ImuCsvOptions& options);

@@ -88,3 +88,35 @@ TEST(ReceiveFusionCli, BadImuInputIsOneInputErrorNamingTheFileAndLeavesNoOutputs
                                                      (s.dir / "bad_no_imu").string()}),
                io::InputError);
 }
+
+// --odometer: loose only (tight and ultra-tight carry no odometer states), a bad odometer file is one InputError
+// naming it, and no outputs either way.
+TEST(ReceiveFusionCli, OdometerIsLooseOnlyAndABadFileIsOneInputErrorNamingIt) {
+  const auto& s = simulated();
+  const fs::path good = s.dir / "odometer.csv", bad = s.dir / "odometer_backwards.csv";
+  std::ofstream(good) << "t_s,pulses,distance_m\n0.1,10,0.8\n0.2,10,0.8\n0.3,10,0.8\n";
+  std::ofstream(bad) << "t_s,pulses,distance_m\n0.1,10,0.8\n0.2,10,0.8\n0.15,10,0.8\n";
+  auto run = [&](const std::string& name, const std::string& coupling, const fs::path& odometer) -> io::InputError {
+    const auto rx = s.dir / ("odo_" + name);
+    auto args = receive_args(rx);
+    args.insert(args.end(), {"--coupling", coupling, "--odometer", odometer.string()});
+    try {
+      test_support::run_command("receive", args);
+    } catch (const io::InputError& e) {
+      for (const char* f : {"summary.json", "nav.csv", "solution.csv"}) EXPECT_FALSE(fs::exists(rx / f)) << name << f;
+      return e;
+    }
+    ADD_FAILURE() << name << ": no error";
+    return io::InputError("", "");
+  };
+  for (const std::string coupling : {"tight", "ultra-tight"}) {
+    const io::InputError e = run(coupling, coupling, good);
+    EXPECT_NE(std::string(e.what()).find("--coupling loose only"), std::string::npos) << e.what();
+  }
+  const io::InputError e = run("backwards", "loose", bad);
+  EXPECT_EQ(e.file(), bad.string()) << e.what();
+  EXPECT_THROW(test_support::run_command("receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8",
+                                                     "--fs", "2.0e6", "--odometer", good.string(), "--out",
+                                                     (s.dir / "odo_scalar").string()}),
+               io::InputError);
+}
