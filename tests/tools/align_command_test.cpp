@@ -92,16 +92,20 @@ struct Case {
   pl::StationaryInputs inputs;
 };
 
-Case make_case(const std::string& name, const Eigen::Vector3d& mounting_deg, std::uint64_t seed) {
+Case make_case(const std::string& name, const pl::StationaryScenario& sc, std::uint64_t seed) {
   Case c;
   c.dir = ultratrack::test::scratch_dir() / name;
   fs::create_directories(c.dir);
-  c.inputs = pl::simulate_stationary_inputs(scenario(mounting_deg), seed);
+  c.inputs = pl::simulate_stationary_inputs(sc, seed);
   c.imu = c.dir / "imu.csv";
   c.attitude = c.dir / "attitude.csv";
   ins::write_imu_csv(c.imu, c.inputs.imu);
   write_attitude(c.attitude, c.inputs);
   return c;
+}
+
+Case make_case(const std::string& name, const Eigen::Vector3d& mounting_deg, std::uint64_t seed) {
+  return make_case(name, scenario(mounting_deg), seed);
 }
 
 std::vector<std::string> base_args(const Case& c, const std::string& out) {
@@ -220,17 +224,10 @@ TEST(AlignCommand, EstimatesTheArrayMountingWithinThreeSigma) {
 TEST(AlignCommand, WarnsNearPitch90) {
   // At 70 deg of pitch the GPS attitude still serves (the filter's limit is 80 deg) but roll and yaw are turning
   // about one axis: the result says so (seed 000 theorem 1: the rank drops at 90 deg).
-  Case c;
-  c.dir = ultratrack::test::scratch_dir() / "steep";
-  fs::create_directories(c.dir);
   pl::StationaryScenario sc = scenario(Eigen::Vector3d::Zero());
   sc.attitude = {10.0 * kDeg, 70.0 * kDeg, -60.0 * kDeg};
   sc.duration_s = 20.0;
-  c.inputs = pl::simulate_stationary_inputs(sc, 8);
-  c.imu = c.dir / "imu.csv";
-  c.attitude = c.dir / "attitude.csv";
-  ins::write_imu_csv(c.imu, c.inputs.imu);
-  write_attitude(c.attitude, c.inputs);
+  const Case c = make_case("steep", sc, 8);
   std::vector<std::string> args = base_args(c, "out");
   args.insert(args.end(), {"--duration", "15"});
   run_command("align", args);
@@ -401,16 +398,9 @@ TEST(ReceiveImuPps, MapsTheImuAndSetsTheTimeOrigin) {
 // velocity updates fix tilt x g + bias together), so starting from that attitude with zero biases leaves an
 // uncompensated specific force and the position drifts; with the file's biases it nearly does not.
 TEST(AlignCommand, AlignmentBiasesStartFuseWithinThreeSigma) {
-  Case c;
-  c.dir = ultratrack::test::scratch_dir() / "bias";
-  fs::create_directories(c.dir);
   pl::StationaryScenario sc = scenario(Eigen::Vector3d::Zero());
   sc.duration_s = 172.0;
-  c.inputs = pl::simulate_stationary_inputs(sc, 9);
-  c.imu = c.dir / "imu.csv";
-  c.attitude = c.dir / "attitude.csv";
-  ins::write_imu_csv(c.imu, c.inputs.imu);
-  write_attitude(c.attitude, c.inputs);
+  const Case c = make_case("bias", sc, 9);
   run_command("align", base_args(c, "out"));
   const fs::path with_file = c.dir / "out" / "alignment.json";
   const pl::AlignmentFileStart f = pl::read_alignment_json(with_file);
