@@ -61,6 +61,10 @@ void check_options(const IntegrationOptions& o) {
   auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
   if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
     throw std::invalid_argument("integration: initial sigmas must be positive");
+  if ((o.sigma_initial_accel_bias_b && !positive(*o.sigma_initial_accel_bias_b)) ||
+      (o.sigma_initial_gyro_bias_b && !positive(*o.sigma_initial_gyro_bias_b)) || !o.initial_accel_bias_b.allFinite() ||
+      !o.initial_gyro_bias_b.allFinite())
+    throw std::invalid_argument("integration: initial biases must be finite, their sigmas positive");
   if (!(o.propagation_interval_s >= 0.0)) throw std::invalid_argument("integration: negative propagation interval");
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
     throw std::invalid_argument("integration: gate probability must lie in (0, 1)");
@@ -130,6 +134,8 @@ class Core final : public CoreBase {
       : opt_(opt), ins_(initial, opt.strapdown), model_(make_model(opt)), filter_(std::move(filter)),
         monitor_(opt.recovery) {
     nominal_.nav = ins_.state();
+    nominal_.accel_bias_b = opt.initial_accel_bias_b;
+    nominal_.gyro_bias_b = opt.initial_gyro_bias_b;
     if constexpr (N == 18) {
       if (opt.height_aiding.fixed_height_m) {
         terrain_ref_m_ = terrain_m_ = *opt.height_aiding.fixed_height_m;  // P0: sigma_t^2, uncorrelated
@@ -488,6 +494,11 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
     P0 = OdometerAugmentedModel(mo, o.odometer).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else
     P0 = InsErrorModel<N>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  // Biases from an alignment: their own 1-sigma (cross terms with the other states stay zero).
+  if (o.sigma_initial_accel_bias_b)
+    P0.template block<3, 3>(ix::kAccelBias, ix::kAccelBias) = o.sigma_initial_accel_bias_b->cwiseAbs2().asDiagonal();
+  if (o.sigma_initial_gyro_bias_b)
+    P0.template block<3, 3>(ix::kGyroBias, ix::kGyroBias) = o.sigma_initial_gyro_bias_b->cwiseAbs2().asDiagonal();
   const StateVector<N> x0 = StateVector<N>::Zero();
   if (o.filter == FilterKind::Ekf)
     return std::make_unique<Core<N, Ekf<N>>>(initial, oo, Ekf<N>(x0, P0, EkfOptions{o.discretisation, o.gate}));

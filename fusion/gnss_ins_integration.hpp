@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "fusion/attitude_measurement.hpp"
@@ -53,6 +54,11 @@ struct IntegrationOptions {
   Eigen::Vector3d sigma_pos_ned_m = Eigen::Vector3d::Constant(10.0);
   Eigen::Vector3d sigma_vel_n_mps = Eigen::Vector3d::Constant(1.0);
   Eigen::Vector3d sigma_att_rad = Eigen::Vector3d::Constant(0.01);
+  // IMU biases already estimated (a stationary alignment), body axes (m/s^2, rad/s): the nominal starts from them;
+  // with their 1-sigma given, those replace `model`'s turn-on bias sigmas in the initial covariance.
+  Eigen::Vector3d initial_accel_bias_b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d initial_gyro_bias_b = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> sigma_initial_accel_bias_b, sigma_initial_gyro_bias_b;
   GateOptions gate;
   // No gate lock-out: a run of rejected fixes (loose) or of epochs with every satellite rejected (tight), or a
   // windowed NIS far above its band, re-opens the covariance of position, velocity, attitude (and clock) and

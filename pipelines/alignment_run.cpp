@@ -229,11 +229,42 @@ AlignmentFileStart read_alignment_json(const std::filesystem::path& file) {
     if (end == start || !std::isfinite(v)) throw io::InputError(name, std::string("\"") + key + "\" is not a finite number");
     return v;
   };
+  // "key": [x, y, z]
+  auto vector3 = [&](const char* key) -> std::optional<Eigen::Vector3d> {
+    const std::string k = std::string("\"") + key + "\":";
+    const auto p = text.find(k);
+    if (p == std::string::npos) return std::nullopt;
+    const char* c = text.c_str() + p + k.size();
+    const auto bad = [&] { return io::InputError(name, std::string("\"") + key + "\" is not a list of 3 finite numbers"); };
+    while (*c == ' ') ++c;
+    if (*c++ != '[') throw bad();
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) {
+      char* end = nullptr;
+      v(i) = std::strtod(c, &end);
+      if (end == c || !std::isfinite(v(i))) throw bad();
+      c = end;
+      while (*c == ' ') ++c;
+      if (*c++ != (i < 2 ? ',' : ']')) throw bad();
+    }
+    return v;
+  };
   AlignmentFileStart f;
   f.attitude_deg = {number("roll_deg"), number("pitch_deg"), number("yaw_deg")};
   f.sigma_attitude_deg = {number("sigma_roll_deg"), number("sigma_pitch_deg"), number("sigma_yaw_deg")};
   if (!(f.sigma_attitude_deg.array() > 0.0).all())
     throw io::InputError(name, "attitude sigmas must be positive");
+  const auto ba = vector3("accel_bias_mps2"), sba = vector3("sigma_accel_bias_mps2");
+  const auto bg = vector3("gyro_bias_dph"), sbg = vector3("sigma_gyro_bias_dph");
+  const int given = int(ba.has_value()) + int(sba.has_value()) + int(bg.has_value()) + int(sbg.has_value());
+  if (given != 0 && given != 4)
+    throw io::InputError(name, "accel_bias_mps2, sigma_accel_bias_mps2, gyro_bias_dph and sigma_gyro_bias_dph go "
+                               "together (all or none)");
+  if (given == 4) {
+    if (!(sba->array() > 0.0).all() || !(sbg->array() > 0.0).all())
+      throw io::InputError(name, "bias sigmas must be positive");
+    f.biases = AlignmentFileStart::Biases{*ba, *sba, *bg * kDegPerHour, *sbg * kDegPerHour};
+  }
   return f;
 }
 
@@ -241,6 +272,12 @@ void apply_alignment_file(FuseConfig& config, const std::filesystem::path& file)
   const AlignmentFileStart f = read_alignment_json(file);
   config.attitude_deg = f.attitude_deg;
   config.sigma_attitude_deg = f.sigma_attitude_deg;
+  if (f.biases) {
+    config.initial_accel_bias_mps2 = f.biases->accel_mps2;
+    config.sigma_accel_bias_mps2 = f.biases->sigma_accel_mps2;
+    config.initial_gyro_bias_rps = f.biases->gyro_rps;
+    config.sigma_gyro_bias_rps = f.biases->sigma_gyro_rps;
+  }
 }
 
 }  // namespace ultratrack::pipelines

@@ -54,10 +54,17 @@ std::string alignment_json(const AlignRunResult& result, const AlignSettings& se
 std::string alignment_csv(const AlignRunResult& result);
 
 // alignment.json read back to start `fuse` or `receive --imu` (`--align file:alignment.json`): the attitude and
-// its 1-sigma become [initial] attitude_deg and sigma_attitude_deg of the configuration (a `config` start).
+// its 1-sigma become [initial] attitude_deg and sigma_attitude_deg of the configuration (a `config` start); the
+// bias estimates and their 1-sigma (when the file has them; all four or none) start the filter's bias states.
+// Throws io::InputError naming the file when a key is missing or malformed, a sigma not positive.
 struct AlignmentFileStart {
   Eigen::Vector3d attitude_deg = Eigen::Vector3d::Zero();  // roll, pitch, yaw
   Eigen::Vector3d sigma_attitude_deg = Eigen::Vector3d::Zero();
+  struct Biases {
+    Eigen::Vector3d accel_mps2, sigma_accel_mps2;  // body axes
+    Eigen::Vector3d gyro_rps, sigma_gyro_rps;      // (deg/h in the file)
+  };
+  std::optional<Biases> biases;
 };
 AlignmentFileStart read_alignment_json(const std::filesystem::path& file);
 void apply_alignment_file(FuseConfig& config, const std::filesystem::path& file);

@@ -23,6 +23,10 @@ struct FuseConfig {
   std::optional<Eigen::Vector3d> position_deg_m;  // lat_deg, lon_deg, height_m
   std::optional<Eigen::Vector3d> velocity_ned_mps;  // --align config without GNSS velocity (receive --imu)
   std::optional<Eigen::Vector3d> sigma_position_m, sigma_velocity_mps, sigma_attitude_deg;
+  // IMU biases already estimated (`ultratrack align`'s alignment.json), body axes, with their 1-sigma: the filter
+  // starts from them instead of zero and the preset's turn-on sigma (--align file:).
+  std::optional<Eigen::Vector3d> initial_accel_bias_mps2, sigma_accel_bias_mps2;
+  std::optional<Eigen::Vector3d> initial_gyro_bias_rps, sigma_gyro_bias_rps;
   double static_duration_s = 60.0;
   double motion_min_speed_mps = 5.0;
   double motion_window_s = 2.0;

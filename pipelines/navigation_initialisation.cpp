@@ -127,6 +127,10 @@ fusion::IntegrationOptions integration_options(const NavigationStart& start, con
   o.sigma_pos_ned_m = start.sigma_pos_ned_m;
   o.sigma_vel_n_mps = start.sigma_vel_n_mps;
   o.sigma_att_rad = start.sigma_att_rad;
+  if (c.initial_accel_bias_mps2) o.initial_accel_bias_b = *c.initial_accel_bias_mps2;
+  if (c.initial_gyro_bias_rps) o.initial_gyro_bias_b = *c.initial_gyro_bias_rps;
+  o.sigma_initial_accel_bias_b = c.sigma_accel_bias_mps2;
+  o.sigma_initial_gyro_bias_b = c.sigma_gyro_bias_rps;
   o.gate = c.gate;
   o.recovery = c.recovery;
   o.land = c.land;

@@ -75,7 +75,8 @@ NavigationStart initialise_navigation(const AttitudeStart& alignment, const Gnss
 
 // The integration's options for that start: coupling and filter, the IMU preset's error model, the lever arm, the
 // start's 1-sigmas, the configuration's gate, UKF parameters and propagation interval. (Tight callers add the
-// clock and the GPS time origin; `fuse` the GPS attitude options.)
+// clock and the GPS time origin; `fuse` the GPS attitude options.) The configuration's initial biases and their
+// 1-sigma (an alignment file's) start the bias states when given.
 fusion::IntegrationOptions integration_options(const NavigationStart& start, const FuseConfig& config,
                                                fusion::Coupling coupling, fusion::FilterKind filter);
 

@@ -109,4 +109,17 @@ std::vector<ins::ImuIncrement> imu_on_gps_time(std::span<const ins::ImuIncrement
   return out;
 }
 
+ImuOnPps imu_on_gps_time_by_pps(std::span<const ins::ImuIncrement> imu, const std::string& imu_file,
+                                const std::filesystem::path& pps_file, const std::optional<signals::GpsTime>& origin) {
+  const std::string name = pps_file.string();
+  ImuOnPps r;
+  r.fit = fit_pps_clock(read_pps_csv(pps_file), name);
+  r.origin = origin.value_or(r.fit.reference);
+  r.imu = imu_on_gps_time(imu, r.fit, r.origin, imu_file);
+  r.note = fmt::format("IMU local clock on GPS time by {}: {} edges used, {} rejected, drift {:.3f} ppm, "
+                       "residual RMS {:.2f} us",
+                       name, r.fit.used, r.fit.rejected, r.fit.drift * 1e6, r.fit.residual_rms_s * 1e6);
+  return r;
+}
+
 }  // namespace ultratrack::pipelines

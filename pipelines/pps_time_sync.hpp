@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -54,5 +55,19 @@ PpsClockFit fit_pps_clock(std::span<const PpsEdge> edges, const std::string& fil
 std::vector<ins::ImuIncrement> imu_on_gps_time(std::span<const ins::ImuIncrement> imu, const PpsClockFit& fit,
                                                const signals::GpsTime& origin, const std::string& imu_file,
                                                const PpsOptions& options = {});
+
+// An IMU file stamped by a local clock put on GPS time through a PPS file (read, fitted, re-stamped as above):
+// t_s = GPS time - origin, the origin being the given one or else the first PPS edge's GPS time. The note says how
+// (edges used and rejected, drift, residual) for messages and summaries. Errors as read_pps_csv, fit_pps_clock
+// and imu_on_gps_time.
+struct ImuOnPps {
+  std::vector<ins::ImuIncrement> imu;
+  PpsClockFit fit;
+  signals::GpsTime origin;  // GPS time of the new t_s = 0
+  std::string note;
+};
+ImuOnPps imu_on_gps_time_by_pps(std::span<const ins::ImuIncrement> imu, const std::string& imu_file,
+                                const std::filesystem::path& pps_file,
+                                const std::optional<signals::GpsTime>& origin = std::nullopt);
 
 }  // namespace ultratrack::pipelines

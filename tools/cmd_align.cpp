@@ -63,14 +63,11 @@ void run_align_command(const AlignCommandOptions& o) {
   const auto attitude = pipelines::read_attitude_csv(o.attitude_file);
   auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
   if (!o.pps_file.empty()) {
-    const auto edges = pipelines::read_pps_csv(o.pps_file);
-    const pipelines::PpsClockFit fit = pipelines::fit_pps_clock(edges, o.pps_file);
+    auto mapped = pipelines::imu_on_gps_time_by_pps(imu, o.imu_file, o.pps_file, s.config.attitude_gps_time_at_imu_zero);
     // Without an origin the IMU time line starts at the first PPS edge.
-    if (!s.config.attitude_gps_time_at_imu_zero) s.config.attitude_gps_time_at_imu_zero = fit.reference;
-    imu = pipelines::imu_on_gps_time(imu, fit, *s.config.attitude_gps_time_at_imu_zero, o.imu_file);
-    s.time_note = fmt::format("IMU local clock on GPS time by {}: {} edges used, {} rejected, drift {:.3f} ppm, "
-                              "residual RMS {:.2f} us",
-                              o.pps_file, fit.used, fit.rejected, fit.drift * 1e6, fit.residual_rms_s * 1e6);
+    s.config.attitude_gps_time_at_imu_zero = mapped.origin;
+    imu = std::move(mapped.imu);
+    s.time_note = mapped.note;
     if (!o.quiet) fmt::print("align: {}\n", s.time_note);
   } else {
     s.time_note = "IMU t_s on the attitude time line by the GPS time origin";

@@ -3,6 +3,8 @@
 // DIR/summary.json (update counts, convergence, RMS against --truth); progress and a summary on stdout.
 // --attitude adds a multi-antenna receiver's GPS attitude (attitude.csv) as a measurement (seed 003);
 // --odometer an odometer's pulses (odometer.csv) as VMS/non-holonomic updates (seed 004), with or without --gnss.
+// --imu-pps puts IMU stamps of a free-running local clock on GPS time through a PPS record (seed 003,
+// pipelines/pps_time_sync.hpp) before anything uses them: t_s = GPS time - the --attitude-origin (or the first edge).
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
@@ -27,6 +29,7 @@
 #include "pipelines/fuse.hpp"
 #include "pipelines/fuse_summary.hpp"
 #include "pipelines/fused_nav_csv.hpp"
+#include "pipelines/pps_time_sync.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/odometer_csv.hpp"
 #include "io/atomic_file.hpp"
@@ -40,7 +43,7 @@ namespace fs = std::filesystem;
 using pipelines::AlignMode;
 
 struct FuseCommandOptions {
-  std::string imu_file, gnss_file, truth_file, config_file, out_dir, attitude_file, odometer_file;
+  std::string imu_file, gnss_file, truth_file, config_file, out_dir, attitude_file, odometer_file, pps_file;
   std::optional<double> gnss_until_s;
   std::vector<double> attitude_origin;  // WEEK TOW
   std::string coupling = "loose", filter = "ekf", align = "motion";
@@ -91,7 +94,13 @@ void run_fuse_command(const FuseCommandOptions& o) {
     s.odometer_file = o.odometer_file;
   }
   s.gnss_until_s = o.gnss_until_s;
-  const auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
+  auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
+  if (!o.pps_file.empty()) {
+    auto mapped = pipelines::imu_on_gps_time_by_pps(imu, o.imu_file, o.pps_file, s.config.attitude_gps_time_at_imu_zero);
+    s.config.attitude_gps_time_at_imu_zero = mapped.origin;  // without an origin the time line starts at the first edge
+    imu = std::move(mapped.imu);
+    if (!o.quiet) fmt::print("fuse: {}\n", mapped.note);
+  }
   const auto gnss = o.gnss_file.empty() ? std::vector<pipelines::GnssFixRow>{} : pipelines::read_gnss_csv(o.gnss_file);
   std::vector<ins::NavState> truth;
   if (!o.truth_file.empty()) truth = sim::read_truth_csv(o.truth_file);
@@ -195,6 +204,10 @@ void add_fuse_command(CLI::App& app) {
   cmd->add_option("--attitude-origin", o->attitude_origin,
                   "WEEK TOW: GPS time of IMU t = 0 (else [attitude] gps_time_at_imu_zero)")
       ->expected(2);
+  cmd->add_option("--imu-pps", o->pps_file,
+                  "PPS CSV (local_s,gps_week,gps_tow_s): IMU stamps are a local clock, mapped to GPS time since "
+                  "--attitude-origin (else the first PPS edge), the time line of the other files")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--truth", o->truth_file, "truth/nav CSV on the IMU time line: RMS errors in summary.json")
       ->check(CLI::ExistingFile);
   cmd->add_option("--outage", o->outage, "START DURATION: drop GNSS fixes in [START, START+DURATION) (repeatable)")

@@ -82,7 +82,10 @@ void run_receive(const ReceiveArgs& args) {
   apply_receive_coupling_args(args.fusion, job.options);
   if (std::string why; !job.options.IsValid(&why)) throw signals::InputError("command line", why);
   const bool fused = pipelines::uses_imu(job.options.coupling);
-  if (fused) job.imu = read_receive_imu(args.fusion.imu, {job.options.navigation.imu_max_gap_s});
+  if (fused) {
+    job.imu = read_receive_imu(args.fusion.imu, {job.options.navigation.imu_max_gap_s});
+    put_receive_imu_on_pps(args.fusion, job.imu, job.options);
+  }
 
   ReceiveProgress progress(args.quiet);
   InterruptGuard interrupt;  // Ctrl-C ends the loop; every output is still finished

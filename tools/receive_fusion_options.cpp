@@ -9,6 +9,7 @@
 #include "ins/odometer_csv.hpp"
 #include "io/input_error.hpp"
 #include "pipelines/alignment_run.hpp"
+#include "pipelines/pps_time_sync.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -35,6 +36,9 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   cmd->add_option("--imu-time-origin", a.time_origin,
                   "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
                   "the GPS time of week) or a GPS time of week in seconds");
+  cmd->add_option("--imu-pps", a.imu_pps,
+                  "PPS CSV (local_s,gps_week,gps_tow_s): IMU stamps are a free-running local clock, mapped to GPS "
+                  "time through the PPS record (instead of --imu-time-origin)");
   cmd->add_option("--ut-measurement", a.ut_measurement,
                   "with --coupling ultra-tight: iq (default: the E/P/L I&Q, seed 001 eqs. 11-17) or discriminator");
   cmd->add_flag("--ut-serial", a.ut_serial,
@@ -71,9 +75,10 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     }
   }
   if (!pipelines::uses_imu(s.coupling)) {
-    if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty())
-      throw io::InputError("command line", "--imu, --filter, --align, --fusion-config and --imu-time-origin need "
-                                           "--coupling loose, tight or ultra-tight");
+    if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty() ||
+        !a.imu_pps.empty())
+      throw io::InputError("command line", "--imu, --filter, --align, --fusion-config, --imu-time-origin and "
+                                           "--imu-pps need --coupling loose, tight or ultra-tight");
     if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
     if (!a.odometer.empty()) throw io::InputError("command line", "--odometer needs --coupling loose and --imu");
     if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
@@ -127,6 +132,9 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     if (std::string why; !s.navigation.odometer.IsValid(&why))
       throw io::InputError(a.config.empty() ? "command line" : a.config, why);
   }
+  if (!a.imu_pps.empty() && !a.time_origin.empty())
+    throw io::InputError("command line", "--imu-pps and --imu-time-origin exclude each other (the PPS record sets "
+                                         "the IMU's time origin)");
   if (a.time_origin.empty() || a.time_origin == "sample0") {
     s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::Sample0;
   } else if (a.time_origin == "tow") {
@@ -145,6 +153,14 @@ std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file, const i
   auto imu = ins::read_imu_csv(file, options);
   if (imu.size() < 2) throw io::InputError(file, "the IMU file needs at least two rows");
   return imu;
+}
+
+void put_receive_imu_on_pps(const ReceiveFusionArgs& a, std::vector<ins::ImuIncrement>& imu,
+                            pipelines::ReceiveOptions& s) {
+  if (a.imu_pps.empty()) return;
+  auto mapped = pipelines::imu_on_gps_time_by_pps(imu, a.imu, a.imu_pps);
+  imu = std::move(mapped.imu);
+  s.imu_time_origin = {pipelines::ImuTimeOrigin::Kind::Tow, mapped.origin.tow_s};
 }
 
 }  // namespace ultratrack::tools

@@ -1,5 +1,5 @@
 // The command-line options of `receive` that choose the coupling and its GNSS/INS settings (--coupling, --imu,
-// --filter, --align, --fusion-config, --imu-time-origin, --ut-measurement, --ut-serial, --ut-pipelined,
+// --filter, --align, --fusion-config, --imu-time-origin, --imu-pps, --ut-measurement, --ut-serial, --ut-pipelined,
 // --vector-carrier, --odometer), parsed into pipelines::ReceiveOptions, and the IMU file's reader. Errors are
 // io::InputError naming the option or the file.
 #pragma once
@@ -18,6 +18,7 @@ namespace ultratrack::tools {
 struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement, vector_carrier;
   std::string odometer;  // --odometer FILE (loose)
+  std::string imu_pps;  // --imu-pps: the PPS record of the IMU's local clock
   bool ut_serial = false;  // --ut-serial
   // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
   bool ut_pipelined = true;
@@ -31,5 +32,10 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 void apply_receive_coupling_args(const ReceiveFusionArgs& args, pipelines::ReceiveOptions& options);
 // The IMU file: InputError naming it when missing, malformed, non-finite or shorter than two rows.
 std::vector<ins::ImuIncrement> read_receive_imu(const std::string& file, const ins::ImuCsvOptions& options);
+// With --imu-pps: the IMU's local stamps put on GPS time since the first PPS edge (pipelines/pps_time_sync.hpp),
+// which becomes the IMU time origin (as --imu-time-origin TOW would); a PPS record that does not cover the IMU file
+// is an InputError. Without it nothing changes.
+void put_receive_imu_on_pps(const ReceiveFusionArgs& args, std::vector<ins::ImuIncrement>& imu,
+                            pipelines::ReceiveOptions& options);
 
 }  // namespace ultratrack::tools

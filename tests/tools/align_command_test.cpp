@@ -1,11 +1,14 @@
 // `ultratrack align` end to end, in process, on simulated inputs with known truth (pipelines/alignment_monte_carlo's
 // IMU at rest with HG1700AE errors, GPS attitude = the array's truth + white Euler noise, written as attitude.csv in
 // GPS time): the attitude inside its 1-sigma, the files, the array's mounting (seed 000 Table 3) estimated within
-// 3 sigma, the IMU on a free-running local clock mapped through a PPS record (seed 003), `fuse --align file:`, and
+// 3 sigma, the IMU on a free-running local clock mapped through a PPS record (seed 003), `fuse --align file:` (the
+// attitude and the bias estimates), and
 // bad input (no fixed rows, no overlap, NaN, PPS gaps and bad rows) as one InputError naming the file.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -13,11 +16,13 @@
 #include <sstream>
 #include <string>
 
+#include "ins/earth_model.hpp"
 #include "ins/imu_csv.hpp"
 #include "io/input_error.hpp"
 #include "io/units.hpp"
 #include "pipelines/alignment_monte_carlo.hpp"
 #include "pipelines/alignment_run.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/pps_time_sync.hpp"
 #include "receive_fusion_options.hpp"
 #include "run_command.hpp"
@@ -87,16 +92,20 @@ struct Case {
   pl::StationaryInputs inputs;
 };
 
-Case make_case(const std::string& name, const Eigen::Vector3d& mounting_deg, std::uint64_t seed) {
+Case make_case(const std::string& name, const pl::StationaryScenario& sc, std::uint64_t seed) {
   Case c;
   c.dir = ultratrack::test::scratch_dir() / name;
   fs::create_directories(c.dir);
-  c.inputs = pl::simulate_stationary_inputs(scenario(mounting_deg), seed);
+  c.inputs = pl::simulate_stationary_inputs(sc, seed);
   c.imu = c.dir / "imu.csv";
   c.attitude = c.dir / "attitude.csv";
   ins::write_imu_csv(c.imu, c.inputs.imu);
   write_attitude(c.attitude, c.inputs);
   return c;
+}
+
+Case make_case(const std::string& name, const Eigen::Vector3d& mounting_deg, std::uint64_t seed) {
+  return make_case(name, scenario(mounting_deg), seed);
 }
 
 std::vector<std::string> base_args(const Case& c, const std::string& out) {
@@ -215,17 +224,10 @@ TEST(AlignCommand, EstimatesTheArrayMountingWithinThreeSigma) {
 TEST(AlignCommand, WarnsNearPitch90) {
   // At 70 deg of pitch the GPS attitude still serves (the filter's limit is 80 deg) but roll and yaw are turning
   // about one axis: the result says so (seed 000 theorem 1: the rank drops at 90 deg).
-  Case c;
-  c.dir = ultratrack::test::scratch_dir() / "steep";
-  fs::create_directories(c.dir);
   pl::StationaryScenario sc = scenario(Eigen::Vector3d::Zero());
   sc.attitude = {10.0 * kDeg, 70.0 * kDeg, -60.0 * kDeg};
   sc.duration_s = 20.0;
-  c.inputs = pl::simulate_stationary_inputs(sc, 8);
-  c.imu = c.dir / "imu.csv";
-  c.attitude = c.dir / "attitude.csv";
-  ins::write_imu_csv(c.imu, c.inputs.imu);
-  write_attitude(c.attitude, c.inputs);
+  const Case c = make_case("steep", sc, 8);
   std::vector<std::string> args = base_args(c, "out");
   args.insert(args.end(), {"--duration", "15"});
   run_command("align", args);
@@ -351,6 +353,111 @@ TEST(AlignCommand, ImuOnALocalClockThroughPps) {
   args.back() = pps.string();
   args[args.size() - 3] = (c.dir / "pps2").string();
   expect_input_error(args, pps.string(), "gap of");
+}
+
+// receive --imu --imu-pps: the local stamps on GPS time since the first PPS edge, which becomes the IMU time origin;
+// --imu-time-origin beside it, or --imu-pps without a GNSS/INS coupling, is an InputError.
+TEST(ReceiveImuPps, MapsTheImuAndSetsTheTimeOrigin) {
+  const fs::path dir = ultratrack::test::scratch_dir() / "receive_pps";
+  fs::create_directories(dir);
+  std::string t = "local_s,gps_week,gps_tow_s\n";
+  for (int k = 0; k <= 20; ++k) t += fmt::format("{:.7f},{},{}\n", local_of(k), kOrigin.week, kOrigin.tow_s + 3 + k);
+  std::ofstream(dir / "pps.csv") << t;
+  ultratrack::tools::ReceiveFusionArgs ra;
+  ra.coupling = "tight";
+  ra.imu = (dir / "imu.csv").string();
+  ra.imu_pps = (dir / "pps.csv").string();
+  ultratrack::pipelines::ReceiveOptions ro;
+  ultratrack::tools::apply_receive_coupling_args(ra, ro);
+  std::vector<ins::ImuIncrement> imu;
+  for (int k = 1; k <= 1900; ++k) imu.push_back({local_of(0.01 * k), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  ultratrack::tools::put_receive_imu_on_pps(ra, imu, ro);
+  EXPECT_EQ(ro.imu_time_origin.kind, pl::ImuTimeOrigin::Kind::Tow);
+  EXPECT_EQ(ro.imu_time_origin.tow_s, kOrigin.tow_s + 3);
+  for (int k = 1; k <= 1900; k += 37) EXPECT_NEAR(imu[k - 1].t_s, 0.01 * k, 1e-9) << k;
+  ra.time_origin = "tow";
+  EXPECT_THROW(ultratrack::tools::apply_receive_coupling_args(ra, ro), InputError);
+  ra.time_origin.clear();
+  ra.coupling = "scalar";
+  EXPECT_THROW(ultratrack::tools::apply_receive_coupling_args(ra, ro), InputError);
+  // IMU rows well past the record: the IMU file is named.
+  ra.coupling = "tight";
+  imu.assign(1, {local_of(40.0), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()});
+  try {
+    ultratrack::tools::put_receive_imu_on_pps(ra, imu, ro);
+    ADD_FAILURE() << "IMU beyond the PPS record accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("imu.csv"), std::string::npos) << e.what();
+  }
+}
+
+// --align file: carries the bias estimates and their 1-sigma into fuse. Truth: the simulated IMU's effective biases
+// over the alignment span (mean measured rate minus the closed-form stationary input: turn-on bias plus scale factor
+// and misalignment times that input, plus the bias instability). Then one minute of pure inertial navigation (a
+// single GNSS fix starts it): the alignment's attitude absorbed the accelerometer bias it estimated (the zero
+// velocity updates fix tilt x g + bias together), so starting from that attitude with zero biases leaves an
+// uncompensated specific force and the position drifts; with the file's biases it nearly does not.
+TEST(AlignCommand, AlignmentBiasesStartFuseWithinThreeSigma) {
+  pl::StationaryScenario sc = scenario(Eigen::Vector3d::Zero());
+  sc.duration_s = 172.0;
+  const Case c = make_case("bias", sc, 9);
+  run_command("align", base_args(c, "out"));
+  const fs::path with_file = c.dir / "out" / "alignment.json";
+  const pl::AlignmentFileStart f = pl::read_alignment_json(with_file);
+  ASSERT_TRUE(f.biases.has_value());
+  const std::string j = read_text(with_file);
+  const double end_s = json_number(j, "t_s");
+  const Eigen::Matrix3d C_bn = ins::quaternion_from_euler(sc.attitude).toRotationMatrix().transpose();
+  const Eigen::Vector3d f_b = C_bn * -ins::gravity_n(sc.lat_rad, sc.height_m), w_b = C_bn * ins::earth_rate_n(sc.lat_rad);
+  const auto& e = c.inputs.errors;  // output = (I + M) input + bias + noise; at rest M acts as a bias too
+  const Eigen::Vector3d accel = e.accel.bias + e.accel.scale_misalignment * f_b;
+  const Eigen::Vector3d gyro = e.gyro.bias + e.gyro.scale_misalignment * w_b;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(f.biases->accel_mps2(i) - accel(i)), 3.0 * f.biases->sigma_accel_mps2(i)) << i;
+    EXPECT_LT(std::abs(f.biases->gyro_rps(i) - gyro(i)), 3.0 * f.biases->sigma_gyro_rps(i)) << i;
+  }
+  // The same alignment without the bias keys (attitude only, as before).
+  const fs::path without_file = c.dir / "attitude_only.json";
+  std::ofstream(without_file) << fmt::format(
+      "{{\"roll_deg\": {}, \"pitch_deg\": {}, \"yaw_deg\": {}, \"sigma_roll_deg\": {}, \"sigma_pitch_deg\": {}, "
+      "\"sigma_yaw_deg\": {}}}\n",
+      f.attitude_deg.x(), f.attitude_deg.y(), f.attitude_deg.z(), f.sigma_attitude_deg.x(), f.sigma_attitude_deg.y(),
+      f.sigma_attitude_deg.z());
+  EXPECT_FALSE(pl::read_alignment_json(without_file).biases.has_value());
+  // One exact fix right after the alignment (between IMU rows), then a minute of pure inertial navigation.
+  std::ofstream(c.dir / "gnss.csv")
+      << "t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m\n"
+      << fmt::format("{:.3f},36.37,127.36,80,0,0,0,0.1,0.1,0.1\n", end_s + 0.205);
+  auto drift = [&](const fs::path& alignment, const std::string& out) {
+    run_command("fuse", {"--imu", c.imu.string(), "--gnss", (c.dir / "gnss.csv").string(), "--align",
+                         "file:" + alignment.string(), "--quiet", "--out", (c.dir / out).string()});
+    const auto rows = pl::read_fused_nav_csv(c.dir / out / "nav.csv");
+    const double t0 = rows.front().nav.t_s;
+    double ss = 0.0, worst = 0.0;
+    int m = 0;
+    for (const auto& r : rows) {
+      if (r.nav.t_s > t0 + 60.0) break;
+      const double north = (r.nav.lat_rad - 36.37 * kDeg) * 6.3567e6;
+      const double east = (r.nav.lon_rad - 127.36 * kDeg) * 6.3567e6 * std::cos(36.37 * kDeg);
+      const double h = std::hypot(north, east);
+      ss += h * h;
+      worst = std::max(worst, h);
+      ++m;
+    }
+    EXPECT_GT(rows.back().nav.t_s, t0 + 60.0);
+    return std::pair(std::sqrt(ss / m), worst);
+  };
+  const auto [rms_with, max_with] = drift(with_file, "fuse_with");
+  const auto [rms_without, max_without] = drift(without_file, "fuse_without");
+  std::printf("first minute of pure inertial navigation, horizontal error RMS / max: with the alignment's biases "
+              "%.3f / %.3f m, without %.3f / %.3f m\n",
+              rms_with, max_with, rms_without, max_without);
+  EXPECT_LT(rms_with, 0.5 * rms_without);
+  // fuse started from the file's biases: no update touched them in pure inertial navigation.
+  const std::string fj = read_text(c.dir / "fuse_with" / "summary.json");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(fj, m, std::regex("\"gyro_dph\": \\[([-+0-9.eE]+)")));
+  EXPECT_NEAR(std::stod(m[1]), f.biases->gyro_rps.x() / (kDeg / 3600.0), 1e-3 * f.biases->sigma_gyro_rps.x() / (kDeg / 3600.0) + 1e-5);
 }
 
 }  // namespace

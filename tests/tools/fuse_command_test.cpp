@@ -1,13 +1,16 @@
 // `ultratrack fuse` end to end, in process, on simulated data: a "foreign" data set (200 Hz IMU, 5 Hz GNSS
 // fixes at non-integer times t = 0.137 + 0.2 k) aligned in motion converges, beats the fixes it was given and
-// stays consistent with its own 1-sigma; static and configured alignments; outages; bad input is one clear
-// InputError. Truth is the trajectory simulator's.
+// stays consistent with its own 1-sigma; static and configured alignments; outages; an IMU on a free-running local
+// clock through its PPS record (--imu-pps); bad input is one clear InputError. Truth is the trajectory simulator's.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -15,6 +18,7 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "ins/imu_csv.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
 #include "io/input_error.hpp"
@@ -233,5 +237,66 @@ TEST(FuseCommand, OdometerWithAndWithoutGnss) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.line(), 4);
     EXPECT_NE(std::string(e.what()).find("odo_bad.csv"), std::string::npos) << e.what();
+  }
+}
+
+// --imu-pps (seed 003's time sync): the same IMU re-stamped by a free-running local clock 50 ppm fast (offset 1000.25
+// s), with its PPS record (1 us jitter, one pulse missing), gives the GPS-stamped run's solution. A mapping error dt
+// shifts the IMU against the fixes by dt, moving the solution by about speed x dt: the PPS fit is good to well under
+// 10 us (PpsTimeSync tests), the land profile below 30 m/s, so rows agree within 30 m/s x 10 us = 0.3 mm (1 mm
+// allowed for the files' rounding) and their times within 10 us.
+TEST(FuseCommand, ImuOnALocalClockThroughPpsGivesTheGpsStampedSolution) {
+  const fs::path dir = make_land_data(120.0);
+  const std::string gnss = (dir / "gnss.csv").string(), truth = (dir / "sim/truth.csv").string();
+  run({"fuse", "--imu", (dir / "sim/imu.csv").string(), "--gnss", gnss, "--truth", truth, "--quiet", "--out",
+       (dir / "gps").string()});
+  auto local_of = [](double t) { return 1000.25 + t * (1.0 + 50e-6); };  // t: GPS seconds since 2190 518400
+  auto imu = ultratrack::ins::read_imu_csv(dir / "sim/imu.csv");
+  for (auto& r : imu) r.t_s = local_of(r.t_s);
+  ultratrack::ins::write_imu_csv(dir / "imu_local.csv", imu);
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> jitter(0.0, 1e-6);
+  std::string pps = "local_s,gps_week,gps_tow_s\n";
+  for (int k = 0; k <= 121; ++k)
+    if (k != 60) pps += fmt::format("{:.7f},2190,{}\n", local_of(k) + jitter(rng), 518400 + k);
+  std::ofstream(dir / "pps.csv") << pps;
+  const std::vector<std::string> pps_args = {"fuse", "--imu", (dir / "imu_local.csv").string(), "--imu-pps",
+                                             (dir / "pps.csv").string(), "--attitude-origin", "2190", "518400",
+                                             "--gnss", gnss, "--truth", truth, "--quiet"};
+  std::vector<std::string> args = pps_args;
+  args.insert(args.end(), {"--out", (dir / "pps").string()});
+  run(args);
+  const auto a = ultratrack::pipelines::read_fused_nav_csv(dir / "gps/nav.csv");
+  const auto b = ultratrack::pipelines::read_fused_nav_csv(dir / "pps/nav.csv");
+  ASSERT_EQ(a.size(), b.size());
+  ASSERT_GT(a.size(), 20000u);
+  constexpr double kEarthRadius_m = 6.378e6;
+  double worst_m = 0.0, worst_t_s = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto &x = a[i].nav, &y = b[i].nav;
+    worst_t_s = std::max(worst_t_s, std::abs(x.t_s - y.t_s));
+    worst_m = std::max({worst_m, kEarthRadius_m * std::abs(x.lat_rad - y.lat_rad),
+                        kEarthRadius_m * std::cos(x.lat_rad) * std::abs(x.lon_rad - y.lon_rad),
+                        std::abs(x.height_m - y.height_m)});
+  }
+  std::printf("fuse --imu-pps against GPS stamps: %zu rows, worst time difference %.3g s, position %.3g m\n", a.size(),
+              worst_t_s, worst_m);
+  EXPECT_LT(worst_t_s, 10e-6);
+  EXPECT_LT(worst_m, 1e-3);
+  EXPECT_NEAR(json_number(dir / "pps/summary.json", "horizontal_m", "rms_converged"),
+              json_number(dir / "gps/summary.json", "horizontal_m", "rms_converged"), 1e-3);
+  // A PPS record that stops half way does not cover the IMU file: one InputError naming the IMU file.
+  std::string half = "local_s,gps_week,gps_tow_s\n";
+  for (int k = 0; k <= 50; ++k) half += fmt::format("{:.7f},2190,{}\n", local_of(k), 518400 + k);
+  std::ofstream(dir / "pps_half.csv") << half;
+  args = pps_args;
+  args[4] = (dir / "pps_half.csv").string();
+  args.insert(args.end(), {"--out", (dir / "half").string()});
+  try {
+    run(args);
+    ADD_FAILURE() << "a PPS record covering half the IMU file was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("imu_local.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("beyond the PPS record"), std::string::npos) << e.what();
   }
 }
