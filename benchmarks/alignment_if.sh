@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Seed 000's alignment end to end from IF, over RUNS runs: scenarios/align_static_if.toml (the seed's 3-antenna
 # array, 3 mm carrier noise, 45 dB-Hz, HG1700AE at 100 Hz, at rest at 0/0/0 for 110 s) simulated with a new signal
 # and IMU seed per run, received by `ultratrack attitude`, aligned by `ultratrack align` (100 s from the first fixed

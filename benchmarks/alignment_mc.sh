@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Seed 000 Table 2 at filter level: the 100-run Monte Carlo of the stationary alignment (fusion/stationary_alignment,
 # pipelines/alignment_monte_carlo: HG1700AE of Table 1, INS 100 Hz, filter 1 Hz, 100 s, attitude 0/0/0, 36.37 N),
 # EKF and UKF, printed beside the seed's Table 2. The seed states carrier noise (3 mm) and the array, not the GPS

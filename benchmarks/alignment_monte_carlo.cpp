@@ -1,15 +1,17 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Seed 000 Table 2 at filter level: the 100-run Monte Carlo of the stationary alignment (HG1700AE of Table 1, INS
 // 100 Hz, filter 1 Hz, 100 s, initial attitude 0/0/0 at 36.37 N), printed beside the seed's figures.
 //   alignment_monte_carlo [--runs N] [--filter ekf|ukf] [--gps-sigma-deg ROLL PITCH YAW]
 // The GPS attitude noise defaults to what our attitude receiver measures at the seed's array with 3 mm of carrier
 // noise (docs/validation.md, issue 8: 0.255 / 0.263 / 0.087 deg, 10 satellites).
+#include "pipelines/alignment_monte_carlo.hpp"
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
 
 #include "io/units.hpp"
-#include "pipelines/alignment_monte_carlo.hpp"
 
 using namespace ultratrack;
 
@@ -40,7 +42,9 @@ int main(int argc, char** argv) {
   const double d = io::kRadPerDeg;
   std::printf("Seed 000 Table 2 (after 100 s), %d runs, %s, GPS attitude noise %.3f / %.3f / %.3f deg\n", r.runs,
               filter.c_str(), gps_deg.x(), gps_deg.y(), gps_deg.z());
-  std::printf("| axis | seed mean | seed 1-sigma | our mean | our std | our RMS | filter 1-sigma | std vs seed | > 3 sigma |\n");
+  std::printf(
+      "| axis | seed mean | seed 1-sigma | our mean | our std | our RMS | filter 1-sigma | std vs seed | > 3 sigma "
+      "|\n");
   std::printf("|---|---|---|---|---|---|---|---|---|\n");
   const char* names[3] = {"roll", "pitch", "yaw"};
   const double seed_mean[3] = {0.0006, 0.0006, 0.0001}, seed_sigma[3] = {0.045, 0.040, 0.025};

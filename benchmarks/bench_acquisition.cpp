@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Acquisition time per PRN at 4 MHz: 1 ms and 10 ms coherent (one block, +-5 kHz, default step), for a
 // single-PRN search and per PRN of a 32-PRN search (signal spectra shared between PRNs); and the receiver's
 // default search (4 ms x 5 non-coherent) per PRN of an 8-PRN blind re-acquisition at 2.6 and 16 MHz.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Correlator engine throughput: carrier wipe-off plus 1, 3 or 5 code correlators over 1 ms blocks at 4 MHz,
 // for 1 and 3 antennas against one replica. Reports samples/s per antenna stream (items) and per call. Also the
 // receiver's own layout (early, prompt, late and the noise tap) over a 1 ms block at 2.6 MHz.

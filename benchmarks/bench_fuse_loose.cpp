@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Loose GNSS/INS integration figures (docs/validation.md), not timing: `ultratrack fuse`'s engine in process
 // on simulated data. (1) Position RMS against the simulator's truth versus the GNSS-only RMS on the seed 001
 // trajectories and the land profile, HG1700AE at 100 Hz, 1 Hz fixes (white 1.5/1.5/3 m, 0.05 m/s).
@@ -10,18 +11,17 @@
 #include <string>
 #include <vector>
 
-#include "io/units.hpp"
-#include "pipelines/fuse.hpp"
-#include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "io/units.hpp"
+#include "pipelines/fuse.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 
 using namespace ultratrack;
 
 namespace {
-
 
 struct Scenario {
   std::vector<ins::NavState> truth;
@@ -52,8 +52,8 @@ std::vector<ins::ImuIncrement> corrupt(const Scenario& s, const std::string& pre
 }
 
 pipelines::FuseResult run_once(const Scenario& s, const ins::TruthInterpolator& truth, const std::string& preset,
-                           std::uint64_t seed, fusion::FilterKind filter, std::vector<std::pair<double, double>> outages,
-                           double gnss_rate_hz) {
+                               std::uint64_t seed, fusion::FilterKind filter,
+                               std::vector<std::pair<double, double>> outages, double gnss_rate_hz) {
   ultratrack::pipelines::GnssFixSimulationOptions g;
   g.rate_hz = gnss_rate_hz;
   g.first_time_s = 0.0;
@@ -65,7 +65,8 @@ pipelines::FuseResult run_once(const Scenario& s, const ins::TruthInterpolator& 
   settings.config.imu_preset = preset;
   settings.config.velocity_sigma_mps = 0.05;
   settings.outages = std::move(outages);
-  return pipelines::fuse(corrupt(s, preset, seed), fixes, ultratrack::pipelines::truth_samples_from_nav(s.truth), settings);
+  return pipelines::fuse(corrupt(s, preset, seed), fixes, ultratrack::pipelines::truth_samples_from_nav(s.truth),
+                         settings);
 }
 
 void BM_LooseRms(benchmark::State& state, std::string profile, fusion::FilterKind filter) {
@@ -93,7 +94,9 @@ void BM_LooseRms(benchmark::State& state, std::string profile, fusion::FilterKin
 
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_LooseRms, straight_ekf, "straight", fusion::FilterKind::Ekf)->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_LooseRms, straight_ekf, "straight", fusion::FilterKind::Ekf)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_LooseRms, circle_ekf, "circle", fusion::FilterKind::Ekf)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_LooseRms, s_ekf, "s", fusion::FilterKind::Ekf)->Iterations(1)->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_LooseRms, spiral_ekf, "spiral", fusion::FilterKind::Ekf)->Iterations(1)->Unit(benchmark::kSecond);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LNAV costs: the data symbol lookup the IF synthesiser makes per sample block, and subframe decoding.
 #include <benchmark/benchmark.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Strapdown mechanisation speed: steps per second (one step = one IMU interval: attitude, velocity,
 // position update with earth model and normal gravity), plus the trajectory/IMU simulator and error model.
 #include <benchmark/benchmark.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IF synthesiser speed: 8 (and 0, 12) satellites at 4 MHz complex, quantised to i8 and written to a file, on one core.
 // The counter realtime_factor is seconds of signal per second of wall time (> 1: faster than real time).
 #include <benchmark/benchmark.h>

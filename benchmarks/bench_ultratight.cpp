@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ultra-tight filter cost per integration period: replica prediction + I&Q updates of 8 satellites (EKF, UKF),
 // the vehicle at rest, taps at their expected values at 45 dB-Hz (the cost does not depend on the values).
 #include <benchmark/benchmark.h>

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Side by side on the same file: GNSS-SDR (Debian package gnss-sdr, run by benchmarks/peers/gnss_sdr_run.sh,
 # whose header documents its configuration: File_Signal_Source, pass-through conditioner, PCPS acquisition
 # +-5 kHz / 250 Hz / pfa 0.01, DLL/PLL 2 Hz / 25 Hz with 0.5 chip spacing, Hybrid observables, RTKLIB single

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Realtime factor of two builds on the same files, interleaved (A, B, A, B, ...) so that the load of a shared
 # machine falls on both alike; prints per job the median signal-seconds / wall-seconds of each build (summary.json's
 # realtime_factor) and their ratio B / A.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Dynamics and blockage test bed (issue 7): runs the receiver on scenarios/ultratight_*.toml (one trajectory
 # drives the IF samples, the IMU data and the truth) at several C/N0 levels and tabulates, per scenario and level:
 #   sats        satellites in the file (satellites.csv)

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # 60 s GNSS outage Monte Carlo through the command line (imusim -> gnsssim -> fuse --outage): land profile
 # 265 s at 100 Hz, 5 Hz fixes (1.5/1.5/3 m, 0.02 m/s velocity), outage from 200.37 s; horizontal error at the
 # outage end, RMS over RUNS runs per preset. The filter-level Monte Carlo (1 Hz, 0.05 m/s) is

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Fusion on a datasheet MEMS unit (issue: fusion on a user's own IMU): the ADIS16405-class drive of
 # scenarios/mems_drive_adis16405.toml over several IMU seeds, 5 Hz fixes at non-integer times from `gnsssim`, `fuse`
 # told only the datasheet values (scenarios/mems_datasheet_fuse.toml) with in-motion alignment, and the errors after

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Data wipe-off with real-world bits against the oracle (issue 27): the same weak-signal files through
 # `receive --coupling ultra-tight` with the default `--nav-bits decoded` and with `--nav-bits oracle`, by
 # benchmarks/tracking_threshold.sh's step protocol (all satellites at 45 dB-Hz for STRONG_S, then a C/N0 step to

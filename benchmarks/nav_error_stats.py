@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Errors of a navigation solution (nav.csv of `fuse`/`ins`/`receive --imu`) against a truth.csv, from a given time on.
 
 Prints one JSON object: horizontal, height, 3-D position RMS (m), roll/pitch/yaw RMS (deg), the fraction of rows with

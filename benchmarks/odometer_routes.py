@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Writes the two land routes of the odometer benchmark (seed 004) as ins/trajectory.hpp segment files:
 scenarios/odometer_loop_segments.csv     a ~12.5 km ordinary-road loop (turns at intersections, roundabouts,
                                          lane changes, long gentle curves of 0.5-2.5 deg/s, slopes, stops)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Seed 004's tables in shape, from simulation (docs/validation.md, "Odometer aiding"):
 #   Table 1: the 12.7 km ordinary-road loop (scenarios/odometer_loop.toml), navigation-grade IMU, GNSS for the
 #            static alignment and the first 170 s only, then odometer aiding: yaw-rate thresholds 1.0 to 2.0 deg/s

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Odometer (VMS) aiding through a tunnel from IF samples (issue 19 "from IF", docs/validation.md "Odometer (VMS)
 # aiding on land"): simulates scenarios/odometer_tunnel.toml (a car at 20 m/s, HG1700AE, a 10 Hz odometer with
 # scale factor, delay and mounting errors, every satellite blocked from 30 s to 90 s) and runs

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Output identity across a refactor: runs a fixed set of jobs with one build and prints one SHA-256 line per
 # output file, so that two builds (before and after a move of code) can be compared with `diff`.
 #

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Whole-receiver throughput: synthesises a standard set of IF files once (cached in a scratch folder), runs
 # `ultratrack receive` on each several times and prints, per file, the median realtime factor (summary.json:
 # signal seconds / wall seconds), the median CPU realtime factor (signal seconds / CPU seconds of all threads,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Snapshot (coarse-time) positioning Monte Carlo (issue 18): synthesises short snapshots with `ultratrack simulate`
 # and solves each with `ultratrack snapshot` WITHOUT an approximate position, from an approximate time that is
 # off by a uniform random error within +-TIME_ERROR s. Case classes: C/N0 45 and 35 dB-Hz x static and an aircraft

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Soak run (issue 21): a long static simulation streamed straight into the receiver (no file: an hour at 2.6 MHz
 // would be 19 GB), reporting the process's resident memory and the fixes' errors as the hours go by, so that a
 // leak, an unbounded buffer or a drift of the time tags shows. The built-in nominal constellation, 45 dB-Hz, hot
@@ -6,7 +7,6 @@
 // Prints one line per report: signal time, VmRSS and VmHWM (kB, /proc/self/status), fixes so far, the 3-D error of
 // the fixes in the last interval (RMS, max) and their time tag minus the true GPS time of their sample (max |.|).
 #include <GeographicLib/Geocentric.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -63,9 +63,12 @@ struct Streaming final : sim::SimulationSink {
     next += static_cast<std::int64_t>(block.size());
     const double t = static_cast<double>(next) / fs;
     if (t + 1e-9 >= next_report_s) {
-      const double rms = fixes->interval_fixes ? std::sqrt(fixes->sum2 / static_cast<double>(fixes->interval_fixes)) : NAN;
-      std::printf("%7.0f s  VmRSS %7ld kB  VmHWM %7ld kB  fixes %6ld  3-D error RMS %.2f m max %.2f m  |time tag - truth| max %.1f ns\n",
-                  t, status_kb("VmRSS:"), status_kb("VmHWM:"), fixes->fixes, rms, fixes->max_m, fixes->max_tag_s * 1e9);
+      const double rms =
+          fixes->interval_fixes ? std::sqrt(fixes->sum2 / static_cast<double>(fixes->interval_fixes)) : NAN;
+      std::printf(
+          "%7.0f s  VmRSS %7ld kB  VmHWM %7ld kB  fixes %6ld  3-D error RMS %.2f m max %.2f m  |time tag - truth| max "
+          "%.1f ns\n",
+          t, status_kb("VmRSS:"), status_kb("VmHWM:"), fixes->fixes, rms, fixes->max_m, fixes->max_tag_s * 1e9);
       std::fflush(stdout);
       fixes->sum2 = fixes->max_m = fixes->max_tag_s = 0.0;
       fixes->interval_fixes = 0;

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Tracking threshold: the C/N0 at which 90 % of 60 s tracking runs keep lock (issue 3). For every C/N0 level it
 # synthesises FILES static files (`ultratrack simulate`, brdc0010.22n, different seeds and start times, every
 # satellite above the horizon at that C/N0: each satellite of each file is one run), receives them hot

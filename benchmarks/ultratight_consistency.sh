@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Receiver-level consistency of the ultra-tight filter (issue 7): the whole receiver on synthesised IF, N seeds.
 # Scenario: the car of the ReceiveUltraTight tests, a level circle of radius 100 m at 30 km/h
 # (scenarios/circle_100m_30kmh_segments.csv), 2 MHz i8, C/N0 --cn0 (45 dB-Hz), HG1700AE IMU at 100 Hz,

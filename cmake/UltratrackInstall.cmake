@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # `cmake --install`: every layer library registered by ultratrack_layer() (global property ULTRATRACK_LAYERS)
 # with its headers as include/ultratrack/<layer>/*.hpp, exported as the package Ultratrack: find_package(Ultratrack)
 # gives Ultratrack::io, Ultratrack::signals, ... (one target per layer, linking the layers it needs), and finds the

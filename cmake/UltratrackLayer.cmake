@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # ultratrack_layer(NAME DEPS...) builds the static library ultratrack_<NAME> from every .cpp in the
 # layer's folder. Headers are included as "<layer>/<file>.hpp". Each layer gets a private include root
 # in the build tree that holds only a link to its own folder, so a layer can include exactly the layers

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "config/antenna_config_toml.hpp"
 
 #include <fmt/core.h>
@@ -7,8 +8,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "signals/input_error.hpp"
 #include "io/why_invalid.hpp"
+#include "signals/input_error.hpp"
 
 namespace ultratrack::config {
 namespace {

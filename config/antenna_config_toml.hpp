@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The antenna file of `ultratrack attitude` (--antennas A.toml): the array's geometry in the scenario's
 // convention, and optional solver settings. Parsed strictly (unknown keys and wrong types are InputErrors
 // naming the file, the line and the key).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "config/campaign_toml.hpp"
 
 #include <fmt/core.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Campaign files (`ultratrack campaign run C.toml`): runs, what each does and computes, the report, Slurm resources.
 // The runs are a product of parameter axes; each simulates a scenario template (or takes a recording) and
 // receives in process. Read strictly: every key known and of the right type, or

@@ -1,11 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "config/fuse_config_toml.hpp"
+
+#include <toml++/toml.h>
 
 #include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
-#include <toml++/toml.h>
 
 #include "ins/imu_datasheet.hpp"
 #include "io/input_error.hpp"
@@ -68,7 +70,8 @@ using Table = std::map<std::string, std::function<void(const Value&, FuseConfig&
 
 // [imu]: the preset and the datasheet keys of ins/imu_datasheet.hpp (the scenario's names).
 Table imu_table() {
-  Table t{{"preset", [](const Value& v, FuseConfig& c) {
+  Table t{{"preset",
+           [](const Value& v, FuseConfig& c) {
              c.imu_preset = v.text();
              const auto& names = ins::imu_preset_names();
              if (std::find(names.begin(), names.end(), c.imu_preset) == names.end())
@@ -223,8 +226,11 @@ FuseConfig read_fuse_config(const std::filesystem::path& path) {
     const auto known = sections().find(section);
     const auto* table = section_node.as_table();
     if (known == sections().end() || !table)
-      throw io::InputError(file, "unknown section '" + section + "' (imu, initial, alignment, gnss, vehicle, odometer, clock, height_aiding, filter, output, attitude)",
-                           static_cast<int>(section_node.source().begin.line));
+      throw io::InputError(
+          file,
+          "unknown section '" + section +
+              "' (imu, initial, alignment, gnss, vehicle, odometer, clock, height_aiding, filter, output, attitude)",
+          static_cast<int>(section_node.source().begin.line));
     for (const auto& [key_name, node] : *table) {
       const std::string key = section + "." + std::string(key_name.str());
       const auto setter = known->second.find(std::string(key_name.str()));

@@ -1,12 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The `fuse` command's TOML configuration (--config). Sections and keys (all optional):
-//   [imu]        preset = "hg1700ae" (the filter's noise model: fusion::error_model_from_preset; ins/imu_error_model.hpp
+//   [imu]        preset = "hg1700ae" (the filter's noise model: fusion::error_model_from_preset;
+//   ins/imu_error_model.hpp
 //                names the presets) and datasheet values over it, each optional, the scenario's names
 //                (ins/imu_datasheet.hpp): gyro_bias_dph, accel_bias_mg, gyro_bias_instability_dph,
 //                accel_bias_instability_mg, bias_correlation_time_s, gyro_arw_dpsh, accel_vrw_mpspsh,
 //                gyro_scale_factor_ppm, accel_scale_factor_ppm; max_gap_s = 1 (a longer gap between IMU rows is
 //                an input error)
 //   [initial]    attitude_deg = [roll, pitch, yaw] (needed by --align config), position_deg_m = [lat, lon, h]
-//                (else the first GNSS fix), velocity_ned_mps = [n, e, d] (else the GNSS velocity), sigma_position_m, sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
+//                (else the first GNSS fix), velocity_ned_mps = [n, e, d] (else the GNSS velocity), sigma_position_m,
+//                sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
 //   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2
 //   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z], update_interval_s = 0
 //                (fixes closer than this to the last one used are skipped: a decorrelating interval for fixes whose

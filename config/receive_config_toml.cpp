@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "config/receive_config_toml.hpp"
+
+#include <toml++/toml.h>
 
 #include <functional>
 #include <map>
 #include <string>
-#include <toml++/toml.h>
 
 #include "io/units.hpp"
 #include "signals/input_error.hpp"
@@ -11,7 +13,6 @@
 
 namespace ultratrack::config {
 namespace {
-
 
 struct Setter {
   std::string file, key;
@@ -27,7 +28,8 @@ struct Setter {
   }
   bool boolean() const {
     if (auto v = node.value<bool>()) return *v;
-    throw signals::InputError(file, "key '" + key + "' must be true or false", static_cast<int>(node.source().begin.line));
+    throw signals::InputError(file, "key '" + key + "' must be true or false",
+                              static_cast<int>(node.source().begin.line));
   }
 };
 

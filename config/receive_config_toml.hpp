@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The `receive` command's TOML configuration (--config): sections [receiver], [acquisition], [tracking] and
 // [pvt] set ReceiverOptions fields by their names (angles in degrees with _deg, booleans for on/off switches).
 // Unknown sections or keys and wrong value types are InputErrors naming the file and the key.

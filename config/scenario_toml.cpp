@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "config/scenario_toml.hpp"
 
 #include <fmt/core.h>
@@ -95,7 +96,8 @@ const toml::array& tables_of(const Reader& r, const toml::node& section_node, co
 
 // [[antenna]]: lever arm (required) and impairments of each antenna.
 void read_antennas(const Reader& r, const toml::node& section_node, Scenario& s) {
-  const auto& arr = tables_of(r, section_node, "antenna", "expected [[antenna]] tables with lever_arm_body_m = [x, y, z]");
+  const auto& arr =
+      tables_of(r, section_node, "antenna", "expected [[antenna]] tables with lever_arm_body_m = [x, y, z]");
   s.lever_arms_body_m.clear();
   s.antenna_impairments.clear();
   for (const auto& e : arr) {
@@ -118,7 +120,8 @@ void read_antennas(const Reader& r, const toml::node& section_node, Scenario& s)
     s.antenna_impairments.push_back(imp);
     if (!lever) r.fail(e, "antenna.lever_arm_body_m", "missing in an [[antenna]] table");
     const auto l = r.triple(*lever, "antenna.lever_arm_body_m");
-    r.check(*lever, "antenna.lever_arm_body_m", std::abs(l[0]) <= 1000 && std::abs(l[1]) <= 1000 && std::abs(l[2]) <= 1000,
+    r.check(*lever, "antenna.lever_arm_body_m",
+            std::abs(l[0]) <= 1000 && std::abs(l[1]) <= 1000 && std::abs(l[2]) <= 1000,
             "each component must be within +-1000 m");
     s.lever_arms_body_m.push_back(l);
   }
@@ -384,9 +387,10 @@ bool read_receiver_position_key(const Reader& r, const std::string& key, const s
     given.offsets = true;
   } else if (key == "attitude_deg") {
     s.attitude_deg = r.triple(n, name);
-    r.check(n, name,
-            std::abs(s.attitude_deg[0]) <= 180 && std::abs(s.attitude_deg[1]) <= 80 && std::abs(s.attitude_deg[2]) <= 360,
-            "roll must be within +-180 deg, pitch +-80 deg, yaw +-360 deg");
+    r.check(
+        n, name,
+        std::abs(s.attitude_deg[0]) <= 180 && std::abs(s.attitude_deg[1]) <= 80 && std::abs(s.attitude_deg[2]) <= 360,
+        "roll must be within +-180 deg, pitch +-80 deg, yaw +-360 deg");
     given.attitude = true;
   } else {
     return false;
@@ -497,7 +501,8 @@ void read_trajectory_key(const Reader& r, const std::string& key, const std::str
     s.odometer_delay_s = r.number(n, name);
     r.check(n, name, s.odometer_delay_s >= 0 && s.odometer_delay_s <= 1, "must be within 0..1 s");
   } else if (key == "odometer_misalignment_pitch_deg" || key == "odometer_misalignment_yaw_deg") {
-    double& m = key == "odometer_misalignment_pitch_deg" ? s.odometer_misalignment_pitch_deg : s.odometer_misalignment_yaw_deg;
+    double& m =
+        key == "odometer_misalignment_pitch_deg" ? s.odometer_misalignment_pitch_deg : s.odometer_misalignment_yaw_deg;
     m = r.number(n, name);
     r.check(n, name, std::abs(m) <= 10, "must be within +-10 deg");
   } else {
@@ -598,12 +603,14 @@ void check_given_keys(const std::string& file, const GivenKeys& given, const Sce
   }
   if (!s.trajectory_enabled()) fail("[trajectory] needs profile = \"NAME\" or file = \"segments.csv\"");
   if (!s.trajectory_profile.empty() && !given.duration) fail("key trajectory.duration_s: missing (profiles)");
-  if (!s.trajectory_file.empty() && given.duration) fail("key trajectory.duration_s: a segment file sets its own duration");
+  if (!s.trajectory_file.empty() && given.duration)
+    fail("key trajectory.duration_s: a segment file sets its own duration");
   if (s.trajectory_file.empty() && given.start_state)
     fail("keys trajectory.speed_mps / heading_deg / coordinated_turns / ramp_s: only with a segment file");
   if (!s.trajectory.empty()) fail("key receiver.trajectory: not with a [trajectory] section");
   if (given.offsets) fail("key receiver.antenna_offsets_enu_m: with [trajectory] use [[antenna]] lever_arm_body_m");
-  if (std::abs(s.llh_deg_m[0]) >= 89.0) fail("key receiver.llh_deg_m: latitude must be within +-89 deg with [trajectory]");
+  if (std::abs(s.llh_deg_m[0]) >= 89.0)
+    fail("key receiver.llh_deg_m: latitude must be within +-89 deg with [trajectory]");
   if (given.attitude && s.trajectory_profile != "static")
     fail("key receiver.attitude_deg: needs [trajectory] profile = \"static\"");
 }
@@ -622,7 +629,8 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
   Scenario s;
   s.source = source;
   GivenKeys given;
-  for (auto&& [section_key, section_node] : root) read_section(r, std::string(section_key.str()), section_node, s, given);
+  for (auto&& [section_key, section_node] : root)
+    read_section(r, std::string(section_key.str()), section_node, s, given);
   if (given.rinex) s.constellation.clear();
   check_given_keys(file, given, s);
   s.signal = given.signal || !given.trajectory;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scenario files: sim::Scenario as TOML, parsed strictly with toml++: every key known and of the right type, or
 // an io::InputError naming the file, the line and the key. Units as in the key names; relative paths resolve
 // against the scenario's folder (sim::resolve_path).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The writing half of config/scenario_toml.hpp: a sim::Scenario as TOML with every key written (defaults filled in,
 // paths absolute, floats in their shortest round-trip form), so that reading it back gives the same scenario.
 #include <fmt/core.h>
@@ -115,7 +116,8 @@ std::string inertial_toml(const Scenario& s) {
   out += fmt::format("imu_rate_hz = {}\nodometer = {}\nodometer_scale_factor_error = {}\n", toml_float(s.imu_rate_hz),
                      s.odometer, toml_float(s.odometer_scale_factor_error));
   // Written only when set, so that the echo of a scenario without them stays as it was.
-  if (s.sideslip_deg_per_mps2 != 0.0) out += fmt::format("sideslip_deg_per_mps2 = {}\n", toml_float(s.sideslip_deg_per_mps2));
+  if (s.sideslip_deg_per_mps2 != 0.0)
+    out += fmt::format("sideslip_deg_per_mps2 = {}\n", toml_float(s.sideslip_deg_per_mps2));
   if (s.odometer_delay_s != 0.0) out += fmt::format("odometer_delay_s = {}\n", toml_float(s.odometer_delay_s));
   if (s.odometer_misalignment_pitch_deg != 0.0 || s.odometer_misalignment_yaw_deg != 0.0)
     out += fmt::format("odometer_misalignment_pitch_deg = {}\nodometer_misalignment_yaw_deg = {}\n",
@@ -123,7 +125,8 @@ std::string inertial_toml(const Scenario& s) {
   out += fmt::format("\n[imu]\npreset = {}\nseed = {}\n", toml_string(s.imu_preset), s.imu_seed);
   if (s.imu_time_offset_s != 0.0) out += fmt::format("time_offset_s = {}\n", toml_float(s.imu_time_offset_s));
   for (const auto& key : ins::imu_datasheet_keys())
-    if (const auto& value = s.imu_datasheet.*(key.member)) out += fmt::format("{} = {}\n", key.name, toml_float(*value));
+    if (const auto& value = s.imu_datasheet.*(key.member))
+      out += fmt::format("{} = {}\n", key.name, toml_float(*value));
   for (std::size_t i = 0; i < s.lever_arms_body_m.size(); ++i) {
     const auto& l = s.lever_arms_body_m[i];
     out += fmt::format("\n[[antenna]]\nlever_arm_body_m = [{}, {}, {}]\n", toml_float(l[0]), toml_float(l[1]),
@@ -131,7 +134,8 @@ std::string inertial_toml(const Scenario& s) {
     // Written only when set, so that the echo of a scenario without them stays as it was.
     if (i < s.antenna_impairments.size() &&
         (s.antenna_impairments[i].line_bias_cycles != 0.0 || s.antenna_impairments[i].phase_noise_m != 0.0))
-      out += fmt::format("line_bias_cycles = {}\nphase_noise_m = {}\n", toml_float(s.antenna_impairments[i].line_bias_cycles),
+      out += fmt::format("line_bias_cycles = {}\nphase_noise_m = {}\n",
+                         toml_float(s.antenna_impairments[i].line_bias_cycles),
                          toml_float(s.antenna_impairments[i].phase_noise_m));
   }
   return out;
@@ -146,8 +150,8 @@ std::string events_toml(const Scenario& s) {
     out += fmt::format("\n[[odometer_slip]]\nstart_s = {}\nduration_s = {}\nratio = {}\n", toml_float(o.start_s),
                        toml_float(o.duration_s), toml_float(o.ratio));
   for (const auto& b : s.blockages)
-    out += fmt::format("\n[[blockage]]\nantenna = {}\nstart_s = {}\nduration_s = {}\n", b.antenna, toml_float(b.start_s),
-                       toml_float(b.duration_s));
+    out += fmt::format("\n[[blockage]]\nantenna = {}\nstart_s = {}\nduration_s = {}\n", b.antenna,
+                       toml_float(b.start_s), toml_float(b.duration_s));
   for (const auto& c : s.cn0_steps) {
     out += fmt::format("\n[[cn0_step]]\nantenna = {}\nstart_s = {}\ncn0_dbhz = {}\n", c.antenna, toml_float(c.start_s),
                        toml_float(c.cn0_dbhz));

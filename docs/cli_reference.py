@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """docs/cli.md from the program itself: `ultratrack --help` and every subcommand's `--help` (and its own
 subcommands'), so the flag reference cannot drift from the code. Run from anywhere:
 

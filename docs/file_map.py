@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The file tables of docs/architecture.md, read from the code: one row per module (a .hpp with its .cpp, or a
 lone .cpp), its job the first sentence of the module's opening comment. Run from the repository root:
 
@@ -20,6 +21,8 @@ def opening_comment(path):
     with open(path, encoding="utf-8") as f:
         for line in f:
             s = line.strip()
+            if s.startswith("//") and "SPDX-License-Identifier" in s:
+                continue  # the licence tag, not the module's description
             if s.startswith("//"):
                 lines.append(s[2:].strip())
             elif lines or (s and not s.startswith("#")):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Observability of the stationary alignment (seed 000 eqs. 18-20): the rank of O = [H; H A; ...; H A^11] of the
 // 12-state model at rest (fusion/stationary_alignment_model.hpp) for a given attitude, and its weakest direction.
 // H_G's rows are scaled by cos(pitch) (roll and yaw rows), which changes no rank away from pitch +-90 deg and has
@@ -13,8 +14,8 @@
 namespace ultratrack::fusion {
 
 struct ObservabilityOptions {
-  bool zero_velocity = true;   // the velocity rows of H
-  bool gps_attitude = true;    // the H_G rows
+  bool zero_velocity = true;  // the velocity rows of H
+  bool gps_attitude = true;   // the H_G rows
   double rank_tolerance = 1e-9;
 };
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GPS attitude (multi-antenna receiver, seed 003; seed 000 eqs. 10-17) as a measurement of the INS
 // psi-angle attitude error. The receiver gives roll/pitch/yaw of its antenna-array frame a; the known
 // misalignment q_ba (array -> IMU body) turns it into a measured C_nb = C_na C_ab.
@@ -27,12 +28,12 @@ namespace ultratrack::fusion {
 // One GPS attitude at its time of validity on the run's time line.
 struct GnssAttitude {
   double t_s = 0.0;
-  ins::EulerAngles euler_a;                                          // array frame a relative to NED
+  ins::EulerAngles euler_a;                                           // array frame a relative to NED
   Eigen::Vector3d sigma_euler_rad = Eigen::Vector3d::Constant(1e-3);  // 1-sigma roll, pitch, yaw
 };
 
 struct AttitudeAidingOptions {
-  Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();  // antenna array -> IMU body (known mounting)
+  Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();    // antenna array -> IMU body (known mounting)
   double max_abs_pitch_rad = 80.0 * std::numbers::pi / 180.0;  // beyond: refused (Euler sigmas degenerate)
 };
 

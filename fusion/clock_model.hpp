@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Receiver clock process noise from the oscillator's power-law (Allan variance) coefficients, two-state model
 // bias' = drift + w_b, drift' = w_d (Brown & Hwang, Introduction to Random Signals and Applied Kalman
 // Filtering, the "two-state clock model"): S_b = c^2 h0 / 2 (white frequency noise), S_d = c^2 2 pi^2 h-2
@@ -16,8 +17,8 @@ namespace ultratrack::fusion {
 
 // The oscillator and its presets are the signal layer's (signals/oscillator_allan.hpp): the simulator's clock
 // and the filters' clock model come from the same coefficients.
-using signals::OscillatorAllan;
 using signals::oscillator_preset;
+using signals::OscillatorAllan;
 
 // The clock part of the error model (PSDs from h0, h-2; initial sigmas kept from `base`).
 ClockNoiseModel clock_noise_from_allan(const OscillatorAllan& allan, const ClockNoiseModel& base = {});

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/coupling.hpp"
 
 namespace ultratrack::fusion {
@@ -13,11 +14,16 @@ std::optional<Coupling> coupling_from_string(std::string_view text) {
 
 std::string to_string(Coupling coupling) {
   switch (coupling) {
-    case Coupling::kScalar: return "scalar";
-    case Coupling::kVector: return "vector";
-    case Coupling::kLoose: return "loose";
-    case Coupling::kTight: return "tight";
-    case Coupling::kUltraTight: return "ultra-tight";
+    case Coupling::kScalar:
+      return "scalar";
+    case Coupling::kVector:
+      return "vector";
+    case Coupling::kLoose:
+      return "loose";
+    case Coupling::kTight:
+      return "tight";
+    case Coupling::kUltraTight:
+      return "ultra-tight";
   }
   return "?";
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // How GNSS and the tracking loops (and an INS) are coupled: the one coupling enum of the tree, used by the
 // GNSS/INS integration (loose, tight), the covariance analysis (tight, ultra-tight) and every receive pipeline
 // (pipelines/ re-exports it as pipelines::Coupling).
@@ -22,7 +23,9 @@ std::optional<Coupling> coupling_from_string(std::string_view text);
 std::string to_string(Coupling coupling);
 
 // Couplings that run an INS (need an IMU file): loose, tight, ultra-tight.
-constexpr bool uses_imu(Coupling c) { return c == Coupling::kLoose || c == Coupling::kTight || c == Coupling::kUltraTight; }
+constexpr bool uses_imu(Coupling c) {
+  return c == Coupling::kLoose || c == Coupling::kTight || c == Coupling::kUltraTight;
+}
 // Couplings whose GNSS/INS filter takes raw observations (ultra-tight pulls in with the tight filter).
 constexpr bool is_tight(Coupling c) { return c == Coupling::kTight || c == Coupling::kUltraTight; }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Covariance analysis of tightly coupled GPS/INS (seed 001 section IV.1): the 17-state INS error model
 // linearised along a simulated trajectory (seed 001 profiles: straight, circle, s, spiral), propagated by an
 // EKF or a UKF and updated once per second with the pseudoranges (optionally rates) of every satellite above
@@ -12,12 +13,11 @@
 // Units SI; NED; times in seconds from the trajectory start.
 #pragma once
 
-#include "fusion/coupling.hpp"
-
 #include <Eigen/Core>
 #include <string>
 #include <vector>
 
+#include "fusion/coupling.hpp"
 #include "fusion/gnss_ins_integration.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/iq_measurements.hpp"
@@ -34,7 +34,7 @@ enum class IqForm {
 
 struct CovarianceAnalysisOptions {
   Coupling coupling = Coupling::kTight;  // kTight or kUltraTight
-  std::string trajectory = "straight";  // ins::profile_spec names: straight, circle, s, spiral (also land)
+  std::string trajectory = "straight";   // ins::profile_spec names: straight, circle, s, spiral (also land)
   FilterKind filter = FilterKind::Ekf;
   double duration_s = 150.0;
   double propagation_interval_s = 0.1;  // linearisation along the truth at this spacing
@@ -42,13 +42,13 @@ struct CovarianceAnalysisOptions {
   double lat_rad = 36.37 * 3.14159265358979323846 / 180.0;
   double lon_rad = 127.36 * 3.14159265358979323846 / 180.0;
   double height_m = 1000.0;
-  signals::GpsTime start{2190, 525600.0};                // 2022-01-01 02:00 GPST (inside brdc0010.22n)
-  std::vector<signals::Ephemeris> ephemerides;           // empty: the nominal 24-slot constellation
+  signals::GpsTime start{2190, 525600.0};       // 2022-01-01 02:00 GPST (inside brdc0010.22n)
+  std::vector<signals::Ephemeris> ephemerides;  // empty: the nominal 24-slot constellation
   double elevation_mask_rad = 10.0 * 3.14159265358979323846 / 180.0;
-  double sigma_range_m = 5.0;     // eq. 38 R^N
-  bool use_range_rate = false;    // eq. 38 gives only pseudorange noise
+  double sigma_range_m = 5.0;   // eq. 38 R^N
+  bool use_range_rate = false;  // eq. 38 gives only pseudorange noise
   double sigma_rate_mps = 0.1;
-  InsErrorModelOptions model;     // eq. 38 R^V and the bias part of P0 (seed001_eq38_model())
+  InsErrorModelOptions model;  // eq. 38 R^V and the bias part of P0 (seed001_eq38_model())
   Eigen::Vector3d sigma_pos_ned_m{5.0, 5.0, 3.1622776601683795};  // eq. 38 P0: (5 m)^2, (5 m)^2, 10 m^2
   Eigen::Vector3d sigma_vel_n_mps{2.0, 2.0, 2.0};
   Eigen::Vector3d sigma_att_rad{0.03 * 3.14159265358979323846 / 180.0, 0.03 * 3.14159265358979323846 / 180.0,
@@ -56,8 +56,8 @@ struct CovarianceAnalysisOptions {
   UkfParameters ukf;
   // Ultra-tight only (update_interval_s should then be iq.integration_time_s: one update per integration).
   IqForm iq_form = IqForm::Iq;
-  IqSettings iq;                          // C/N0, T, tap offset; the noise is N(0, 1) per I or Q (eq. 16)
-  bool discriminator_squaring_loss = true;  // discriminator_noise's bracket; false: the first-order variances
+  IqSettings iq;                             // C/N0, T, tap offset; the noise is N(0, 1) per I or Q (eq. 16)
+  bool discriminator_squaring_loss = true;   // discriminator_noise's bracket; false: the first-order variances
   double discriminator_sigma_range_m = 0.0;  // > 0 overrides the closed form (for equivalence checks)
   double discriminator_sigma_rate_mps = 0.0;
   bool discriminator_use_rate = true;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Numerically safe covariance handling shared by the filters: symmetrisation, a positive-semidefinite
 // repair (eigenvalues clamped at zero) and a Cholesky square root that falls back to the repaired
 // matrix (with a relative jitter) when the plain factorisation fails.

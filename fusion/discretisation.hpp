@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Discrete transition matrix Phi and process noise Qd over dt from a continuous linear(ised) model
 // xdot = F x + G w, E[w w'] = Qc delta(t). Van Loan (exact for constant F over dt, via the matrix exponential
 // of [[-F, G Qc G'], [0, F']] dt) or the second-order series (Phi = I + F dt + F^2 dt^2 / 2,

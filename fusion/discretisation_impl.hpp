@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Template implementation of discretisation.hpp (included from it).
 #pragma once
 

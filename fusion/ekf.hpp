@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Extended (error-state) Kalman filter on a fixed-size state: prediction through the model's f with the
 // covariance propagated by the discretised continuous model (discretisation.hpp), measurement update in
 // Joseph form P = (I - K H) P (I - K H)' + K R K' (stays symmetric PSD under rounding and suboptimal gains),
@@ -8,11 +9,11 @@
 #include <Eigen/Core>
 #include <limits>
 
-#include "receiver/chi_square.hpp"
 #include "fusion/covariance_utils.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"
 #include "fusion/innovation_gate.hpp"
+#include "receiver/chi_square.hpp"
 
 namespace ultratrack::fusion {
 
@@ -32,7 +33,7 @@ class Ekf {
 
   // x <- f(x, dt); P <- Phi P Phi' + Qd with Phi, Qd from F, G, Qc evaluated at the prior x. dt >= 0.
   template <class M>
-    requires ProcessModel<M, N>
+  requires ProcessModel<M, N>
   void predict(const M& model, double dt) {
     const Matrix F = model.F(x_);
     const Eigen::Matrix<double, N, M::kNoiseSize> G = model.G(x_);
@@ -47,8 +48,7 @@ class Ekf {
   // Linearised update at the current estimate. Rejected (state unchanged) if the gate refuses it or the
   // innovation covariance is not positive definite.
   template <class M>
-    requires MeasurementModel<M, N>
-  UpdateResult update(const M& model) {
+  requires MeasurementModel<M, N> UpdateResult update(const M& model) {
     UpdateResult r;
     const Eigen::VectorXd z = model.z();
     const MeasurementJacobian<N> H = model.H(x_);

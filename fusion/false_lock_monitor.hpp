@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A tracking channel's carrier against a navigation filter's prediction: the mean, in Hz, of (the channel's carrier
 // frequency - the predicted Doppler) over an averaging time. A weak channel whose PLL sits on a false lock (25 Hz
 // off: half a cycle per 20 ms epoch) or runs away from its signal shows it as a mean far from zero; a locked one

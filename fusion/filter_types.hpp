@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared vocabulary of the generic filters (ekf.hpp, ukf.hpp): fixed-size state vectors and covariances,
 // the process and measurement model concepts both filters accept, innovation gating and update results.
 // Units are whatever the model uses; covariances are of the state's own units.
@@ -59,7 +60,7 @@ concept MeasurementModel = requires(const M& m, const StateVector<N>& x) {
 template <class M>
 inline constexpr int measurement_size_v = Eigen::Dynamic;
 template <class M>
-  requires requires { M::kMeasurementSize; }
+requires requires { M::kMeasurementSize; }
 inline constexpr int measurement_size_v<M> = M::kMeasurementSize;
 
 // Innovation chi-square gate: a measurement is rejected (no state change) when its normalised innovation
@@ -72,9 +73,9 @@ struct GateOptions {
 
 struct UpdateResult {
   bool accepted = false;
-  double nis = 0.0;        // normalised innovation squared
-  double threshold = 0.0;  // gate threshold used (infinity when gating is off)
-  int dof = 0;             // measurement size k
+  double nis = 0.0;            // normalised innovation squared
+  double threshold = 0.0;      // gate threshold used (infinity when gating is off)
+  int dof = 0;                 // measurement size k
   Eigen::VectorXd innovation;  // z - predicted (EKF: h(x); UKF: weighted mean of h at the sigma points)
 };
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // In-motion coarse alignment for a MEMS IMU (which cannot gyrocompass): heading from the GNSS track once
 // the vehicle moves (no sideslip assumed: body x along the horizontal velocity), roll and pitch from the
 // accelerometers with the GNSS-measured acceleration removed: f_n = dv_n/dt - g_n + (2 w_ie + w_en) x v_n.

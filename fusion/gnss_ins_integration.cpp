@@ -1,12 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/gnss_ins_integration.hpp"
 
 #include <cmath>
 #include <deque>
-#include <optional>
-#include <string>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <variant>
 
@@ -16,7 +17,7 @@
 namespace ultratrack::fusion {
 namespace {
 
-constexpr double kTimeEpsilon_s = 1e-9;  // measurement this close to the INS time: applied there
+constexpr double kTimeEpsilon_s = 1e-9;    // measurement this close to the INS time: applied there
 constexpr std::size_t kMaxRecords = 8192;  // update records kept when nobody takes them (oldest half dropped)
 
 struct PendingFix {
@@ -38,17 +39,17 @@ using Pending = std::variant<PendingFix, PendingEpoch, PendingAttitude, PendingO
 bool finite(const Pending& p) {
   if (const auto* f = std::get_if<PendingFix>(&p)) {
     const GnssFix& x = f->fix;
-    const bool pos_ok = !x.has_position || (std::isfinite(x.lat_rad) && std::isfinite(x.lon_rad) &&
-                                            std::isfinite(x.height_m) && (x.sigma_pos_ned_m.array() > 0.0).all() &&
-                                            x.sigma_pos_ned_m.allFinite());
+    const bool pos_ok =
+        !x.has_position || (std::isfinite(x.lat_rad) && std::isfinite(x.lon_rad) && std::isfinite(x.height_m) &&
+                            (x.sigma_pos_ned_m.array() > 0.0).all() && x.sigma_pos_ned_m.allFinite());
     const bool vel_ok = !x.has_velocity || (x.v_n_mps.allFinite() && (x.sigma_vel_n_mps.array() > 0.0).all() &&
                                             x.sigma_vel_n_mps.allFinite());
     return pos_ok && vel_ok;
   }
   if (const auto* a = std::get_if<PendingAttitude>(&p)) {
     const GnssAttitude& x = a->attitude;
-    return std::isfinite(x.euler_a.roll_rad) && std::isfinite(x.euler_a.pitch_rad) && std::isfinite(x.euler_a.yaw_rad) &&
-           x.sigma_euler_rad.allFinite() && (x.sigma_euler_rad.array() > 0.0).all();
+    return std::isfinite(x.euler_a.roll_rad) && std::isfinite(x.euler_a.pitch_rad) &&
+           std::isfinite(x.euler_a.yaw_rad) && x.sigma_euler_rad.allFinite() && (x.sigma_euler_rad.array() > 0.0).all();
   }
   if (const auto* o = std::get_if<PendingOdometer>(&p))
     return std::isfinite(o->speed.speed_mps) && std::isfinite(o->speed.window_s) && o->speed.window_s > 0.0;
@@ -76,7 +77,8 @@ void check_options(const IntegrationOptions& o) {
     throw std::invalid_argument("integration: " + why);
   if (o.odometer.enabled && o.coupling != Coupling::kLoose)
     throw std::invalid_argument("integration: odometer aiding is implemented for the loose coupling only");
-  if (o.land.nhc && (!(o.land.nhc_sigma_mps > 0.0) || !(o.land.nhc_interval_s >= 0.0) || !o.land.lever_arm_b.allFinite()))
+  if (o.land.nhc &&
+      (!(o.land.nhc_sigma_mps > 0.0) || !(o.land.nhc_interval_s >= 0.0) || !o.land.lever_arm_b.allFinite()))
     throw std::invalid_argument("integration: non-holonomic constraints need a positive sigma and interval >= 0");
   if (!o.attitude.q_ba.coeffs().allFinite() || std::abs(o.attitude.q_ba.norm() - 1.0) > 1e-6)
     throw std::invalid_argument("integration: attitude mounting q_ba must be a unit quaternion");
@@ -84,8 +86,9 @@ void check_options(const IntegrationOptions& o) {
     throw std::invalid_argument("integration: attitude pitch limit must lie in (0, 90] deg");
   const HeightAidingOptions& h = o.height_aiding;
   if (!(h.sigma0_m > 0.0) || !std::isfinite(h.sigma0_m) || !(h.terrain_sigma_m > 0.0) ||
-      !std::isfinite(h.terrain_sigma_m) || !(h.terrain_correlation_s > 0.0) || !std::isfinite(h.terrain_correlation_s) ||
-      !(h.min_interval_s >= 0.0) || (h.fixed_height_m && !std::isfinite(*h.fixed_height_m)))
+      !std::isfinite(h.terrain_sigma_m) || !(h.terrain_correlation_s > 0.0) ||
+      !std::isfinite(h.terrain_correlation_s) || !(h.min_interval_s >= 0.0) ||
+      (h.fixed_height_m && !std::isfinite(*h.fixed_height_m)))
     throw std::invalid_argument(
         "integration: height aiding needs positive sigmas and correlation time, interval >= 0, a finite height");
 }
@@ -109,9 +112,8 @@ namespace {
 // 15: loose; 17: tight (clock bias, drift); 18: tight with height aiding (+ terrain height, height_aiding.hpp);
 // 19: loose with odometer aiding (+ VMS delay, misalignment, scale factor; odometer_error_model.hpp).
 template <int N>
-using ProcessModelFor =
-    std::conditional_t<N == 18, TerrainAugmentedModel,
-                       std::conditional_t<N == 19, OdometerAugmentedModel, InsErrorModel<N>>>;
+using ProcessModelFor = std::conditional_t<N == 18, TerrainAugmentedModel,
+                                           std::conditional_t<N == 19, OdometerAugmentedModel, InsErrorModel<N>>>;
 
 // A measurement model written for 15 or 17 states, as the filter of N states takes it.
 template <int N, class M>
@@ -131,7 +133,10 @@ class Core final : public CoreBase {
 
  public:
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
-      : opt_(opt), ins_(initial, opt.strapdown), model_(make_model(opt)), filter_(std::move(filter)),
+      : opt_(opt),
+        ins_(initial, opt.strapdown),
+        model_(make_model(opt)),
+        filter_(std::move(filter)),
         monitor_(opt.recovery) {
     nominal_.nav = ins_.state();
     nominal_.accel_bias_b = opt.initial_accel_bias_b;
@@ -222,7 +227,8 @@ class Core final : public CoreBase {
     nominal_.nav = ins_.state();
     if constexpr (kClock) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
     if constexpr (N == 18)  // the nominal terrain follows the Gauss-Markov mean back to the reference
-      terrain_m_ = terrain_ref_m_ + (terrain_m_ - terrain_ref_m_) * std::exp(-dt / opt_.height_aiding.terrain_correlation_s);
+      terrain_m_ =
+          terrain_ref_m_ + (terrain_m_ - terrain_ref_m_) * std::exp(-dt / opt_.height_aiding.terrain_correlation_s);
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
     if constexpr (N == 19) record_history();
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
@@ -455,7 +461,8 @@ class Core final : public CoreBase {
       if (!gate.speed_ok) ++counters.odometer_gated_speed;
       if (!gate.update()) return;
       const double span = nominal_.nav.t_s - it->t_s;
-      const Eigen::Vector3d a_n = span > 0.0 ? Eigen::Vector3d((nominal_.nav.v_n - it->v_n) / span) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d a_n =
+          span > 0.0 ? Eigen::Vector3d((nominal_.nav.v_n - it->v_n) / span) : Eigen::Vector3d::Zero();
       const Eigen::Vector3d a_b = nominal_.nav.q_nb.conjugate() * a_n;
       ++(update(VmsMeasurement(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer), -4)
              ? counters.odometer_accepted
@@ -489,9 +496,11 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
   oo.model = mo;
   StateMatrix<N> P0;
   if constexpr (N == 18)
-    P0 = TerrainAugmentedModel(mo, o.height_aiding).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+    P0 = TerrainAugmentedModel(mo, o.height_aiding)
+             .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else if constexpr (N == 19)
-    P0 = OdometerAugmentedModel(mo, o.odometer).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+    P0 = OdometerAugmentedModel(mo, o.odometer)
+             .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else
     P0 = InsErrorModel<N>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   // Biases from an alignment: their own 1-sigma (cross terms with the other states stay zero).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Closed-loop GNSS/INS integration driver (seed 003 feedback filter; seed 001 17-state tight model).
 // Feed IMU increments and GNSS data in time order at any rates and times: the INS (ins::Strapdown, raw IMU
 // samples compensated by the estimated biases) runs through every IMU interval; a GNSS measurement at time t
@@ -23,10 +24,10 @@
 #include <vector>
 
 #include "fusion/attitude_measurement.hpp"
+#include "fusion/coupling.hpp"
 #include "fusion/ekf.hpp"
 #include "fusion/height_aiding.hpp"
 #include "fusion/ins_error_model.hpp"
-#include "fusion/coupling.hpp"
 #include "fusion/ins_error_state.hpp"
 #include "fusion/lockout_recovery.hpp"
 #include "fusion/loose_measurements.hpp"
@@ -48,7 +49,7 @@ enum class FilterKind { Ekf, Ukf };
 struct IntegrationOptions {
   Coupling coupling = Coupling::kLoose;  // kLoose or kTight
   FilterKind filter = FilterKind::Ekf;
-  InsErrorModelOptions model;                    // error_model_from_preset(...) is a good start
+  InsErrorModelOptions model;                             // error_model_from_preset(...) is a good start
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // IMU -> antenna, body axes [m]
   // Initial 1-sigma of the nav errors (biases and clock: from `model`).
   Eigen::Vector3d sigma_pos_ned_m = Eigen::Vector3d::Constant(10.0);
@@ -107,20 +108,20 @@ struct IntegrationOutput {
   double clock_bias_m = 0.0, clock_drift_mps = 0.0;  // tight mode (else 0)
   double sigma_clock_bias_m = 0.0, sigma_clock_drift_mps = 0.0;
   double terrain_height_m = 0.0, sigma_terrain_height_m = 0.0;  // tight with height aiding (else 0)
-  OdometerEstimate odometer;  // odometer aiding (else 0)
+  OdometerEstimate odometer;                                    // odometer aiding (else 0)
 };
 
 struct IntegrationCounters {
   long long imu_steps = 0;
-  long long epochs = 0;             // GNSS fixes / observation epochs applied
-  long long accepted = 0;           // measurement updates (a satellite, or a fix) passed by the gate
-  long long rejected = 0;           // refused by the gate
-  long long late = 0;               // GNSS data older than the INS time when it came (dropped)
+  long long epochs = 0;    // GNSS fixes / observation epochs applied
+  long long accepted = 0;  // measurement updates (a satellite, or a fix) passed by the gate
+  long long rejected = 0;  // refused by the gate
+  long long late = 0;      // GNSS data older than the INS time when it came (dropped)
   long long satellites_missing_ephemeris = 0;
-  long long invalid = 0;            // ignored: non-finite IMU increments or fixes, IMU times not increasing
+  long long invalid = 0;  // ignored: non-finite IMU increments or fixes, IMU times not increasing
   // Per measurement type (the totals above include them). Loose fixes: one update each.
   long long fix_accepted = 0, fix_rejected = 0;
-  long long attitude_epochs = 0;    // GPS attitudes applied at their time (accepted + rejected + unusable)
+  long long attitude_epochs = 0;  // GPS attitudes applied at their time (accepted + rejected + unusable)
   long long attitude_accepted = 0;
   long long attitude_rejected = 0;  // refused by the innovation gate
   long long attitude_unusable = 0;  // refused before the gate: near vertical (Euler sigmas degenerate)
@@ -131,9 +132,9 @@ struct IntegrationCounters {
   // pseudo-measurements applied there (accepted / refused by the gate; none before a height is known).
   long long epochs_few_satellites = 0;
   long long height_accepted = 0, height_rejected = 0;
-  long long recoveries = 0;  // lock-out recoveries (recovery_events() says when and why)
+  long long recoveries = 0;                      // lock-out recoveries (recovery_events() says when and why)
   long long nhc_accepted = 0, nhc_rejected = 0;  // non-holonomic constraint updates
-  long long fixes_skipped = 0;  // loose: within fix_min_interval_s of the last fix used
+  long long fixes_skipped = 0;                   // loose: within fix_min_interval_s of the last fix used
   // Odometer windows: updates accepted / refused by the innovation gate; gated out by the heading-rate rule and
   // by the speed rule (a window failing both counts in both); unusable (no INS history over the window yet).
   long long odometer_accepted = 0, odometer_rejected = 0;

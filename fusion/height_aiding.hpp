@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Height aiding for tight integration when an epoch has fewer than 4 usable satellites (land vehicles), with a
 // terrain-height state: the filter gains an 18th state, the error of its estimate of the terrain height under
 // the vehicle (estimate minus truth, metres). The terrain height is modelled as a first-order Gauss-Markov
@@ -20,9 +21,9 @@
 namespace ultratrack::fusion {
 
 struct HeightAidingOptions {
-  bool enabled = false;        // off by default (aircraft; or any vehicle free to change height)
-  int min_satellites = 4;      // aid epochs with fewer usable satellites than this
-  double sigma0_m = 2.0;       // white part of each aid (IMU height above the terrain varies by this much)
+  bool enabled = false;                  // off by default (aircraft; or any vehicle free to change height)
+  int min_satellites = 4;                // aid epochs with fewer usable satellites than this
+  double sigma0_m = 2.0;                 // white part of each aid (IMU height above the terrain varies by this much)
   double terrain_sigma_m = 10.0;         // stationary 1-sigma of the terrain about the reference height
   double terrain_correlation_s = 100.0;  // terrain correlation time (correlation distance / speed)
   double min_interval_s = 1.0;           // at most one aid per interval

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The innovation test both filters apply before an update: factor the innovation covariance S, compute the
 // normalised innovation squared nu' S^-1 nu and compare it with the chi-square gate (GateOptions). One copy,
 // so that the EKF and the UKF accept and reject by exactly the same rule.
@@ -9,8 +10,8 @@
 #include <cstddef>
 #include <limits>
 
-#include "receiver/chi_square.hpp"
 #include "fusion/filter_types.hpp"
+#include "receiver/chi_square.hpp"
 
 namespace ultratrack::fusion {
 

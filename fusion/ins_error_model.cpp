@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/ins_error_model.hpp"
 
 #include <cmath>
@@ -63,7 +64,7 @@ StateMatrix<N> ins_error_dynamics(const InsLinearisation& lin, const InsErrorMod
   const double RM = r.meridian_m, RN = r.transverse_m;
   const double w2 = 1.0 - e2 * sL * sL;
   const double dRM = 3.0 * RM * e2 * sL * cL / w2;  // dR_M / dlat
-  const double dRN = RN * e2 * sL * cL / w2;         // dR_N / dlat
+  const double dRN = RN * e2 * sL * cL / w2;        // dR_N / dlat
   const double Rm = RM + h, Rn = RN + h;
   (void)kWgs84A;
 
@@ -86,8 +87,8 @@ StateMatrix<N> ins_error_dynamics(const InsLinearisation& lin, const InsErrorMod
   Matrix3d Wie_p = Matrix3d::Zero();
   Wie_p.col(0) = Vector3d(-W * sL, 0.0, -W * cL);
   Matrix3d Wen_p = Matrix3d::Zero();
-  Wen_p.col(0) = Vector3d(-v.y() * dRN / (Rn * Rn), v.x() * dRM / (Rm * Rm),
-                          -v.y() * (Rn / (cL * cL) - tL * dRN) / (Rn * Rn));
+  Wen_p.col(0) =
+      Vector3d(-v.y() * dRN / (Rn * Rn), v.x() * dRM / (Rm * Rm), -v.y() * (Rn / (cL * cL) - tL * dRN) / (Rn * Rn));
   Wen_p.col(2) = Vector3d(-v.y() / (Rn * Rn), v.x() / (Rm * Rm), v.y() * tL / (Rn * Rn));
   Matrix3d Wen_v = Matrix3d::Zero();
   Wen_v(0, 1) = 1.0 / Rn;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Continuous-time INS error dynamics in NED for the error state of ins_error_state.hpp (15 or 17 states),
 // linearised about the current nominal: position, velocity and psi-angle attitude errors driven by the
 // residual IMU biases and white sensor noise, including the position/velocity dependence of earth rate,
@@ -25,11 +26,11 @@ enum class BiasModel {
 
 struct SensorNoiseModel {
   BiasModel bias_model = BiasModel::RandomConstant;
-  double bias_sigma = 0.0;          // initial 1-sigma of the residual bias (turn-on) [m/s^2 | rad/s]
-  double gm_sigma = 0.0;            // steady-state sigma of the Gauss-Markov part
+  double bias_sigma = 0.0;  // initial 1-sigma of the residual bias (turn-on) [m/s^2 | rad/s]
+  double gm_sigma = 0.0;    // steady-state sigma of the Gauss-Markov part
   double correlation_time_s = 3600.0;
   double bias_random_walk_psd = 0.0;  // extra random-walk PSD on the bias [(m/s^2)^2/Hz | (rad/s)^2/Hz]
-  double white_noise_psd = 0.0;     // VRW^2 [(m/s)^2/s] | ARW^2 [rad^2/s]
+  double white_noise_psd = 0.0;       // VRW^2 [(m/s)^2/s] | ARW^2 [rad^2/s]
 };
 
 struct ClockNoiseModel {

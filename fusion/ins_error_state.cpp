@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/ins_error_state.hpp"
 
 #include "ins/attitude.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ultra-tight measurements (seed 001 eqs. 5-8, 11-17): the early/prompt/late in-phase and quadrature correlator
 // outputs of one channel as functions of the 17-state error, and the "pre-filtered" alternative (code and
 // frequency discriminators turned into range and range-rate errors), both with closed-form noise from C/N0.

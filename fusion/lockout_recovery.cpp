@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/lockout_recovery.hpp"
 
 #include <fmt/core.h>
@@ -40,7 +41,8 @@ std::optional<RecoveryEvent> LockoutMonitor::observe(double t_s, bool accepted, 
     first_rejection_t_s_ = t_s;
   }
   if (rejections_ >= opt_.consecutive_rejections && t_s - first_rejection_t_s_ >= opt_.min_span_s) {
-    RecoveryEvent e{t_s, fmt::format("{} consecutive rejections over {:.1f} s", rejections_, t_s - first_rejection_t_s_)};
+    RecoveryEvent e{t_s,
+                    fmt::format("{} consecutive rejections over {:.1f} s", rejections_, t_s - first_rejection_t_s_)};
     reset();
     return e;
   }
@@ -77,8 +79,8 @@ Eigen::MatrixXd inflate_for_recovery(const Eigen::MatrixXd& P_in, const Eigen::V
     var(ix::kVel + i) = std::max(var(ix::kVel + i), 4.0 * dvi * dvi + 1.0);
     var(ix::kAtt + i) = std::max(var(ix::kAtt + i), o.attitude_sigma_rad(i) * o.attitude_sigma_rad(i));
   }
-  std::vector<int> opened{ix::kPos, ix::kPos + 1, ix::kPos + 2, ix::kVel, ix::kVel + 1, ix::kVel + 2,
-                          ix::kAtt, ix::kAtt + 1, ix::kAtt + 2};
+  std::vector<int> opened{ix::kPos,     ix::kPos + 1, ix::kPos + 2, ix::kVel,    ix::kVel + 1,
+                          ix::kVel + 2, ix::kAtt,     ix::kAtt + 1, ix::kAtt + 2};
   if (n >= 17) {
     var(ix::kClockBias) = std::max(var(ix::kClockBias), 4.0 * clock_innovation_m * clock_innovation_m + 1.0);
     var(ix::kClockDrift) = std::max(var(ix::kClockDrift), 4.0 * v_from_p * v_from_p + 1.0);

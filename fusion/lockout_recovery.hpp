@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // No gate lock-out: a GNSS/INS filter whose state has drifted away from its measurements rejects every fix at the
 // innovation gate, and then nothing can bring it back (a MEMS unit after an outage, a bad start, a burst of bad
 // fixes that got in). LockoutMonitor watches the updates of one measurement stream and says when the filter must
@@ -18,9 +19,9 @@ namespace ultratrack::fusion {
 
 struct LockoutRecoveryOptions {
   bool enabled = true;
-  int consecutive_rejections = 5;  // fixes (loose) or all-rejected epochs (tight) in a row ...
-  double min_span_s = 2.0;         // ... spanning at least this long
-  int nis_window = 20;             // updates in the windowed NIS test (0: no window test)
+  int consecutive_rejections = 5;        // fixes (loose) or all-rejected epochs (tight) in a row ...
+  double min_span_s = 2.0;               // ... spanning at least this long
+  int nis_window = 20;                   // updates in the windowed NIS test (0: no window test)
   double nis_window_probability = 1e-6;  // re-open when the window's NIS sum passes this upper-tail quantile
   // After a recovery the attitude 1-sigma is at least this (north, east, down psi angles) [rad].
   Eigen::Vector3d attitude_sigma_rad{0.035, 0.035, 0.35};

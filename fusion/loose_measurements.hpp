@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Loosely coupled GNSS measurements of the INS error state: antenna position (geodetic fix expressed as
 // NED metres about a reference point, so the numbers stay small) and antenna velocity in NED, with the
 // IMU-to-antenna lever arm l_b: r_ant = r_imu + C_nb l_b, v_ant_n = v_n + C_nb (w_nb_b x l_b).
@@ -49,8 +50,8 @@ class LooseMeasurement {
   NominalState nominal_;
   Eigen::Vector3d lever_b_, w_ib_b_;
   bool pos_ = false, vel_ = false;
-  Eigen::Vector3d r_ref_e_;      // reference point of the position rows (nominal antenna position)
-  Eigen::Matrix3d C_ne_ref_;     // ECEF -> NED at the reference point
+  Eigen::Vector3d r_ref_e_;   // reference point of the position rows (nominal antenna position)
+  Eigen::Matrix3d C_ne_ref_;  // ECEF -> NED at the reference point
   Eigen::VectorXd z_;
   Eigen::MatrixXd R_;
 };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The antenna array's mounting on the IMU (seed 000 Table 3): the rotation q_ba (array -> IMU body) from the mean
 // of the GPS array attitudes over a span and an attitude of the body from elsewhere (a reference INS, or the IMU's
 // own levelling and gyrocompassing), q_ba = q_nb_ref^-1 * mean(q_na). Its 1-sigma: the reference's NED psi-angle
@@ -17,8 +18,8 @@ namespace ultratrack::fusion {
 
 struct MountingEstimate {
   Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();
-  ins::EulerAngles angles;                                  // roll, pitch, yaw of q_ba
-  Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();      // 1-sigma of those angles
+  ins::EulerAngles angles;                                        // roll, pitch, yaw of q_ba
+  Eigen::Vector3d sigma_rad = Eigen::Vector3d::Zero();            // 1-sigma of those angles
   Eigen::Quaterniond q_na_mean = Eigen::Quaterniond::Identity();  // the averaged GPS attitude
   int samples = 0;
 };

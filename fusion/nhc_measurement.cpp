@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/nhc_measurement.hpp"
 
 #include "ins/attitude.hpp"
@@ -5,7 +6,8 @@
 
 namespace ultratrack::fusion {
 
-Eigen::Vector3d body_velocity_at(const ins::NavState& nav, const Eigen::Vector3d& w_ib_b, const Eigen::Vector3d& lever_b) {
+Eigen::Vector3d body_velocity_at(const ins::NavState& nav, const Eigen::Vector3d& w_ib_b,
+                                 const Eigen::Vector3d& lever_b) {
   const Eigen::Vector3d w_in =
       ins::earth_rate_n(nav.lat_rad) + ins::transport_rate_n(nav.lat_rad, nav.height_m, nav.v_n);
   const Eigen::Vector3d w_nb_b = w_ib_b - nav.q_nb.conjugate() * w_in;

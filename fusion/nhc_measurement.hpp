@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Non-holonomic constraints of a land vehicle (seed 004 eqs. 11-15 without the odometer row): a wheeled vehicle
 // neither slides sideways nor leaves the road, so at its non-holonomic point (the rear axle's centre, at
 // lever_arm_b from the IMU in body axes) the body-frame velocity has zero lateral (y) and vertical (z)
@@ -43,7 +44,8 @@ class NhcMeasurement {
 };
 
 // The body-frame velocity at the point lever_b of a nav state with body rate w_ib_b [m/s].
-Eigen::Vector3d body_velocity_at(const ins::NavState& nav, const Eigen::Vector3d& w_ib_b, const Eigen::Vector3d& lever_b);
+Eigen::Vector3d body_velocity_at(const ins::NavState& nav, const Eigen::Vector3d& w_ib_b,
+                                 const Eigen::Vector3d& lever_b);
 
 extern template class NhcMeasurement<15>;
 extern template class NhcMeasurement<17>;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/odometer_error_model.hpp"
 
 #include <cmath>
@@ -34,7 +35,8 @@ OdometerNominal corrected(const OdometerNominal& n, const StateVector<19>& dx) {
   return out;
 }
 
-OdometerAugmentedModel::OdometerAugmentedModel(const InsErrorModelOptions& options, const OdometerAidingOptions& odometer)
+OdometerAugmentedModel::OdometerAugmentedModel(const InsErrorModelOptions& options,
+                                               const OdometerAidingOptions& odometer)
     : ins_(options), odo_(odometer) {
   if (std::string why; !odometer.IsValid(&why)) throw std::invalid_argument(why);
   set_linearisation(InsLinearisation{});

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The 19-state land-navigation error model of seed 004 (sec. 2-1): the 15 INS error states of
 // fusion/ins_error_state.hpp plus four odometer (VMS) states, each estimate minus truth:
 //   [15] VMS time delay error, s         [16] mounting misalignment pitch error, rad (about the vehicle's y)
@@ -33,7 +34,7 @@ struct OdometerAidingOptions {
   bool enabled = false;
   OdometerMode mode = OdometerMode::kGated;
   double yaw_rate_threshold_rad_s = 1.5 * 3.14159265358979323846 / 180.0;  // eq. 16 (|heading change| per second)
-  double min_speed_mps = 5.0;                                               // eq. 17 (VMS speed)
+  double min_speed_mps = 5.0;                                              // eq. 17 (VMS speed)
   double update_rate_hz = 1.0;  // one update per 1 / rate: the VMS speed is the distance over that window / window
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // IMU -> wheels' non-holonomic point, body axes [m]
   // Initial 1-sigma of the odometer states (their nominal starts at zero).

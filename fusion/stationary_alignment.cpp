@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/stationary_alignment.hpp"
 
 #include <algorithm>
@@ -25,9 +26,9 @@ Eigen::Vector3d euler_sigma(const AlignmentMatrix& P, const ins::EulerAngles& e)
 
 template <class Filter>
 StationaryAlignmentResult run(Filter& filter, std::span<const ins::ImuIncrement> imu, std::size_t first_row,
-                              std::span<const GnssAttitude> attitudes, std::size_t first_attitude,
-                              ins::NavState nav, const StationaryAlignmentOptions& o,
-                              const StationaryAlignmentModelOptions& model_options, double zupt_sigma) {
+                              std::span<const GnssAttitude> attitudes, std::size_t first_attitude, ins::NavState nav,
+                              const StationaryAlignmentOptions& o, const StationaryAlignmentModelOptions& model_options,
+                              double zupt_sigma) {
   StationaryAlignmentResult r;
   r.start_s = nav.t_s;
   const double t_end = o.duration_s > 0.0 ? nav.t_s + o.duration_s : imu.back().t_s;
@@ -50,7 +51,7 @@ StationaryAlignmentResult run(Filter& filter, std::span<const ins::ImuIncrement>
     last_epoch = s.t_s;
     next_epoch += o.filter_interval_s;
     filter.update(ZeroVelocityMeasurement(s.v_n, zupt_sigma)).accepted ? ++r.zero_velocity_updates
-                                                                      : ++r.zero_velocity_rejected;
+                                                                       : ++r.zero_velocity_rejected;
     const GnssAttitude* latest = nullptr;
     while (a < attitudes.size() && attitudes[a].t_s <= s.t_s) {
       if (attitude_usable(attitudes[a], usable))
@@ -61,8 +62,8 @@ StationaryAlignmentResult run(Filter& filter, std::span<const ins::ImuIncrement>
     }
     AlignmentEpoch epoch;
     if (latest) {
-      const auto u = filter.update(
-          EulerAttitudeMeasurement(s.q_nb, measured_q_nb(*latest, o.q_ba), latest->sigma_euler_rad));
+      const auto u =
+          filter.update(EulerAttitudeMeasurement(s.q_nb, measured_q_nb(*latest, o.q_ba), latest->sigma_euler_rad));
       epoch.attitude_used = u.accepted;
       u.accepted ? ++r.attitude_updates : ++r.attitude_rejected;
     }
@@ -127,7 +128,8 @@ StationaryAlignmentResult align_stationary(std::span<const ins::ImuIncrement> im
       o.zero_velocity_sigma_mps > 0.0 ? o.zero_velocity_sigma_mps : std::max(1e-3, o.imu.accel.output_white_noise);
 
   AlignmentMatrix P0 = AlignmentMatrix::Zero();
-  P0.block<3, 3>(kVel, kVel) = Eigen::Matrix3d::Identity() * o.initial_velocity_sigma_mps * o.initial_velocity_sigma_mps;
+  P0.block<3, 3>(kVel, kVel) =
+      Eigen::Matrix3d::Identity() * o.initial_velocity_sigma_mps * o.initial_velocity_sigma_mps;
   const Eigen::Matrix3d M = euler_rate_to_rotation_n(a0.euler_a);
   P0.block<3, 3>(kAtt, kAtt) = M * a0.sigma_euler_rad.cwiseAbs2().asDiagonal() * M.transpose();
   const double sa = std::max(1e-5, std::hypot(o.imu.accel.bias_sigma, o.imu.accel.bias_instability_sigma));

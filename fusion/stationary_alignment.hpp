@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fine alignment of a strapdown INS at rest from zero velocity and a multi-antenna receiver's GPS attitude
 // (seed 000, Fig. 1): the INS runs at the IMU rate from the first usable GPS attitude; every filter interval the
 // 12-state filter (fusion/stationary_alignment_model.hpp, EKF or UKF) predicts, takes the zero-velocity
@@ -26,13 +27,13 @@ struct StationaryAlignmentOptions {
   FilterKind filter = FilterKind::Ekf;
   UkfParameters ukf;
   GateOptions gate;
-  double filter_interval_s = 1.0;        // seed 000: 1 s
-  double duration_s = 0.0;               // from the first GPS attitude; 0: to the end of the IMU data
+  double filter_interval_s = 1.0;  // seed 000: 1 s
+  double duration_s = 0.0;         // from the first GPS attitude; 0: to the end of the IMU data
   double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
   ins::ImuErrorSpec imu;                 // noise PSDs and initial bias 1-sigmas (floors 1e-5 m/s^2, 1e-8 rad/s)
   double zero_velocity_sigma_mps = 0.0;  // 0: the accelerometer's output white noise, at least 1 mm/s
   double initial_velocity_sigma_mps = 0.01;
-  Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();  // antenna array -> IMU body (known mounting)
+  Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();    // antenna array -> IMU body (known mounting)
   double max_abs_pitch_rad = 80.0 * std::numbers::pi / 180.0;  // GPS attitudes beyond are not used
 };
 
@@ -53,7 +54,8 @@ struct StationaryAlignmentResult {
   AlignmentMatrix P = AlignmentMatrix::Zero();  // of the (reset) error state at end_s
   Eigen::Vector3d sigma_euler_rad = Eigen::Vector3d::Zero();
   std::vector<AlignmentEpoch> history;
-  long long zero_velocity_updates = 0, zero_velocity_rejected = 0, attitude_updates = 0, attitude_rejected = 0, attitude_unusable = 0;
+  long long zero_velocity_updates = 0, zero_velocity_rejected = 0, attitude_updates = 0, attitude_rejected = 0,
+            attitude_unusable = 0;
 };
 
 // Throws std::invalid_argument when no usable GPS attitude lies inside the IMU data, or the IMU holds fewer than

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/stationary_alignment_model.hpp"
 
 #include <cmath>
@@ -33,20 +34,20 @@ AlignmentMatrix stationary_error_dynamics(const Eigen::Matrix3d& C_nb, const Sta
   const Eigen::Vector3d W = ins::earth_rate_n(o.lat_rad);  // (Omega_N, 0, Omega_D)
   const double WN = W.x(), WD = W.z(), g = o.gravity_mps2;
   Eigen::Matrix3d F11, F12, F22;
-  F11 << 0.0, 2.0 * WD, 0.0,  //
+  F11 << 0.0, 2.0 * WD, 0.0,     //
       -2.0 * WD, 0.0, 2.0 * WN,  //
       0.0, -2.0 * WN, 0.0;       // eq. 6
-  F12 << 0.0, g, 0.0,  //
-      -g, 0.0, 0.0,    //
-      0.0, 0.0, 0.0;   // eq. 7
-  F22 << 0.0, WD, 0.0,  //
-      -WD, 0.0, WN,     //
-      0.0, -WN, 0.0;    // eq. 8
+  F12 << 0.0, g, 0.0,            //
+      -g, 0.0, 0.0,              //
+      0.0, 0.0, 0.0;             // eq. 7
+  F22 << 0.0, WD, 0.0,           //
+      -WD, 0.0, WN,              //
+      0.0, -WN, 0.0;             // eq. 8
   AlignmentMatrix A = AlignmentMatrix::Zero();
   A.block<3, 3>(kVel, kVel) = F11;
   A.block<3, 3>(kVel, kAtt) = F12;
   A.block<3, 3>(kAtt, kAtt) = F22;
-  A.block<3, 3>(kVel, kAccelBias) = C_nb;    // eq. 9
+  A.block<3, 3>(kVel, kAccelBias) = C_nb;  // eq. 9
   A.block<3, 3>(kAtt, kGyroBias) = -C_nb;
   return A;
 }

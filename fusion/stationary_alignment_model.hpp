@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The 12-state stationary alignment filter of seed 000 (eqs. 2-17): the error model of a strapdown INS at rest
 // and its two measurements, zero velocity and the GPS Euler attitude through H_G.
 //   [0,3)  dv_n  velocity error, NED m/s             [3,6)  psi  attitude error, NED rad (psi-angle, the
@@ -35,10 +36,10 @@ inline constexpr int kGyroBias = 9;
 struct StationaryAlignmentModelOptions {
   double lat_rad = 0.0;
   double gravity_mps2 = 9.80665;
-  double accel_white_psd = 0.0;       // VRW^2, (m/s)^2/s
-  double gyro_white_psd = 0.0;        // ARW^2, rad^2/s
-  double accel_bias_walk_psd = 0.0;   // (m/s^2)^2/s
-  double gyro_bias_walk_psd = 0.0;    // (rad/s)^2/s
+  double accel_white_psd = 0.0;      // VRW^2, (m/s)^2/s
+  double gyro_white_psd = 0.0;       // ARW^2, rad^2/s
+  double accel_bias_walk_psd = 0.0;  // (m/s^2)^2/s
+  double gyro_bias_walk_psd = 0.0;   // (rad/s)^2/s
 };
 
 // The model's noise from an IMU spec (random walks -> white PSDs; bias instability as a random walk of PSD

@@ -1,8 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/tight_measurements.hpp"
 
 #include <GeographicLib/Constants.hpp>
 #include <GeographicLib/Geocentric.hpp>
-
 #include <algorithm>
 #include <cmath>
 
@@ -27,7 +27,8 @@ double sigma_scale(double elevation_rad, double cn0_dbhz) {
   return std::max(cn0_factor, 0.3) / std::sin(el);
 }
 
-Eigen::Vector3d antenna_velocity_e(const ins::NavState& nav, const Eigen::Vector3d& w_ib_b, const Eigen::Vector3d& l_b) {
+Eigen::Vector3d antenna_velocity_e(const ins::NavState& nav, const Eigen::Vector3d& w_ib_b,
+                                   const Eigen::Vector3d& l_b) {
   return ins::C_en(nav.lat_rad, nav.lon_rad) * antenna_velocity_n(nav, w_ib_b, l_b);
 }
 
@@ -112,17 +113,19 @@ std::vector<SatelliteObservable> prepare_satellites(const receiver::ObservationE
     s.elevation_rad = la.elevation_rad;
     s.azimuth_rad = la.azimuth_rad;
     if (opt.ionosphere && iono.valid)
-      s.atmosphere_m += kSpeedOfLight_mps * signals::klobuchar_delay_s(iono, lat, lon, la.azimuth_rad,
-                                                                      la.elevation_rad, t_tx.tow_s);
+      s.atmosphere_m +=
+          kSpeedOfLight_mps * signals::klobuchar_delay_s(iono, lat, lon, la.azimuth_rad, la.elevation_rad, t_tx.tow_s);
     if (opt.troposphere) {
       const double el = la.elevation_rad;
       s.atmosphere_m += signals::troposphere_delay_m(lat, h, el);
       // Central differences of the model (smooth in both: mapping 1 / sqrt(0.002 + sin^2), barometric height).
       constexpr double kDel = 1e-4, kDh = 1.0;
       s.troposphere_per_elevation_m =
-          (signals::troposphere_delay_m(lat, h, el + kDel) - signals::troposphere_delay_m(lat, h, el - kDel)) / (2.0 * kDel);
+          (signals::troposphere_delay_m(lat, h, el + kDel) - signals::troposphere_delay_m(lat, h, el - kDel)) /
+          (2.0 * kDel);
       s.troposphere_per_height =
-          (signals::troposphere_delay_m(lat, h + kDh, el) - signals::troposphere_delay_m(lat, h - kDh, el)) / (2.0 * kDh);
+          (signals::troposphere_delay_m(lat, h + kDh, el) - signals::troposphere_delay_m(lat, h - kDh, el)) /
+          (2.0 * kDh);
       s.up_e = Eigen::Vector3d(std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat));
     }
     s.pseudorange_m = o.pseudorange_m;
@@ -158,9 +161,9 @@ double troposphere_rate_mps(const SatelliteObservable& sat, const Eigen::Vector3
   const Eigen::Vector3d u = los / rho;
   const Eigen::Vector3d& up = sat.up_e;
   const Eigen::Vector3d v_rel = sat.v_sat_e - v_ant_e;
-  const Eigen::Vector3d du = (v_rel - u * u.dot(v_rel)) / rho;          // the line of sight turning
+  const Eigen::Vector3d du = (v_rel - u * u.dot(v_rel)) / rho;  // the line of sight turning
   const double v_up = v_ant_e.dot(up);
-  const Eigen::Vector3d dup = (v_ant_e - up * v_up) / (r_ant_e.norm()); // the local vertical turning
+  const Eigen::Vector3d dup = (v_ant_e - up * v_up) / (r_ant_e.norm());  // the local vertical turning
   const double sin_el = u.dot(up);
   const double cos_el = std::sqrt(std::max(1e-12, 1.0 - sin_el * sin_el));
   const double el_rate = (du.dot(up) + u.dot(dup)) / cos_el;
@@ -190,9 +193,7 @@ SatelliteMeasurement17::SatelliteMeasurement17(const NominalState& nominal, cons
   }
 }
 
-Eigen::VectorXd SatelliteMeasurement17::h(const StateVector<17>& dx) const {
-  return predicted(dx, rate_).head(size());
-}
+Eigen::VectorXd SatelliteMeasurement17::h(const StateVector<17>& dx) const { return predicted(dx, rate_).head(size()); }
 
 Eigen::Vector2d SatelliteMeasurement17::predicted(const StateVector<17>& dx, bool with_rate) const {
   // fusion::corrected's position step (ins::correct_position), with the nominal's radii computed once.
@@ -251,8 +252,7 @@ MeasurementJacobian<17> SatelliteMeasurement17::H(const StateVector<17>&) const 
 }
 
 EpochMeasurement17::EpochMeasurement17(const NominalState& nominal, const std::vector<SatelliteObservable>& sats,
-                                       const Eigen::Vector3d& lever_arm_b, const Eigen::Vector3d& w_ib_b,
-                                       bool use_rate)
+                                       const Eigen::Vector3d& lever_arm_b, const Eigen::Vector3d& w_ib_b, bool use_rate)
     : nominal_(nominal), sats_(sats), lever_b_(lever_arm_b), w_ib_b_(w_ib_b), rate_(use_rate) {
   const int n = static_cast<int>(sats_.size());
   int k = n;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tightly coupled GNSS measurements: the pseudorange and pseudorange rate of one satellite predicted from the
 // INS antenna position/velocity and the receiver clock states (17-state error model). Satellite position,
 // velocity and clock come from the broadcast ephemeris at the transmit time implied by the pseudorange
@@ -24,7 +25,7 @@ namespace ultratrack::fusion {
 
 struct TightOptions {
   double elevation_mask_rad = 10.0 * 3.14159265358979 / 180.0;
-  bool ionosphere = true;   // broadcast Klobuchar when the parameters are valid
+  bool ionosphere = true;  // broadcast Klobuchar when the parameters are valid
   bool troposphere = true;
   bool use_range_rate = true;  // Doppler rows (a non-finite doppler_hz means absent for that satellite)
   // 1-sigma at zenith and 45 dB-Hz; grows with 1/sin(elevation) and lower C/N0 as in receiver/pvt.
@@ -38,9 +39,9 @@ struct SatelliteObservable {
   int prn = 0;
   Eigen::Vector3d r_sat_e = Eigen::Vector3d::Zero();  // at transmit time, rotated to the receive-time frame
   Eigen::Vector3d v_sat_e = Eigen::Vector3d::Zero();  // apparent velocity in the receive-time frame
-  double sv_clock_m = 0.0;     // c * (af polynomial + relativistic - TGD)
-  double sv_drift_mps = 0.0;   // c * SV clock drift
-  double atmosphere_m = 0.0;   // ionosphere + troposphere delay
+  double sv_clock_m = 0.0;                            // c * (af polynomial + relativistic - TGD)
+  double sv_drift_mps = 0.0;                          // c * SV clock drift
+  double atmosphere_m = 0.0;                          // ionosphere + troposphere delay
   // The troposphere model's slopes at the antenna (0 without troposphere): d delay / d elevation (m/rad) and
   // d delay / d height (m/m), with the local up direction (ECEF unit vector) they refer to.
   double troposphere_per_elevation_m = 0.0, troposphere_per_height = 0.0;

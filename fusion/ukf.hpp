@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Unscented Kalman filter on a fixed-size state with scaled sigma points (seed 001 eqs. 18-37):
 // lambda = alpha^2 (n + kappa) - n, sigma points x +- columns of the Cholesky factor of (n + lambda) P,
 // weights Wm0 = lambda / (n + lambda), Wc0 = Wm0 + 1 - alpha^2 + beta, Wi = 1 / (2 (n + lambda)) (seed 001
@@ -15,11 +16,11 @@
 #include <limits>
 #include <stdexcept>
 
-#include "receiver/chi_square.hpp"
 #include "fusion/covariance_utils.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/filter_types.hpp"
 #include "fusion/innovation_gate.hpp"
+#include "receiver/chi_square.hpp"
 
 namespace ultratrack::fusion {
 
@@ -70,7 +71,7 @@ class Ukf {
   // sigma points: with f(x) = Phi x they give mean Phi x and covariance Phi (sum_i Wc_i (X_i - x)(X_i - x)') Phi'
   // = Phi L L' Phi' = Phi P Phi' (the weights of the 2N symmetric points sum to 1 / (N + lambda)), exactly.
   template <class M>
-    requires ProcessModel<M, N>
+  requires ProcessModel<M, N>
   void predict(const M& model, double dt) {
     const Matrix F = model.F(x_);
     const Eigen::Matrix<double, N, M::kNoiseSize> G = model.G(x_);
@@ -103,8 +104,7 @@ class Ukf {
   // A model with a compile-time size (static constexpr int kMeasurementSize, measurement_size_v) runs on
   // fixed-size matrices: no heap allocation in the sums over the sigma points.
   template <class M>
-    requires MeasurementModel<M, N>
-  UpdateResult update(const M& model) {
+  requires MeasurementModel<M, N> UpdateResult update(const M& model) {
     constexpr int K = measurement_size_v<M>;
     using ZVector = Eigen::Matrix<double, K, 1>;
     using ZMatrix = Eigen::Matrix<double, K, K>;

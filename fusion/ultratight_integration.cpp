@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/ultratight_integration.hpp"
 
 #include <Eigen/Cholesky>
@@ -263,8 +264,8 @@ class UltraTightCore final : public UltraTightCoreBase {
         const double theta = std::atan2(c->taps.q[1], c->taps.i[1]);
         const double a2 = std::pow(iq_amplitude(is), 2);
         if (std::abs(theta) < 0.5 * M_PI && a2 > 0.0)
-          end_phases.push_back({&ch, rep, offset, theta, (1.0 + 1.0 / a2) / a2, rate_slope * T_, r.t_start_s + T_,
-                                dx_before});
+          end_phases.push_back(
+              {&ch, rep, offset, theta, (1.0 + 1.0 / a2) / a2, rate_slope * T_, r.t_start_s + T_, dx_before});
       }
       ch.coasting = !ok;
       if (!ok) ++counters.coasting;
@@ -293,8 +294,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   void predict_satellites(std::vector<SatelliteObservable>& out) const {
     const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
     receiver::ObservationEpoch epoch;
-    epoch.receive_time =
-        signals::add_seconds(opt_.gps_time_origin, nominal_.nav.t_s + nominal_.clock_bias_m / kC);
+    epoch.receive_time = signals::add_seconds(opt_.gps_time_origin, nominal_.nav.t_s + nominal_.clock_bias_m / kC);
     // One observation per PRN: ephemerides may hold several sets of a satellite (a day's RINEX: ~12), and
     // prepare_satellites picks the set valid at the transmit time.
     std::set<int> prns;
@@ -325,8 +325,8 @@ class UltraTightCore final : public UltraTightCoreBase {
   // Pseudorange and rate of each satellite from the current nominal (antenna position/velocity, clock).
   void predict_ranges(std::vector<SatelliteObservable>& sats) const {
     const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
-    const Eigen::Vector3d v_ant =
-        ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) * antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
+    const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
+                                  antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
     for (auto& s : sats) {
       s.pseudorange_m = predicted_pseudorange_m(s, r_ant, nominal_.clock_bias_m);
       s.range_rate_mps = predicted_range_rate_mps(s, r_ant, v_ant, nominal_.clock_drift_mps);
@@ -423,7 +423,7 @@ class UltraTightCore final : public UltraTightCoreBase {
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;
   UpdateResult last_result_;
-  StateVector<17> last_dx_ = StateVector<17>::Zero();  // the correction of the latest accepted update
+  StateVector<17> last_dx_ = StateVector<17>::Zero();    // the correction of the latest accepted update
   StateVector<17> period_dx_ = StateVector<17>::Zero();  // the corrections of this period's updates, summed
 };
 
@@ -447,11 +447,12 @@ UltraTightIntegration::UltraTightIntegration(const ins::NavState& initial, std::
       model.initial_covariance(options.sigma_pos_ned_m, options.sigma_vel_n_mps, options.sigma_att_rad);
   const StateVector<17> x0 = StateVector<17>::Zero();
   if (options.filter == FilterKind::Ekf)
-    impl_->core = std::make_unique<UltraTightCore<Ekf<17>>>(initial, std::move(eph), impl_->options,
-                                                          Ekf<17>(x0, P0, EkfOptions{mo.discretisation, options.gate}));
+    impl_->core = std::make_unique<UltraTightCore<Ekf<17>>>(
+        initial, std::move(eph), impl_->options, Ekf<17>(x0, P0, EkfOptions{mo.discretisation, options.gate}));
   else
     impl_->core = std::make_unique<UltraTightCore<Ukf<17>>>(
-        initial, std::move(eph), impl_->options, Ukf<17>(x0, P0, UkfOptions{options.ukf, mo.discretisation, options.gate}));
+        initial, std::move(eph), impl_->options,
+        Ukf<17>(x0, P0, UkfOptions{options.ukf, mo.discretisation, options.gate}));
 }
 
 UltraTightIntegration::~UltraTightIntegration() = default;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Closed-loop ultra-tight GPS/INS driver (seed 001): the INS (ins::Strapdown on bias-compensated IMU samples) and
 // the 17-state error filter (EKF or UKF) predict every satellite's replica for each integration period T
 // (code phase/rate, carrier frequency, running carrier phase: the "INS-predicted replica", as NcoCommands), then
@@ -8,12 +9,12 @@
 // Time line: t_s of the IMU samples (GPS time minus gps_time_origin). Metres, m/s, chips, Hz, cycles.
 // Model assumption (iq_measurements.hpp): data bits known/wiped off, carrier NCO phase realigned at the start
 // of every period (the phase error inside a period is 2 pi df s), or its error at the start given as a variance
-// (ChannelCorrelation::start_phase_var_rad2: a closed PLL's residual, taken as noise in R). Over a period the taps see the mean range
-// error and the rate error at a third of the period (period_replica_errors). The receiver clock's frequency within
-// the period differs from the drift state by a noise e common to the period's satellites (from options.model.clock):
-// the period's updates run on x' = x + u e (u the drift axis), after which e is conditioned out (exact for a linear
-// measurement; no 18th state). A continuous-carrier channel (ChannelCorrelation::continuous_carrier) starts each
-// period with the phase its previous epoch ended with.
+// (ChannelCorrelation::start_phase_var_rad2: a closed PLL's residual, taken as noise in R). Over a period the taps see
+// the mean range error and the rate error at a third of the period (period_replica_errors). The receiver clock's
+// frequency within the period differs from the drift state by a noise e common to the period's satellites (from
+// options.model.clock): the period's updates run on x' = x + u e (u the drift axis), after which e is conditioned out
+// (exact for a linear measurement; no 18th state). A continuous-carrier channel
+// (ChannelCorrelation::continuous_carrier) starts each period with the phase its previous epoch ended with.
 #pragma once
 
 #include <Eigen/Core>
@@ -42,19 +43,19 @@ struct UltraTightOptions {
   UkfParameters ukf;
   Discretisation discretisation = Discretisation::SecondOrderSeries;
   ins::StrapdownOptions strapdown;
-  TightOptions tight;               // elevation mask, troposphere, ionosphere (with `iono`)
+  TightOptions tight;  // elevation mask, troposphere, ionosphere (with `iono`)
   // Satellites between tight.elevation_mask_rad (above it: predicted, a replica command every period) and this
   // mask are commanded but never update the filter ("aided only"): a low satellite's INS-predicted replica keeps
   // its channel on the signal, while its measurements (multipath, troposphere mapping, fast line-of-sight
   // geometry in a 10 g turn) stay out of the filter. -inf: every predicted satellite updates.
   double measurement_mask_rad = -std::numeric_limits<double>::infinity();
   signals::KlobucharParameters iono;  // broadcast ionosphere (default: invalid, no ionospheric delay)
-  double tap_offset_chips = 0.5;    // early/late offset d
+  double tap_offset_chips = 0.5;      // early/late offset d
   // true: the taps' code correlation is the C/A code's own (its one-chip autocorrelation, IqSettings::
   // code_lag1_correlation: E and L 3.1 % of A higher for PRN 7, 15, 17, 21, 24 at d = 0.5); false: the ideal
   // triangle (the correlation-level simulator's truth).
   bool ca_code_correlation = false;
-  double coast_cn0_dbhz = 14.0;     // below: no update, the channel coasts on the INS (on a ~1 s C/N0)
+  double coast_cn0_dbhz = 14.0;  // below: no update, the channel coasts on the INS (on a ~1 s C/N0)
   signals::GpsTime gps_time_origin;
   double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;
   // IMU biases already estimated (e.g. by the tight filter the receiver hands over from); the filter's bias
@@ -67,22 +68,22 @@ struct UltraTightOptions {
 struct ReplicaCommand {
   int prn = 0;
   double t_start_s = 0.0;
-  receiver::NcoCommand nco;       // code rate (with code Doppler) and carrier frequency (Doppler)
-  double pseudorange_m = 0.0;     // replica code phase at t_start as a pseudorange (chips = m / chip length)
-  double range_rate_mps = 0.0;    // replica pseudorange rate (= -lambda * carrier frequency)
+  receiver::NcoCommand nco;           // code rate (with code Doppler) and carrier frequency (Doppler)
+  double pseudorange_m = 0.0;         // replica code phase at t_start as a pseudorange (chips = m / chip length)
+  double range_rate_mps = 0.0;        // replica pseudorange rate (= -lambda * carrier frequency)
   double carrier_phase_cycles = 0.0;  // running replica carrier phase at t_start (continuous, integral of nco)
   double elevation_rad = 0.0;
-  bool coasting = false;          // no accepted measurement in the last period
-  bool aided_only = false;        // below measurement_mask_rad: commanded, never used to update
+  bool coasting = false;    // no accepted measurement in the last period
+  bool aided_only = false;  // below measurement_mask_rad: commanded, never used to update
 };
 
 // Measured correlations of one satellite over one period (normalised: unit noise variance per I or Q).
 struct ChannelCorrelation {
   int prn = 0;
   IqTaps taps;
-  double cn0_dbhz = 0.0;           // the channel's C/N0 estimate
+  double cn0_dbhz = 0.0;  // the channel's C/N0 estimate
   double integration_time_s = 0.020;
-  bool data_wiped = true;          // false: this period is not used (sign ambiguity)
+  bool data_wiped = true;  // false: this period is not used (sign ambiguity)
   // The replica that actually ran, when it was not the commanded one (a receiver channel whose carrier follows
   // its own PLL, whose correlation epoch is not the driver's period): its start time (s), its code pseudorange
   // at that start and its constant carrier range rate. has_replica false: the ReplicaCommand of this PRN.
@@ -117,7 +118,7 @@ struct UltraTightSatelliteUpdate {
 struct UltraTightCounters {
   long long periods = 0;
   long long updates = 0, accepted = 0, rejected = 0;
-  long long coasting = 0;  // satellite-periods without a usable measurement
+  long long coasting = 0;    // satellite-periods without a usable measurement
   long long aided_only = 0;  // satellite-periods below the measurement mask (commanded, not used)
 };
 

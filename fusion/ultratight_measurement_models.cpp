@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/ultratight_measurement_models.hpp"
 
 #include <algorithm>
@@ -24,8 +25,8 @@ double period_span_s(double t_update_s, double replica_t_start_s, double period_
 }
 
 Eigen::Vector2d period_signal_offset(double replica_range_start_m, double replica_rate_mps, double replica_t_start_s,
-                                     double period_s, double t_update_s, double signal_range_m,
-                                     double signal_rate_mps, double signal_rate_slope_mps2) {
+                                     double period_s, double t_update_s, double signal_range_m, double signal_rate_mps,
+                                     double signal_rate_slope_mps2) {
   const double back_end = t_update_s - (replica_t_start_s + period_s);
   const double rate_end = signal_rate_mps - signal_rate_slope_mps2 * back_end;
   const double range_end = signal_range_m - 0.5 * (rate_end + signal_rate_mps) * back_end;
@@ -48,9 +49,13 @@ PeriodIqMeasurement::PeriodIqMeasurement(const NominalState& nominal, const Sate
                                          const Eigen::Vector3d& lever_arm_b, const Eigen::Vector3d& w_ib_b,
                                          const IqSettings& settings, const IqTaps& measured,
                                          const IqPeriodOptions& period)
-    : replica_(nominal, {sat}, lever_arm_b, w_ib_b), s_(settings), offset_(period.offset),
-      M_(period_mixing(period.span_s)), R_(iq_noise_covariance(settings)),
-      code_sigma_(period.prior_code_sigma_chips), start_phase_(period.start_phase_rad) {
+    : replica_(nominal, {sat}, lever_arm_b, w_ib_b),
+      s_(settings),
+      offset_(period.offset),
+      M_(period_mixing(period.span_s)),
+      R_(iq_noise_covariance(settings)),
+      code_sigma_(period.prior_code_sigma_chips),
+      start_phase_(period.start_phase_rad) {
   const TrackingErrors at_nominal = errors(StateVector<17>::Zero());
   if (period.clock_rate_var_m2ps2 > 0.0) {
     const Vector6 g = iq_jacobian(at_nominal, s_).col(1) / kLambda_m;
@@ -109,7 +114,10 @@ PeriodDiscriminatorMeasurement::PeriodDiscriminatorMeasurement(
     const NominalState& nominal, const SatelliteObservable& sat, const Eigen::Vector3d& lever_arm_b,
     const Eigen::Vector3d& w_ib_b, const Eigen::Vector2d& offset, double span_s, const Eigen::Vector2d& measured,
     const DiscriminatorNoise& noise, double clock_rate_var_m2ps2, double start_phase_rate_var_m2ps2)
-    : replica_(nominal, {sat}, lever_arm_b, w_ib_b), offset_(offset), M_(period_mixing(span_s)), z_(measured),
+    : replica_(nominal, {sat}, lever_arm_b, w_ib_b),
+      offset_(offset),
+      M_(period_mixing(span_s)),
+      z_(measured),
       R_(Eigen::MatrixXd::Zero(2, 2)) {
   R_(0, 0) = noise.range_sigma_m * noise.range_sigma_m;
   R_(1, 1) = noise.rate_sigma_mps * noise.rate_sigma_mps + clock_rate_var_m2ps2 + start_phase_rate_var_m2ps2;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The ultra-tight filter's measurement of one satellite over one integration period (fusion/ultratight_integration):
 // the replica that ran over [t0, t0 + T] against the signal the 17-state error dx predicts, seen by the filter at
 // the update time t_u >= t0 + T, in two forms: the I&Q taps (6 rows: I_E, I_P, I_L, Q_E, Q_P, Q_L, unit noise per
@@ -39,8 +40,8 @@ double period_span_s(double t_update_s, double replica_t_start_s, double period_
 // rate m/s) is carried back to the period's end t0 + T along that slope (t_u may lie after it: a receiver
 // channel's epoch that ended before the driver's period).
 Eigen::Vector2d period_signal_offset(double replica_range_start_m, double replica_rate_mps, double replica_t_start_s,
-                                     double period_s, double t_update_s, double signal_range_m,
-                                     double signal_rate_mps, double signal_rate_slope_mps2);
+                                     double period_s, double t_update_s, double signal_range_m, double signal_rate_mps,
+                                     double signal_rate_slope_mps2);
 
 // The prior 1-sigma (chips) of the period's mean code error: sqrt(h P h') / chip length with h the mean-range row
 // of M(span) J_rep. P: the 17-state covariance (units of ins_error_state.hpp).
@@ -55,12 +56,12 @@ double prompt_code_slope_weight(double code_error_chips, double prior_code_sigma
 struct IqPeriodOptions {
   Eigen::Vector2d offset = Eigen::Vector2d::Zero();  // period_signal_offset (m, m/s)
   double span_s = 0.0;                               // period_span_s
-  double prior_code_sigma_chips = 0.0;  // > 0: the prompt's code slope weighted (prompt_code_slope_weight)
+  double prior_code_sigma_chips = 0.0;               // > 0: the prompt's code slope weighted (prompt_code_slope_weight)
   // Receiver-clock frequency noise within the period (m^2/s^2), in R along the taps' rate derivative g:
   // R += var g g' (the ultra-tight driver keeps it in P instead and passes 0).
   double clock_rate_var_m2ps2 = 0.0;
-  double start_phase_rad = 0.0;        // the replica's carrier phase error at t0 (signal minus replica)
-  double start_phase_var_rad2 = 0.0;   // its variance: R += var g g' with g the taps' phase derivative
+  double start_phase_rad = 0.0;       // the replica's carrier phase error at t0 (signal minus replica)
+  double start_phase_var_rad2 = 0.0;  // its variance: R += var g g' with g the taps' phase derivative
 };
 
 // One satellite's I&Q over the period. z: the measured taps (I_E, I_P, I_L, Q_E, Q_P, Q_L); h(dx): expected_iq of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/vector_carrier_phase.hpp"
 
 #include <algorithm>
@@ -14,8 +15,8 @@ double loop_noise_bandwidth_hz(double k_phase, double k_freq, double t_s) {
   return (k_phase / t_s + k_freq / k_phase) / 4.0;
 }
 
-void VectorCarrierPhase::start(std::int64_t at, double replica_phase_cycles, double discriminator_cycles,
-                               double nu0_hz, double disc_variance_cycles2) {
+void VectorCarrierPhase::start(std::int64_t at, double replica_phase_cycles, double discriminator_cycles, double nu0_hz,
+                               double disc_variance_cycles2) {
   active_ = true;
   fell_back_ = false;
   sample_ = at;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The per-channel carrier states of the vector PLL (VectorCarrier::kPll, fusion/vector_tracking.hpp).
 //
 // Which vector PLL this is. The literature has two families. (a) Absolute phase in the navigation filter
@@ -28,16 +29,15 @@
 // use the same discriminators (nu is a residual on top of the prediction, not independent of it).
 //
 // Lock: the Costas lock indicator mean(I^2 - Q^2) / mean(I^2 + Q^2) (cos 2 phi) over lock_average_s; below
-// lock_threshold for loss_time_s (after lock_average_s) the channel's phase is declared lost and it falls back to the vector FLL (the
-// filter commands the frequency alone, the channel detects bits differentially and flags its phase: LLI).
-// Units: cycles, Hz, s, samples.
+// lock_threshold for loss_time_s (after lock_average_s) the channel's phase is declared lost and it falls back to the
+// vector FLL (the filter commands the frequency alone, the channel detects bits differentially and flags its phase:
+// LLI). Units: cycles, Hz, s, samples.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cmath>
 #include <cstdint>
-
-#include <Eigen/Core>
 
 namespace ultratrack::fusion {
 

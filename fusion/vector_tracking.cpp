@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/vector_tracking.hpp"
 
 #include <algorithm>
@@ -47,9 +48,12 @@ double code_discriminator_gain(double cn0_hz, double t_s) {
 
 const char* to_string(VectorCarrier carrier) {
   switch (carrier) {
-    case VectorCarrier::kFll: return "fll";
-    case VectorCarrier::kPll: return "pll";
-    default: return "aided-pll";
+    case VectorCarrier::kFll:
+      return "fll";
+    case VectorCarrier::kPll:
+      return "pll";
+    default:
+      return "aided-pll";
   }
 }
 
@@ -166,8 +170,8 @@ std::optional<SatelliteObservable> VectorTrackingFilter::observable(const receiv
   t.troposphere = opt_.troposphere;
   t.use_range_rate = false;
   static const signals::KlobucharParameters no_iono{};
-  const auto sats = prepare_satellites(epoch, *in.ephemerides, in.iono ? *in.iono : no_iono,
-                                       ekf_->x().segment<3>(vx::kPos), t);
+  const auto sats =
+      prepare_satellites(epoch, *in.ephemerides, in.iono ? *in.iono : no_iono, ekf_->x().segment<3>(vx::kPos), t);
   if (sats.empty()) return std::nullopt;
   return sats.front();
 }
@@ -286,8 +290,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     }
     if (opt_.use_doppler && ch.has_doppler) {
       const double delta_d = static_cast<double>(in.sample - ch.doppler_sample) / in.fs_hz;
-      const double sigma_hz = std::sqrt(
-          receiver::phase_change_frequency_variance_hz2(cn0, ch.integration_time_s, ch.doppler_interval_s));
+      const double sigma_hz =
+          std::sqrt(receiver::phase_change_frequency_variance_hz2(cn0, ch.integration_time_s, ch.doppler_interval_s));
       const double sigma_rate = signals::kL1Wavelength_m * sigma_hz;
       const double z = -signals::kL1Wavelength_m * ch.measured_doppler_hz;
       const VectorRangeMeasurement m(shifted(*now, -delta_d), delta_d, true, z, sigma_rate);
@@ -357,8 +361,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       continue;
     }
     // The replica at its next epoch start, if left at its current code rate.
-    const double replica_m =
-        ch.replica_pseudorange_m + kSpeedOfLight_mps * (1.0 - ch.code_rate_chips_per_s / signals::kCaChipRate_hz) * delta_e;
+    const double replica_m = ch.replica_pseudorange_m +
+                             kSpeedOfLight_mps * (1.0 - ch.code_rate_chips_per_s / signals::kCaChipRate_hz) * delta_e;
     const double jump = (replica_m - p.pseudorange_m) / kChip_m;  // replica too far away: advance it
     log.code_jump_chips = jump;
     if (!(std::abs(jump) <= opt_.max_jump_chips)) {
@@ -377,7 +381,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       // run (no long sums, no pure PLL): its bits stay differential (coherent while phase-locked, kPll).
       const double half_epoch_s = 0.5 * (ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02);
       commands[i].carrier_frequency_hz =
-          predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s)).doppler_hz;
+          predict_replica(shifted(*now, delta_e + half_epoch_s), propagate(ekf_->x(), delta_e + half_epoch_s))
+              .doppler_hz;
       commands[i].carrier = receiver::CarrierControl::kFrequency;
       commands[i].filter_driven = opt_.filter_driven;
       if (opt_.carrier == VectorCarrier::kPll) {
@@ -390,7 +395,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
                                : std::min(ratio_hz(ch.cn0_dbhz), st.cn0_mean_hz);
         // The prediction's Doppler variance (Hz^2): the rate row's Jacobian through the covariance.
         const MeasurementJacobian<8> Hr = VectorRangeMeasurement(*now, 0.0, true, 0.0, 1.0).H(ekf_->x());
-        const double var_hz2 = (Hr * ekf_->P() * Hr.transpose())(0, 0) / (signals::kL1Wavelength_m * signals::kL1Wavelength_m);
+        const double var_hz2 =
+            (Hr * ekf_->P() * Hr.transpose())(0, 0) / (signals::kL1Wavelength_m * signals::kL1Wavelength_m);
         command_pll(ch, doppler_at, var_hz2, strong, cn0, step_s, in.fs_hz, commands[i], log);
       }
     } else {
@@ -434,9 +440,8 @@ namespace ultratrack::fusion {
 
 void VectorTrackingFilter::command_pll(const receiver::VectorChannelInput& ch,
                                        const std::function<double(std::int64_t)>& doppler_at,
-                                       double prediction_variance_hz2, bool usable_now,
-                                       double cn0_hz, double step_s, double fs_hz,
-                                       receiver::VectorChannelCommand& command, VectorChannelLog& log) {
+                                       double prediction_variance_hz2, bool usable_now, double cn0_hz, double step_s,
+                                       double fs_hz, receiver::VectorChannelCommand& command, VectorChannelLog& log) {
   VectorCarrierPhase& ph = phase_[static_cast<std::size_t>(ch.prn)];
   const double t = ch.integration_time_s > 0.0 ? ch.integration_time_s : 0.02;
   const double variance = costas_phase_variance_cycles2(cn0_hz, t);

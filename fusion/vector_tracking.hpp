@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Vector tracking without an IMU: an 8-state EKF (ECEF position, velocity, receiver clock bias and drift, in m,
 // m/s, m, m/s) with a constant-velocity process model (white acceleration) and a crystal clock model (Allan h0,
 // h-2), updated with every channel's code discriminator as a pseudorange error and its carrier Doppler as a
@@ -111,18 +112,18 @@ const char* to_string(VectorCarrier carrier);
 struct VectorTrackingOptions {
   VectorProcessNoise process;
   GateOptions gate{true, 0.9999};
-  double min_cn0_dbhz = 25.0;         // channels below are neither used nor commanded
+  double min_cn0_dbhz = 25.0;  // channels below are neither used nor commanded
   double elevation_mask_rad = 5.0 * 3.14159265358979 / 180.0;
-  bool ionosphere = true, troposphere = true;  // as the receiver's PVT (the filter's clock absorbs the rest)
-  double code_spacing_chips = 1.0;    // E-L spacing of the channels (2 x early_late_offset_chips)
-  bool use_doppler = true;            // pseudorange-rate rows
-  bool carrier_aiding = true;         // the predicted Doppler's changes aid each vector channel's PLL
+  bool ionosphere = true, troposphere = true;        // as the receiver's PVT (the filter's clock absorbs the rest)
+  double code_spacing_chips = 1.0;                   // E-L spacing of the channels (2 x early_late_offset_chips)
+  bool use_doppler = true;                           // pseudorange-rate rows
+  bool carrier_aiding = true;                        // the predicted Doppler's changes aid each vector channel's PLL
   VectorCarrier carrier = VectorCarrier::kAidedPll;  // kFll, kPll: the filter commands the carrier NCOs
-  VectorPllOptions pll;                                // kPll's per-channel carrier states
-  int join_after_updates = 25;        // accepted pseudorange updates (20 ms each) before a channel is commanded
-  int max_rejections = 10;            // consecutive gate rejections that return a channel to scalar
-  double max_jump_chips = 0.3;        // a prediction further than this from the replica returns it to scalar
-  int min_satellites = 4;             // fewer accepted channels for reset_after_s restarts the filter
+  VectorPllOptions pll;                              // kPll's per-channel carrier states
+  int join_after_updates = 25;  // accepted pseudorange updates (20 ms each) before a channel is commanded
+  int max_rejections = 10;      // consecutive gate rejections that return a channel to scalar
+  double max_jump_chips = 0.3;  // a prediction further than this from the replica returns it to scalar
+  int min_satellites = 4;       // fewer accepted channels for reset_after_s restarts the filter
   double reset_after_s = 1.0;
   // Coasting: a channel in vector mode whose signal fades (C/N0 below min_cn0_dbhz, or the channel reports
   // coasting) keeps being commanded from the prediction, without measurement updates, for at most max_coast_s
@@ -140,16 +141,16 @@ struct VectorTrackingOptions {
   // discriminators keep updating the filter below min_cn0_dbhz (down to whatever the presence test keeps), with
   // their variances from the lower of the channel's 0.2 s C/N0 and its weak_cn0_average_s running mean (linear):
   // at 22 dB-Hz the 0.2 s estimates span 16-25 dB-Hz (threshold runs) and the DLL variance grows as 1 / C/N0^2
-  // there, so an estimate reading high would give the gate far too small a sigma. Joining (join_after_updates) still needs
-  // min_cn0_dbhz. false: vector channels keep the scalar loss test and are used only above min_cn0_dbhz.
+  // there, so an estimate reading high would give the gate far too small a sigma. Joining (join_after_updates) still
+  // needs min_cn0_dbhz. false: vector channels keep the scalar loss test and are used only above min_cn0_dbhz.
   bool filter_driven = true;
   double weak_cn0_average_s = 1.0;
   // False PLL lock of a weak channel (running mean C/N0 below false_lock_below_dbhz): the mean over
-  // doppler_bias_average_s of its measured minus predicted Doppler (fusion/false_lock_monitor.hpp, kRunning). Above doppler_bias_hz its Doppler rows are left
-  // out; above false_lock_hz (after at least one averaging time) its carrier aiding steps once by that mean,
-  // putting the PLL back on the predicted frequency. Locked channels of the threshold runs kept 15 s means within
-  // 2 Hz (the PLL's own noise averaged, and the prediction's error); false locks sat at 20-25 Hz. Strong channels are left
-  // alone: in a 2 g step turn the prediction, not the PLL, is what lags.
+  // doppler_bias_average_s of its measured minus predicted Doppler (fusion/false_lock_monitor.hpp, kRunning). Above
+  // doppler_bias_hz its Doppler rows are left out; above false_lock_hz (after at least one averaging time) its carrier
+  // aiding steps once by that mean, putting the PLL back on the predicted frequency. Locked channels of the threshold
+  // runs kept 15 s means within 2 Hz (the PLL's own noise averaged, and the prediction's error); false locks sat at
+  // 20-25 Hz. Strong channels are left alone: in a 2 g step turn the prediction, not the PLL, is what lags.
   double false_lock_below_dbhz = 35.0;
   double doppler_bias_average_s = 0.5;
   double doppler_bias_hz = 4.0;
@@ -161,7 +162,7 @@ struct VectorTrackingOptions {
 // One channel's view of a vector epoch, for logs (vector.csv) and tests.
 struct VectorChannelLog {
   int prn = 0;
-  bool vector = false;               // commanded in vector mode this epoch
+  bool vector = false;                      // commanded in vector mode this epoch
   bool pr_used = false, rate_used = false;  // measurement updates accepted
   double pr_innovation_m = NAN, rate_innovation_mps = NAN;
   double pr_sigma_m = NAN, rate_sigma_mps = NAN;
@@ -169,8 +170,8 @@ struct VectorChannelLog {
   double replica_code_rate_chips_per_s = NAN, predicted_code_rate_chips_per_s = NAN;
   double code_jump_chips = NAN;
   double cn0_dbhz = NAN;
-  bool coasting = false;             // commanded from the prediction alone (faded or coasting)
-  double coast_s = 0.0;              // time since it last had a usable measurement while commanded
+  bool coasting = false;               // commanded from the prediction alone (faded or coasting)
+  double coast_s = 0.0;                // time since it last had a usable measurement while commanded
   double predicted_sigma_chips = NAN;  // 1-sigma of the predicted pseudorange
   // kPll: the channel's carrier phase closed by the filter this epoch (false: not in kPll, or fallen back to the
   // FLL); its discriminator (cycles), gated innovation, state 1-sigma, frequency residual nu (Hz), lock indicator,
@@ -187,8 +188,8 @@ struct VectorEpochLog {
   signals::GpsTime receive_time;
   VectorState x = VectorState::Zero();
   Eigen::Matrix<double, 8, 1> sigma = Eigen::Matrix<double, 8, 1>::Zero();
-  int used = 0;     // channels with an accepted pseudorange
-  int vector = 0;   // channels commanded
+  int used = 0;    // channels with an accepted pseudorange
+  int vector = 0;  // channels commanded
   std::vector<VectorChannelLog> channels;
 };
 
@@ -213,14 +214,14 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
 
  private:
   struct PrnState {
-    int accepted = 0;     // pseudorange updates accepted since it (re)joined
-    int rejections = 0;   // consecutive rejections
-    double coast_s = 0.0;  // commanded without a usable measurement (faded, coasting) this long
+    int accepted = 0;          // pseudorange updates accepted since it (re)joined
+    int rejections = 0;        // consecutive rejections
+    double coast_s = 0.0;      // commanded without a usable measurement (faded, coasting) this long
     double cn0_mean_hz = NAN;  // running mean of the channel's C/N0 estimates (ratio-Hz), while synchronised
     // Running mean of measured minus predicted Doppler over doppler_bias_average_s (its epochs: Doppler
     // measurements since the last aiding step).
     FalseLockMonitor doppler_bias{FalseLockMonitor::Averaging::kRunning, 0.5};
-    double aid_offset_hz = 0.0;    // steps given to the carrier aiding (false-lock resets)
+    double aid_offset_hz = 0.0;  // steps given to the carrier aiding (false-lock resets)
   };
   // Whether a channel's measurements may update the filter and keep it commanded as tracked (not faded).
   bool usable(const receiver::VectorChannelInput& ch, const PrnState& st) const;
@@ -232,8 +233,8 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   // command; doppler_at(sample) is the filter's predicted Doppler of the channel at a receiver sample, with error
   // variance prediction_variance_hz2.
   void command_pll(const receiver::VectorChannelInput& ch, const std::function<double(std::int64_t)>& doppler_at,
-                   double prediction_variance_hz2, bool usable_now, double cn0_hz, double step_s, double fs_hz, receiver::VectorChannelCommand& command,
-                   VectorChannelLog& log);
+                   double prediction_variance_hz2, bool usable_now, double cn0_hz, double step_s, double fs_hz,
+                   receiver::VectorChannelCommand& command, VectorChannelLog& log);
 
   VectorTrackingOptions opt_;
   VectorProcessModel model_;

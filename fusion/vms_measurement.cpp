@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion/vms_measurement.hpp"
 
 #include <cmath>
@@ -26,8 +27,14 @@ void C_bv_derivatives(double pitch, double yaw, Eigen::Matrix3d& d_pitch, Eigen:
 VmsMeasurement::VmsMeasurement(const NominalState& nominal, const OdometerNominal& odometer,
                                const Eigen::Vector3d& w_ib_b, const Eigen::Vector3d& a_b, const OdometerSpeed& speed,
                                const OdometerAidingOptions& o)
-    : nominal_(nominal), odo_(odometer), w_ib_b_(w_ib_b), a_b_(a_b), lever_b_(o.lever_arm_b),
-      half_window_s_(0.5 * speed.window_s), z_(3), R_(Eigen::MatrixXd::Zero(3, 3)) {
+    : nominal_(nominal),
+      odo_(odometer),
+      w_ib_b_(w_ib_b),
+      a_b_(a_b),
+      lever_b_(o.lever_arm_b),
+      half_window_s_(0.5 * speed.window_s),
+      z_(3),
+      R_(Eigen::MatrixXd::Zero(3, 3)) {
   z_ << speed.speed_mps, 0.0, 0.0;
   R_.diagonal() << o.sigma_forward_mps * o.sigma_forward_mps, o.sigma_lateral_mps * o.sigma_lateral_mps,
       o.sigma_vertical_mps * o.sigma_vertical_mps;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Attitude helpers: Euler angles (yaw-pitch-roll, z-y-x), body-to-NED quaternions q_nb / DCMs C_nb,
 // rotation vectors and small-angle attitude errors. Angles in radians; C_nb = Rz(yaw) Ry(pitch) Rx(roll),
 // v_n = q_nb * v_b.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Coarse (analytic) self-alignment from stationary IMU data (seed 002 eq. 17, in its levelling +
 // gyrocompassing form): roll and pitch from the mean specific force, heading from the mean body rate
 // resolved in the levelled frame. Also the closed-form alignment errors caused by sensor biases.

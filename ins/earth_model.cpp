@@ -1,5 +1,5 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "ins/earth_model.hpp"
-#include "io/units.hpp"
 
 #include <GeographicLib/Constants.hpp>
 #include <GeographicLib/Geocentric.hpp>
@@ -7,11 +7,10 @@
 #include <cmath>
 #include <numbers>
 
+#include "io/units.hpp"
+
 namespace ultratrack::ins {
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 Radii radii_of_curvature(double lat_rad) {
   const double a = GeographicLib::Constants::WGS84_a();

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // WGS-84 earth model for local-level NED navigation: radii of curvature, earth rate and transport rate
 // in the navigation frame, normal gravity (GeographicLib, gravitation + centrifugal) and geodetic <-> ECEF.
 // Units: rad, m, m/s, rad/s, m/s^2. Frames: n = NED at the point, e = ECEF.

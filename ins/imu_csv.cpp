@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "ins/imu_csv.hpp"
 
 #include <fmt/core.h>
@@ -57,9 +58,10 @@ ImuCsvForm imu_csv_form(const std::filesystem::path& file) {
     if (t.empty() || t.front() == '#') continue;
     if (header_is(t, imu_header())) return ImuCsvForm::Increments;
     if (header_is(t, rate_header())) return ImuCsvForm::Rates;
-    throw InputError(file.string(), fmt::format("bad header, expected increments '{}' or rates '{}'", joined(imu_header()),
-                                                joined(rate_header())),
-                     line_no);
+    throw InputError(
+        file.string(),
+        fmt::format("bad header, expected increments '{}' or rates '{}'", joined(imu_header()), joined(rate_header())),
+        line_no);
   }
   throw InputError(file.string(), "empty IMU file: missing header");
 }
@@ -74,9 +76,9 @@ std::vector<ImuIncrement> read_imu_csv(const std::filesystem::path& file, const 
     if (!have_prev) return;
     if (!(t > t_prev)) throw InputError(file.string(), fmt::format("time does not increase (t_s {})", t), line);
     if (t - t_prev > options.max_gap_s)
-      throw InputError(file.string(), fmt::format("a gap of {:.3f} s before t_s {} (the limit is {} s)", t - t_prev, t,
-                                                  options.max_gap_s),
-                       line);
+      throw InputError(
+          file.string(),
+          fmt::format("a gap of {:.3f} s before t_s {} (the limit is {} s)", t - t_prev, t, options.max_gap_s), line);
   };
   const auto& columns = form == ImuCsvForm::Increments ? imu_header() : rate_header();
   io::read_numeric_csv(file, "IMU file", columns, [&](int line, std::span<const double> v) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IMU CSV in either of two forms, told apart by the header:
 //   increments  `t_s,dtheta_x_rad,dtheta_y_rad,dtheta_z_rad,dv_x_mps,dv_y_mps,dv_z_mps`: one row per interval
 //               ending at t_s (what the writer writes, with round-trip precision);
@@ -20,7 +21,6 @@ class AtomicFile;
 }
 
 namespace ultratrack::ins {
-
 
 struct ImuCsvOptions {
   double max_gap_s = 1.0;  // a longer interval between rows is an error (lost data, a logger restart)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // An IMU described the way its datasheet describes it: turn-on biases, in-run bias instability with a correlation
 // time, angle and velocity random walks, scale-factor errors, each optional over a named preset. One block (the
 // `[imu]` keys of a scenario, of `fuse --config` and of `receive --fusion-config`) then describes a sensor to the

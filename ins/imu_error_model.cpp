@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "ins/imu_error_model.hpp"
 
 #include <cmath>
@@ -98,7 +99,8 @@ ImuErrorSpec make_datasheet(double gyro_bias_dps, double gyro_instability_dph, d
 
 // Datasheet presets (docs/imu_models.md gives each value's source; turn-on biases are the datasheets' initial
 // or repeatability figures taken as 1 sigma; in-run instability with the correlation time named there).
-ImuErrorSpec make_adis16405() {  // ADIS16405: 3 deg/s, 0.007 deg/s in run, 2 deg/sqrt(h); 50 mg, 0.2 mg, 0.2 m/s/sqrt(h)
+ImuErrorSpec
+make_adis16405() {  // ADIS16405: 3 deg/s, 0.007 deg/s in run, 2 deg/sqrt(h); 50 mg, 0.2 mg, 0.2 m/s/sqrt(h)
   return make_datasheet(3.0, 0.007 * 3600.0, 2.0, 50.0, 0.2, 0.2, 100.0);
 }
 ImuErrorSpec make_adis16465() {  // ADIS16465-1: 2 deg/h in run, 0.15 deg/sqrt(h); 3.6 ug in run, 0.012 m/s/sqrt(h)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IMU error models applied to ideal increments: turn-on bias, bias instability (first-order Gauss-Markov),
 // angle/velocity random walk, white noise on the integrated output, scale factor, misalignment,
 // quantisation. Named presets (`ideal`, `hg1700ae`, `dmu6x`, `navigation`, `mems`, and the datasheet parts

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Error-state corrections of a NavState, for the fusion layer's feedback. Errors are estimate minus truth:
 // position error in NED metres, velocity error in NED m/s, attitude error as the psi-angle of
 // attitude_error_n (C_nb_est = (I - [psi x]) C_nb_true). Each correction removes its error exactly for the

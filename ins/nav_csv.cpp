@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "ins/nav_csv.hpp"
 
 #include <fmt/core.h>
@@ -16,7 +17,6 @@
 
 namespace ultratrack::ins {
 namespace {
-
 
 const std::vector<std::string>& nav_header() {
   static const std::vector<std::string> h{"t_s",       "lat_deg",   "lon_deg",  "height_m",  "vel_n_mps",
@@ -56,8 +56,9 @@ NavCsvWriter::~NavCsvWriter() = default;
 
 void NavCsvWriter::write(const NavState& s) {
   const EulerAngles e = euler_from_quaternion(s.q_nb);
-  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / io::kRadPerDeg, s.lon_rad / io::kRadPerDeg, s.height_m,
-                          s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg));
+  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / io::kRadPerDeg,
+                          s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(),
+                          e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg));
 }
 
 void NavCsvWriter::commit() { out_->commit(); }

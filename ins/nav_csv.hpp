@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Navigation / truth CSV:
 // `t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,roll_deg,pitch_deg,yaw_deg`
 // (WGS-84 geodetic position, NED velocity, z-y-x Euler attitude of body to NED). Readers reject malformed
@@ -16,7 +17,6 @@ class AtomicFile;
 }
 
 namespace ultratrack::ins {
-
 
 std::vector<NavState> read_nav_csv(const std::filesystem::path& file);
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The navigation state of the strapdown INS and the IMU increment it consumes.
 // Conventions (for the fusion layer applying error-state corrections):
 //   position: geodetic WGS-84 latitude/longitude [rad], ellipsoidal height [m];

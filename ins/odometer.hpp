@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer (vehicle motion sensor, VMS) simulation from truth: wheel pulses counted over each output interval
 // with every error seed 004's filter models: a scale-factor error (eq. 1: measured distance = (1 + sf) true
 // distance), a time delay (the pulses of time t are those the wheel made at t - delay), pulse quantisation, and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Reading odometer.csv (`t_s,pulses,distance_m`, as sim/simulation_files writes it): one row per counting
 // interval ending at t_s, at a constant rate. The reader rejects (io::InputError naming the file and line) a
 // missing or other header, an empty file, NaN/inf or malformed fields, time that does not increase, negative,

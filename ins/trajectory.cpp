@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "ins/trajectory.hpp"
 
 #include <cmath>
@@ -61,21 +62,21 @@ TrajectorySpec profile_spec(std::string_view name, double duration_s, double lat
   } else if (name == "land") {
     // One cycle (230 s): speeds 0-30 m/s, two stops, right and left turns, a hill up and down.
     const std::vector<Segment> cycle{
-        {10.0},                              // stopped
-        {10.0, 2.0},                         // 0 -> 20 m/s
-        {20.0},                              // cruise
+        {10.0},                                        // stopped
+        {10.0, 2.0},                                   // 0 -> 20 m/s
+        {20.0},                                        // cruise
         {20.0, 0.0, 0.0, 0.0, 4.0 * io::kRadPerDeg},   // uphill 4 %
         {20.0, 0.0, 0.0, 0.0, -4.0 * io::kRadPerDeg},  // downhill
-        {10.0, -1.0},                        // 20 -> 10 m/s
+        {10.0, -1.0},                                  // 20 -> 10 m/s
         {10.0, 0.0, 9.0 * io::kRadPerDeg},             // 90 deg right turn
-        {10.0, 2.0},                         // 10 -> 30 m/s
-        {30.0},                              // cruise
-        {10.0, -3.0},                        // 30 -> 0 m/s
-        {10.0},                              // stopped
-        {10.0, 1.0},                         // 0 -> 10 m/s
+        {10.0, 2.0},                                   // 10 -> 30 m/s
+        {30.0},                                        // cruise
+        {10.0, -3.0},                                  // 30 -> 0 m/s
+        {10.0},                                        // stopped
+        {10.0, 1.0},                                   // 0 -> 10 m/s
         {15.0, 0.0, -6.0 * io::kRadPerDeg},            // 90 deg left turn
         {25.0, 0.0, 0.0, 0.0, 2.0 * io::kRadPerDeg},   // gentle hill
-        {10.0, -1.0},                        // 10 -> 0 m/s
+        {10.0, -1.0},                                  // 10 -> 0 m/s
     };
     double t = 0.0;
     while (t < duration_s) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Truth and exact IMU increments for a TrajectorySpec. The vehicle kinematics (speed, heading, height,
 // Euler attitude) are smooth analytic functions of the commands; position is integrated with RK4 on fine
 // sub-steps, and delta-theta / delta-v are the integrals of w_ib_b and f_b over each IMU interval on the same

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Truth at any time between simulator samples, and the motion of an antenna on the vehicle in ECEF:
 // r_ant_e = r_imu_e + C_en C_nb l_b, v_ant_e = C_en v_n + C_en C_nb (w_eb_b x l_b). Antenna position and
 // velocity are cubic-Hermite interpolated (position and velocity match at both samples), attitude is slerped.

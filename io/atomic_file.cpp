@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "io/atomic_file.hpp"
 
 #include <system_error>
@@ -8,7 +9,8 @@ namespace ultratrack::io {
 
 AtomicFile::AtomicFile(std::filesystem::path path, bool binary)
     : path_(std::move(path)), partial_path_(path_.string() + ".partial") {
-  stream_.open(partial_path_, binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
+  stream_.open(partial_path_,
+               binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
   if (!stream_) throw InputError(path_.string(), "cannot open for writing");
 }
 

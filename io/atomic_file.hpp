@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // An output file that is written completely or not at all: the content goes to "<path>.partial" and
 // commit() flushes and renames it to <path>. Destroying an uncommitted AtomicFile removes the partial
 // file, so an error or an interrupted run never leaves a half-written output under the final name.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The typed exception for bad input at the edges (files, configs, command line): it names the file,
 // optionally the line, and what is wrong. The `ultratrack` program turns it into one message and exit 2.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Text for the JSON files we write by hand (summary.json): a string's content escaped as JSON requires
 // (quote, backslash and control characters; everything else, UTF-8 included, passes through).
 #pragma once

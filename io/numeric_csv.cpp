@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "io/numeric_csv.hpp"
 
 #include <charconv>
@@ -107,8 +108,7 @@ int read_numeric_csv(const std::filesystem::path& file, std::string_view what, c
       const std::string& column = field_names[i];
       const auto v = parse_csv_number(name, line, column, fields[i]);
       if (!v) throw InputError(name, column + " is not a number: ''", line);
-      if (!std::isfinite(*v))
-        throw InputError(name, column + " is not finite: '" + std::string(fields[i]) + "'", line);
+      if (!std::isfinite(*v)) throw InputError(name, column + " is not finite: '" + std::string(fields[i]) + "'", line);
       values[i] = *v;
     }
     row(line, values);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Strict reading of numeric CSV files (IMU increments, navigation/truth rows, trajectories, segments):
 // a header row naming the columns, then rows of exactly that many finite numbers. Blank lines and lines
 // starting with '#' are skipped; anything else that is wrong is an InputError naming the file and line.

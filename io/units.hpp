@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The one degree constant of the tree: angles are radians inside, degrees only at the edges (files, command lines,
 // configuration keys with _deg in their names).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/alignment_monte_carlo.hpp"
 
 #include <cmath>
@@ -58,8 +59,8 @@ AlignmentMonteCarloResult alignment_monte_carlo(const StationaryScenario& sc, fu
   for (int i = 0; i < 3; ++i) {
     axes[i]->mean = sum(i) / runs;
     axes[i]->rms = std::sqrt(sum2(i) / runs);
-    axes[i]->std = runs > 1 ? std::sqrt(std::max(0.0, (sum2(i) - runs * axes[i]->mean * axes[i]->mean) / (runs - 1)))
-                            : 0.0;
+    axes[i]->std =
+        runs > 1 ? std::sqrt(std::max(0.0, (sum2(i) - runs * axes[i]->mean * axes[i]->mean) / (runs - 1))) : 0.0;
     axes[i]->mean_sigma = sigma(i) / runs;
   }
   return r;

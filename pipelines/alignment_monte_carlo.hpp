@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Filter-level Monte Carlo of the stationary alignment (seed 000 section IV.1, Table 2): per run, an IMU at rest
 // (closed-form earth rate and gravity increments at the IMU rate, corrupted by errors drawn from the IMU spec) and
 // GPS attitudes (the array's truth attitude plus white Euler noise at the attitude rate), aligned by
@@ -18,14 +19,14 @@
 namespace ultratrack::pipelines {
 
 struct StationaryScenario {
-  ins::EulerAngles attitude;              // IMU body relative to NED (truth)
+  ins::EulerAngles attitude;  // IMU body relative to NED (truth)
   double lat_rad = 0.0, height_m = 0.0;
   double duration_s = 100.0;
   double imu_rate_hz = 100.0;
   double attitude_rate_hz = 1.0;
-  double attitude_offset_s = 0.005;       // first attitude time (IMU rows at k / rate, k >= 1)
+  double attitude_offset_s = 0.005;  // first attitude time (IMU rows at k / rate, k >= 1)
   Eigen::Vector3d gps_sigma_euler_rad = Eigen::Vector3d::Constant(1e-3);  // white noise of each GPS attitude
-  Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();  // true mounting, array -> body
+  Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();               // true mounting, array -> body
   ins::ImuErrorSpec imu;
 };
 
@@ -39,8 +40,8 @@ StationaryInputs simulate_stationary_inputs(const StationaryScenario& scenario, 
 
 struct AxisStatistics {
   double mean = 0.0, std = 0.0, rms = 0.0;  // of the final error over the runs
-  double mean_sigma = 0.0;                 // the filter's final 1-sigma, averaged over the runs
-  int outside_3sigma = 0;                  // runs whose error exceeds 3 of their own sigma
+  double mean_sigma = 0.0;                  // the filter's final 1-sigma, averaged over the runs
+  int outside_3sigma = 0;                   // runs whose error exceeds 3 of their own sigma
 };
 
 struct AlignmentMonteCarloResult {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/alignment_run.hpp"
 
 #include <fmt/format.h>
@@ -31,11 +32,13 @@ AlignRunResult run_alignment(const std::vector<ins::ImuIncrement>& imu, const st
   const FuseConfig& c = s.config;
   if (imu.size() < 2) throw io::InputError(s.imu_file, "fewer than 2 IMU rows");
   if (!c.position_deg_m)
-    throw io::InputError("configuration", "align needs the position (latitude for gravity and earth rate): "
-                                          "--position LAT LON H or [initial] position_deg_m");
+    throw io::InputError("configuration",
+                         "align needs the position (latitude for gravity and earth rate): "
+                         "--position LAT LON H or [initial] position_deg_m");
   if (!c.attitude_gps_time_at_imu_zero)
-    throw io::InputError("command line", "align needs the GPS time of IMU t = 0: --attitude-origin WEEK TOW, "
-                                         "--imu-pps, or [attitude] gps_time_at_imu_zero");
+    throw io::InputError("command line",
+                         "align needs the GPS time of IMU t = 0: --attitude-origin WEEK TOW, "
+                         "--imu-pps, or [attitude] gps_time_at_imu_zero");
   AlignRunResult r;
   r.attitude_rows = static_cast<long long>(attitude.size());
   std::vector<fusion::GnssAttitude> gps;
@@ -94,9 +97,10 @@ AlignRunResult run_alignment(const std::vector<ins::ImuIncrement>& imu, const st
   const double g = ins::gravity_n(o.lat_rad, o.height_m).z();
   r.observability = fusion::alignment_observability(e, fusion::alignment_model_options(o.imu, o.lat_rad, g));
   if (r.observability.rank < 12 || std::abs(e.pitch_rad) > 60.0 * kDeg)
-    r.warnings.push_back(fmt::format("pitch {:.1f} deg: near 90 deg roll and yaw turn about one axis and the GPS "
-                                     "attitude observes one angle less (observability rank {} of 12)",
-                                     e.pitch_rad / kDeg, r.observability.rank));
+    r.warnings.push_back(
+        fmt::format("pitch {:.1f} deg: near 90 deg roll and yaw turn about one axis and the GPS "
+                    "attitude observes one angle less (observability rank {} of 12)",
+                    e.pitch_rad / kDeg, r.observability.rank));
 
   // The IMU's own attitude over the same span (levelling + gyrocompassing) and the mounting it implies.
   std::size_t i0 = 0, i1 = 0;
@@ -108,9 +112,9 @@ AlignRunResult run_alignment(const std::vector<ins::ImuIncrement>& imu, const st
   r.reference_attitude = ref.euler;
   const Eigen::Vector3d noise = ins::alignment_noise_sigma(o.imu, ref.duration_s, o.lat_rad, g);
   const double tilt = std::hypot(o.imu.accel.bias_sigma / g, noise.x());
-  const double heading = std::hypot(std::hypot(o.imu.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(o.lat_rad)),
-                                               tilt * std::tan(o.lat_rad)),
-                                    noise.z());
+  const double heading = std::hypot(
+      std::hypot(o.imu.gyro.bias_sigma / (ins::kEarthRate_rps * std::cos(o.lat_rad)), tilt * std::tan(o.lat_rad)),
+      noise.z());
   r.reference_sigma_rad = {tilt, tilt, heading};
   Eigen::Quaterniond q_nb_ref = ref.q_nb;
   Eigen::Matrix3d P_ref = r.reference_sigma_rad.cwiseAbs2().asDiagonal();
@@ -130,21 +134,21 @@ AlignRunResult run_alignment(const std::vector<ins::ImuIncrement>& imu, const st
   // IMU's bias explains. Small, it shows as horizontal accelerometer biases beyond the IMU's; large, the velocity
   // the INS then builds up fails the zero-velocity gate (as it would if the vehicle moved).
   if (a.zero_velocity_rejected > 0)
-    r.warnings.push_back(fmt::format("{} of {} zero-velocity updates rejected: the vehicle moved, or the GPS attitude's "
-                                     "level disagrees with the accelerometers' (the array mounted off the assumed "
-                                     "misalignment_deg? the mounting estimate is ({:.2f}, {:.2f}, {:.2f}) deg); the "
-                                     "alignment is not valid",
-                                     a.zero_velocity_rejected, a.zero_velocity_rejected + a.zero_velocity_updates,
-                                     r.mounting.angles.roll_rad / kDeg, r.mounting.angles.pitch_rad / kDeg,
-                                     r.mounting.angles.yaw_rad / kDeg));
+    r.warnings.push_back(fmt::format(
+        "{} of {} zero-velocity updates rejected: the vehicle moved, or the GPS attitude's "
+        "level disagrees with the accelerometers' (the array mounted off the assumed "
+        "misalignment_deg? the mounting estimate is ({:.2f}, {:.2f}, {:.2f}) deg); the "
+        "alignment is not valid",
+        a.zero_velocity_rejected, a.zero_velocity_rejected + a.zero_velocity_updates, r.mounting.angles.roll_rad / kDeg,
+        r.mounting.angles.pitch_rad / kDeg, r.mounting.angles.yaw_rad / kDeg));
   const double limit = 5.0 * std::max(o.imu.accel.bias_sigma, 1e-5);
   if (a.accel_bias_b.head<2>().cwiseAbs().maxCoeff() > limit)
-    r.warnings.push_back(fmt::format("horizontal accelerometer bias estimates ({:.2f}, {:.2f} mg) exceed 5 sigma of "
-                                     "the IMU's: the array is probably mounted off the assumed misalignment_deg; the "
-                                     "mounting estimate is ({:.2f}, {:.2f}, {:.2f}) deg",
-                                     a.accel_bias_b.x() / 9.80665e-3, a.accel_bias_b.y() / 9.80665e-3,
-                                     r.mounting.angles.roll_rad / kDeg, r.mounting.angles.pitch_rad / kDeg,
-                                     r.mounting.angles.yaw_rad / kDeg));
+    r.warnings.push_back(
+        fmt::format("horizontal accelerometer bias estimates ({:.2f}, {:.2f} mg) exceed 5 sigma of "
+                    "the IMU's: the array is probably mounted off the assumed misalignment_deg; the "
+                    "mounting estimate is ({:.2f}, {:.2f}, {:.2f}) deg",
+                    a.accel_bias_b.x() / 9.80665e-3, a.accel_bias_b.y() / 9.80665e-3, r.mounting.angles.roll_rad / kDeg,
+                    r.mounting.angles.pitch_rad / kDeg, r.mounting.angles.yaw_rad / kDeg));
   return r;
 }
 
@@ -173,20 +177,23 @@ std::string alignment_json(const AlignRunResult& r, const AlignSettings& s) {
   j += "  \"gyro_bias_dph\": " + vec(a.gyro_bias_b, kDegPerHour) + ",\n";
   j += "  \"sigma_gyro_bias_dph\": " + vec(sbg, kDegPerHour) + ",\n";
   j += "  \"mounting_assumed_deg\": " + vec(assumed, 1.0) + ",\n";
-  j += fmt::format("  \"mounting\": {{\"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": {:.6f}, "
-                   "\"sigma_roll_deg\": {:.6f}, \"sigma_pitch_deg\": {:.6f}, \"sigma_yaw_deg\": {:.6f}, "
-                   "\"samples\": {}, \"reference\": \"{}\", "
-                   "\"reference_deg\": [{:.6f}, {:.6f}, {:.6f}], \"reference_sigma_deg\": {}}},\n",
-                   m.angles.roll_rad / kDeg, m.angles.pitch_rad / kDeg, m.angles.yaw_rad / kDeg,
-                   m.sigma_rad.x() / kDeg, m.sigma_rad.y() / kDeg, m.sigma_rad.z() / kDeg, m.samples,
-                   s.reference_attitude ? "given reference attitude" : "IMU levelling and gyrocompassing",
-                   r.reference_attitude.roll_rad / kDeg, r.reference_attitude.pitch_rad / kDeg,
-                   r.reference_attitude.yaw_rad / kDeg, vec(r.reference_sigma_rad, kDeg));
-  j += fmt::format("  \"observability_rank\": {},\n  \"observability_singular_values\": [{}],\n",
-                   r.observability.rank, sv);
-  j += fmt::format("  \"updates\": {{\"zero_velocity\": {}, \"zero_velocity_rejected\": {}, \"attitude\": {}, \"attitude_rejected\": {}, "
-                   "\"attitude_unusable\": {}}},\n",
-                   a.zero_velocity_updates, a.zero_velocity_rejected, a.attitude_updates, a.attitude_rejected, a.attitude_unusable);
+  j += fmt::format(
+      "  \"mounting\": {{\"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": {:.6f}, "
+      "\"sigma_roll_deg\": {:.6f}, \"sigma_pitch_deg\": {:.6f}, \"sigma_yaw_deg\": {:.6f}, "
+      "\"samples\": {}, \"reference\": \"{}\", "
+      "\"reference_deg\": [{:.6f}, {:.6f}, {:.6f}], \"reference_sigma_deg\": {}}},\n",
+      m.angles.roll_rad / kDeg, m.angles.pitch_rad / kDeg, m.angles.yaw_rad / kDeg, m.sigma_rad.x() / kDeg,
+      m.sigma_rad.y() / kDeg, m.sigma_rad.z() / kDeg, m.samples,
+      s.reference_attitude ? "given reference attitude" : "IMU levelling and gyrocompassing",
+      r.reference_attitude.roll_rad / kDeg, r.reference_attitude.pitch_rad / kDeg, r.reference_attitude.yaw_rad / kDeg,
+      vec(r.reference_sigma_rad, kDeg));
+  j += fmt::format("  \"observability_rank\": {},\n  \"observability_singular_values\": [{}],\n", r.observability.rank,
+                   sv);
+  j += fmt::format(
+      "  \"updates\": {{\"zero_velocity\": {}, \"zero_velocity_rejected\": {}, \"attitude\": {}, "
+      "\"attitude_rejected\": {}, "
+      "\"attitude_unusable\": {}}},\n",
+      a.zero_velocity_updates, a.zero_velocity_rejected, a.attitude_updates, a.attitude_rejected, a.attitude_unusable);
   j += fmt::format("  \"attitude_rows\": {},\n  \"fixed_rows\": {},\n", r.attitude_rows, r.fixed_rows);
   j += "  \"imu_file\": " + io::json_string(s.imu_file) + ",\n";
   j += "  \"attitude_file\": " + io::json_string(s.attitude_file) + ",\n";
@@ -201,13 +208,13 @@ std::string alignment_csv(const AlignRunResult& r) {
       "accel_bias_x_mps2,accel_bias_y_mps2,accel_bias_z_mps2,gyro_bias_x_dph,gyro_bias_y_dph,gyro_bias_z_dph,"
       "attitude_used\n";
   for (const auto& h : r.alignment.history)
-    out += fmt::format("{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.9g},{:.9g},{:.9g},"
-                       "{:.6f},{:.6f},{:.6f},{}\n",
-                       h.t_s, h.euler.roll_rad / kDeg, h.euler.pitch_rad / kDeg, h.euler.yaw_rad / kDeg,
-                       h.sigma_euler_rad.x() / kDeg, h.sigma_euler_rad.y() / kDeg, h.sigma_euler_rad.z() / kDeg,
-                       h.v_n.x(), h.v_n.y(), h.v_n.z(), h.accel_bias_b.x(), h.accel_bias_b.y(), h.accel_bias_b.z(),
-                       h.gyro_bias_b.x() / kDegPerHour, h.gyro_bias_b.y() / kDegPerHour,
-                       h.gyro_bias_b.z() / kDegPerHour, h.attitude_used ? 1 : 0);
+    out += fmt::format(
+        "{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.9g},{:.9g},{:.9g},"
+        "{:.6f},{:.6f},{:.6f},{}\n",
+        h.t_s, h.euler.roll_rad / kDeg, h.euler.pitch_rad / kDeg, h.euler.yaw_rad / kDeg, h.sigma_euler_rad.x() / kDeg,
+        h.sigma_euler_rad.y() / kDeg, h.sigma_euler_rad.z() / kDeg, h.v_n.x(), h.v_n.y(), h.v_n.z(), h.accel_bias_b.x(),
+        h.accel_bias_b.y(), h.accel_bias_b.z(), h.gyro_bias_b.x() / kDegPerHour, h.gyro_bias_b.y() / kDegPerHour,
+        h.gyro_bias_b.z() / kDegPerHour, h.attitude_used ? 1 : 0);
   return out;
 }
 
@@ -226,7 +233,8 @@ AlignmentFileStart read_alignment_json(const std::filesystem::path& file) {
     const char* start = text.c_str() + p + k.size();
     char* end = nullptr;
     const double v = std::strtod(start, &end);
-    if (end == start || !std::isfinite(v)) throw io::InputError(name, std::string("\"") + key + "\" is not a finite number");
+    if (end == start || !std::isfinite(v))
+      throw io::InputError(name, std::string("\"") + key + "\" is not a finite number");
     return v;
   };
   // "key": [x, y, z]
@@ -235,7 +243,9 @@ AlignmentFileStart read_alignment_json(const std::filesystem::path& file) {
     const auto p = text.find(k);
     if (p == std::string::npos) return std::nullopt;
     const char* c = text.c_str() + p + k.size();
-    const auto bad = [&] { return io::InputError(name, std::string("\"") + key + "\" is not a list of 3 finite numbers"); };
+    const auto bad = [&] {
+      return io::InputError(name, std::string("\"") + key + "\" is not a list of 3 finite numbers");
+    };
     while (*c == ' ') ++c;
     if (*c++ != '[') throw bad();
     Eigen::Vector3d v;
@@ -252,14 +262,14 @@ AlignmentFileStart read_alignment_json(const std::filesystem::path& file) {
   AlignmentFileStart f;
   f.attitude_deg = {number("roll_deg"), number("pitch_deg"), number("yaw_deg")};
   f.sigma_attitude_deg = {number("sigma_roll_deg"), number("sigma_pitch_deg"), number("sigma_yaw_deg")};
-  if (!(f.sigma_attitude_deg.array() > 0.0).all())
-    throw io::InputError(name, "attitude sigmas must be positive");
+  if (!(f.sigma_attitude_deg.array() > 0.0).all()) throw io::InputError(name, "attitude sigmas must be positive");
   const auto ba = vector3("accel_bias_mps2"), sba = vector3("sigma_accel_bias_mps2");
   const auto bg = vector3("gyro_bias_dph"), sbg = vector3("sigma_gyro_bias_dph");
   const int given = int(ba.has_value()) + int(sba.has_value()) + int(bg.has_value()) + int(sbg.has_value());
   if (given != 0 && given != 4)
-    throw io::InputError(name, "accel_bias_mps2, sigma_accel_bias_mps2, gyro_bias_dph and sigma_gyro_bias_dph go "
-                               "together (all or none)");
+    throw io::InputError(name,
+                         "accel_bias_mps2, sigma_accel_bias_mps2, gyro_bias_dph and sigma_gyro_bias_dph go "
+                         "together (all or none)");
   if (given == 4) {
     if (!(sba->array() > 0.0).all() || !(sbg->array() > 0.0).all())
       throw io::InputError(name, "bias sigmas must be positive");

@@ -1,11 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The work of `ultratrack align`, callable in process: an IMU at rest and a multi-antenna receiver's attitude.csv
 // through seed 000's stationary alignment (fusion/stationary_alignment.hpp), with the observability of the final
 // attitude (fusion/alignment_observability.hpp, a warning near pitch 90 deg), the array's mounting on the IMU
 // (fusion/mounting_misalignment.hpp: mean GPS attitude against the IMU's own levelling and gyrocompassing over the
-// same span, or against a given reference attitude), and the files: alignment.json (the result) and alignment.csv (one row per filter epoch).
-// The settings come from `fuse`'s configuration keys: [imu] (the filter's error model), [initial] position_deg_m
-// (needed: latitude and gravity), [attitude] gps_time_at_imu_zero, misalignment_deg (the mounting assumed),
-// max_pitch_deg, [filter] ukf_* and gate keys. Times on the IMU time line (s); angles rad inside, deg in files.
+// same span, or against a given reference attitude), and the files: alignment.json (the result) and alignment.csv (one
+// row per filter epoch). The settings come from `fuse`'s configuration keys: [imu] (the filter's error model),
+// [initial] position_deg_m (needed: latitude and gravity), [attitude] gps_time_at_imu_zero, misalignment_deg (the
+// mounting assumed), max_pitch_deg, [filter] ukf_* and gate keys. Times on the IMU time line (s); angles rad inside,
+// deg in files.
 #pragma once
 
 #include <filesystem>
@@ -39,7 +41,7 @@ struct AlignRunResult {
   fusion::StationaryAlignmentResult alignment;
   fusion::ObservabilityReport observability;
   fusion::MountingEstimate mounting;
-  ins::EulerAngles reference_attitude;               // the IMU's own levelling + gyrocompassing, or the given one
+  ins::EulerAngles reference_attitude;  // the IMU's own levelling + gyrocompassing, or the given one
   Eigen::Vector3d reference_sigma_rad = Eigen::Vector3d::Zero();
   std::vector<std::string> warnings;
   long long attitude_rows = 0, fixed_rows = 0, rows_in_span = 0;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/attitude_file.hpp"
 
 #include <fmt/core.h>
@@ -19,18 +20,21 @@ namespace ultratrack::pipelines {
 AttitudeFileResult attitude_file(AttitudeFileJob job, std::stop_token stop, const AttitudeProgressCallback& progress) {
   const std::size_t n_ant = job.solver.array.lever_arm_body_m.size();
   if (job.inputs.size() != n_ant)
-    throw signals::InputError("inputs", fmt::format("{} files for the {} antennas of the array", job.inputs.size(), n_ant));
+    throw signals::InputError("inputs",
+                              fmt::format("{} files for the {} antennas of the array", job.inputs.size(), n_ant));
   receiver::ReceiverOptions& options = job.options;
   options.num_antennas = static_cast<int>(n_ant);
   if (options.reference_week == 0 && job.navigation.ephemerides.empty())
-    throw signals::InputError("options", "give navigation data or a reference week (the full GPS week of the recording)");
+    throw signals::InputError("options",
+                              "give navigation data or a reference week (the full GPS week of the recording)");
   date_recording(options, job.navigation, 0);
   if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError("options", why);
   if (job.duration_s < 0.0) throw signals::InputError("options", "duration: must not be negative");
 
   receiver::MultiSampleSource source(job.inputs, job.format, job.source);
   std::int64_t to_process = source.total_samples();
-  if (job.duration_s > 0.0) to_process = std::min<std::int64_t>(to_process, std::llround(job.duration_s * options.fs_hz));
+  if (job.duration_s > 0.0)
+    to_process = std::min<std::int64_t>(to_process, std::llround(job.duration_s * options.fs_hz));
 
   receiver::AttitudeOutputs outputs(job.out, options.fs_hz, options.observation_interval_s, job.solver,
                                     job.line_bias_cycles);

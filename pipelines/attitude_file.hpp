@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Several recordings of one antenna array received into an output folder: the whole of `ultratrack attitude`
 // below its command line, for programs, tests and bindings. The files (one per antenna, master first, recorded on
 // one clock) are read sample-synchronously (receiver/multi_sample_source.hpp) in 50 ms blocks; the scalar receiver
@@ -25,14 +26,14 @@ namespace ultratrack::pipelines {
 struct AttitudeFileJob {
   std::vector<std::filesystem::path> inputs;  // one per antenna of solver.array, master first
   signals::SampleFormat format = signals::SampleFormat::i8;
-  receiver::SampleSourceOptions source;      // fs_hz, if_hz
+  receiver::SampleSourceOptions source;  // fs_hz, if_hz
   // fs_hz = source.fs_hz; num_antennas is set from inputs; reference_week 0: the navigation's (date_recording).
   receiver::ReceiverOptions options;
-  receiver::AttitudeSolverOptions solver;    // the array (lever arms) and the solver's settings
-  std::vector<double> line_bias_cycles;      // per antenna
-  signals::RinexNavData navigation;          // hot start (may be empty)
-  double duration_s = 0.0;                   // seconds of signal to process; 0: to the end
-  std::filesystem::path out;                 // created when missing
+  receiver::AttitudeSolverOptions solver;  // the array (lever arms) and the solver's settings
+  std::vector<double> line_bias_cycles;    // per antenna
+  signals::RinexNavData navigation;        // hot start (may be empty)
+  double duration_s = 0.0;                 // seconds of signal to process; 0: to the end
+  std::filesystem::path out;               // created when missing
 };
 
 struct AttitudeFileResult {

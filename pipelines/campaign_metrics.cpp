@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/campaign_metrics.hpp"
 
 #include <fmt/core.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // What a campaign run computes from its output files (lock outcomes, nav z-scores). Written per run, so that a
 // report can be redone from the run folders alone:
 //   lock outcomes   each simulated satellite of a receive classified from tracking.csv (the tracking threshold);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A campaign's runs: the product of its parameter axes, and its templates filled in per run. The order is fixed
 // (the first axis outermost, the last varying fastest), each run numbered 0..N-1 and carrying one value of every
 // parameter as text. An axis may carry zipped columns (parameters that vary with it, one value per axis value: e.g. a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A campaign's report: what is complete, failed and missing, and the tables the campaign asks for. They reduce
 // whatever runs are complete (pipelines/campaign_run.hpp's folders). The reductions print the tables the
 // benchmark scripts printed (benchmarks/tracking_threshold.sh, ultratight_consistency.sh), in the same format:

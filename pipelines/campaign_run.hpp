@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One campaign run into its own folder, its completion marker written last. It simulates a scenario (or takes a
 // recording), receives it in process (pipelines/receive_file.hpp) and computes what the campaign asks
 // (pipelines/campaign_metrics.hpp). A run folder holds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The coupling of a receive run: fusion::Coupling (fusion/coupling.hpp, the one coupling enum of the tree), named
 // here as the pipelines use it.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/format_diagnosis.hpp"
 
 #include <fmt/core.h>
@@ -63,8 +64,8 @@ FormatDiagnosis diagnose_sample_format(const std::filesystem::path& input, signa
       if (better_than_best && n >= kMinimumSatellites && n >= d.detected_as_given + kMargin) {
         best = found;
         d.better_prns = found.prns;
-        d.better_flags = fmt::format("--2bit-coding {} --2bit-order {}", signals::to_string(coding),
-                                     signals::to_string(order));
+        d.better_flags =
+            fmt::format("--2bit-coding {} --2bit-order {}", signals::to_string(coding), signals::to_string(order));
       }
     }
   return d;

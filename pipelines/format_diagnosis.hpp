@@ -1,10 +1,12 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Why a recording yields nothing: when the receiver tracks no satellite, the likeliest cause is a sample convention
 // the user gave wrong, and the one a receiver can test cheaply is the 2-bit packing (coding and bit order of r2/i2
 // files: a wrong one scrambles every sample, yet the level histogram looks right). The first 10 ms are searched
 // (FFT acquisition, 10 x 1 ms non-coherent, pfa 1e-3 per PRN) with the layout as given and with every other layout;
 // a layout that detects at least 4 satellites, and 3 more than the given one, is named with the flags that select
-// it (the most satellites; among as many, the strongest peaks: a bit order read backwards still detects many). I/Q swap and Q negation are not diagnosed: they mirror the spectrum, and acquisition finds the satellites
-// either way (at mirrored Dopplers), so they cannot be the reason nothing is tracked.
+// it (the most satellites; among as many, the strongest peaks: a bit order read backwards still detects many). I/Q swap
+// and Q negation are not diagnosed: they mirror the spectrum, and acquisition finds the satellites either way (at
+// mirrored Dopplers), so they cannot be the reason nothing is tracked.
 #pragma once
 
 #include <filesystem>
@@ -18,7 +20,7 @@ namespace ultratrack::pipelines {
 
 struct FormatDiagnosis {
   int detected_as_given = 0;
-  std::string better_flags;  // e.g. "--2bit-coding sign-magnitude --2bit-order msb-first"; empty: none better
+  std::string better_flags;      // e.g. "--2bit-coding sign-magnitude --2bit-order msb-first"; empty: none better
   std::vector<int> better_prns;  // what the better layout detects
 };
 

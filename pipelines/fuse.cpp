@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/fuse.hpp"
 
 #include <fmt/core.h>
@@ -16,7 +17,6 @@
 
 namespace ultratrack::pipelines {
 namespace {
-
 
 // GNSS position/velocity linearly interpolated at t (clamped to the fixes' span).
 struct GnssState {
@@ -155,8 +155,9 @@ std::vector<TimedAttitude> timed_attitudes(const FuseSettings& s, double imu_sta
   if (s.attitude.empty()) return out;
   const auto& origin = s.config.attitude_gps_time_at_imu_zero;
   if (!origin)
-    throw io::InputError("configuration", "GPS attitude needs the GPS time of IMU t = 0: [attitude] "
-                                          "gps_time_at_imu_zero = [week, tow_s] or --attitude-origin WEEK TOW");
+    throw io::InputError("configuration",
+                         "GPS attitude needs the GPS time of IMU t = 0: [attitude] "
+                         "gps_time_at_imu_zero = [week, tow_s] or --attitude-origin WEEK TOW");
   for (const auto& r : s.attitude) {
     if (!r.fixed) continue;
     TimedAttitude t;
@@ -186,12 +187,14 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
   const bool odometer_only = gnss.empty() && !s.odometer.empty();
   if (gnss.empty() && !odometer_only) throw io::InputError("GNSS file", "no fixes");
   if (odometer_only && (s.align != AlignMode::Config || !c.position_deg_m))
-    throw io::InputError("command line", "without --gnss the start is the configuration's: --align config with "
-                                         "[initial] attitude_deg, position_deg_m (and velocity_ned_mps)");
+    throw io::InputError("command line",
+                         "without --gnss the start is the configuration's: --align config with "
+                         "[initial] attitude_deg, position_deg_m (and velocity_ned_mps)");
   const double imu_start = imu[0].t_s - (imu[1].t_s - imu[0].t_s);  // the first row's interval start
   if (!odometer_only && (gnss.back().t_s <= imu_start || gnss.front().t_s >= imu.back().t_s))
-    throw io::InputError("GNSS file", fmt::format("fixes ({:.3f}-{:.3f} s) do not overlap the IMU data ({:.3f}-{:.3f} s)",
-                                                  gnss.front().t_s, gnss.back().t_s, imu_start, imu.back().t_s));
+    throw io::InputError("GNSS file",
+                         fmt::format("fixes ({:.3f}-{:.3f} s) do not overlap the IMU data ({:.3f}-{:.3f} s)",
+                                     gnss.front().t_s, gnss.back().t_s, imu_start, imu.back().t_s));
   const ins::ImuErrorSpec preset = imu_error_spec(c);
   const fusion::AttitudeAidingOptions attitude_options = attitude_aiding_options(c);
   const std::vector<TimedAttitude> attitude = timed_attitudes(s, imu_start, imu.back().t_s);
@@ -205,11 +208,13 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     const std::size_t end = static_span_end(imu, imu_start, c, "IMU file");
     start = align_static(std::span(imu).first(end), imu_start, lat_hint, preset);
     if (start.heading_sigma_rad > 10.0 * io::kRadPerDeg)
-      start.note += fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
-                                start.heading_sigma_rad / io::kRadPerDeg);
+      start.note +=
+          fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
+                      start.heading_sigma_rad / io::kRadPerDeg);
   } else if (s.align == AlignMode::Motion) {
     // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
-    const bool position_only = std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
+    const bool position_only =
+        std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
     const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
     std::vector<fusion::GnssVelocitySample> velocities = gnss_velocities(gnss);
     if (s.gnss_until_s)  // the alignment too uses GNSS only until then
@@ -232,9 +237,10 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       return a.t_s >= from && a.t_s < imu.back().t_s && fusion::attitude_usable(a.attitude, attitude_options);
     });
     if (it == attitude.end())
-      throw AlignmentUnavailable(s.attitude_file + ": " + fmt::format("--align attitude: no fixed attitude within the IMU and GNSS "
-                                                        "data ({:.3f}-{:.3f} s)",
-                                                        from, imu.back().t_s));
+      throw AlignmentUnavailable(s.attitude_file + ": " +
+                                 fmt::format("--align attitude: no fixed attitude within the IMU and GNSS "
+                                             "data ({:.3f}-{:.3f} s)",
+                                             from, imu.back().t_s));
     start.t_s = it->t_s;
     start.q_nb = fusion::measured_q_nb(it->attitude, attitude_options.q_ba);
     // One GPS attitude's accuracy: its Euler sigmas as NED rotation sigmas (fusion/attitude_measurement.hpp).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The work of `ultratrack fuse`, callable in process (tests, figures): external GNSS fixes and IMU increments
 // through fusion::GnssInsIntegration (loose, EKF or UKF) after a coarse alignment (static: levelling +
 // gyrocompassing over the first seconds; motion: heading from the GNSS track, tilt from the accelerometers;
@@ -24,9 +25,9 @@
 #include <vector>
 
 #include "fusion/gnss_ins_integration.hpp"
-#include "ins/odometer.hpp"
 #include "ins/attitude.hpp"
 #include "ins/nav_state.hpp"
+#include "ins/odometer.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "pipelines/fuse_config.hpp"
 #include "pipelines/fuse_inputs.hpp"
@@ -57,7 +58,7 @@ struct FuseSettings {
 
 // Odometer aiding's account (seed 004's metric: error / distance travelled since GNSS was last used, in %).
 struct OdometerUse {
-  long long windows = 0;  // odometer windows handed to the filter
+  long long windows = 0;              // odometer windows handed to the filter
   fusion::OdometerEstimate estimate;  // at the end
   double gnss_last_used_s = 0.0;      // the last fix handed to the filter (else the navigation start)
   // Against truth, from gnss_last_used_s to the end (nothing without truth or without distance travelled):
@@ -71,7 +72,7 @@ struct AttitudeUse {
   long long before_start = 0;     // at or before the navigation start (the alignment's row among them)
   long long after_end = 0;        // after the last IMU row
   long long in_outage = 0;
-  long long used = 0;             // handed to the filter
+  long long used = 0;  // handed to the filter
 };
 
 struct ErrorRms {

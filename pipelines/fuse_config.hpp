@@ -1,7 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The navigation settings shared by `fuse` and `receive --coupling loose|tight|ultra-tight` (the TOML keys of
-// config/fuse_config_toml.hpp fill it): the IMU error preset and datasheet values, the initial state and its 1-sigmas, the alignment spans,
-// the GNSS fix weights and lever arm, the filter's UKF and gate parameters, the receiver clock's oscillator and
-// height aiding (tight), and GPS attitude's time origin and misalignment. Units: SI except where the name says deg.
+// config/fuse_config_toml.hpp fill it): the IMU error preset and datasheet values, the initial state and its 1-sigmas,
+// the alignment spans, the GNSS fix weights and lever arm, the filter's UKF and gate parameters, the receiver clock's
+// oscillator and height aiding (tight), and GPS attitude's time origin and misalignment. Units: SI except where the
+// name says deg.
 #pragma once
 
 #include <Eigen/Core>
@@ -17,10 +19,10 @@ namespace ultratrack::pipelines {
 
 struct FuseConfig {
   std::string imu_preset = "hg1700ae";
-  ins::ImuDatasheet imu_datasheet;  // [imu] datasheet keys over the preset
-  double imu_max_gap_s = 1.0;       // [imu] max_gap_s: a longer gap between IMU rows is an input error
-  std::optional<Eigen::Vector3d> attitude_deg;    // roll, pitch, yaw
-  std::optional<Eigen::Vector3d> position_deg_m;  // lat_deg, lon_deg, height_m
+  ins::ImuDatasheet imu_datasheet;                  // [imu] datasheet keys over the preset
+  double imu_max_gap_s = 1.0;                       // [imu] max_gap_s: a longer gap between IMU rows is an input error
+  std::optional<Eigen::Vector3d> attitude_deg;      // roll, pitch, yaw
+  std::optional<Eigen::Vector3d> position_deg_m;    // lat_deg, lon_deg, height_m
   std::optional<Eigen::Vector3d> velocity_ned_mps;  // --align config without GNSS velocity (receive --imu)
   std::optional<Eigen::Vector3d> sigma_position_m, sigma_velocity_mps, sigma_attitude_deg;
   // IMU biases already estimated (`ultratrack align`'s alignment.json), body axes, with their 1-sigma: the filter
@@ -31,7 +33,7 @@ struct FuseConfig {
   double motion_min_speed_mps = 5.0;
   double motion_window_s = 2.0;
   double velocity_sigma_mps = 0.1;
-  double fix_min_interval_s = 0.0;  // [gnss] update_interval_s: a decorrelating interval between fixes used
+  double fix_min_interval_s = 0.0;       // [gnss] update_interval_s: a decorrelating interval between fixes used
   double fix_error_correlation_s = 0.0;  // [gnss] error_correlation_time_s: fixes' errors Gauss-Markov (0: white)
   bool use_velocity = true;
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();
@@ -48,7 +50,7 @@ struct FuseConfig {
   double attitude_max_pitch_deg = 80.0;
   std::string clock_oscillator = "tcxo";
   fusion::OscillatorAllan clock_allan = *fusion::oscillator_preset("tcxo");  // preset, then h0 / h_minus2
-  std::optional<double> clock_allan_h0, clock_allan_hm2;  // as given in the file
+  std::optional<double> clock_allan_h0, clock_allan_hm2;                     // as given in the file
   fusion::HeightAidingOptions height_aiding;
 };
 

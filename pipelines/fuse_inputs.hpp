@@ -1,7 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The external measurements `fuse` takes besides the IMU increments: GNSS fixes on the IMU time line (a geodetic
 // antenna position, optional NED velocity, NED position 1-sigmas) and GPS attitude rows of a multi-antenna receiver
-// (GPS time tags; angles of the antenna-array frame relative to NED). pipelines/gnss_fix_csv.hpp and pipelines/gps_attitude_csv.hpp
-// read them from files. Units: rad, m, m/s, s.
+// (GPS time tags; angles of the antenna-array frame relative to NED). pipelines/gnss_fix_csv.hpp and
+// pipelines/gps_attitude_csv.hpp read them from files. Units: rad, m, m/s, s.
 #pragma once
 
 #include <Eigen/Core>
@@ -22,7 +23,7 @@ struct GnssFixRow {
 struct GpsAttitudeRow {
   int line = 0;  // in the file, for messages
   signals::GpsTime time;
-  ins::EulerAngles euler;                                      // rad (nan when not fixed)
+  ins::EulerAngles euler;  // rad (nan when not fixed)
   double sigma_roll_rad = 0.0, sigma_pitch_rad = 0.0, sigma_yaw_rad = 0.0;
   int num_sats = 0;
   bool fixed = false;

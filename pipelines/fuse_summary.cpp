@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/fuse_summary.hpp"
 
 #include <fmt/core.h>
@@ -27,7 +28,8 @@ std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounter
       n.odometer_rejected, n.odometer_gated_yaw_rate, n.odometer_gated_speed, n.odometer_unusable);
   j += fmt::format(
       "\"scale_factor\": {:.6g}, \"sigma_scale_factor\": {:.6g}, \"misalignment_pitch_deg\": {:.6g}, "
-      "\"sigma_misalignment_pitch_deg\": {:.6g}, \"misalignment_yaw_deg\": {:.6g}, \"sigma_misalignment_yaw_deg\": {:.6g}, "
+      "\"sigma_misalignment_pitch_deg\": {:.6g}, \"misalignment_yaw_deg\": {:.6g}, \"sigma_misalignment_yaw_deg\": "
+      "{:.6g}, "
       "\"delay_s\": {:.6g}, \"sigma_delay_s\": {:.6g}, ",
       v.scale_factor, sd.scale_factor, v.pitch_rad / io::kRadPerDeg, sd.pitch_rad / io::kRadPerDeg,
       v.yaw_rad / io::kRadPerDeg, sd.yaw_rad / io::kRadPerDeg, v.delay_s, sd.delay_s);
@@ -60,18 +62,22 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   };
   const char* align = to_string(s.align);
   std::string j = "{\n";
-  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", io::json_escape(imu_file), io::json_escape(gnss_file));
+  j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", io::json_escape(imu_file),
+                   io::json_escape(gnss_file));
   if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", io::json_escape(truth_file));
-  j += fmt::format("  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
-                   s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
+  j += fmt::format(
+      "  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
+      s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);
   j += "  \"imu_model\": " + imu_model_json(s.config) + ",\n";
-  j += fmt::format("  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
-                   "\"yaw_deg\": {:.6f}}},\n",
-                   io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / io::kRadPerDeg,
-                   r.initial_attitude.pitch_rad / io::kRadPerDeg, r.initial_attitude.yaw_rad / io::kRadPerDeg);
+  j += fmt::format(
+      "  \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
+      "\"yaw_deg\": {:.6f}}},\n",
+      io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / io::kRadPerDeg,
+      r.initial_attitude.pitch_rad / io::kRadPerDeg, r.initial_attitude.yaw_rad / io::kRadPerDeg);
   j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
-  j += fmt::format("  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
-                   r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
+  j += fmt::format(
+      "  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",
+      r.counters.imu_steps, r.fixes_used, r.fixes_before_start, r.fixes_in_outage);
   j += fmt::format("  \"updates_accepted\": {},\n  \"updates_rejected\": {},\n  \"fixes_late\": {},\n",
                    r.counters.accepted, r.counters.rejected, r.counters.late);
   j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
@@ -91,39 +97,43 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
     const AttitudeUse& a = r.attitude;
     const auto& n = r.counters;
     const Eigen::Vector3d& m = s.config.attitude_misalignment_deg;
-    j += fmt::format("  \"attitude\": {{\"file\": \"{}\", \"rows\": {}, \"fixed_rows\": {}, \"unfixed_skipped\": {}, "
-                     "\"before_start\": {}, \"after_end\": {}, \"in_outage\": {}, \"used\": {}, \"updates\": {}, "
-                     "\"updates_accepted\": {}, \"updates_rejected\": {}, \"rejected_near_vertical\": {}, \"late\": {}, "
-                     "\"fallback_fixes\": {}, \"misalignment_deg\": [{}, {}, {}], \"max_pitch_deg\": {}}},\n",
-                     io::json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start,
-                     a.after_end, a.in_outage, a.used, n.attitude_epochs, n.attitude_accepted, n.attitude_rejected,
-                     n.attitude_unusable, n.attitude_late, n.fixes_without_attitude, m.x(), m.y(), m.z(),
-                     s.config.attitude_max_pitch_deg);
+    j += fmt::format(
+        "  \"attitude\": {{\"file\": \"{}\", \"rows\": {}, \"fixed_rows\": {}, \"unfixed_skipped\": {}, "
+        "\"before_start\": {}, \"after_end\": {}, \"in_outage\": {}, \"used\": {}, \"updates\": {}, "
+        "\"updates_accepted\": {}, \"updates_rejected\": {}, \"rejected_near_vertical\": {}, \"late\": {}, "
+        "\"fallback_fixes\": {}, \"misalignment_deg\": [{}, {}, {}], \"max_pitch_deg\": {}}},\n",
+        io::json_escape(s.attitude_file), a.rows, a.fixed_rows, a.unfixed_skipped, a.before_start, a.after_end,
+        a.in_outage, a.used, n.attitude_epochs, n.attitude_accepted, n.attitude_rejected, n.attitude_unusable,
+        n.attitude_late, n.fixes_without_attitude, m.x(), m.y(), m.z(), s.config.attitude_max_pitch_deg);
   }
   j += fmt::format("  \"converged\": {},\n  \"converged_at_s\": {},\n", r.converged_at_s.has_value(),
                    r.converged_at_s ? fmt::format("{}", *r.converged_at_s) : std::string("null"));
   j += fmt::format("  \"convergence_heading_sigma_deg\": {},\n", s.config.convergence_heading_sigma_deg);
   const NavSigma& g = r.final_sigma;
-  j += fmt::format("  \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, \"vel_mps\": {:.6g}, "
-                   "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
-                   g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
-                   g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg, g.attitude_ned_rad.z() / io::kRadPerDeg);
+  j += fmt::format(
+      "  \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, \"vel_mps\": {:.6g}, "
+      "\"tilt_n_deg\": {:.6g}, \"tilt_e_deg\": {:.6g}, \"heading_deg\": {:.6g}}},\n",
+      g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
+      g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg,
+      g.attitude_ned_rad.z() / io::kRadPerDeg);
   constexpr double kMg = 9.80665e-3, kDph = io::kRadPerDeg / 3600.0;
   auto triple = [](const Eigen::Vector3d& v, double unit) {
     return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x() / unit, v.y() / unit, v.z() / unit);
   };
-  j += fmt::format("  \"bias_estimates\": {{\"accel_mg\": {}, \"sigma_accel_mg\": {}, \"gyro_dph\": {}, "
-                   "\"sigma_gyro_dph\": {}}},\n",
-                   triple(r.accel_bias_b, kMg), triple(r.sigma_accel_bias_b, kMg), triple(r.gyro_bias_b, kDph),
-                   triple(r.sigma_gyro_bias_b, kDph));
+  j += fmt::format(
+      "  \"bias_estimates\": {{\"accel_mg\": {}, \"sigma_accel_mg\": {}, \"gyro_dph\": {}, "
+      "\"sigma_gyro_dph\": {}}},\n",
+      triple(r.accel_bias_b, kMg), triple(r.sigma_accel_bias_b, kMg), triple(r.gyro_bias_b, kDph),
+      triple(r.sigma_gyro_bias_b, kDph));
   if (r.rms_all) j += "  \"rms_all\": " + rms_json(*r.rms_all) + ",\n";
   if (r.rms_converged) j += "  \"rms_converged\": " + rms_json(*r.rms_converged) + ",\n";
   if (r.gnss_rms) j += "  \"gnss_only_rms\": " + rms_json(*r.gnss_rms) + ",\n";
   j += "  \"outages\": [";
   for (std::size_t i = 0; i < r.outages.size(); ++i)
-    j += fmt::format("{}{{\"start_s\": {}, \"end_s\": {}, \"horizontal_error_m\": {:.6g}, \"sigma_horizontal_m\": {:.6g}}}",
-                     i ? ", " : "", r.outages[i].start_s, r.outages[i].end_s, r.outages[i].horizontal_error_m,
-                     r.outages[i].sigma_horizontal_m);
+    j += fmt::format(
+        "{}{{\"start_s\": {}, \"end_s\": {}, \"horizontal_error_m\": {:.6g}, \"sigma_horizontal_m\": {:.6g}}}",
+        i ? ", " : "", r.outages[i].start_s, r.outages[i].end_s, r.outages[i].horizontal_error_m,
+        r.outages[i].sigma_horizontal_m);
   j += "]\n}\n";
   return j;
 }

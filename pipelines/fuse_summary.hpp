@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // summary.json of a `fuse` run (pipelines/fuse.hpp): the inputs, alignment, update counts, GPS attitude use,
 // convergence, final 1-sigmas and the RMS errors against truth. Angles in degrees, the rest SI.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/fused_nav_csv.hpp"
 
 #include <fmt/core.h>
@@ -15,20 +16,18 @@
 namespace ultratrack::pipelines {
 namespace {
 
-
 const std::vector<std::string>& header() {
   static const std::vector<std::string> h{
-      "t_s",          "lat_deg",      "lon_deg",      "height_m",        "vel_n_mps",       "vel_e_mps",
-      "vel_d_mps",    "roll_deg",     "pitch_deg",    "yaw_deg",         "sigma_n_m",       "sigma_e_m",
-      "sigma_d_m",    "sigma_vn_mps", "sigma_ve_mps", "sigma_vd_mps",    "sigma_att_n_deg", "sigma_att_e_deg",
-      "sigma_att_d_deg"};
+      "t_s",          "lat_deg",         "lon_deg",         "height_m",       "vel_n_mps",
+      "vel_e_mps",    "vel_d_mps",       "roll_deg",        "pitch_deg",      "yaw_deg",
+      "sigma_n_m",    "sigma_e_m",       "sigma_d_m",       "sigma_vn_mps",   "sigma_ve_mps",
+      "sigma_vd_mps", "sigma_att_n_deg", "sigma_att_e_deg", "sigma_att_d_deg"};
   return h;
 }
 
 }  // namespace
 
-FusedNavCsvWriter::FusedNavCsvWriter(const std::filesystem::path& file)
-    : out_(std::make_unique<io::AtomicFile>(file)) {
+FusedNavCsvWriter::FusedNavCsvWriter(const std::filesystem::path& file) : out_(std::make_unique<io::AtomicFile>(file)) {
   std::string h;
   for (const auto& n : header()) h += (h.empty() ? "" : ",") + n;
   out_->write(h + "\n");
@@ -38,11 +37,13 @@ FusedNavCsvWriter::~FusedNavCsvWriter() = default;
 
 void FusedNavCsvWriter::write(const ins::NavState& s, const NavSigma& g) {
   const ins::EulerAngles e = ins::euler_from_quaternion(s.q_nb);
-  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.t_s, s.lat_rad / io::kRadPerDeg,
-                          s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / io::kRadPerDeg,
-                          e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg, g.position_ned_m.x(), g.position_ned_m.y(),
-                          g.position_ned_m.z(), g.velocity_ned_mps.x(), g.velocity_ned_mps.y(), g.velocity_ned_mps.z(),
-                          g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg, g.attitude_ned_rad.z() / io::kRadPerDeg));
+  out_->write(fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.t_s,
+                          s.lat_rad / io::kRadPerDeg, s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(),
+                          s.v_n.z(), e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg,
+                          e.yaw_rad / io::kRadPerDeg, g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(),
+                          g.velocity_ned_mps.x(), g.velocity_ned_mps.y(), g.velocity_ned_mps.z(),
+                          g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg,
+                          g.attitude_ned_rad.z() / io::kRadPerDeg));
 }
 
 void FusedNavCsvWriter::commit() { out_->commit(); }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/gnss_fix_csv.hpp"
 
 #include <fmt/core.h>
@@ -29,7 +30,8 @@ bool parse_field(const std::string& file, int line, int column, std::string_view
   const auto& name = gnss_header()[static_cast<std::size_t>(column)];
   const auto v = io::parse_csv_number(file, line, name, field);
   if (!v) return false;
-  if (!std::isfinite(*v)) throw io::InputError(file, fmt::format("{} is not finite: '{}'", name, io::trim(field)), line);
+  if (!std::isfinite(*v))
+    throw io::InputError(file, fmt::format("{} is not finite: '{}'", name, io::trim(field)), line);
   out = *v;
   return true;
 }
@@ -54,8 +56,7 @@ std::vector<GnssCsvRow> read_gnss_csv(const std::filesystem::path& file) {
     for (int i : {7, 8, 9})
       if (!(v[i] > 0.0)) throw io::InputError(name, fmt::format("{} must be positive", gnss_header()[i]), line);
     if (!fixes.empty() && !(v[0] > fixes.back().t_s))
-      throw io::InputError(name, fmt::format("time does not increase (t_s {} after {})", v[0], fixes.back().t_s),
-                           line);
+      throw io::InputError(name, fmt::format("time does not increase (t_s {} after {})", v[0], fixes.back().t_s), line);
     GnssCsvRow f;
     f.t_s = v[0];
     f.lat_rad = v[1] * io::kRadPerDeg;
@@ -77,8 +78,8 @@ void write_gnss_csv(const std::filesystem::path& file, std::span<const GnssCsvRo
   for (const auto& f : fixes) {
     const std::string vel =
         f.has_velocity ? fmt::format("{},{},{}", f.v_n.x(), f.v_n.y(), f.v_n.z()) : std::string(",,");
-    out.write(fmt::format("{},{},{},{},{},{},{},{}\n", f.t_s, f.lat_rad / io::kRadPerDeg, f.lon_rad / io::kRadPerDeg, f.height_m, vel,
-                          f.sigma_ned_m.x(), f.sigma_ned_m.y(), f.sigma_ned_m.z()));
+    out.write(fmt::format("{},{},{},{},{},{},{},{}\n", f.t_s, f.lat_rad / io::kRadPerDeg, f.lon_rad / io::kRadPerDeg,
+                          f.height_m, vel, f.sigma_ned_m.x(), f.sigma_ned_m.y(), f.sigma_ned_m.z()));
   }
   out.commit();
 }

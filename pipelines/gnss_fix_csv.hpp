@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // External GNSS fixes for `ultratrack fuse`: the CSV
 // `t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m`
 // (WGS-84 geodetic antenna position, NED velocity, 1-sigma NED position error). The three velocity fields

@@ -1,7 +1,7 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/gnss_fix_simulation.hpp"
 
 #include <GeographicLib/Geocentric.hpp>
-
 #include <cmath>
 #include <numbers>
 #include <random>

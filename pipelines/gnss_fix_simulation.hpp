@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Simulated external GNSS fixes from a truth trajectory (for `ultratrack gnsssim`, tests and the loose
 // integration figures): position (and optionally velocity) of an antenna at lever_arm_b at times
 // t0 + k / rate, with first-order Gauss-Markov position errors (white when correlation_time_s = 0) and white
@@ -8,17 +9,17 @@
 #include <cstdint>
 #include <vector>
 
-#include "pipelines/gnss_fix_csv.hpp"
 #include "ins/nav_state.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
 
 namespace ultratrack::pipelines {
 
 struct GnssFixSimulationOptions {
   double rate_hz = 1.0;
-  double first_time_s = 0.0;                              // time of the first fix (clamped into the truth span)
-  Eigen::Vector3d sigma_ned_m{1.5, 1.5, 3.0};             // steady-state 1-sigma position error (and the column)
-  double correlation_time_s = 0.0;                        // 0: white position errors
+  double first_time_s = 0.0;                   // time of the first fix (clamped into the truth span)
+  Eigen::Vector3d sigma_ned_m{1.5, 1.5, 3.0};  // steady-state 1-sigma position error (and the column)
+  double correlation_time_s = 0.0;             // 0: white position errors
   bool with_velocity = true;
   double sigma_velocity_mps = 0.05;                       // white, per axis
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // antenna in body axes from the IMU [m]

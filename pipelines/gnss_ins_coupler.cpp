@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/gnss_ins_coupler.hpp"
 
 #include <fmt/core.h>
@@ -17,18 +18,19 @@
 #include "io/input_error.hpp"
 #include "io/json_text.hpp"
 #include "io/units.hpp"
+#include "pipelines/fuse_summary.hpp"
+#include "pipelines/imu_model_json.hpp"
 #include "pipelines/navigation_initialisation.hpp"
 #include "receiver/loop_filters.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
-#include "pipelines/fuse_summary.hpp"
-#include "pipelines/imu_model_json.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kC = signals::kSpeedOfLight_mps;
-constexpr double kDllUpdate_s = 0.020;  // the DLL's update interval after bit sync (the tight filter starts after frame sync)
+constexpr double kDllUpdate_s =
+    0.020;  // the DLL's update interval after bit sync (the tight filter starts after frame sync)
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -87,7 +89,7 @@ struct GnssInsCoupler::Impl {
   ins::EulerAngles initial_attitude;
   double start_s = 0.0;
 
-  std::optional<receiver::ObservationEpoch> held;  // waits for its fix (on_fix follows on_observations)
+  std::optional<receiver::ObservationEpoch> held;       // waits for its fix (on_fix follows on_observations)
   std::optional<ins::NavState> previous_nav, last_nav;  // the driving filter's last two rows, after the hand-over
 
   // Odometer aiding (loose, settings.odometer given): the speed windows and the next one to hand over.
@@ -109,8 +111,14 @@ struct GnssInsCoupler::Impl {
 
   Impl(const ReceiveOptions& s, std::vector<ins::ImuIncrement> i, receiver::ReceiverObserver& d, ReceiveSink& k,
        std::vector<signals::Ephemeris> eph)
-      : settings(s), imu(std::move(i)), downstream(&d), sink(&k), fs_hz(s.receiver.fs_hz),
-        nav_ephemerides(std::move(eph)), all_ephemerides(nav_ephemerides), clock(s.receiver.fs_hz) {
+      : settings(s),
+        imu(std::move(i)),
+        downstream(&d),
+        sink(&k),
+        fs_hz(s.receiver.fs_hz),
+        nav_ephemerides(std::move(eph)),
+        all_ephemerides(nav_ephemerides),
+        clock(s.receiver.fs_hz) {
     const receiver::ReceiverOptions& ro = s.receiver;
     tight.elevation_mask_rad = ro.pvt.elevation_mask_rad;
     tight.ionosphere = ro.pvt.ionosphere;
@@ -121,8 +129,8 @@ struct GnssInsCoupler::Impl {
     // 2.21 at the defaults). Without it the tight filter, and the ultra-tight one it hands over to, stated a
     // position 1-sigma ~1.7x too small (benchmarks/ultratight_consistency.sh, docs/validation.md).
     tight.sigma_range_zenith_m =
-        ro.pvt.sigma_zenith_m * receiver::dll_white_equivalent_sigma_factor(ro.tracking.dll_bw_coherent_hz, kDllUpdate_s,
-                                                                            ro.observation_interval_s);
+        ro.pvt.sigma_zenith_m * receiver::dll_white_equivalent_sigma_factor(ro.tracking.dll_bw_coherent_hz,
+                                                                            kDllUpdate_s, ro.observation_interval_s);
     tight.sigma_rate_zenith_mps = ro.pvt.sigma_doppler_mps;
   }
 
@@ -165,10 +173,11 @@ struct GnssInsCoupler::Impl {
 
   void check_covered(double t, const signals::GpsTime& g) const {
     if (t >= imu.front().t_s && t <= imu.back().t_s + 1e-6) return;
-    throw io::InputError(settings.imu_name,
-                         fmt::format("does not cover the signal: the epoch at GPS week {} tow {:.3f} s is IMU time "
-                                     "{:.3f} s (--imu-time-origin {}), the IMU rows span {:.3f}-{:.3f} s",
-                                     g.week, g.tow_s, t, to_string(settings.imu_time_origin), imu.front().t_s, imu.back().t_s));
+    throw io::InputError(
+        settings.imu_name,
+        fmt::format("does not cover the signal: the epoch at GPS week {} tow {:.3f} s is IMU time "
+                    "{:.3f} s (--imu-time-origin {}), the IMU rows span {:.3f}-{:.3f} s",
+                    g.week, g.tow_s, t, to_string(settings.imu_time_origin), imu.front().t_s, imu.back().t_s));
   }
 
   void emit() {
@@ -320,10 +329,11 @@ struct GnssInsCoupler::Impl {
       // No fix (fewer than four satellites): the clock from the configured position (only to map this epoch's
       // time: an error of tens of metres there is tens of nanoseconds).
       const FuseConfig& c = settings.navigation;
-      const Eigen::Vector3d r_e =
-          ins::ecef_from_geodetic(c.position_deg_m->x() * io::kRadPerDeg, c.position_deg_m->y() * io::kRadPerDeg, c.position_deg_m->z());
-      const Eigen::Vector3d v_e = ins::C_en(c.position_deg_m->x() * io::kRadPerDeg, c.position_deg_m->y() * io::kRadPerDeg) *
-                                  c.velocity_ned_mps.value_or(Eigen::Vector3d::Zero());
+      const Eigen::Vector3d r_e = ins::ecef_from_geodetic(
+          c.position_deg_m->x() * io::kRadPerDeg, c.position_deg_m->y() * io::kRadPerDeg, c.position_deg_m->z());
+      const Eigen::Vector3d v_e =
+          ins::C_en(c.position_deg_m->x() * io::kRadPerDeg, c.position_deg_m->y() * io::kRadPerDeg) *
+          c.velocity_ned_mps.value_or(Eigen::Vector3d::Zero());
       if (const auto clock = fit_clock(e, r_e, v_e)) g = signals::add_seconds(e.receive_time, -clock->first / kC);
     } else if (integration && last_fix_clock) {
       // Loose, no fix this epoch: the time from the last fix's clock bias and drift; the INS runs on to it.
@@ -397,7 +407,9 @@ void GnssInsCoupler::on_tracking(const receiver::TrackingRecord& r) { impl_->dow
 void GnssInsCoupler::on_acquisition(std::int64_t first, const std::vector<receiver::AcquisitionResult>& r) {
   impl_->downstream->on_acquisition(first, r);
 }
-void GnssInsCoupler::on_antenna_phases(const receiver::AntennaPhaseEpoch& e) { impl_->downstream->on_antenna_phases(e); }
+void GnssInsCoupler::on_antenna_phases(const receiver::AntennaPhaseEpoch& e) {
+  impl_->downstream->on_antenna_phases(e);
+}
 
 void GnssInsCoupler::on_observations(const receiver::ObservationEpoch& epoch) {
   impl_->downstream->on_observations(epoch);
@@ -473,7 +485,7 @@ std::optional<std::pair<std::int64_t, double>> GnssInsCoupler::last_epoch_time()
 void GnssInsCoupler::hand_over() { impl_->handed_over = true; }
 bool GnssInsCoupler::handed_over() const { return impl_->handed_over; }
 void GnssInsCoupler::write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
-                              const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad) {
+                               const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad) {
   Impl& m = *impl_;
   m.final_sigma = NavSigma{sigma_pos_ned_m, sigma_vel_n_mps, sigma_att_rad};
   if (m.nav_rows > 0 && !(nav.t_s > m.last_row_t_s)) return;
@@ -490,48 +502,54 @@ std::string GnssInsCoupler::summary_json() const {
   const Impl& m = *impl_;
   const char* align = to_string(m.settings.align);
   std::string j = "\"fusion\": {";
-  j += fmt::format("\"coupling\": \"{}\", \"filter\": \"{}\", \"align\": \"{}\", \"imu_file\": \"{}\", "
-                   "\"imu_time_origin\": \"{}\", \"imu_preset\": \"{}\", \"started\": {}",
-                   to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align,
-                   io::json_escape(m.settings.imu_name), to_string(m.settings.imu_time_origin), io::json_escape(m.settings.navigation.imu_preset),
-                   m.integration.has_value());
+  j += fmt::format(
+      "\"coupling\": \"{}\", \"filter\": \"{}\", \"align\": \"{}\", \"imu_file\": \"{}\", "
+      "\"imu_time_origin\": \"{}\", \"imu_preset\": \"{}\", \"started\": {}",
+      to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align,
+      io::json_escape(m.settings.imu_name), to_string(m.settings.imu_time_origin),
+      io::json_escape(m.settings.navigation.imu_preset), m.integration.has_value());
   j += ", \"imu_model\": " + imu_model_json(m.settings.navigation);
   if (m.origin)
     j += fmt::format(", \"imu_time_origin_gps\": {{\"week\": {}, \"tow_s\": {:.9f}}}", m.origin->week, m.origin->tow_s);
-  j += fmt::format(", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
-                   "\"epochs_unused\": {}",
-                   m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
-  if (m.settings.coupling == Coupling::kUltraTight)
-    j += fmt::format(", \"handed_over\": {}", m.handed_over);
+  j += fmt::format(
+      ", \"epochs_seen\": {}, \"fixes_seen\": {}, \"epochs_before_start\": {}, \"epochs_used\": {}, "
+      "\"epochs_unused\": {}",
+      m.epochs_seen, m.fixes_seen, m.before_start, m.used, m.unused);
+  if (m.settings.coupling == Coupling::kUltraTight) j += fmt::format(", \"handed_over\": {}", m.handed_over);
   if (m.is_tight()) j += fmt::format(", \"epochs_fewer_than_4_satellites\": {}", m.epochs_below_4);
   j += fmt::format(", \"clock_jumps_removed\": {}, \"nav_rows\": {}", m.clock.jumps(), m.nav_rows);
   if (!m.integration) return j + fmt::format(", \"reason\": \"{}\"}}", io::json_escape(m.not_started));
   const auto& k = m.integration->counters();
   const auto& e = m.initial_attitude;
-  j += fmt::format(", \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
-                   "\"yaw_deg\": {:.6f}}}",
-                   io::json_escape(m.alignment_note), m.start_s, e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
-  j += fmt::format(", \"start_s\": {}, \"end_s\": {}, \"imu_steps\": {}, \"updates_accepted\": {}, "
-                   "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
-                   m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
-                   k.satellites_missing_ephemeris);
+  j += fmt::format(
+      ", \"alignment\": {{\"note\": \"{}\", \"t_s\": {}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, "
+      "\"yaw_deg\": {:.6f}}}",
+      io::json_escape(m.alignment_note), m.start_s, e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg,
+      e.yaw_rad / io::kRadPerDeg);
+  j += fmt::format(
+      ", \"start_s\": {}, \"end_s\": {}, \"imu_steps\": {}, \"updates_accepted\": {}, "
+      "\"updates_rejected\": {}, \"late\": {}, \"invalid\": {}, \"satellites_missing_ephemeris\": {}",
+      m.start_s, m.integration->output().nav.t_s, k.imu_steps, k.accepted, k.rejected, k.late, k.invalid,
+      k.satellites_missing_ephemeris);
   j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": {}", k.recoveries,
                    recovery_events_json(m.integration->recovery_events()));
   if (m.odometer_use)
     j += ", \"odometer\": " +
          odometer_json(*m.odometer_use, k, m.settings.navigation.odometer, m.settings.odometer_name);
   if (m.is_tight())
-    j += fmt::format(", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
-                     "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "
-                     "\"rejected\": {}}}",
-                     m.settings.navigation.clock_oscillator, m.settings.navigation.clock_allan.h0,
-                     m.settings.navigation.clock_allan.h_minus2, m.settings.navigation.height_aiding.enabled ? "auto" : "off",
-                     k.epochs_few_satellites, k.height_accepted, k.height_rejected);
+    j += fmt::format(
+        ", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
+        "\"height_aiding\": {{\"mode\": \"{}\", \"epochs_few_satellites\": {}, \"accepted\": {}, "
+        "\"rejected\": {}}}",
+        m.settings.navigation.clock_oscillator, m.settings.navigation.clock_allan.h0,
+        m.settings.navigation.clock_allan.h_minus2, m.settings.navigation.height_aiding.enabled ? "auto" : "off",
+        k.epochs_few_satellites, k.height_accepted, k.height_rejected);
   const NavSigma& g = m.final_sigma;
-  j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
-                   "\"vel_mps\": {:.6g}, \"heading_deg\": {:.6g}}}}}",
-                   g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
-                   g.attitude_ned_rad.z() / io::kRadPerDeg);
+  j += fmt::format(
+      ", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
+      "\"vel_mps\": {:.6g}, \"heading_deg\": {:.6g}}}}}",
+      g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
+      g.attitude_ned_rad.z() / io::kRadPerDeg);
   return j;
 }
 
@@ -547,10 +565,11 @@ std::string GnssInsCoupler::report() const {
       m.start_s, m.used, m.before_start, k.accepted, k.rejected, m.final_sigma.position_ned_m.head<2>().norm(),
       m.final_sigma.position_ned_m.z(), m.nav_rows);
   if (m.odometer_use)
-    r += fmt::format("\nreceive: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading "
-                     "rate {}, by speed {}",
-                     m.odometer_use->windows, k.odometer_accepted, k.odometer_rejected, k.odometer_gated_yaw_rate,
-                     k.odometer_gated_speed);
+    r += fmt::format(
+        "\nreceive: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading "
+        "rate {}, by speed {}",
+        m.odometer_use->windows, k.odometer_accepted, k.odometer_rejected, k.odometer_gated_yaw_rate,
+        k.odometer_gated_speed);
   return r;
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GNSS/INS integration fed by the running receiver (`receive --coupling loose|tight`, and ultra-tight's pull-in).
 // GnssInsCoupler sits between the ReceiverEngine and the receiver's own observer (it forwards every call) and feeds
 // fusion::GnssInsIntegration: loose: each PVT fix (position and Doppler velocity with the PVT's a-priori
@@ -5,8 +6,8 @@
 // navigation file and the decoded ones; the PVT's elevation mask, atmosphere switches and elevation/C/N0 sigma
 // model) -> pseudorange and rate updates, also with fewer than four satellites. Loose with odometer rows
 // (ReceiveOptions::odometer): their speed windows as `fuse --odometer`'s VMS/NHC updates (pipelines/fuse.hpp), which
-// bridge signal blockages; summary.json's fusion object then has fuse's "odometer" object. The INS starts after the alignment
-// (static: levelling + gyrocompassing over the first seconds; motion: from the fixes' velocities; config: the
+// bridge signal blockages; summary.json's fusion object then has fuse's "odometer" object. The INS starts after the
+// alignment (static: levelling + gyrocompassing over the first seconds; motion: from the fixes' velocities; config: the
 // configuration's attitude, position and velocity) and hands each solution (IMU position) to the sink's
 // on_navigation. Time: IMU t_s on the time line of pipelines/imu_time_line.hpp; receiver clock jumps are taken out
 // of the tight filter's pseudoranges and epoch times, so its clock states stay continuous. Units SI; angles in
@@ -71,8 +72,8 @@ class GnssInsCoupler final : public receiver::ReceiverObserver {
   std::optional<std::pair<std::int64_t, double>> last_epoch_time() const;
   void hand_over();
   bool handed_over() const;
-  void write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m, const Eigen::Vector3d& sigma_vel_n_mps,
-                 const Eigen::Vector3d& sigma_att_rad);
+  void write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
+                 const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad);
 
  private:
   struct Impl;

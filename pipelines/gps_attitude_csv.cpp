@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/gps_attitude_csv.hpp"
 
 #include <fmt/core.h>
@@ -18,9 +19,9 @@ namespace {
 constexpr std::size_t kColumns = 11;
 
 const std::vector<std::string>& attitude_header() {
-  static const std::vector<std::string> h{"gps_week",        "tow_s",           "roll_deg",      "pitch_deg",
-                                          "yaw_deg",         "sigma_roll_deg",  "sigma_pitch_deg", "sigma_yaw_deg",
-                                          "num_sats",        "fixed",           "ratio"};
+  static const std::vector<std::string> h{"gps_week",       "tow_s",           "roll_deg",      "pitch_deg", "yaw_deg",
+                                          "sigma_roll_deg", "sigma_pitch_deg", "sigma_yaw_deg", "num_sats",  "fixed",
+                                          "ratio"};
   return h;
 }
 
@@ -44,7 +45,8 @@ std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file)
     const auto v = parse_row(name, line, fields);
     auto fail = [&](const std::string& what) { throw io::InputError(name, what, line); };
     for (int i : {0, 1, 8, 9, 10})
-      if (!std::isfinite(v[static_cast<std::size_t>(i)])) fail(attitude_header()[static_cast<std::size_t>(i)] + " is not finite");
+      if (!std::isfinite(v[static_cast<std::size_t>(i)]))
+        fail(attitude_header()[static_cast<std::size_t>(i)] + " is not finite");
     if (v[0] < 0.0 || v[0] != std::floor(v[0])) fail("gps_week must be a non-negative integer");
     if (!(v[1] >= 0.0 && v[1] < 604800.0)) fail("tow_s outside [0, 604800)");
     if (v[8] < 0.0 || v[8] != std::floor(v[8])) fail("num_sats must be a non-negative integer");

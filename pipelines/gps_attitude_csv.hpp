@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Reader of the multi-antenna receiver's attitude.csv (receiver/attitude_outputs.hpp, `ultratrack attitude`) for
 // `ultratrack fuse --attitude`: gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,
 // sigma_yaw_deg,num_sats,fixed,ratio. Angles of the antenna-array frame relative to NED; GPS time tags.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/imu_time_line.hpp"
 
 #include <fmt/core.h>
@@ -16,9 +17,12 @@ constexpr double kClockJumpDetect_s = 1e-7;  // receiver clock offsets change on
 
 std::string to_string(const ImuTimeOrigin& origin) {
   switch (origin.kind) {
-    case ImuTimeOrigin::Kind::Sample0: return "sample0";
-    case ImuTimeOrigin::Kind::WeekStart: return "tow";
-    case ImuTimeOrigin::Kind::Tow: return fmt::format("{}", origin.tow_s);
+    case ImuTimeOrigin::Kind::Sample0:
+      return "sample0";
+    case ImuTimeOrigin::Kind::WeekStart:
+      return "tow";
+    case ImuTimeOrigin::Kind::Tow:
+      return fmt::format("{}", origin.tow_s);
   }
   return "?";
 }
@@ -26,9 +30,12 @@ std::string to_string(const ImuTimeOrigin& origin) {
 signals::GpsTime imu_time_origin_gps(const ImuTimeOrigin& origin, const signals::GpsTime& g, std::int64_t sample,
                                      double fs_hz) {
   switch (origin.kind) {
-    case ImuTimeOrigin::Kind::Sample0: return signals::add_seconds(g, -static_cast<double>(sample) / fs_hz);
-    case ImuTimeOrigin::Kind::WeekStart: return signals::GpsTime{g.week, 0.0};
-    case ImuTimeOrigin::Kind::Tow: break;
+    case ImuTimeOrigin::Kind::Sample0:
+      return signals::add_seconds(g, -static_cast<double>(sample) / fs_hz);
+    case ImuTimeOrigin::Kind::WeekStart:
+      return signals::GpsTime{g.week, 0.0};
+    case ImuTimeOrigin::Kind::Tow:
+      break;
   }
   signals::GpsTime o{g.week, origin.tow_s};
   const double d = signals::seconds_between(g, o);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The IMU's time line against the receiver's. An IMU file's t_s is seconds of GPS time since an origin
 // (ImuTimeOrigin): the GPS time of the input's first sample (what `simulate` writes), the start of the GPS week
 // (t_s is the time of week), or a given time of week. ReceiverClockJumps takes the receiver's clock jumps (whole

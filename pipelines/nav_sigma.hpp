@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A navigation solution's 1-sigmas as nav.csv reports them: NED position (m) and velocity (m/s), attitude as the
 // psi-angle about north, east, down (rad: tilts and heading).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/navigation_initialisation.hpp"
 
 #include <fmt/core.h>
@@ -22,10 +23,14 @@ constexpr double kG = 9.80665;
 
 const char* to_string(AlignMode mode) {
   switch (mode) {
-    case AlignMode::Static: return "static";
-    case AlignMode::Motion: return "motion";
-    case AlignMode::Config: return "config";
-    case AlignMode::Attitude: return "attitude";
+    case AlignMode::Static:
+      return "static";
+    case AlignMode::Motion:
+      return "motion";
+    case AlignMode::Config:
+      return "config";
+    case AlignMode::Attitude:
+      return "attitude";
   }
   return "?";
 }
@@ -41,8 +46,8 @@ std::size_t static_span_end(std::span<const ins::ImuIncrement> imu, double t0_s,
   std::size_t end = 0;
   while (end < imu.size() && imu[end].t_s <= t0_s + config.static_duration_s + 1e-9) ++end;
   if (end < 2 || end == imu.size())
-    throw io::InputError(imu_name, fmt::format("the static alignment span ({} s) needs IMU data beyond it",
-                                               config.static_duration_s));
+    throw io::InputError(
+        imu_name, fmt::format("the static alignment span ({} s) needs IMU data beyond it", config.static_duration_s));
   return end;
 }
 

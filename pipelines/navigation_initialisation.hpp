@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The one GNSS/INS start of `fuse` and `receive --coupling loose|tight|ultra-tight`: an alignment gives the time,
 // attitude (and for motion the velocity) with their 1-sigmas; initialise_navigation adds the position (the
 // configuration's, or a GNSS fix's moved from the antenna to the IMU by the lever arm) and the configuration's
@@ -26,7 +27,7 @@
 namespace ultratrack::pipelines {
 
 enum class AlignMode { Static, Motion, Config, Attitude };
-const char* to_string(AlignMode mode);  // "static", "motion", "config", "attitude"
+const char* to_string(AlignMode mode);                                   // "static", "motion", "config", "attitude"
 std::optional<AlignMode> align_mode_from_string(std::string_view name);  // to_string's names; nothing otherwise
 
 // An alignment's result: the INS start time, attitude and velocity, their 1-sigmas, and a note for summaries.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/pps_time_sync.hpp"
 
 #include <fmt/format.h>
@@ -13,22 +14,20 @@ namespace ultratrack::pipelines {
 std::vector<PpsEdge> read_pps_csv(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::vector<PpsEdge> edges;
-  io::read_numeric_csv(file, "PPS file", {"local_s", "gps_week", "gps_tow_s"},
-                       [&](int line, std::span<const double> v) {
-                         if (v[1] < 0.0 || v[1] != std::floor(v[1]))
-                           throw io::InputError(name, "gps_week must be a whole number >= 0", line);
-                         if (!(v[2] >= 0.0 && v[2] < 604800.0) || std::abs(v[2] - std::round(v[2])) > 1e-6)
-                           throw io::InputError(name, "gps_tow_s must be a whole second in [0, 604800) (a PPS edge)",
-                                                line);
-                         PpsEdge e{line, v[0], {static_cast<int>(v[1]), std::round(v[2])}};
-                         if (!edges.empty()) {
-                           if (!(e.local_s > edges.back().local_s))
-                             throw io::InputError(name, "local_s must increase", line);
-                           if (!(signals::seconds_between(e.gps, edges.back().gps) > 0.0))
-                             throw io::InputError(name, "GPS time must increase", line);
-                         }
-                         edges.push_back(e);
-                       });
+  io::read_numeric_csv(
+      file, "PPS file", {"local_s", "gps_week", "gps_tow_s"}, [&](int line, std::span<const double> v) {
+        if (v[1] < 0.0 || v[1] != std::floor(v[1]))
+          throw io::InputError(name, "gps_week must be a whole number >= 0", line);
+        if (!(v[2] >= 0.0 && v[2] < 604800.0) || std::abs(v[2] - std::round(v[2])) > 1e-6)
+          throw io::InputError(name, "gps_tow_s must be a whole second in [0, 604800) (a PPS edge)", line);
+        PpsEdge e{line, v[0], {static_cast<int>(v[1]), std::round(v[2])}};
+        if (!edges.empty()) {
+          if (!(e.local_s > edges.back().local_s)) throw io::InputError(name, "local_s must increase", line);
+          if (!(signals::seconds_between(e.gps, edges.back().gps) > 0.0))
+            throw io::InputError(name, "GPS time must increase", line);
+        }
+        edges.push_back(e);
+      });
   return edges;
 }
 
@@ -36,10 +35,11 @@ PpsClockFit fit_pps_clock(std::span<const PpsEdge> edges, const std::string& fil
   if (edges.size() < 3) throw io::InputError(file, fmt::format("{} PPS edges: at least 3 are needed", edges.size()));
   for (std::size_t i = 1; i < edges.size(); ++i)
     if (edges[i].local_s - edges[i - 1].local_s > o.max_gap_s)
-      throw io::InputError(file, fmt::format("a gap of {:.1f} s between PPS edges (lines {} and {}), more than {} s",
-                                             edges[i].local_s - edges[i - 1].local_s, edges[i - 1].line,
-                                             edges[i].line, o.max_gap_s),
-                           edges[i].line);
+      throw io::InputError(
+          file,
+          fmt::format("a gap of {:.1f} s between PPS edges (lines {} and {}), more than {} s",
+                      edges[i].local_s - edges[i - 1].local_s, edges[i - 1].line, edges[i].line, o.max_gap_s),
+          edges[i].line);
   PpsClockFit f;
   f.reference = edges.front().gps;
   f.local_reference_s = edges.front().local_s;
@@ -98,11 +98,12 @@ PpsClockFit fit_pps_clock(std::span<const PpsEdge> edges, const std::string& fil
 std::vector<ins::ImuIncrement> imu_on_gps_time(std::span<const ins::ImuIncrement> imu, const PpsClockFit& fit,
                                                const signals::GpsTime& origin, const std::string& imu_file,
                                                const PpsOptions& o) {
-  if (!imu.empty() && (imu.front().t_s < fit.first_local_s - o.max_gap_s || imu.back().t_s > fit.last_local_s + o.max_gap_s))
-    throw io::InputError(imu_file, fmt::format("IMU stamps ({:.3f}-{:.3f} s local) reach beyond the PPS record "
-                                               "({:.3f}-{:.3f} s local) by more than {} s",
-                                               imu.front().t_s, imu.back().t_s, fit.first_local_s, fit.last_local_s,
-                                               o.max_gap_s));
+  if (!imu.empty() &&
+      (imu.front().t_s < fit.first_local_s - o.max_gap_s || imu.back().t_s > fit.last_local_s + o.max_gap_s))
+    throw io::InputError(
+        imu_file, fmt::format("IMU stamps ({:.3f}-{:.3f} s local) reach beyond the PPS record "
+                              "({:.3f}-{:.3f} s local) by more than {} s",
+                              imu.front().t_s, imu.back().t_s, fit.first_local_s, fit.last_local_s, o.max_gap_s));
   const double shift = signals::seconds_between(fit.reference, origin);
   std::vector<ins::ImuIncrement> out(imu.begin(), imu.end());
   for (auto& r : out) r.t_s = shift + fit.gps_seconds_since_reference(r.t_s);
@@ -116,9 +117,10 @@ ImuOnPps imu_on_gps_time_by_pps(std::span<const ins::ImuIncrement> imu, const st
   r.fit = fit_pps_clock(read_pps_csv(pps_file), name);
   r.origin = origin.value_or(r.fit.reference);
   r.imu = imu_on_gps_time(imu, r.fit, r.origin, imu_file);
-  r.note = fmt::format("IMU local clock on GPS time by {}: {} edges used, {} rejected, drift {:.3f} ppm, "
-                       "residual RMS {:.2f} us",
-                       name, r.fit.used, r.fit.rejected, r.fit.drift * 1e6, r.fit.residual_rms_s * 1e6);
+  r.note = fmt::format(
+      "IMU local clock on GPS time by {}: {} edges used, {} rejected, drift {:.3f} ppm, "
+      "residual RMS {:.2f} us",
+      name, r.fit.used, r.fit.rejected, r.fit.drift * 1e6, r.fit.residual_rms_s * 1e6);
   return r;
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Time synchronisation of an IMU stamped by a free-running local clock, through the GPS receiver's PPS record (seed
 // 003's synchronisation of the IMU and the 1 PPS). The record gives the local time of each pulse edge with the GPS
 // time it marks (a whole GPS second); a straight line local -> GPS time (offset and drift) is fitted robustly (least
@@ -27,15 +28,15 @@ struct PpsEdge {
 };
 
 struct PpsOptions {
-  double max_gap_s = 5.0;         // between consecutive edges (local time): longer = a gap in the record
-  double outlier_floor_s = 20e-6; // residuals below this are never outliers
+  double max_gap_s = 5.0;          // between consecutive edges (local time): longer = a gap in the record
+  double outlier_floor_s = 20e-6;  // residuals below this are never outliers
 };
 
 std::vector<PpsEdge> read_pps_csv(const std::filesystem::path& file);
 
 // GPS time = reference + (1 + drift) (local - local_reference) + offset_s.
 struct PpsClockFit {
-  signals::GpsTime reference;   // the first edge's GPS time
+  signals::GpsTime reference;  // the first edge's GPS time
   double local_reference_s = 0.0;
   double offset_s = 0.0;        // at local_reference_s
   double drift = 0.0;           // dimensionless (50 ppm = 5e-5): local clock rate error, GPS per local - 1

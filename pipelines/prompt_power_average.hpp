@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The ultra-tight I&Q model's signal power of one channel (pipelines/ultratight_loop.hpp). Units: taps on the raw
 // correlator scale; A^2 on the unit-noise scale.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/receive_csv_files.hpp"
 
 #include <fmt/core.h>
@@ -42,20 +43,22 @@ void ReceiveCsvFiles::on_vector_epoch(const fusion::VectorEpochLog& e) {
   if (!vector_channels_) return;
   const double t = static_cast<double>(e.sample) / fs_hz_;
   for (const auto& c : e.channels)
-    fmt::print(vector_channels_->stream(), "{},{:.3f},{},{:d},{:.2f},{:d},{:.3f},{:.3f},{:d},{:.4f},{:.4f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:d},{:.3f},{:.4f},{:d},{:.5f},{:.5f},{:.5f},{:.3f},{:.3f},{:.2f},{:.5f},{},{:.5f}\n",
+    fmt::print(vector_channels_->stream(),
+               "{},{:.3f},{},{:d},{:.2f},{:d},{:.3f},{:.3f},{:d},{:.4f},{:.4f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:d},"
+               "{:.3f},{:.4f},{:d},{:.5f},{:.5f},{:.5f},{:.3f},{:.3f},{:.2f},{:.5f},{},{:.5f}\n",
                e.sample, t, c.prn, c.vector, c.cn0_dbhz, c.pr_used, c.pr_innovation_m, c.pr_sigma_m, c.rate_used,
                c.rate_innovation_mps, c.rate_sigma_mps, c.measured_doppler_hz, c.predicted_doppler_hz,
                c.replica_code_rate_chips_per_s, c.predicted_code_rate_chips_per_s, c.code_jump_chips, c.coasting,
                c.coast_s, c.predicted_sigma_chips, c.phase_tracking, c.phase_disc_cycles, c.phase_innovation_cycles,
-               c.phase_sigma_cycles, c.phase_nu_hz, c.phase_lock, c.phase_bn_hz, c.phase_jump_cycles, c.measurement_sample,
-               c.replica_phase_mid_cycles);
+               c.phase_sigma_cycles, c.phase_nu_hz, c.phase_lock, c.phase_bn_hz, c.phase_jump_cycles,
+               c.measurement_sample, c.replica_phase_mid_cycles);
   const auto& x = e.x;
   const auto& s = e.sigma;
   fmt::print(vector_state_->stream(),
              "{},{:.3f},{},{:.6f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.4f},{:.3f},{:.4f},{:.3f},{:.3f},{:.3f},{:.4f},"
              "{:.4f},{:.4f},{:.3f},{:.4f},{},{}\n",
-             e.sample, t, e.receive_time.week, e.receive_time.tow_s, x(0), x(1), x(2), x(3), x(4), x(5), x(6), x(7), s(0),
-             s(1), s(2), s(3), s(4), s(5), s(6), s(7), e.used, e.vector);
+             e.sample, t, e.receive_time.week, e.receive_time.tow_s, x(0), x(1), x(2), x(3), x(4), x(5), x(6), x(7),
+             s(0), s(1), s(2), s(3), s(4), s(5), s(6), s(7), e.used, e.vector);
 }
 
 void ReceiveCsvFiles::on_ultratight_epoch(const UltraTightEpochLog& e) {
@@ -65,7 +68,8 @@ void ReceiveCsvFiles::on_ultratight_epoch(const UltraTightEpochLog& e) {
   fmt::memory_buffer rows;
   for (const UltraTightChannelLog& c : e.channels) {
     fmt::format_to(std::back_inserter(rows),
-                   "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{:d},{:d},{:.3f}",
+                   "{},{:.3f},{},{:d},{:d},{:d},{:.2f},{:.2f},{:.3f},{:.3f},{:.3f},{:.3f},{:.3f},{:.4f},{:.4f},{:.5f},{"
+                   ":d},{:d},{:.3f}",
                    e.sample, e.time_s, c.prn, c.synchronised, c.ultratight, c.coasting, c.coast_s, c.cn0_dbhz,
                    c.measured_pseudorange_m, c.predicted_pseudorange_m, c.measured_doppler_hz, c.predicted_doppler_hz,
                    c.replica_carrier_hz, c.replica_code_rate_chips_per_s, c.predicted_code_rate_chips_per_s,

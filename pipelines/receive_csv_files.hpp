@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receive pipeline's CSV logs in an output folder (a ReceiveSink, as receiver/receiver_outputs.hpp is the
 // receiver's observer): nav.csv (pipelines/fused_nav_csv.hpp) with loose, tight or ultra-tight coupling;
 // vector.csv (one row per channel per vector epoch: predicted vs measured Doppler and code rate, code jump,

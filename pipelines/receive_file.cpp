@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/receive_file.hpp"
 
 #include <fmt/core.h>
@@ -6,12 +7,12 @@
 #include <chrono>
 #include <cmath>
 
+#include "io/why_invalid.hpp"
 #include "pipelines/format_diagnosis.hpp"
 #include "pipelines/receive_csv_files.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::pipelines {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One recording received into an output folder: the whole of `ultratrack receive` below its command line, for
 // programs, tests and bindings. Opens the sample file, checks that it holds enough signal for one acquisition, runs
 // pipelines::Receiver over it (50 ms blocks, a stop token, a callback per block) and writes every output into
@@ -53,6 +54,7 @@ void date_recording(receiver::ReceiverOptions& options, const signals::RinexNavD
 // acquisition needs, no satellite found in the whole signal, or none tracked while another 2-bit packing would
 // find them (the message names its flags: pipelines/format_diagnosis.hpp; no outputs written in these cases),
 // options that do not fit together (checked before anything is written).
-ReceiveFileResult receive_file(ReceiveFileJob job, std::stop_token stop = {}, const ReceiveProgressCallback& progress = {});
+ReceiveFileResult receive_file(ReceiveFileJob job, std::stop_token stop = {},
+                               const ReceiveProgressCallback& progress = {});
 
 }  // namespace ultratrack::pipelines

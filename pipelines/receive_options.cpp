@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/receive_options.hpp"
 
 #include <algorithm>
@@ -6,7 +7,6 @@
 #include "io/why_invalid.hpp"
 
 namespace ultratrack::pipelines {
-
 
 bool ReceiveOptions::IsValid(std::string* error) const {
   auto fail = [&](std::string why) {
@@ -21,8 +21,9 @@ bool ReceiveOptions::IsValid(std::string* error) const {
   if (std::find(names.begin(), names.end(), navigation.imu_preset) == names.end())
     return fail("unknown IMU preset '" + navigation.imu_preset + "'");
   if (!odometer.empty() && coupling != Coupling::kLoose)
-    return fail("--odometer works with --coupling loose only (the odometer states are not in the tight and "
-                "ultra-tight filters yet)");
+    return fail(
+        "--odometer works with --coupling loose only (the odometer states are not in the tight and "
+        "ultra-tight filters yet)");
   if (align == AlignMode::Attitude) return fail("--align attitude is `fuse`'s (GPS attitude rows)");
   if (align == AlignMode::Config && !navigation.attitude_deg)
     return fail("--align config needs [initial] attitude_deg in --fusion-config");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Everything a receive pipeline (pipelines/receiver_pipeline.hpp) needs to know before the first sample: the
 // receiver's options, the coupling, the vector filter's carrier mode, and for the GNSS/INS couplings the filter,
 // the alignment, the navigation settings and the IMU's time origin; for ultra-tight the measurement form and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Where a receive pipeline's own epochs go (the receiver's, solution.csv and the rest, go to its
 // receiver::ReceiverObserver): the GNSS/INS navigation solution after each IMU step (nav.csv), the vector
 // filter's epochs (vector.csv, vector_state.csv) and the ultra-tight loop's (ultratight.csv). Every method has an

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/receiver_pipeline.hpp"
 
 #include <algorithm>
@@ -56,8 +57,8 @@ void Receiver::process(std::span<const std::complex<float>> samples, std::int64_
   impl_->engine.process(samples, first_sample);
 }
 
-void Receiver::process(std::span<const std::complex<float>> samples, std::int64_t first_sample,
-                       receiver::PlanarI16 i16, float i16_gain) {
+void Receiver::process(std::span<const std::complex<float>> samples, std::int64_t first_sample, receiver::PlanarI16 i16,
+                       float i16_gain) {
   impl_->engine.process(samples, first_sample, i16, i16_gain);
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // pipelines::Receiver: the receiver with every coupling behind one object. It owns the receiver engine and, by
 // ReceiveOptions::coupling, the loop that closes the channels: none (scalar), the vector filter
 // (pipelines/vector_loop_driver.hpp), the GNSS/INS integration on the way (pipelines/gnss_ins_coupler.hpp: loose,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/snapshot_file.hpp"
 
 #include <fmt/core.h>
@@ -6,10 +7,10 @@
 #include <cmath>
 #include <complex>
 
+#include "io/why_invalid.hpp"
 #include "receiver/ionosphere_model.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/input_error.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::pipelines {
 
@@ -26,7 +27,8 @@ SnapshotFileResult snapshot_file(const SnapshotFileJob& job) {
   receiver::SampleSource source(job.input, job.format, job.source);
   const std::int64_t wanted = std::llround(job.snapshot_ms * 1e-3 * job.source.fs_hz);
   const std::int64_t available = source.total_samples() - job.source.start_sample;
-  std::vector<std::complex<float>> samples(static_cast<std::size_t>(std::max<std::int64_t>(0, std::min(wanted, available))));
+  std::vector<std::complex<float>> samples(
+      static_cast<std::size_t>(std::max<std::int64_t>(0, std::min(wanted, available))));
   samples.resize(source.read(samples).count);
   result.used_ms = static_cast<double>(samples.size()) / job.source.fs_hz * 1e3;
   result.shortened = available < wanted;
@@ -55,9 +57,10 @@ SnapshotFileResult snapshot_file(const SnapshotFileJob& job) {
     measurements.push_back(m);
   }
   if (measurements.size() < 5)
-    result.solution.failure = fmt::format("{} satellites detected, {} with a healthy ephemeris at the time: at least 5 "
-                                          "are needed",
-                                          result.detections.size(), measurements.size());
+    result.solution.failure = fmt::format(
+        "{} satellites detected, {} with a healthy ephemeris at the time: at least 5 "
+        "are needed",
+        result.detections.size(), measurements.size());
   else
     result.solution =
         receiver::solve_snapshot(measurements, job.approximate_time, job.approximate_position_e_m, options);

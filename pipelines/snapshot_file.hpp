@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A position from a snapshot of a recording (tens to hundreds of ms) with broadcast ephemerides and an approximate
 // time: `ultratrack snapshot` below its command line. Reads the snapshot from the file, detects every satellite with
 // its fine code phase and Doppler (receiver/snapshot_measurement.hpp), pairs each with its ephemeris at the
@@ -7,7 +8,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -29,18 +29,18 @@ struct SnapshotFileJob {
   double snapshot_ms = 100.0;            // the file's remaining length when shorter (>= 10 ms needed)
   std::vector<int> prns;                 // searched
   receiver::SnapshotSearchOptions search;
-  receiver::SnapshotOptions navigation;  // time_sigma_s; klobuchar is set from `nav`
-  signals::GpsTime approximate_time;     // of the snapshot's first sample
+  receiver::SnapshotOptions navigation;                     // time_sigma_s; klobuchar is set from `nav`
+  signals::GpsTime approximate_time;                        // of the snapshot's first sample
   std::optional<Eigen::Vector3d> approximate_position_e_m;  // ECEF; without it a Doppler fix and a grid search
   signals::RinexNavData nav;
 };
 
 struct SnapshotFileResult {
-  double used_ms = 0.0;     // signal read (shorter than asked when the file ends)
-  bool shortened = false;   // the file held less than snapshot_ms
-  std::string ionosphere;   // which Klobuchar set was used
+  double used_ms = 0.0;    // signal read (shorter than asked when the file ends)
+  bool shortened = false;  // the file held less than snapshot_ms
+  std::string ionosphere;  // which Klobuchar set was used
   std::vector<receiver::SnapshotDetection> detections;
-  std::vector<int> without_ephemeris;  // detected, but no healthy ephemeris at the time
+  std::vector<int> without_ephemeris;   // detected, but no healthy ephemeris at the time
   receiver::SnapshotSolution solution;  // valid, or failure says why
 };
 

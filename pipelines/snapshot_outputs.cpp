@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The files of a snapshot fix (pipelines/snapshot_file.hpp): snapshot.json, every field of the job, the detections
 // and the solution with its sigmas and tests (null where there is no solution), and solution.csv with the fix.
 #include <fmt/core.h>
@@ -16,7 +17,6 @@ namespace ultratrack::pipelines {
 
 namespace {
 
-
 std::string number_or_null(double v, const char* format = "{:.3f}") {
   return std::isfinite(v) ? fmt::format(fmt::runtime(format), v) : "null";
 }
@@ -27,9 +27,11 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotFileJo
   const signals::GpsTime& t0 = job.approximate_time;
   io::AtomicFile file(path);
   auto& out = file.stream();
-  fmt::print(out, "{{\n  \"input\": {{\"file\": {}, \"format\": {}, \"fs_hz\": {}, \"if_hz\": {}, \"snapshot_ms\": {:.3f}}},\n",
-             io::json_string(job.input.string()), io::json_string(format_label), job.source.fs_hz, job.source.if_hz,
-             r.used_ms);
+  fmt::print(
+      out,
+      "{{\n  \"input\": {{\"file\": {}, \"format\": {}, \"fs_hz\": {}, \"if_hz\": {}, \"snapshot_ms\": {:.3f}}},\n",
+      io::json_string(job.input.string()), io::json_string(format_label), job.source.fs_hz, job.source.if_hz,
+      r.used_ms);
   fmt::print(out, "  \"approximate_time\": {{\"week\": {}, \"tow_s\": {:.6f}, \"sigma_s\": {}}},\n", t0.week, t0.tow_s,
              job.navigation.time_sigma_s);
   fmt::print(out, "  \"valid\": {},\n  \"failure\": {},\n  \"quality\": {},\n  \"a_priori\": {},\n", s.valid,
@@ -38,8 +40,8 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotFileJo
   const bool solved = s.used >= 5;
   if (solved) {
     fmt::print(out, "  \"ecef_m\": [{:.3f}, {:.3f}, {:.3f}],\n", s.r_e_m.x(), s.r_e_m.y(), s.r_e_m.z());
-    fmt::print(out, "  \"llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n", s.lat_rad * io::kDegPerRad,
-               s.lon_rad * io::kDegPerRad, s.height_m);
+    fmt::print(out, "  \"llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n",
+               s.lat_rad * io::kDegPerRad, s.lon_rad * io::kDegPerRad, s.height_m);
     fmt::print(out, "  \"time\": {{\"week\": {}, \"tow_s\": {:.9f}}},\n  \"time_correction_s\": {:.9f},\n", s.time.week,
                s.time.tow_s, s.time_correction_s);
     fmt::print(out, "  \"clock_bias_m\": {:.3f},\n  \"clock_drift_mps\": {:.3f},\n", s.clock_bias_m, s.clock_drift_mps);
@@ -84,8 +86,8 @@ void write_snapshot_json(const std::filesystem::path& path, const SnapshotFileJo
       fmt::print(out,
                  ", \"used\": {}, \"elevation_deg\": {:.2f}, \"azimuth_deg\": {:.2f}, \"residual_m\": {:.3f}, "
                  "\"sigma_m\": {:.3f}, \"doppler_residual_hz\": {:.2f}",
-                 sat->used, sat->elevation_rad * io::kDegPerRad, sat->azimuth_rad * io::kDegPerRad, sat->residual_m, sat->sigma_m,
-                 sat->doppler_residual_hz);
+                 sat->used, sat->elevation_rad * io::kDegPerRad, sat->azimuth_rad * io::kDegPerRad, sat->residual_m,
+                 sat->sigma_m, sat->doppler_residual_hz);
     else
       fmt::print(out, ", \"used\": false");
     fmt::print(out, "}}");

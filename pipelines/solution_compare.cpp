@@ -1,9 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/solution_compare.hpp"
 
 #include <fmt/format.h>
 
-#include <GeographicLib/Geocentric.hpp>
 #include <Eigen/Geometry>
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -33,7 +34,8 @@ std::vector<std::string_view> split(std::string_view line) {
 
 // Reads a CSV with a header row; for every data row calls row(line, values of the named columns). Columns not
 // named are ignored (and may be empty); a named column must hold a finite number.
-void read_named_columns(const std::filesystem::path& file, const std::string& what, const std::vector<std::string>& names,
+void read_named_columns(const std::filesystem::path& file, const std::string& what,
+                        const std::vector<std::string>& names,
                         const std::function<void(int, const std::vector<double>&)>& row) {
   const std::string name = file.string();
   std::ifstream in(file);
@@ -77,9 +79,7 @@ void read_named_columns(const std::filesystem::path& file, const std::string& wh
 Eigen::Matrix3d enu_from_ecef(double lat, double lon) {
   const double sl = std::sin(lat), cl = std::cos(lat), so = std::sin(lon), co = std::cos(lon);
   Eigen::Matrix3d c;
-  c << -so, co, 0.0,
-       -sl * co, -sl * so, cl,
-       cl * co, cl * so, sl;
+  c << -so, co, 0.0, -sl * co, -sl * so, cl, cl * co, cl * so, sl;
   return c;
 }
 
@@ -107,19 +107,19 @@ std::vector<SolutionFix> read_solution_csv(const std::filesystem::path& file) {
 
 std::vector<TruthPoint> read_simulation_truth_csv(const std::filesystem::path& file) {
   std::vector<TruthPoint> out;
-  read_named_columns(file, "truth file",
-                     {"gps_week", "tow_s", "ecef_x_m", "ecef_y_m", "ecef_z_m", "vel_n_mps", "vel_e_mps", "vel_d_mps"},
-                     [&](int line, const std::vector<double>& v) {
-                       TruthPoint p;
-                       p.gps_week = static_cast<int>(v[0]);
-                       p.tow_s = v[1];
-                       p.r_e_m = {v[2], v[3], v[4]};
-                       p.v_ned_mps = {v[5], v[6], v[7]};
-                       if (!out.empty() &&
-                           !(seconds(p.gps_week, p.tow_s) > seconds(out.back().gps_week, out.back().tow_s)))
-                         throw io::InputError(file.string(), "GPS time does not increase", line);
-                       out.push_back(p);
-                     });
+  read_named_columns(
+      file, "truth file",
+      {"gps_week", "tow_s", "ecef_x_m", "ecef_y_m", "ecef_z_m", "vel_n_mps", "vel_e_mps", "vel_d_mps"},
+      [&](int line, const std::vector<double>& v) {
+        TruthPoint p;
+        p.gps_week = static_cast<int>(v[0]);
+        p.tow_s = v[1];
+        p.r_e_m = {v[2], v[3], v[4]};
+        p.v_ned_mps = {v[5], v[6], v[7]};
+        if (!out.empty() && !(seconds(p.gps_week, p.tow_s) > seconds(out.back().gps_week, out.back().tow_s)))
+          throw io::InputError(file.string(), "GPS time does not increase", line);
+        out.push_back(p);
+      });
   return out;
 }
 
@@ -143,7 +143,8 @@ SolutionComparison compare_solution(const std::vector<SolutionFix>& solution, co
     }
     if (seconds(truth[k].gps_week, truth[k].tow_s) > t) k = 0;
     while (k + 2 < truth.size() && seconds(truth[k + 1].gps_week, truth[k + 1].tow_s) < t) ++k;
-    const double ta = seconds(truth[k].gps_week, truth[k].tow_s), tb = seconds(truth[k + 1].gps_week, truth[k + 1].tow_s);
+    const double ta = seconds(truth[k].gps_week, truth[k].tow_s),
+                 tb = seconds(truth[k + 1].gps_week, truth[k + 1].tow_s);
     const double w = (t - ta) / (tb - ta);
     // Linear interpolation: at 10 Hz truth the chord error of a 100 m circle at 8.3 m/s is v^2 dt^2 / 8R < 1 mm.
     const Eigen::Vector3d r = (1.0 - w) * truth[k].r_e_m + w * truth[k + 1].r_e_m;
@@ -181,7 +182,8 @@ SolutionComparison compare_solution(const std::vector<SolutionFix>& solution, co
 std::string to_json(const SolutionComparison& c) {
   return fmt::format(
       "{{\n  \"fixes\": {},\n  \"fixes_outside_truth\": {},\n  \"first_tow_s\": {:.3f},\n  \"last_tow_s\": {:.3f},\n"
-      "  \"rms_3d_m\": {:.4f},\n  \"rms_horizontal_m\": {:.4f},\n  \"rms_vertical_m\": {:.4f},\n  \"max_3d_m\": {:.4f},\n"
+      "  \"rms_3d_m\": {:.4f},\n  \"rms_horizontal_m\": {:.4f},\n  \"rms_vertical_m\": {:.4f},\n  \"max_3d_m\": "
+      "{:.4f},\n"
       "  \"mean_enu_m\": [{:.4f}, {:.4f}, {:.4f}],\n  \"rms_velocity_mps\": {:.5f},\n"
       "  \"rms_velocity_horizontal_mps\": {:.5f},\n  \"rms_velocity_vertical_mps\": {:.5f},\n"
       "  \"max_velocity_mps\": {:.5f}\n}}\n",

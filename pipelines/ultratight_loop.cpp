@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/ultratight_loop.hpp"
 
 #include <fmt/core.h>
@@ -30,7 +31,8 @@ UltraTightLoop::UltraTightLoop(GnssInsCoupler& fusion, ReceiveSink& sink, UltraT
 
 UltraTightLoop::ChannelState& UltraTightLoop::channel(int prn) {
   auto [it, made] = channels_.try_emplace(prn);
-  if (made) it->second.runaway = fusion::FalseLockMonitor(fusion::FalseLockMonitor::Averaging::kBlock, ut_.runaway_average_s);
+  if (made)
+    it->second.runaway = fusion::FalseLockMonitor(fusion::FalseLockMonitor::Averaging::kBlock, ut_.runaway_average_s);
   return it->second;
 }
 
@@ -41,9 +43,9 @@ void UltraTightLoop::attach(receiver::ReceiverEngine& engine) {
 // IMU time of a receiver sample: the receive time on the clock continuous since the hand-over, less the
 // driver's clock bias (carried to that time by its drift).
 double UltraTightLoop::imu_time(const receiver::VectorEpochInput& epoch, std::int64_t sample) const {
-  const signals::GpsTime rx = signals::add_seconds(
-      epoch.receive_time,
-      (epoch.clock_corrections_s - corrections_at_start_s_) + static_cast<double>(sample - epoch.sample) / epoch.fs_hz);
+  const signals::GpsTime rx =
+      signals::add_seconds(epoch.receive_time, (epoch.clock_corrections_s - corrections_at_start_s_) +
+                                                   static_cast<double>(sample - epoch.sample) / epoch.fs_hz);
   const double t_rx = signals::seconds_between(rx, origin_);
   const auto& o = driver_->output();
   const double bias_m = o.clock_bias_m + o.clock_drift_mps * (t_rx - t_ins_);
@@ -129,13 +131,13 @@ void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) 
 }
 
 std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const receiver::VectorEpochInput& epoch,
-                                                                        double t_k) {
+                                                                     double t_k) {
   std::vector<fusion::ChannelCorrelation> out;
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
   for (const auto& in : epoch.channels) {
     if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
     if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
-    if (!(in.iq_scale > 0.0)) continue;  // no noise estimate
+    if (!(in.iq_scale > 0.0)) continue;                                   // no noise estimate
     const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
     const double t_start_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz;
     // A channel whose PLL ran away from the prediction correlates mostly noise against a replica carrier tens of
@@ -168,7 +170,7 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     // seed model.
     const int n = in.pll_coherent_epochs;
     const double jitter_rad = receiver::pll_thermal_jitter_rad(receiver::long_coherent_pll_bw_hz(options_.tracking, n),
-                                                              n * ut_.period_s, c.cn0_dbhz);
+                                                               n * ut_.period_s, c.cn0_dbhz);
     c.start_phase_var_rad2 = a2 > 0.0 ? jitter_rad * jitter_rad : 0.0;
     // The NCO phase is never jumped (only its frequency changes): each epoch starts where the previous one ended,
     // and the driver carries the previous epoch's measured phase over (ChannelCorrelation::continuous_carrier).
@@ -251,8 +253,8 @@ std::map<int, double> UltraTightLoop::propagated_doppler_change() {
   const fusion::NominalState n = driver_->nominal();
   const auto& o = driver_->options();
   const Eigen::Vector3d r_ant = fusion::antenna_position_e(n.nav, o.lever_arm_b);
-  const Eigen::Vector3d v_ant =
-      ins::C_en(n.nav.lat_rad, n.nav.lon_rad) * fusion::antenna_velocity_n(n.nav, Eigen::Vector3d::Zero(), o.lever_arm_b);
+  const Eigen::Vector3d v_ant = ins::C_en(n.nav.lat_rad, n.nav.lon_rad) *
+                                fusion::antenna_velocity_n(n.nav, Eigen::Vector3d::Zero(), o.lever_arm_b);
   receiver::ObservationEpoch e;
   e.receive_time = signals::add_seconds(origin_, n.nav.t_s + n.clock_bias_m / kC);
   for (const auto& [prn, r] : period_replicas_) {
@@ -272,8 +274,8 @@ std::map<int, double> UltraTightLoop::propagated_doppler_change() {
 }
 
 void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k,
-                                std::span<receiver::VectorChannelCommand> commands,
-                                const std::map<int, double>& aid_change) {
+                             std::span<receiver::VectorChannelCommand> commands,
+                             const std::map<int, double>& aid_change) {
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
   std::map<int, const fusion::UltraTightSatelliteUpdate*> updates;
   for (const auto& u : driver_->last_updates()) updates[u.prn] = &u;
@@ -338,9 +340,9 @@ void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k
           st.aid_hz = r.nco.carrier_frequency_hz;  // joins (the channel only uses changes of it)
         else
           st.aid_hz += change->second;
-        // Carrier runaway: the aiding steps once by minus the offset of the last 5 epochs, which the channel adds to its PLL's
-        // frequency (ScalarTracking::aid_frequency), putting it back on the prediction; the phase is flagged while
-        // the channel is judged off (its phase is not the signal's, and the step starts a new arc).
+        // Carrier runaway: the aiding steps once by minus the offset of the last 5 epochs, which the channel adds to
+        // its PLL's frequency (ScalarTracking::aid_frequency), putting it back on the prediction; the phase is flagged
+        // while the channel is judged off (its phase is not the signal's, and the step starts a new arc).
         if (st.pending_step_hz != 0.0) {
           st.aid_hz += st.pending_step_hz;
           st.pending_step_hz = 0.0;
@@ -397,7 +399,7 @@ void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k
 }
 
 void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
-                               std::span<receiver::VectorChannelCommand> commands) {
+                            std::span<receiver::VectorChannelCommand> commands) {
   if (!driver_) {
     if (fusion_.handed_over() || !fusion_.integration() || !epoch.ephemerides) return;
     const auto origin = fusion_.imu_time_origin();
@@ -427,8 +429,8 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
   // Sets decoded since the hand-over (the engine appends them): a satellite without one at the hand-over, or a new
   // IODE, is predicted from them from this period on (each from the set valid at its transmit time).
   if (epoch.ephemerides && epoch.ephemerides->size() > ephemerides_seen_) {
-    const std::vector<signals::Ephemeris> fresh(epoch.ephemerides->begin() + static_cast<std::ptrdiff_t>(ephemerides_seen_),
-                                                epoch.ephemerides->end());
+    const std::vector<signals::Ephemeris> fresh(
+        epoch.ephemerides->begin() + static_cast<std::ptrdiff_t>(ephemerides_seen_), epoch.ephemerides->end());
     ephemerides_seen_ = epoch.ephemerides->size();
     driver_->add_ephemerides(fresh);
     ephemerides_.insert(ephemerides_.end(), fresh.begin(), fresh.end());
@@ -464,33 +466,38 @@ std::string UltraTightLoop::summary_json() const {
   for (const auto& [prn, st] : channels_) channels += st.ever;
   const auto& k = driver_->counters();
   const auto& o = driver_->output();
-  j += fmt::format(", \"handover_t_s\": {:.3f}, \"handover_sample\": {}, \"end_t_s\": {:.3f}, \"channels_handed_over\": {}, "
-                   "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
-                   "\"releases\": {}, \"measurements\": {}, \"known_bits\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": {}, "
-                   "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}, \"aided_only_satellite_periods\": {}, "
-                   "\"carrier_recentres\": {}, \"runaway_left_out\": {}, \"runaway_releases\": {}",
-                   handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_,
-                   coasting_channel_epochs_, relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates,
-                   k.accepted, k.rejected, k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_, runaway_releases_);
-  j += fmt::format(", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
-                   "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
-                   o.sigma_pos_ned_m.x(), o.sigma_pos_ned_m.y(), o.sigma_pos_ned_m.z(), o.sigma_clock_bias_m,
-                   o.sigma_clock_drift_mps);
+  j += fmt::format(
+      ", \"handover_t_s\": {:.3f}, \"handover_sample\": {}, \"end_t_s\": {:.3f}, \"channels_handed_over\": {}, "
+      "\"vector_epochs\": {}, \"channel_epochs\": {}, \"coasting_channel_epochs\": {}, \"relocks\": {}, "
+      "\"releases\": {}, \"measurements\": {}, \"known_bits\": {}, \"not_wiped\": {}, \"periods\": {}, \"updates\": "
+      "{}, "
+      "\"accepted\": {}, \"rejected\": {}, \"coasting_satellite_periods\": {}, \"aided_only_satellite_periods\": {}, "
+      "\"carrier_recentres\": {}, \"runaway_left_out\": {}, \"runaway_releases\": {}",
+      handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_, coasting_channel_epochs_,
+      relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates, k.accepted, k.rejected,
+      k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_, runaway_releases_);
+  j += fmt::format(
+      ", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
+      "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
+      o.sigma_pos_ned_m.x(), o.sigma_pos_ned_m.y(), o.sigma_pos_ned_m.z(), o.sigma_clock_bias_m,
+      o.sigma_clock_drift_mps);
   return j;
 }
 
 std::string UltraTightLoop::report() const {
-  if (!driver_) return "receive: ultra-tight: never handed over (the tight integration did not start or ran too briefly)";
+  if (!driver_)
+    return "receive: ultra-tight: never handed over (the tight integration did not start or ran too briefly)";
   const auto& k = driver_->counters();
   long long channels = 0;
   for (const auto& [prn, st] : channels_) channels += st.ever;
-  return fmt::format("receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
-                     "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
-                     "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}",
-                     fusion_.options().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
-                     fusion_.options().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators",
-                     handover_t_s_, channels, channel_epochs_, coasting_channel_epochs_, relocks_, releases_,
-                     k.accepted, k.rejected, k.aided_only, runaway_recentres_, runaway_releases_);
+  return fmt::format(
+      "receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
+      "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
+      "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}",
+      fusion_.options().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
+      fusion_.options().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators", handover_t_s_, channels,
+      channel_epochs_, coasting_channel_epochs_, relocks_, releases_, k.accepted, k.rejected, k.aided_only,
+      runaway_recentres_, runaway_releases_);
 }
 
 }  // namespace ultratrack::pipelines

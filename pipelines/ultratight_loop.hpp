@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ultra-tight coupling (`receive --imu F --coupling ultra-tight --filter ekf|ukf [--ut-measurement iq|discriminator]`):
 // the closed-loop ultra-tight driver (fusion/ultratight_integration.hpp) attached to the receiver engine through the
 // vector-loop seam (receiver/vector_loop.hpp). Channels acquire and pull in as scalar while the tight integration
@@ -35,10 +36,10 @@
 namespace ultratrack::pipelines {
 
 struct UltraTightLoopOptions {
-  double period_s = 0.020;          // vector epoch = the driver's period = the channels' 20 ms coherent epochs
-  double handover_after_s = 2.0;    // the tight integration runs this long (IMU time) before the hand-over
-  double max_jump_chips = 0.5;      // a channel joins / stays only while prediction and replica agree this well
-  double max_coast_s = 30.0;        // a coasting channel is released (scalar, then lost) after this
+  double period_s = 0.020;        // vector epoch = the driver's period = the channels' 20 ms coherent epochs
+  double handover_after_s = 2.0;  // the tight integration runs this long (IMU time) before the hand-over
+  double max_jump_chips = 0.5;    // a channel joins / stays only while prediction and replica agree this well
+  double max_coast_s = 30.0;      // a coasting channel is released (scalar, then lost) after this
   // Satellites above this elevation are commanded by the loop (INS-predicted replicas); only those above the
   // PVT's mask update the filter (fusion::UltraTightOptions::measurement_mask_rad). Between the two masks a
   // channel is "aided only": its replica follows the prediction, its correlations are not used.
@@ -81,7 +82,7 @@ class UltraTightLoop final : public receiver::VectorLoop {
     bool ever = false;
     bool was_coasting = false;
     PromptPowerAverage prompt_power;  // the I&Q model's amplitude
-    double aid_hz = NAN;  // the carrier aiding sent (changes by the INS propagation only)
+    double aid_hz = NAN;              // the carrier aiding sent (changes by the INS propagation only)
     // The command sent last (vector): a pipelined loop's is still pending when the next inputs are taken.
     double sent_code_rate_chips_per_s = 0.0, sent_jump_chips = 0.0;
     // Carrier runaway (UltraTightLoopOptions::runaway_hz): the monitor, whether the channel is judged off its
@@ -89,9 +90,9 @@ class UltraTightLoop final : public receiver::VectorLoop {
     fusion::FalseLockMonitor runaway;  // kBlock over UltraTightLoopOptions::runaway_average_s
     bool runaway_off = false;
     double pending_step_hz = 0.0;
-    int runaway_repeats = 0;     // re-centrings in a row each followed by a 1 s mean still beyond runaway_hz
+    int runaway_repeats = 0;        // re-centrings in a row each followed by a 1 s mean still beyond runaway_hz
     bool runaway_given_up = false;  // released for that; commanded again only after a new synchronisation
-    double last_offset_hz = NAN;  // the latest epoch's replica minus predicted Doppler (ultratight.csv)
+    double last_offset_hz = NAN;    // the latest epoch's replica minus predicted Doppler (ultratight.csv)
   };
   ChannelState& channel(int prn);  // made on first use
   void start(const receiver::VectorEpochInput& epoch, double t_k);
@@ -118,7 +119,7 @@ class UltraTightLoop final : public receiver::VectorLoop {
   double t_ins_ = 0.0;                   // the driver's INS time (IMU rows split at vector epochs)
   std::size_t next_imu_ = 0;
   bool period_open_ = false;
-  std::map<int, fusion::ReplicaCommand> period_replicas_;  // the open period's replicas by PRN
+  std::map<int, fusion::ReplicaCommand> period_replicas_;    // the open period's replicas by PRN
   std::map<int, fusion::ReplicaCommand> previous_replicas_;  // the period's before it (predicted Doppler's slope)
   std::map<int, ChannelState> channels_;
   std::optional<double> first_integration_t_s_;

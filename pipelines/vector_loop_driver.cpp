@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/vector_loop_driver.hpp"
 
 #include <fmt/core.h>
@@ -5,7 +6,7 @@
 namespace ultratrack::pipelines {
 
 fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
-                                                     fusion::VectorCarrier carrier) {
+                                                      fusion::VectorCarrier carrier) {
   fusion::VectorTrackingOptions v;
   v.carrier = carrier;
   v.ionosphere = options.pvt.ionosphere;
@@ -33,19 +34,20 @@ void VectorLoopDriver::log(const fusion::VectorEpochLog& e) {
 }
 
 std::string VectorLoopDriver::summary_json() const {
-  return fmt::format("\"vector\": {{\"carrier\": \"{}\", \"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
-                     "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}, \"frequency_resets\": {}, "
-                     "\"phase_arcs\": {}, \"phase_losses\": {}}}",
-                     fusion::to_string(carrier_), vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_,
-                     filter_.initialisations(), filter_.resets(), filter_.frequency_resets(), filter_.phase_arcs(),
-                     filter_.phase_losses());
+  return fmt::format(
+      "\"vector\": {{\"carrier\": \"{}\", \"vector_epochs\": {}, \"vector_channel_epochs\": {}, "
+      "\"coasting_channel_epochs\": {}, \"filter_starts\": {}, \"filter_resets\": {}, \"frequency_resets\": {}, "
+      "\"phase_arcs\": {}, \"phase_losses\": {}}}",
+      fusion::to_string(carrier_), vector_epochs_, vector_channel_epochs_, coasting_channel_epochs_,
+      filter_.initialisations(), filter_.resets(), filter_.frequency_resets(), filter_.phase_arcs(),
+      filter_.phase_losses());
 }
 
 std::string VectorLoopDriver::report() const {
-  return fmt::format("receive: vector tracking: {} epochs with channels in vector mode ({} channel-epochs), filter "
-                     "started {} times, reset {} times; {} channel-epochs coasting",
-                     vector_epochs_, vector_channel_epochs_, filter_.initialisations(), filter_.resets(),
-                     coasting_channel_epochs_);
+  return fmt::format(
+      "receive: vector tracking: {} epochs with channels in vector mode ({} channel-epochs), filter "
+      "started {} times, reset {} times; {} channel-epochs coasting",
+      vector_epochs_, vector_channel_epochs_, filter_.initialisations(), filter_.resets(), coasting_channel_epochs_);
 }
 
 }  // namespace ultratrack::pipelines

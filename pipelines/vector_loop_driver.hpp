@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Vector coupling: the vector tracking filter (fusion/vector_tracking.hpp) attached to the receiver engine through
 // receiver::VectorLoop, its epochs handed to a ReceiveSink (vector.csv, vector_state.csv) and counted for the
 // summary. Units: s, m, m/s, Hz, chips.
@@ -13,7 +14,7 @@ namespace ultratrack::pipelines {
 
 // The filter's options for a receiver configuration (the PVT's atmosphere models, the channels' E-L spacing).
 fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
-                                                     fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
+                                                      fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
 
 class VectorLoopDriver {
  public:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ultratrack.acquire: FFT acquisition (receiver/acquisition.hpp) of the first K x T_coh of a recording, read
 // from a file as `ultratrack acquire` reads it, or of complex baseband samples given as a numpy array. Returns
 // one dict per searched PRN (the detected ones, or all).
@@ -56,9 +57,11 @@ py::list acquire(const py::object& input, const std::string& format, double fs_h
   std::string name = "samples";
   if (py::isinstance<py::array>(input)) {
     if (if_hz != 0.0 || iq_swap || q_negate)
-      throw io::InputError("python", "acquire on a numpy array takes complex baseband samples: no if_hz, iq_swap or q_negate");
+      throw io::InputError("python",
+                           "acquire on a numpy array takes complex baseband samples: no if_hz, iq_swap or q_negate");
     const Samples array = Samples::ensure(input);
-    if (!array || array.ndim() != 1) throw io::InputError("python", "samples: a one-dimensional complex array is needed");
+    if (!array || array.ndim() != 1)
+      throw io::InputError("python", "samples: a one-dimensional complex array is needed");
     samples.assign(array.data(), array.data() + array.size());
   } else {
     name = py::str(input).cast<std::string>();
@@ -73,7 +76,8 @@ py::list acquire(const py::object& input, const std::string& format, double fs_h
     source_options.q_negate = q_negate;
     receiver::SampleSource source(name, *sample_format, source_options);
     samples.resize(static_cast<std::size_t>(std::min<std::int64_t>(source.total_samples(), block * noncoherent)));
-    if (source.read(samples).count != samples.size()) throw io::InputError(name, "ended before the samples it reported");
+    if (source.read(samples).count != samples.size())
+      throw io::InputError(name, "ended before the samples it reported");
   }
   // Shorter than K blocks: searched with the whole blocks it holds, as the command line does.
   const std::int64_t blocks = static_cast<std::int64_t>(samples.size()) / block;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ultratrack.attitude: the multi-antenna receiver on one recording per antenna (pipelines/attitude_file.hpp) with
 // `ultratrack attitude`'s settings under its names; the array from an antenna file (config/antenna_config_toml.hpp).
 // Returns the run's statistics as a dict.
@@ -49,8 +50,9 @@ py::dict attitude(const std::vector<std::string>& inputs, const std::string& for
   pipelines::AttitudeFileResult result;
   {
     py::gil_scoped_release release;
-    result = pipelines::attitude_file(std::move(job), interrupt.token(),
-                                      [&](const receiver::ReceiverEngine&, const receiver::AttitudeStats&) { interrupt.poll(); });
+    result = pipelines::attitude_file(
+        std::move(job), interrupt.token(),
+        [&](const receiver::ReceiverEngine&, const receiver::AttitudeStats&) { interrupt.poll(); });
   }
   interrupt.rethrow();
   const receiver::AttitudeStats& s = result.stats;

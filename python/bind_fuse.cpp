@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ultratrack.fuse: loosely coupled GNSS/INS from an IMU CSV and a GNSS fix CSV (pipelines/fuse.hpp) into
 // out/nav.csv and out/summary.json, with `ultratrack fuse`'s settings under its names. Returns summary.json's text
 // (the Python wrapper reads it into a dict).
@@ -11,8 +12,8 @@
 
 #include "bindings.hpp"
 #include "config/fuse_config_toml.hpp"
-#include "io/atomic_file.hpp"
 #include "ins/imu_csv.hpp"
+#include "io/atomic_file.hpp"
 #include "pipelines/fuse.hpp"
 #include "pipelines/fuse_summary.hpp"
 #include "pipelines/fused_nav_csv.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ultratrack.receive: one recording received into a folder (pipelines/receive_file.hpp) with `ultratrack
 // receive`'s settings under the command line's names (--elevation-mask-deg -> elevation_mask_deg), applied in
 // the command's order (defaults, then `config`, then the single settings), so that the same settings give the
@@ -36,25 +37,27 @@ void apply_fusion_options(py::dict& o, pipelines::ReceiveOptions& s) {
   const bool has_pipelined = take_option(o, "ut_pipelined", ut_pipelined);
   if (take_option(o, "vector_carrier", vector_carrier)) {
     if (s.coupling != Coupling::kVector) throw io::InputError("python", "vector_carrier needs coupling='vector'");
-    s.vector_carrier = enum_from_name("vector_carrier", vector_carrier,
-                                      {fusion::VectorCarrier::kAidedPll, fusion::VectorCarrier::kFll,
-                                       fusion::VectorCarrier::kPll},
-                                      [](fusion::VectorCarrier c) { return fusion::to_string(c); });
+    s.vector_carrier =
+        enum_from_name("vector_carrier", vector_carrier,
+                       {fusion::VectorCarrier::kAidedPll, fusion::VectorCarrier::kFll, fusion::VectorCarrier::kPll},
+                       [](fusion::VectorCarrier c) { return fusion::to_string(c); });
   }
   if (!pipelines::uses_imu(s.coupling)) {
     if (has_filter || has_align || has_config || has_origin)
-      throw io::InputError("python", "imu, filter, align, fusion_config and imu_time_origin need coupling "
-                                     "'loose', 'tight' or 'ultra-tight'");
-    if (has_form || has_pipelined) throw io::InputError("python", "ut_measurement and ut_pipelined need coupling 'ultra-tight'");
+      throw io::InputError("python",
+                           "imu, filter, align, fusion_config and imu_time_origin need coupling "
+                           "'loose', 'tight' or 'ultra-tight'");
+    if (has_form || has_pipelined)
+      throw io::InputError("python", "ut_measurement and ut_pipelined need coupling 'ultra-tight'");
     return;
   }
   if ((has_form || has_pipelined) && s.coupling != Coupling::kUltraTight)
     throw io::InputError("python", "ut_measurement and ut_pipelined need coupling 'ultra-tight'");
   s.ut_pipelined = ut_pipelined;
   if (has_form)
-    s.ut_form = enum_from_name("ut_measurement", ut_measurement,
-                               {fusion::UltraTightForm::Iq, fusion::UltraTightForm::Discriminator},
-                               [](fusion::UltraTightForm f) { return f == fusion::UltraTightForm::Iq ? "iq" : "discriminator"; });
+    s.ut_form = enum_from_name(
+        "ut_measurement", ut_measurement, {fusion::UltraTightForm::Iq, fusion::UltraTightForm::Discriminator},
+        [](fusion::UltraTightForm f) { return f == fusion::UltraTightForm::Iq ? "iq" : "discriminator"; });
   if (has_filter)
     s.filter = enum_from_name("filter", filter, {fusion::FilterKind::Ekf, fusion::FilterKind::Ukf},
                               [](fusion::FilterKind f) { return f == fusion::FilterKind::Ekf ? "ekf" : "ukf"; });
@@ -65,7 +68,8 @@ void apply_fusion_options(py::dict& o, pipelines::ReceiveOptions& s) {
   if (has_config) s.navigation = config::read_fuse_config(fusion_config);
   (void)ins::imu_preset(s.navigation.imu_preset);  // an unknown preset fails here, before any output
   if (s.align == pipelines::AlignMode::Config && !s.navigation.attitude_deg)
-    throw io::InputError(has_config ? fusion_config : "python", "align='config' needs [initial] attitude_deg in fusion_config");
+    throw io::InputError(has_config ? fusion_config : "python",
+                         "align='config' needs [initial] attitude_deg in fusion_config");
   if (time_origin.is_none() || (py::isinstance<py::str>(time_origin) && time_origin.cast<std::string>() == "sample0")) {
     s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::Sample0;
   } else if (py::isinstance<py::str>(time_origin) && time_origin.cast<std::string>() == "tow") {
@@ -135,14 +139,16 @@ py::dict receive(const std::string& input, const std::string& format, double fs_
   std::string coding, order;
   if (take_option(options, "two_bit_coding", coding)) {
     const auto c = signals::parse_two_bit_coding(coding);
-    if (!c) throw io::InputError("python", "two_bit_coding: unknown coding '" + coding + "' (" +
-                                               std::string(signals::two_bit_coding_names()) + ")");
+    if (!c)
+      throw io::InputError("python", "two_bit_coding: unknown coding '" + coding + "' (" +
+                                         std::string(signals::two_bit_coding_names()) + ")");
     source.two_bit.coding = *c;
   }
   if (take_option(options, "two_bit_order", order)) {
     const auto b = signals::parse_bit_order(order);
-    if (!b) throw io::InputError("python", "two_bit_order: unknown bit order '" + order + "' (" +
-                                               std::string(signals::bit_order_names()) + ")");
+    if (!b)
+      throw io::InputError("python", "two_bit_order: unknown bit order '" + order + "' (" +
+                                         std::string(signals::bit_order_names()) + ")");
     source.two_bit.order = *b;
   }
   source.fs_hz = fs_hz;
@@ -159,23 +165,28 @@ py::dict receive(const std::string& input, const std::string& format, double fs_
   std::string config;
   if (take_option(options, "config", config)) config::apply_receive_config(config, r);
   double mask_deg = 0.0;
-  if (take_option(options, "elevation_mask_deg", mask_deg)) r.pvt.elevation_mask_rad = mask_deg * M_PI / 180.0;  // as the command line, to the bit
+  if (take_option(options, "elevation_mask_deg", mask_deg))
+    r.pvt.elevation_mask_rad = mask_deg * M_PI / 180.0;  // as the command line, to the bit
   take_option(options, "troposphere", r.pvt.troposphere);
   take_option(options, "ionosphere", r.pvt.ionosphere);
   take_option(options, "channels", r.channels);
   take_option(options, "threads", r.threads);
   std::string nav_bits;
-  if (take_option(options, "nav_bits", nav_bits)) r.nav_bits = receiver::parse_nav_bit_source("python: nav_bits", nav_bits);
+  if (take_option(options, "nav_bits", nav_bits))
+    r.nav_bits = receiver::parse_nav_bit_source("python: nav_bits", nav_bits);
   take_option(options, "prn", r.prns);
   if (!nav.empty()) job.navigation = signals::read_rinex_nav(nav);
   if (take_option(options, "reference_week", r.reference_week)) r.reference_week_is_signal_week = true;
   pipelines::date_recording(r, job.navigation, fallback_week);
   take_option(options, "duration", job.duration_s);
   if (job.duration_s < 0.0) throw io::InputError("python", "duration: must not be negative");
-  if (const std::string why = io::why_invalid(r); !why.empty()) throw io::InputError(config.empty() ? "python" : config, why);
+  if (const std::string why = io::why_invalid(r); !why.empty())
+    throw io::InputError(config.empty() ? "python" : config, why);
 
   const auto c = pipelines::coupling_from_string(coupling);
-  if (!c) throw io::InputError("python", "coupling must be scalar, vector, loose, tight or ultra-tight, got '" + coupling + "'");
+  if (!c)
+    throw io::InputError("python",
+                         "coupling must be scalar, vector, loose, tight or ultra-tight, got '" + coupling + "'");
   job.options.coupling = *c;
   if (!imu.empty() && !pipelines::uses_imu(*c))
     throw io::InputError("python", "imu needs coupling 'loose', 'tight' or 'ultra-tight'");
@@ -205,9 +216,8 @@ py::dict receive(const std::string& input, const std::string& format, double fs_
 }  // namespace
 
 void register_receive(py::module_& m) {
-  m.def("_receive", &receive, py::arg("input"), py::arg("format"), py::arg("fs"), py::arg("if_hz"),
-        py::arg("coupling"), py::arg("imu"), py::arg("nav"), py::arg("out"), py::arg("fallback_week"),
-        py::arg("options"));
+  m.def("_receive", &receive, py::arg("input"), py::arg("format"), py::arg("fs"), py::arg("if_hz"), py::arg("coupling"),
+        py::arg("imu"), py::arg("nav"), py::arg("out"), py::arg("fallback_week"), py::arg("options"));
 }
 
 }  // namespace ultratrack::python

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ultratrack.simulate: a scenario (a TOML file, or its text) simulated into a folder as `ultratrack simulate`
 // writes it (sim/simulation_files.hpp), scenario.toml being the scenario with every key (config::to_toml).
 #include <pybind11/stl.h>
@@ -13,10 +14,10 @@ namespace ultratrack::python {
 namespace {
 
 py::dict simulate(const std::string& scenario_file, const std::string& scenario_text, const std::string& out) {
-  const sim::Scenario scenario = scenario_text.empty()
-                                     ? config::read_scenario(scenario_file)
-                                     : config::parse_scenario(scenario_text, scenario_file.empty() ? "scenario text"
-                                                                                                  : scenario_file);
+  const sim::Scenario scenario =
+      scenario_text.empty()
+          ? config::read_scenario(scenario_file)
+          : config::parse_scenario(scenario_text, scenario_file.empty() ? "scenario text" : scenario_file);
   PythonInterrupt interrupt;
   sim::SimulationResult r;
   {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The compiled half of the Python package `ultratrack` (python/ultratrack/): one register_* function per bound
 // area of the library, each in its own file, called once by module.cpp. Arguments arrive already shaped by the
 // package's Python wrappers (python/ultratrack/__init__.py): paths as text, options as a dict of the command

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The extension module ultratrack._ultratrack: the library's entry points for Python (python/bindings.hpp),
 // io::InputError translated to ultratrack.InputError (a ValueError) with the same message.
 #include <pybind11/pybind11.h>

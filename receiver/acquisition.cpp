@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/acquisition.hpp"
 
 #include <algorithm>
@@ -110,7 +111,8 @@ void Acquisition::spread(WorkerPool* pool, int n, F&& f) {
     for (int i = 0; i < n; ++i) f(i, *scratch_[0]);
     return;
   }
-  while (scratch_.size() < static_cast<std::size_t>(jobs)) scratch_.push_back(std::make_unique<Scratch>(fft_size_, lags_));
+  while (scratch_.size() < static_cast<std::size_t>(jobs))
+    scratch_.push_back(std::make_unique<Scratch>(fft_size_, lags_));
   // One job per scratch set; each takes the next item until none is left. Items are independent, so which
   // thread computes which does not change any result.
   std::atomic<int> next{0};
@@ -225,16 +227,19 @@ void Acquisition::correlate_bin(std::span<const std::complex<float>> samples, co
     multiply(fft_size_ - shift, fft_size_, x + 2 * shift - 2 * fft_size_);
     backward_.execute(s.product, s.correlation);
     const double start = -static_cast<double>(k) * static_cast<double>(block_size_);
-    std::ptrdiff_t lag_shift = static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
+    std::ptrdiff_t lag_shift =
+        static_cast<std::ptrdiff_t>(std::llround(start - period * std::round(start / period))) % n;
     if (lag_shift < 0) lag_shift += n;
     // acc[lag] += |corr[(lag + lag_shift) mod n]|^2, in the two unwrapped runs.
     const auto* y = reinterpret_cast<const float*>(s.correlation.data());
     const auto first_run =
         static_cast<std::size_t>(std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(lags_), n - lag_shift));
     const float* a = y + 2 * lag_shift;
-    for (std::size_t lag = 0; lag < first_run; ++lag) acc[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
+    for (std::size_t lag = 0; lag < first_run; ++lag)
+      acc[lag] += a[2 * lag] * a[2 * lag] + a[2 * lag + 1] * a[2 * lag + 1];
     const float* b = y - 2 * static_cast<std::ptrdiff_t>(first_run);
-    for (std::size_t lag = first_run; lag < lags_; ++lag) acc[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
+    for (std::size_t lag = first_run; lag < lags_; ++lag)
+      acc[lag] += b[2 * lag] * b[2 * lag] + b[2 * lag + 1] * b[2 * lag + 1];
   }
 }
 

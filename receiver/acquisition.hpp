@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GPS L1 C/A acquisition: parallel code-phase search (FFT circular correlation, FFTW single precision)
 // over a Doppler grid, K coherent blocks of T_coh = 1..10 ms summed non-coherently, a detection
 // threshold from a false-alarm probability, then refinement of Doppler and code phase and a C/N0
@@ -48,8 +49,8 @@
 
 #include <array>
 #include <complex>
-#include <memory>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -129,10 +130,10 @@ class Acquisition {
   struct Scratch {
     explicit Scratch(std::size_t fft_size, std::size_t lags);
     FftwBuffer mixed, product, correlation, spectrum;
-    std::vector<float> grid;                  // all rows [bin * lags + lag]
-    std::vector<double> row_noise;            // row sums, then noise cell mean per Doppler row
-    std::vector<std::size_t> row_top;         // lag of each row's largest cell
-    std::vector<double> segment_re, segment_im;  // 0.1 ms partial sums of one code phase [block * segments + j]
+    std::vector<float> grid;                      // all rows [bin * lags + lag]
+    std::vector<double> row_noise;                // row sums, then noise cell mean per Doppler row
+    std::vector<std::size_t> row_top;             // lag of each row's largest cell
+    std::vector<double> segment_re, segment_im;   // 0.1 ms partial sums of one code phase [block * segments + j]
     std::array<float, 256> base_re{}, base_im{};  // carrier wipe-off phasors of one chunk
   };
   const FftwBuffer& code_spectrum(int prn);
@@ -172,10 +173,10 @@ class Acquisition {
   std::size_t fft_size_;    // F: one code period when it is a whole number of samples (folding), else N
   std::size_t lags_;        // code lags searched: one code period, min(N, ceil(1023 fs / f_chip))
   double samples_per_chip_;
-  std::size_t rotation_;    // R: grid bins per FFT bin (fs / (F step)) when whole, else 0 (no rotation)
-  std::size_t segment_;     // samples per partial sum of the fine search (0.1 ms)
+  std::size_t rotation_;  // R: grid bins per FFT bin (fs / (F step)) when whole, else 0 (no rotation)
+  std::size_t segment_;   // samples per partial sum of the fine search (0.1 ms)
   FftwPlan forward_, backward_;
-  std::vector<std::unique_ptr<Scratch>> scratch_;       // [0] always; more for parallel searches
+  std::vector<std::unique_ptr<Scratch>> scratch_;        // [0] always; more for parallel searches
   std::vector<std::optional<FftwBuffer>> code_spectra_;  // index prn - 1
   std::vector<FftwBuffer> spectrum_cache_;               // [base * K + k] of the grid being searched
   std::vector<std::complex<float>> cleaned_;             // samples with confirmed signals cancelled

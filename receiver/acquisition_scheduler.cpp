@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/acquisition_scheduler.hpp"
 
 #include <algorithm>

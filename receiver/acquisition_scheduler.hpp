@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // When and what the receiver searches: a snapshot of the first samples (and of later ones for re-acquisition),
 // the PRNs to search on it (assisted by an ephemeris or almanac and the last fix: a Doppler window; blind when
 // nothing is known; predicted below the horizon only now and then; those with no orbit known at a low duty
@@ -76,20 +77,20 @@ class AcquisitionScheduler final {
   };
 
   std::optional<DopplerWindow> assistance(int prn, const signals::GpsTime& t, const Eigen::Vector3d& r_rx,
-                                          const std::optional<PvtSolution>& last_fix,
-                                          const NavigationStore& navigation, bool* below_horizon) const;
+                                          const std::optional<PvtSolution>& last_fix, const NavigationStore& navigation,
+                                          bool* below_horizon) const;
 
   ReceiverOptions options_;
   WorkerPool& pool_;
   Acquisition acquisition_;
   AcquisitionTask search_;
-  std::size_t blind_cursor_ = 0;  // round robin over prns_ for blind re-acquisitions
+  std::size_t blind_cursor_ = 0;    // round robin over prns_ for blind re-acquisitions
   std::size_t unknown_cursor_ = 0;  // the same for PRNs with no orbit known at the low duty cycle (blind_revisit_s)
   std::vector<int> prns_;
   std::array<std::int64_t, 33> lost_at_{};  // sample at which a PRN's channel was last released (lost lock)
   std::array<bool, 33> ever_lost_{};
-  std::size_t hidden_cursor_ = 0;        // round robin over prns_ for checks of PRNs predicted below the horizon
-  std::int64_t next_hidden_check_ = 0;   // sample from which the next such check may run
+  std::size_t hidden_cursor_ = 0;       // round robin over prns_ for checks of PRNs predicted below the horizon
+  std::int64_t next_hidden_check_ = 0;  // sample from which the next such check may run
   std::int64_t next_reacquisition_ = 0;
 
   std::vector<std::complex<float>> snapshot_;

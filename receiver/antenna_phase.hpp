@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The seam between the multi-antenna receiver and the attitude solver: at one receive epoch, for each satellite,
 // the carrier phase of every antenna measured against the master antenna's one replica (all antennas sampled on
 // one clock), the line of sight, and the slip flags. Units: cycles of L1, metres, dB-Hz; frames in the names.
@@ -8,11 +9,10 @@
 // antenna k and N_k an integer that stays fixed while no slip flag is raised for antenna k.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "receiver/correlation_epoch.hpp"
 #include "signals/gps_time.hpp"

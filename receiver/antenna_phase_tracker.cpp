@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/antenna_phase_tracker.hpp"
 
 #include <algorithm>
@@ -134,7 +135,8 @@ AntennaPhaseObservation make_antenna_observation(AntennaPhaseTracker& tracker, i
     const AntennaPhaseSample a = tracker.report(k, sample_index, fs_hz);
     const auto i = static_cast<std::size_t>(k);
     o.carrier_phase_cycles[i] = master_phase_cycles + a.phase_cycles;
-    o.cn0_dbhz[i] = std::isnan(a.cn0_dbhz) ? master_cn0_dbhz + 10.0 * std::log10(std::max(a.power_ratio, 1e-6)) : a.cn0_dbhz;
+    o.cn0_dbhz[i] =
+        std::isnan(a.cn0_dbhz) ? master_cn0_dbhz + 10.0 * std::log10(std::max(a.power_ratio, 1e-6)) : a.cn0_dbhz;
     o.usable[i] = a.usable;
     // A new master track restarts the between-antenna trackers too (a new channel), so its slip covers all.
     o.slip[i] = a.slip || master_slip;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Per-channel between-antenna carrier phase: every antenna is correlated against the master antenna's one
 // replica, so arg(P_k conj(P_0)) is the carrier phase of antenna k minus that of the master, free of the
 // replica's error and of the navigation bit. This tracker unwraps it by continuity across correlation epochs
@@ -29,16 +30,16 @@ struct AntennaPhaseTrackerOptions {
   // |innovation| of the between-antenna phase (measured - predicted) above this: continuity lost (slip).
   // The epoch-to-epoch jitter is ~0.01-0.02 cycles at 45 dB-Hz with 3 mm of extra phase noise.
   double slip_threshold_cycles = 0.2;
-  double rate_gain = 0.05;          // beta of the alpha-beta predictor (alpha = 1: the output is the measurement)
-  double min_cn0_dbhz = 25.0;       // antenna k's C/N0 below this: unusable
-  double cn0_time_constant_s = 0.2; // smoothing of the per-antenna power estimates
+  double rate_gain = 0.05;           // beta of the alpha-beta predictor (alpha = 1: the output is the measurement)
+  double min_cn0_dbhz = 25.0;        // antenna k's C/N0 below this: unusable
+  double cn0_time_constant_s = 0.2;  // smoothing of the per-antenna power estimates
 };
 
 // The state of antenna k's between-antenna phase at one sample.
 struct AntennaPhaseSample {
   double phase_cycles = 0.0;  // phase_k - phase_0, cycles, RINEX sense, extrapolated to the sample
-  double cn0_dbhz = NAN;     // from antenna k's prompt and noise tap; NaN without a noise tap (or no noise)
-  double power_ratio = 0.0;  // smoothed |P_k|^2 / |P_0|^2
+  double cn0_dbhz = NAN;      // from antenna k's prompt and noise tap; NaN without a noise tap (or no noise)
+  double power_ratio = 0.0;   // smoothed |P_k|^2 / |P_0|^2
   bool usable = false;
   // Continuity was lost since the previous usable report: raised with the first usable phase after the break
   // (never while unusable), cleared by report().
@@ -64,7 +65,7 @@ class AntennaPhaseTracker {
     bool started = false;  // continuity holds from the last (re)start
     bool faded = false;
     int good_epochs = 0;
-    bool slip_pending = true;  // the first report after a (re)start is a slip
+    bool slip_pending = true;   // the first report after a (re)start is a slip
     double phase_cycles = 0.0;  // unwrapped phase_k - phase_0 at sample_mid
     double rate_hz = 0.0;
     double sample_mid = 0.0;

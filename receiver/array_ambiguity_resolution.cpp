@@ -1,12 +1,12 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/array_ambiguity_resolution.hpp"
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "receiver/chi_square.hpp"
 #include "receiver/lambda.hpp"
@@ -145,8 +145,8 @@ AmbiguityResolution resolve_array_ambiguities(const ArrayFitter& fitter,
       const std::vector<IntegerCandidate> best2 = lambda_search(dd.dd_cycles.segment(b, c), Qa, 2);
       out.candidates_enumerated += static_cast<int>(best2.size());
       out.integers.segment(b, c) = best2.front().a;
-      const double r = best2.size() > 1 ? best2[1].squared_norm / best2[0].squared_norm
-                                        : std::numeric_limits<double>::infinity();
+      const double r =
+          best2.size() > 1 ? best2[1].squared_norm / best2[0].squared_norm : std::numeric_limits<double>::infinity();
       min_ratio = std::min(min_ratio, r);
     }
     out.fit = fitter.fit(out.integers);

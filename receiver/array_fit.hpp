@@ -1,22 +1,22 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Attitude of a rigid antenna array from double differences with fixed integer ambiguities: each baseline's float
 // (least-squares) vector, Wahba's SVD rotation of those baselines as the start, then Gauss-Newton on all DDs with
 // their full covariance (the same estimator as the rotation fit weighted by the joint baseline covariance), giving
 // the rotation R_eb (body -> ECEF), its small-rotation covariance and the DD residuals. Units: cycles, m, rad.
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "receiver/phase_differences.hpp"
 
 namespace ultratrack::receiver {
 
 struct BaselineFloat {
-  bool ok = false;              // at least 3 rows and a full-rank geometry
+  bool ok = false;  // at least 3 rows and a full-rank geometry
   Eigen::Vector3d b_e = Eigen::Vector3d::Zero();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // m^2
-  double residual_chi2 = 0.0;   // rows - 3 degrees of freedom
+  double residual_chi2 = 0.0;                            // rows - 3 degrees of freedom
 };
 
 struct ArrayFit {
@@ -46,7 +46,7 @@ class ArrayFitter {
  private:
   const DoubleDifferences* dd_;
   std::vector<Eigen::Vector3d> body_;
-  Eigen::MatrixXd weight_;                 // Q^-1
+  Eigen::MatrixXd weight_;                     // Q^-1
   std::vector<Eigen::MatrixXd> block_weight_;  // per antenna: (Q_kk)^-1
 };
 

@@ -1,11 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/attitude_geometry.hpp"
-
-#include <algorithm>
-#include <cmath>
-#include <numbers>
 
 #include <Eigen/Geometry>
 #include <GeographicLib/Geocentric.hpp>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
 
 namespace ultratrack::receiver {
 
@@ -16,8 +16,8 @@ Eigen::Matrix3d ned_to_ecef_rotation(const Eigen::Vector3d& r_e) {
   const double lon = lon_deg * std::numbers::pi / 180.0;
   const double sl = std::sin(lat), cl = std::cos(lat), so = std::sin(lon), co = std::cos(lon);
   Eigen::Matrix3d C_en;
-  C_en.col(0) << -sl * co, -sl * so, cl;  // north
-  C_en.col(1) << -so, co, 0.0;            // east
+  C_en.col(0) << -sl * co, -sl * so, cl;   // north
+  C_en.col(1) << -so, co, 0.0;             // east
   C_en.col(2) << -cl * co, -cl * so, -sl;  // down
   return C_en;
 }

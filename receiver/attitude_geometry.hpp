@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Frames and angles of the attitude solver: the local NED frame at an ECEF position (WGS-84 geodetic latitude and
 // longitude from GeographicLib), z-y-x Euler angles (yaw, pitch, roll) of C_nb (body to NED), and the propagation of
 // a small-rotation covariance into Euler-angle covariance. Radians.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/attitude_outputs.hpp"
 
 #include <fmt/core.h>
@@ -10,7 +11,6 @@
 
 namespace ultratrack::receiver {
 namespace {
-
 
 std::filesystem::path made(const std::filesystem::path& dir) {
   std::error_code ec;
@@ -53,9 +53,9 @@ void AttitudeOutputs::on_antenna_phases(const receiver::AntennaPhaseEpoch& epoch
   for (const auto& sat : corrected_.satellites) {
     for (int k = 0; k < sat.num_antennas; ++k) {
       const auto i = static_cast<std::size_t>(k);
-      ph << fmt::format("{},{:.4f},{},{},{:.3f},{:.5f},{:.2f},{},{}\n", epoch.receive_time.week, epoch.receive_time.tow_s,
-                        sat.prn, k, sat.elevation_rad / io::kRadPerDeg, sat.carrier_phase_cycles[i], sat.cn0_dbhz[i],
-                        sat.usable[i] ? 1 : 0, sat.slip[i] ? 1 : 0);
+      ph << fmt::format("{},{:.4f},{},{},{:.3f},{:.5f},{:.2f},{},{}\n", epoch.receive_time.week,
+                        epoch.receive_time.tow_s, sat.prn, k, sat.elevation_rad / io::kRadPerDeg,
+                        sat.carrier_phase_cycles[i], sat.cn0_dbhz[i], sat.usable[i] ? 1 : 0, sat.slip[i] ? 1 : 0);
       if (sat.slip[i]) ++stats_.slips[i];
       if (!sat.usable[i]) ++stats_.unusable[i];
     }
@@ -72,8 +72,8 @@ void AttitudeOutputs::on_antenna_phases(const receiver::AntennaPhaseEpoch& epoch
     stats_.sum_sats += sol.num_sats;
     if (!stats_.first_attitude_sample) stats_.first_attitude_sample = epoch.sample_index;
     const auto sd = [&](int i) { return std::sqrt(std::max(0.0, sol.covariance_rad2(i, i))) / io::kRadPerDeg; };
-    out << fmt::format("{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},", sol.roll_rad / io::kRadPerDeg, sol.pitch_rad / io::kRadPerDeg,
-                       sol.yaw_rad / io::kRadPerDeg, sd(0), sd(1), sd(2));
+    out << fmt::format("{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},{:.5f},", sol.roll_rad / io::kRadPerDeg,
+                       sol.pitch_rad / io::kRadPerDeg, sol.yaw_rad / io::kRadPerDeg, sd(0), sd(1), sd(2));
   } else {
     out << "nan,nan,nan,nan,nan,nan,";
   }
@@ -92,9 +92,9 @@ void AttitudeOutputs::finish(const receiver::ReceiverEngine& engine, const recei
                              : -1.0;
   int after_first = 0;  // epochs from the first attitude on
   if (s.first_attitude_sample && s.first_epoch_sample)
-    after_first = s.epochs - static_cast<int>(std::llround(static_cast<double>(*s.first_attitude_sample -
-                                                                               *s.first_epoch_sample) /
-                                                           (engine.options().observation_interval_s * fs_hz_)));
+    after_first =
+        s.epochs - static_cast<int>(std::llround(static_cast<double>(*s.first_attitude_sample - *s.first_epoch_sample) /
+                                                 (engine.options().observation_interval_s * fs_hz_)));
   std::string files, slips, unusable;
   for (const auto& f : inputs) files += fmt::format("{}\"{}\"", files.empty() ? "" : ", ", json_text(f));
   for (std::size_t k = 0; k < inputs.size(); ++k) {
@@ -103,9 +103,11 @@ void AttitudeOutputs::finish(const receiver::ReceiverEngine& engine, const recei
   }
   const std::string json = fmt::format(
       "{{\n  \"command\": \"attitude\",\n  \"inputs\": [{}],\n  \"antennas\": {},\n  \"format\": \"{}\",\n"
-      "  \"fs_hz\": {},\n  \"if_hz\": {},\n  \"signal_s\": {:.3f},\n  \"wall_s\": {:.3f},\n  \"realtime_factor\": {:.2f},\n"
+      "  \"fs_hz\": {},\n  \"if_hz\": {},\n  \"signal_s\": {:.3f},\n  \"wall_s\": {:.3f},\n  \"realtime_factor\": "
+      "{:.2f},\n"
       "  \"interrupted\": {},\n  \"position_fix\": {},\n  \"phase_epochs\": {},\n  \"attitude_epochs\": {},\n"
-      "  \"fixed_epochs\": {},\n  \"fix_rate\": {:.4f},\n  \"fix_rate_after_first_fix\": {:.4f},\n  \"new_fixes\": {},\n"
+      "  \"fixed_epochs\": {},\n  \"fix_rate\": {:.4f},\n  \"fix_rate_after_first_fix\": {:.4f},\n  \"new_fixes\": "
+      "{},\n"
       "  \"time_to_first_attitude_s\": {:.3f},\n  \"mean_satellites\": {:.2f},\n"
       "  \"slip_flags_per_antenna\": [{}],\n  \"unusable_per_antenna\": [{}]\n}}\n",
       files, inputs.size(), json_text(run.format), run.fs_hz, run.if_hz, signal_s, run.wall_time_s,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The files of `ultratrack attitude`, fed as a ReceiverObserver: the position solution in DIR/position/ (the
 // scalar receiver's ReceiverOutputs, as `receive` writes it), and in DIR: attitude.csv (one row per epoch with
 // antenna phases: gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,
@@ -20,15 +21,15 @@
 namespace ultratrack::receiver {
 
 struct AttitudeStats {
-  int epochs = 0;            // epochs with antenna phases
-  int attitude_epochs = 0;   // with a valid attitude
+  int epochs = 0;           // epochs with antenna phases
+  int attitude_epochs = 0;  // with a valid attitude
   int fixed_epochs = 0;
   int new_fixes = 0;
   std::optional<std::int64_t> first_attitude_sample;
   std::optional<std::int64_t> first_epoch_sample;
   double sum_sats = 0.0;
-  std::array<int, receiver::kMaxAntennas> slips{};            // slip flags raised, per antenna
-  std::array<int, receiver::kMaxAntennas> unusable{};         // satellite-epochs without a usable phase
+  std::array<int, receiver::kMaxAntennas> slips{};     // slip flags raised, per antenna
+  std::array<int, receiver::kMaxAntennas> unusable{};  // satellite-epochs without a usable phase
 };
 
 class AttitudeOutputs final : public receiver::ReceiverObserver {

@@ -1,5 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/attitude_solver.hpp"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,9 +10,7 @@
 #include <set>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/Geometry>
-
+#include "io/why_invalid.hpp"
 #include "receiver/array_ambiguity_resolution.hpp"
 #include "receiver/array_fit.hpp"
 #include "receiver/attitude_geometry.hpp"
@@ -17,12 +18,11 @@
 #include "receiver/phase_differences.hpp"
 #include "receiver/wahba_rotation.hpp"
 #include "signals/gps_constants.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::receiver {
 
 bool AttitudeSolverOptions::IsValid(std::string* why) const {
-    const AttitudeSolverOptions& o = *this;
+  const AttitudeSolverOptions& o = *this;
   const std::string problem = [&]() -> std::string {
     const auto& lever = o.array.lever_arm_body_m;
     if (lever.size() < 3 || lever.size() > static_cast<std::size_t>(kMaxAntennas)) {
@@ -31,7 +31,8 @@ bool AttitudeSolverOptions::IsValid(std::string* why) const {
     bool two_directions = false;
     for (std::size_t k = 1; k < lever.size(); ++k) {
       const Eigen::Vector3d bk = lever[k] - lever[0];
-      if (!bk.allFinite() || bk.norm() < 0.1) return "antenna " + std::to_string(k) + " is less than 0.1 m from the master";
+      if (!bk.allFinite() || bk.norm() < 0.1)
+        return "antenna " + std::to_string(k) + " is less than 0.1 m from the master";
       for (std::size_t j = 1; j < k; ++j) {
         const Eigen::Vector3d bj = lever[j] - lever[0];
         if (bj.cross(bk).norm() > 0.1 * bj.norm() * bk.norm()) two_directions = true;
@@ -139,8 +140,9 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
     const auto ku = static_cast<std::size_t>(k);
     if (bias_count_[ku] == 0) continue;
     sol.line_bias_cycles[ku] = wrap_half(bias_mean_[ku]);
-    sol.line_bias_sigma_cycles[ku] = bias_count_[ku] >= 2 ? std::sqrt(bias_m2_[ku] / (bias_count_[ku] - 1) / bias_count_[ku])
-                                                          : std::numeric_limits<double>::quiet_NaN();
+    sol.line_bias_sigma_cycles[ku] = bias_count_[ku] >= 2
+                                         ? std::sqrt(bias_m2_[ku] / (bias_count_[ku] - 1) / bias_count_[ku])
+                                         : std::numeric_limits<double>::quiet_NaN();
   }
 
   if (!epoch.master_position_e.allFinite() || epoch.master_position_e.norm() < 1.0e6) return sol;
@@ -155,7 +157,8 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
   auto usable = [&](std::size_t s, int k) {
     const AntennaPhaseObservation& o = *sats[s];
     return k < o.num_antennas && o.usable[static_cast<std::size_t>(k)] &&
-           std::isfinite(o.carrier_phase_cycles[static_cast<std::size_t>(k)]) && std::isfinite(o.carrier_phase_cycles[0]);
+           std::isfinite(o.carrier_phase_cycles[static_cast<std::size_t>(k)]) &&
+           std::isfinite(o.carrier_phase_cycles[0]);
   };
   auto sat_index = [&](int prn) -> int {
     for (std::size_t s = 0; s < sats.size(); ++s) {
@@ -182,7 +185,9 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
 
   const Eigen::Matrix3d C_en = ned_to_ecef_rotation(epoch.master_position_e);
   const double pfa = options_.residual_test_pfa;
-  auto passes = [&](const ArrayFit& f) { return f.ok && f.dof >= 1 && f.chi2 <= chi_square_upper_quantile(f.dof, pfa); };
+  auto passes = [&](const ArrayFit& f) {
+    return f.ok && f.dof >= 1 && f.chi2 <= chi_square_upper_quantile(f.dof, pfa);
+  };
   // Carried DDs: the satellites with a kept ambiguity, on the baselines that keep at least 4 of them (3 DDs).
   auto carried_dd = [&]() {
     std::vector<int> kept_sats(lever.size(), 0);
@@ -261,9 +266,9 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
       bias_m2_[ku] += delta * (d - bias_mean_[ku]);
       sol.line_bias_cycles[ku] = wrap_half(bias_mean_[ku]);
       // One epoch's mean of n SDs has the SD noise / sqrt(n); over epochs, the scatter of the epoch means.
-      sol.line_bias_sigma_cycles[ku] =
-          bias_count_[ku] >= 2 ? std::sqrt(bias_m2_[ku] / (bias_count_[ku] - 1) / bias_count_[ku])
-                               : std::sqrt(2.0) * sigma_cycles / std::sqrt(static_cast<double>(n));
+      sol.line_bias_sigma_cycles[ku] = bias_count_[ku] >= 2
+                                           ? std::sqrt(bias_m2_[ku] / (bias_count_[ku] - 1) / bias_count_[ku])
+                                           : std::sqrt(2.0) * sigma_cycles / std::sqrt(static_cast<double>(n));
     }
     have_attitude_ = true;
     last_R_eb_ = fit.R_eb;
@@ -337,8 +342,8 @@ AttitudeSolution AttitudeSolver::update(const AntennaPhaseEpoch& epoch) {
     slip = slip || sats[r.sat]->slip[0] || sats[r.sat]->slip[k] || sats[r.ref_sat]->slip[0] || sats[r.ref_sat]->slip[k];
   }
   const bool multi = options_.use_length_constraint && options_.multi_epoch;
-  const bool continue_pending = multi && !pending_.empty() && rows == pending_rows_ && !slip &&
-                                pending_epochs_ < options_.multi_epoch_max_epochs;
+  const bool continue_pending =
+      multi && !pending_.empty() && rows == pending_rows_ && !slip && pending_epochs_ < options_.multi_epoch_max_epochs;
   Eigen::VectorXd integers;
   ArrayFit fit;
   double ratio = 0.0;

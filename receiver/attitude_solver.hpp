@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Carrier-phase attitude of a rigid antenna array (2..4 antennas, antenna 0 the master) from AntennaPhaseEpochs:
 // double differences between antennas and satellites, integer ambiguities by LAMBDA with the known baseline
 // lengths and angles as constraints, ratio and difference tests (on one epoch, or on the summed fits of several
@@ -11,10 +12,9 @@
 // (The comment in antenna_phase.hpp writes +; the physics of a phase that grows with range gives -.)
 #pragma once
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "receiver/antenna_phase.hpp"
 #include "signals/gps_time.hpp"
@@ -30,9 +30,9 @@ struct AntennaArray {
 
 struct AttitudeSolverOptions {
   AntennaArray array;
-  double phase_sigma_m = 0.003;       // carrier noise of one antenna's phase (1 sigma, uniform over elevation), m
+  double phase_sigma_m = 0.003;  // carrier noise of one antenna's phase (1 sigma, uniform over elevation), m
   double elevation_mask_rad = 0.17453292519943295;  // 10 deg; satellites below it are left out
-  int min_satellites = 5;             // satellites (reference included) needed on a baseline to resolve
+  int min_satellites = 5;                           // satellites (reference included) needed on a baseline to resolve
   // Validation of a new fix, both tests on the rigid-fit chi-square of the best and second-best candidates: ratio
   // test J2 / J1 >= ratio_threshold (Euler & Schaffrin 1991) and difference test J2 - J1 >= difference_threshold
   // (Tiberius & de Jonge 1995). The difference test is what keeps wrong fixes rare at 5 satellites, where a wrong
@@ -77,14 +77,14 @@ struct SdAmbiguity {
 
 struct AttitudeSolution {
   signals::GpsTime time;
-  bool valid = false;     // an attitude is given (only from validated integer ambiguities)
-  bool fixed = false;     // the ambiguities used this epoch are fixed and passed this epoch's checks
-  bool new_fix = false;   // resolved from scratch this epoch (false: carried from earlier epochs)
+  bool valid = false;    // an attitude is given (only from validated integer ambiguities)
+  bool fixed = false;    // the ambiguities used this epoch are fixed and passed this epoch's checks
+  bool new_fix = false;  // resolved from scratch this epoch (false: carried from earlier epochs)
   // Ratio test value (J2 / J1) of the fix in use, from the epoch it was resolved; 1e9 when no rival candidate passed
   // the constraints; when not fixed, the value that failed (0 if no candidate at all).
   double ratio = 0.0;
-  int num_sats = 0;       // satellites in the attitude fit (reference included)
-  double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;  // yaw in [0, 2 pi)
+  int num_sats = 0;                                           // satellites in the attitude fit (reference included)
+  double roll_rad = 0.0, pitch_rad = 0.0, yaw_rad = 0.0;      // yaw in [0, 2 pi)
   Eigen::Matrix3d covariance_rad2 = Eigen::Matrix3d::Zero();  // (roll, pitch, yaw), from the DD covariance
   Eigen::Matrix3d C_nb = Eigen::Matrix3d::Identity();
   std::vector<Eigen::Vector3d> baseline_n_m;  // fitted baselines master -> antenna k (k >= 1), NED, m
@@ -94,8 +94,8 @@ struct AttitudeSolution {
   // its 1-sigma; [0] = 0. NaN for an antenna until a fix. Averaged over the fixed epochs since the last restart.
   std::vector<double> line_bias_cycles;
   std::vector<double> line_bias_sigma_cycles;
-  std::vector<SdAmbiguity> ambiguities;       // the fixed ambiguities used this epoch
-  std::vector<int> slipped_prns;              // satellites whose ambiguity restarted this epoch (flag or check)
+  std::vector<SdAmbiguity> ambiguities;  // the fixed ambiguities used this epoch
+  std::vector<int> slipped_prns;         // satellites whose ambiguity restarted this epoch (flag or check)
 };
 
 // Stateful: keeps the fixed ambiguities (per antenna and satellite) from epoch to epoch. Each epoch: drop the
@@ -118,8 +118,8 @@ class AttitudeSolver {
 
  private:
   AttitudeSolverOptions options_;
-  std::vector<SdAmbiguity> fixed_;             // carried SD ambiguities
-  std::vector<double> bias_mean_, bias_m2_;    // running line-bias calibration per antenna (Welford)
+  std::vector<SdAmbiguity> fixed_;           // carried SD ambiguities
+  std::vector<double> bias_mean_, bias_m2_;  // running line-bias calibration per antenna (Welford)
   std::vector<int> bias_count_;
   double last_ratio_ = 0.0;
   // Multi-epoch resolution in progress: the candidates' summed chi-squares, and the DD rows they were formed on.

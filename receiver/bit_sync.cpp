@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/bit_sync.hpp"
 
 #include <algorithm>
@@ -72,7 +73,8 @@ void BitSynchronizer::add(std::int64_t code_period, std::complex<float> prompt) 
     }
   }
   if (have_previous_ && code_period == previous_period_ + 1) {
-    const double dot = static_cast<double>(prompt.real()) * previous_.real() + static_cast<double>(prompt.imag()) * previous_.imag();
+    const double dot =
+        static_cast<double>(prompt.real()) * previous_.real() + static_cast<double>(prompt.imag()) * previous_.imag();
     if (dot < 0.0) ++bins_[static_cast<std::size_t>(((code_period % 20) + 20) % 20)];
   }
   have_previous_ = true;

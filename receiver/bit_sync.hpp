@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bit synchronisation for GPS LNAV (50 bit/s, 20 code periods per bit): a histogram of prompt sign changes
 // between successive 1 ms epochs over the 20 possible bit-edge positions, and the maximum-likelihood test on the
 // energy of 20 ms prompt sums at the 20 candidate offsets (whichever decides first); then assembly of 20 ms bits
@@ -31,13 +32,13 @@ namespace ultratrack::receiver {
 // their summed difference, its variance estimated from the bits themselves (per-bit variance plus the lag-1
 // covariance of neighbouring bits, whose windows overlap).
 struct BitSyncOptions {
-  int min_edges = 10;          // transitions counted in the winning bin before deciding; [3, 1000]
-  double min_ratio = 3.0;      // winning bin / runner-up bin; [1.5, 100]
-  double min_lead_sigma = 4.0; // (winning - runner-up) / sqrt(winning + runner-up); [3, 100]
-  int max_periods = 10000;     // give up (failed()) after this many 1 ms epochs; >= 200
-  bool energy_test = true;         // also run the energy (maximum-likelihood) test
-  int min_energy_bits = 25;        // complete 20-window sets before the energy test may decide; [10, 1000]
-  double min_energy_sigma = 5.0;   // lead over every other offset, in standard deviations; [3, 100]
+  int min_edges = 10;             // transitions counted in the winning bin before deciding; [3, 1000]
+  double min_ratio = 3.0;         // winning bin / runner-up bin; [1.5, 100]
+  double min_lead_sigma = 4.0;    // (winning - runner-up) / sqrt(winning + runner-up); [3, 100]
+  int max_periods = 10000;        // give up (failed()) after this many 1 ms epochs; >= 200
+  bool energy_test = true;        // also run the energy (maximum-likelihood) test
+  int min_energy_bits = 25;       // complete 20-window sets before the energy test may decide; [10, 1000]
+  double min_energy_sigma = 5.0;  // lead over every other offset, in standard deviations; [3, 100]
 };
 
 class BitSynchronizer final {
@@ -110,7 +111,7 @@ class BitAssembler final {
 
  private:
   bool differential_ = false;
-  bool have_previous_ = false;   // previous_ is the bit just before the current one
+  bool have_previous_ = false;  // previous_ is the bit just before the current one
   std::complex<double> previous_sum_{};
   int previous_value_ = 1;
   std::int64_t previous_period_ = 0;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Who closes a tracking channel's carrier: its own PLL or an external (vector) loop. The one carrier-control
 // setting of the seam (VectorChannelCommand::carrier) and of the channel (ScalarTrackingControl::carrier), so that
 // a phase-locked carrier without a commanded frequency cannot be written.

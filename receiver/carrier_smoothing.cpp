@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/carrier_smoothing.hpp"
 
 #include <algorithm>
@@ -15,8 +16,7 @@ constexpr double kJumpSigmas = 6.0;
 double CarrierSmoothing::update(int prn, std::int64_t epoch_index, double pseudorange_m, double carrier_phase_cycles,
                                 bool new_track, double code_sigma_m) {
   State& s = state_[static_cast<std::size_t>(prn)];
-  const double predicted =
-      s.smoothed_m + signals::kL1Wavelength_m * (carrier_phase_cycles - s.last_phase_cycles);
+  const double predicted = s.smoothed_m + signals::kL1Wavelength_m * (carrier_phase_cycles - s.last_phase_cycles);
   const bool restart = new_track || s.n == 0 || epoch_index != s.last_epoch + 1 ||
                        std::abs(pseudorange_m - predicted) > std::max(slip_threshold_m_, kJumpSigmas * code_sigma_m);
   if (restart) {

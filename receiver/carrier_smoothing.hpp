@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Carrier-smoothed pseudoranges (Hatch filter) for the PVT: the code's thermal noise (DLL jitter, ~1 m at
 // 45 dB-Hz with 1 chip E-L spacing) averaged against the carrier's millimetre-level phase changes:
 //     P_s(k) = P(k) / n + (n - 1) / n * (P_s(k-1) + lambda (L(k) - L(k-1))),  n = min(k, window)

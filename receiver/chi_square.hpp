@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The chi-square distribution of every statistical test in the tree (PVT and snapshot residual tests, the attitude
 // solver's gates, the filters' innovation gates, consistency bands): exact, through the regularised incomplete gamma
 // functions (series / Lentz continued fraction, relative error ~1e-12), each tail computed directly so that a small

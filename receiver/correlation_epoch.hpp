@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // CorrelationEpoch: what a tracking channel returns for one coherent integration (1 code period = 1 ms, or 20
 // after bit sync): complex correlator sums per antenna and the replica's state at the epoch's start and end
 // (code phase in chips, carrier phase in cycles, rates in chips/s and Hz), as the observables need them.

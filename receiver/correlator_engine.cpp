@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/correlator_engine.hpp"
 
 #include <algorithm>
@@ -45,9 +46,11 @@ CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_
   table_.resize(5 * kCodeLength + 8);
   for (int i = 0; i < static_cast<int>(table_.size()); ++i) table_[i] = static_cast<float>(chips[i % kCodeLength]);
   table_i8_.resize(table_.size() + 32);  // the AVX2 integer copy reads 16-byte windows past the last chip used
-  for (int i = 0; i < static_cast<int>(table_i8_.size()); ++i) table_i8_[i] = static_cast<std::int8_t>(chips[i % kCodeLength]);
+  for (int i = 0; i < static_cast<int>(table_i8_.size()); ++i)
+    table_i8_[i] = static_cast<std::int8_t>(chips[i % kCodeLength]);
   table_i16_.resize(table_.size() + 64);  // the AVX-512 copy reads 32-word windows past the last chip used
-  for (int i = 0; i < static_cast<int>(table_i16_.size()); ++i) table_i16_[i] = static_cast<std::int16_t>(chips[i % kCodeLength]);
+  for (int i = 0; i < static_cast<int>(table_i16_.size()); ++i)
+    table_i16_[i] = static_cast<std::int16_t>(chips[i % kCodeLength]);
   const CorrelatorIsa level = resolve_correlator_isa(isa);
   std::uint32_t share = 0;  // per tap: the first tap a whole number of chips from it (the AVX-512 copy's pattern)
   for (int t = 0; t < num_taps_; ++t) {
@@ -60,11 +63,12 @@ CorrelatorEngine::CorrelatorEngine(int prn, std::span<const double> tap_offsets_
   kernel_i16_ = select_kernel_i16(level, num_taps_, share);
 }
 
-void CorrelatorEngine::correlate_i16(std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& replica,
-                                     double scale, std::span<TapSums> sums) const {
+void CorrelatorEngine::correlate_i16(std::span<const PlanarI16> antennas, int num_samples,
+                                     const ReplicaSegment& replica, double scale, std::span<TapSums> sums) const {
   const std::uint32_t step = table_step(replica.carrier_step_q32);
   if (!rotation_.valid || rotation_.step_q32 != step) build_rotation(step, rotation_);
-  kernel_i16_(table_i8_.data(), table_i16_.data(), offsets_.data(), num_taps_, antennas, num_samples, replica, rotation_, scale, sums);
+  kernel_i16_(table_i8_.data(), table_i16_.data(), offsets_.data(), num_taps_, antennas, num_samples, replica,
+              rotation_, scale, sums);
 }
 
 void convert_to_planar_i16(const std::complex<float>* in, int n, float gain, std::int16_t* re, std::int16_t* im) {

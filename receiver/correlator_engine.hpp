@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Correlator engine: the hot path's single home. Carrier wipe-off and up to kMaxTaps code correlators (very
 // early, early, prompt, late, very late, noise: any set of code offsets in chips) over one block of complex
 // baseband samples, for 1..kMaxAntennas antennas against one replica in one pass. Code chips come from a table
@@ -36,7 +37,8 @@ CorrelatorIsa correlator_auto_isa();
 
 // The replica over one block: prompt code phase at the first sample, chips, measured from a code period start
 // and within [-1023, 2046), with at most 1023 chips covered by the block (so that every tap stays in the
-// engine's 5-period table); code step in chips per sample; carrier phase at the first sample and its step per sample in 2^-32 cycles (wrapping).
+// engine's 5-period table); code step in chips per sample; carrier phase at the first sample and its step per sample in
+// 2^-32 cycles (wrapping).
 struct ReplicaSegment {
   double code_phase_chips = 0.0;
   double code_step_chips = 0.0;
@@ -77,8 +79,9 @@ class CorrelatorEngine final {
 
  public:
   // One instruction-set-specific copy of the kernel for this engine's tap count, picked at construction.
-  using Kernel = void (*)(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
-                          int num_samples, const ReplicaSegment& replica, std::span<TapSums> sums);
+  using Kernel = void (*)(const float* table, const double* offsets,
+                          std::span<const std::complex<float>* const> antennas, int num_samples,
+                          const ReplicaSegment& replica, std::span<TapSums> sums);
   // The carrier rotation over one chunk of the integer kernel, Q15, for one carrier step (cached: the two
   // halves of an epoch and every antenna share it).
   struct Rotation {
@@ -97,7 +100,7 @@ class CorrelatorEngine final {
   int num_taps_;
   std::array<double, kMaxTaps> offsets_{};
   std::vector<float> table_;  // 5 code periods of +1/-1 chips (float: no conversion per sample): index = chip + 2046
-  std::vector<std::int8_t> table_i8_;  // the same chips as int8 (the integer kernel's byte shuffles)
+  std::vector<std::int8_t> table_i8_;    // the same chips as int8 (the integer kernel's byte shuffles)
   std::vector<std::int16_t> table_i16_;  // and as int16 (the AVX-512 copy's word permutes)
   Kernel kernel_ = nullptr;
   KernelI16 kernel_i16_ = nullptr;
@@ -108,8 +111,9 @@ class CorrelatorEngine final {
 // it (same results as the portable loop: round to nearest even in both). Allocates nothing.
 void convert_to_planar_i16(const std::complex<float>* in, int n, float gain, std::int16_t* re, std::int16_t* im);
 
-// A lag (chips, -723..-300: the noise replica lags prompt) where this PRN's periodic autocorrelation is -1/1023 at that lag and its two neighbours
-// on each side: a replica shifted by it sees noise only, whatever the fractional code error. Throws for bad PRNs.
+// A lag (chips, -723..-300: the noise replica lags prompt) where this PRN's periodic autocorrelation is -1/1023 at that
+// lag and its two neighbours on each side: a replica shifted by it sees noise only, whatever the fractional code error.
+// Throws for bad PRNs.
 double noise_tap_offset_chips(int prn);
 
 // cos and sin of 2*pi*phase for a 2^-32-cycle fixed-point phase; |error| < 1e-6. Exposed for tests.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/correlator_isa.hpp"
 
 #include <cstdlib>
@@ -59,8 +60,9 @@ CorrelatorIsa auto_isa() {
 CorrelatorIsa resolve_isa(CorrelatorIsa isa) {
   if (isa == CorrelatorIsa::kAuto) return auto_isa();
   if (!isa_available(isa))
-    throw std::invalid_argument(isa == CorrelatorIsa::kAvx2 ? "CorrelatorEngine: AVX2+FMA kernel not available here"
-                                                            : "CorrelatorEngine: AVX-512 BW/VL/VNNI kernel not available here");
+    throw std::invalid_argument(isa == CorrelatorIsa::kAvx2
+                                    ? "CorrelatorEngine: AVX2+FMA kernel not available here"
+                                    : "CorrelatorEngine: AVX-512 BW/VL/VNNI kernel not available here");
   return isa;
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The correlator's instruction-set copies: which ones this build has (ULTRATRACK_HAVE_AVX2_KERNEL: GCC-compatible
 // compiler on x86, the AVX2 and AVX-512 copies compiled per function with target attributes) and the level an
 // engine runs. The public choice (CorrelatorIsa, correlator_isa_available, correlator_auto_isa, the

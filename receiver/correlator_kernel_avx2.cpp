@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The AVX2+FMA copies (compiled per function with target attributes; chosen at run time when the CPU has them):
 // the float kernel with the code fill fused into the multiply-accumulate loop, the integer kernel (16 samples
 // per step), and the float-to-planar-int16 conversion.
@@ -124,11 +125,10 @@ struct LaneIndexAvx2 {  // per call: thresholds 2^22 - 1 - g_l in pack order, wh
 };
 
 template <int kTaps, std::uint32_t kShare>
-__attribute__((target("avx2,fma"), always_inline)) inline void avx2_chunk(const std::int16_t* xr_p, const std::int16_t* xi_p, int n,
-                                                                         const CorrelatorEngine::Rotation& rot,
-                                                                         const std::int8_t* const* base, const std::uint32_t* frac,
-                                                                         std::uint32_t step, const LaneIndexAvx2& lanes,
-                                                                         std::int64_t* re, std::int64_t* im) {
+__attribute__((target("avx2,fma"), always_inline)) inline void avx2_chunk(
+    const std::int16_t* xr_p, const std::int16_t* xi_p, int n, const CorrelatorEngine::Rotation& rot,
+    const std::int8_t* const* base, const std::uint32_t* frac, std::uint32_t step, const LaneIndexAvx2& lanes,
+    std::int64_t* re, std::int64_t* im) {
   __m256i acc_re[kTaps], acc_im[kTaps];
   for (int t = 0; t < kTaps; ++t) acc_re[t] = acc_im[t] = _mm256_setzero_si256();
   for (int i = 0; i < n; i += 16) {
@@ -156,8 +156,10 @@ __attribute__((target("avx2,fma"), always_inline)) inline void avx2_chunk(const 
         const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
         first[t] = p >> kFracBits;
         const __m256i q = _mm256_set1_epi32(static_cast<int>(p & kFracMask));
-        const __m256i carry = _mm256_packs_epi32(_mm256_cmpgt_epi32(q, lanes.below_lo), _mm256_cmpgt_epi32(q, lanes.below_hi));
-        rel[t] = _mm_sub_epi8(lanes.whole, _mm_packs_epi16(_mm256_castsi256_si128(carry), _mm256_extracti128_si256(carry, 1)));
+        const __m256i carry =
+            _mm256_packs_epi32(_mm256_cmpgt_epi32(q, lanes.below_lo), _mm256_cmpgt_epi32(q, lanes.below_hi));
+        rel[t] = _mm_sub_epi8(lanes.whole,
+                              _mm_packs_epi16(_mm256_castsi256_si128(carry), _mm256_extracti128_si256(carry, 1)));
       } else {
         rel[t] = rel[lead];
         first[t] = first[lead];
@@ -182,10 +184,11 @@ __attribute__((target("avx2,fma"), always_inline)) inline void avx2_chunk(const 
 
 template <int kTaps, std::uint32_t kShare>
 __attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* table, const std::int16_t* table16,
-                                                           const double* offsets, int num_taps,
-                                                           std::span<const PlanarI16> antennas, int num_samples,
-                                                           const ReplicaSegment& rep, const CorrelatorEngine::Rotation& rot,
-                                                           double scale, std::span<TapSums> sums) {
+                                                            const double* offsets, int num_taps,
+                                                            std::span<const PlanarI16> antennas, int num_samples,
+                                                            const ReplicaSegment& rep,
+                                                            const CorrelatorEngine::Rotation& rot, double scale,
+                                                            std::span<TapSums> sums) {
   if (!(rep.code_step_chips <= 0.99)) {  // 16 samples could span more than 16 chips
     correlate_i16_portable(table, table16, offsets, num_taps, antennas, num_samples, rep, rot, scale, sums);
     return;
@@ -218,9 +221,11 @@ __attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* t
     for (std::size_t a = 0; a < antennas.size(); ++a) {
       std::int64_t re[kMaxTaps], im[kMaxTaps];
       if (kShare == no_sharing(kTaps) || !shared)
-        avx2_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+        avx2_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step,
+                                             lanes, re, im);
       else
-        avx2_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+        avx2_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re,
+                                  im);
       finish_chunk(re, im, kTaps, phase0, scale, sums[a]);
     }
   }
@@ -228,39 +233,54 @@ __attribute__((target("avx2,fma"))) void correlate_i16_avx2(const std::int8_t* t
 
 struct Avx2Kernels {
   template <int kTaps, std::uint32_t kShare>
-  static constexpr CorrelatorEngine::KernelI16 get() { return &correlate_i16_avx2<kTaps, kShare>; }
+  static constexpr CorrelatorEngine::KernelI16 get() {
+    return &correlate_i16_avx2<kTaps, kShare>;
+  }
 };
 
 }  // namespace
 
 CorrelatorEngine::Kernel float_kernel_avx2(int num_taps) {
   switch (num_taps) {
-    case 1: return &correlate_avx2<1>;
-    case 2: return &correlate_avx2<2>;
-    case 3: return &correlate_avx2<3>;
-    case 4: return &correlate_avx2<4>;
-    case 5: return &correlate_avx2<5>;
-    default: return &correlate_avx2<6>;
+    case 1:
+      return &correlate_avx2<1>;
+    case 2:
+      return &correlate_avx2<2>;
+    case 3:
+      return &correlate_avx2<3>;
+    case 4:
+      return &correlate_avx2<4>;
+    case 5:
+      return &correlate_avx2<5>;
+    default:
+      return &correlate_avx2<6>;
   }
 }
 
 CorrelatorEngine::KernelI16 i16_kernel_avx2(int num_taps, std::uint32_t share) {
   switch (num_taps) {
-    case 1: return select_shared<1, Avx2Kernels>(share);
-    case 2: return select_shared<2, Avx2Kernels>(share);
-    case 3: return select_shared<3, Avx2Kernels>(share);
-    case 4: return select_shared<4, Avx2Kernels>(share);
-    case 5: return select_shared<5, Avx2Kernels>(share);
-    default: return select_shared<6, Avx2Kernels>(share);
+    case 1:
+      return select_shared<1, Avx2Kernels>(share);
+    case 2:
+      return select_shared<2, Avx2Kernels>(share);
+    case 3:
+      return select_shared<3, Avx2Kernels>(share);
+    case 4:
+      return select_shared<4, Avx2Kernels>(share);
+    case 5:
+      return select_shared<5, Avx2Kernels>(share);
+    default:
+      return select_shared<6, Avx2Kernels>(share);
   }
 }
 
-__attribute__((target("avx2,fma"))) void convert_planar_avx2(const std::complex<float>* in, int n, float gain, std::int16_t* re,
-                                                            std::int16_t* im) {
+__attribute__((target("avx2,fma"))) void convert_planar_avx2(const std::complex<float>* in, int n, float gain,
+                                                             std::int16_t* re, std::int16_t* im) {
   const float* x = reinterpret_cast<const float*>(in);
   const __m256 g = _mm256_set1_ps(gain), top = _mm256_set1_ps(32767.0f), bottom = _mm256_set1_ps(-32768.0f);
   const __m256i order = _mm256_setr_epi32(0, 1, 4, 5, 2, 3, 6, 7);
-#define ULTRATRACK_SCALED(p) _mm256_cvtps_epi32(_mm256_max_ps(_mm256_min_ps(_mm256_mul_ps(_mm256_loadu_ps(p), g), top), bottom))
+#define ULTRATRACK_SCALED(p) \
+  _mm256_cvtps_epi32(_mm256_max_ps(_mm256_min_ps(_mm256_mul_ps(_mm256_loadu_ps(p), g), top), bottom))
   const int n_vec = n - n % 16;
   for (int i = 0; i < n_vec; i += 16) {
     // Each 8-float load holds 4 samples. The int16 pack of two of them holds samples 0 1 4 5 | 2 3 6 7 (an
@@ -270,8 +290,8 @@ __attribute__((target("avx2,fma"))) void convert_planar_avx2(const std::complex<
     const __m256i ab = _mm256_permutevar8x32_epi32(_mm256_packs_epi32(a, b), order);
     const __m256i cd = _mm256_permutevar8x32_epi32(_mm256_packs_epi32(c, d), order);
     // now ab = r0 i0 r1 i1 ... r7 i7 (natural); split I/Q: byte shuffle within lanes, then 64-bit permute
-    const __m256i split = _mm256_setr_epi8(0, 1, 4, 5, 8, 9, 12, 13, 2, 3, 6, 7, 10, 11, 14, 15, 0, 1, 4, 5, 8, 9, 12, 13, 2, 3,
-                                           6, 7, 10, 11, 14, 15);
+    const __m256i split = _mm256_setr_epi8(0, 1, 4, 5, 8, 9, 12, 13, 2, 3, 6, 7, 10, 11, 14, 15, 0, 1, 4, 5, 8, 9, 12,
+                                           13, 2, 3, 6, 7, 10, 11, 14, 15);
     const __m256i abs = _mm256_permute4x64_epi64(_mm256_shuffle_epi8(ab, split), 0xD8);  // [r0-7 | i0-7]
     const __m256i cds = _mm256_permute4x64_epi64(_mm256_shuffle_epi8(cd, split), 0xD8);  // [r8-15 | i8-15]
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(re + i), _mm256_permute2x128_si256(abs, cds, 0x20));

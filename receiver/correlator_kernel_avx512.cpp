@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The integer kernel's AVX-512 BW+VL+VNNI copy (compiled per function with target attributes; chosen at run time
 // when the CPU has them): 32 samples per step, bit-identical to the portable and AVX2 copies.
 #include "receiver/correlator_kernels.hpp"
@@ -9,7 +10,8 @@ namespace {
 // Sum of the 16 int32 lanes. Zero-masked extracts: GCC 12's plain ones (and _mm512_reduce_add_epi32,
 // _mm512_castsi512_si256) warn about an undefined register.
 __attribute__((target("avx2,avx512f"), always_inline)) inline std::int32_t lane_sum(__m512i v) {
-  const __m256i h = _mm256_add_epi32(_mm512_maskz_extracti64x4_epi64(0xFF, v, 0), _mm512_maskz_extracti64x4_epi64(0xFF, v, 1));
+  const __m256i h =
+      _mm256_add_epi32(_mm512_maskz_extracti64x4_epi64(0xFF, v, 0), _mm512_maskz_extracti64x4_epi64(0xFF, v, 1));
   __m128i x = _mm_add_epi32(_mm256_castsi256_si128(h), _mm256_extracti128_si256(h, 1));
   x = _mm_add_epi32(x, _mm_shuffle_epi32(x, 0x4E));
   x = _mm_add_epi32(x, _mm_shuffle_epi32(x, 0xB1));
@@ -50,7 +52,8 @@ __attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"), always_i
         const std::uint32_t p = frac[t] + step * static_cast<std::uint32_t>(i);
         first[t] = p >> kFracBits;
         const __m512i q = _mm512_set1_epi32(static_cast<int>(p & kFracMask));
-        const __mmask32 carry = _mm512_kunpackw(_mm512_cmpge_epu32_mask(q, lanes.threshold_hi), _mm512_cmpge_epu32_mask(q, lanes.threshold_lo));
+        const __mmask32 carry = _mm512_kunpackw(_mm512_cmpge_epu32_mask(q, lanes.threshold_hi),
+                                                _mm512_cmpge_epu32_mask(q, lanes.threshold_lo));
         rel[t] = _mm512_mask_add_epi16(lanes.whole, carry, lanes.whole, one);
       } else {
         rel[t] = rel[lead];
@@ -100,9 +103,11 @@ __attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"))) void co
     for (std::size_t a = 0; a < antennas.size(); ++a) {
       std::int64_t re[kMaxTaps], im[kMaxTaps];
       if (kShare == no_sharing(kTaps) || !shared)
-        avx512_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+        avx512_chunk<kTaps, no_sharing(kTaps)>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step,
+                                               lanes, re, im);
       else
-        avx512_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re, im);
+        avx512_chunk<kTaps, kShare>(antennas[a].re + start, antennas[a].im + start, n, rot, base, frac, step, lanes, re,
+                                    im);
       finish_chunk(re, im, kTaps, phase0, scale, sums[a]);
     }
   }
@@ -110,19 +115,27 @@ __attribute__((target("avx2,fma,avx512f,avx512bw,avx512vl,avx512vnni"))) void co
 
 struct Avx512Kernels {
   template <int kTaps, std::uint32_t kShare>
-  static constexpr CorrelatorEngine::KernelI16 get() { return &correlate_i16_avx512<kTaps, kShare>; }
+  static constexpr CorrelatorEngine::KernelI16 get() {
+    return &correlate_i16_avx512<kTaps, kShare>;
+  }
 };
 
 }  // namespace
 
 CorrelatorEngine::KernelI16 i16_kernel_avx512(int num_taps, std::uint32_t share) {
   switch (num_taps) {
-    case 1: return select_shared<1, Avx512Kernels>(share);
-    case 2: return select_shared<2, Avx512Kernels>(share);
-    case 3: return select_shared<3, Avx512Kernels>(share);
-    case 4: return select_shared<4, Avx512Kernels>(share);
-    case 5: return select_shared<5, Avx512Kernels>(share);
-    default: return select_shared<6, Avx512Kernels>(share);
+    case 1:
+      return select_shared<1, Avx512Kernels>(share);
+    case 2:
+      return select_shared<2, Avx512Kernels>(share);
+    case 3:
+      return select_shared<3, Avx512Kernels>(share);
+    case 4:
+      return select_shared<4, Avx512Kernels>(share);
+    case 5:
+      return select_shared<5, Avx512Kernels>(share);
+    default:
+      return select_shared<6, Avx512Kernels>(share);
   }
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The float kernel's portable copy: C++ written for auto-vectorisation on baseline x86-64.
 #include "receiver/correlator_kernels.hpp"
 
@@ -15,18 +16,25 @@ void correlate_baseline(const float* table, const double* offsets, std::span<con
 
 }  // namespace
 
-__attribute__((noinline)) void fill_code_baseline(const float* __restrict chips, float frac, float step, int n, float* __restrict out) {
+__attribute__((noinline)) void fill_code_baseline(const float* __restrict chips, float frac, float step, int n,
+                                                  float* __restrict out) {
   for (int i = 0; i < n; ++i) out[i] = chips[static_cast<int>(frac + step * static_cast<float>(i))];
 }
 
 CorrelatorEngine::Kernel float_kernel_baseline(int num_taps) {
   switch (num_taps) {
-    case 1: return &correlate_baseline<1>;
-    case 2: return &correlate_baseline<2>;
-    case 3: return &correlate_baseline<3>;
-    case 4: return &correlate_baseline<4>;
-    case 5: return &correlate_baseline<5>;
-    default: return &correlate_baseline<6>;
+    case 1:
+      return &correlate_baseline<1>;
+    case 2:
+      return &correlate_baseline<2>;
+    case 3:
+      return &correlate_baseline<3>;
+    case 4:
+      return &correlate_baseline<4>;
+    case 5:
+      return &correlate_baseline<5>;
+    default:
+      return &correlate_baseline<6>;
   }
 }
 

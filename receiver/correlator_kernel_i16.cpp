@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The integer kernel's portable copy, and the chunk arithmetic every integer copy shares (rotation table, chip
 // indices per chunk, the exact finish of a chunk's sums).
 #include "receiver/correlator_kernels.hpp"
@@ -40,9 +41,10 @@ __attribute__((noinline)) void finish_chunk(const std::int64_t* re, const std::i
   }
 }
 
-void correlate_i16_portable(const std::int8_t* table, const std::int16_t* /*table16*/, const double* offsets, int num_taps,
-                            std::span<const PlanarI16> antennas, int num_samples, const ReplicaSegment& rep,
-                            const CorrelatorEngine::Rotation& rot, double scale, std::span<TapSums> sums) {
+void correlate_i16_portable(const std::int8_t* table, const std::int16_t* /*table16*/, const double* offsets,
+                            int num_taps, std::span<const PlanarI16> antennas, int num_samples,
+                            const ReplicaSegment& rep, const CorrelatorEngine::Rotation& rot, double scale,
+                            std::span<TapSums> sums) {
   const std::uint32_t step = step_q24(rep);
   for (int start = 0; start < num_samples; start += kChunkI16) {
     const int n = num_samples - start < kChunkI16 ? num_samples - start : kChunkI16;
@@ -54,7 +56,8 @@ void correlate_i16_portable(const std::int8_t* table, const std::int16_t* /*tabl
       const std::int16_t* xr = antennas[a].re + start;
       const std::int16_t* xi = antennas[a].im + start;
       std::int64_t re[kMaxTaps] = {}, im[kMaxTaps] = {};
-      for (int i = 0; i < n; ++i) mac_sample(xr[i], xi[i], rot.re[i], rot.im[i], table, whole, frac, step, i, num_taps, re, im);
+      for (int i = 0; i < n; ++i)
+        mac_sample(xr[i], xi[i], rot.re[i], rot.im[i], table, whole, frac, step, i, num_taps, re, im);
       finish_chunk(re, im, num_taps, phase0, scale, sums[a]);
     }
   }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Internal to the correlator engine: what its kernel files share (correlator_engine.cpp and
 // correlator_kernel_float.cpp, correlator_kernel_i16.cpp, correlator_kernel_avx2.cpp, correlator_kernel_avx512.cpp):
 // the fixed-point sin/cos, the float kernel's chunked body (inlined into each instruction-set copy), the integer
@@ -51,8 +52,9 @@ __attribute__((noinline)) void fill_code_baseline(const float* __restrict chips,
                                                   float* __restrict out);
 
 template <int kTaps, CodeFill kFill>
-ULTRATRACK_ALWAYS_INLINE void correlate_chunked(const float* table, const double* offsets, std::span<const std::complex<float>* const> antennas,
-                       int num_samples, const ReplicaSegment& rep, std::span<TapSums> sums) {
+ULTRATRACK_ALWAYS_INLINE void correlate_chunked(const float* table, const double* offsets,
+                                                std::span<const std::complex<float>* const> antennas, int num_samples,
+                                                const ReplicaSegment& rep, std::span<TapSums> sums) {
   alignas(64) float carrier_cos[kChunk];
   alignas(64) float carrier_sin[kChunk];
   alignas(64) float code[kTaps][kChunk];
@@ -143,15 +145,15 @@ ULTRATRACK_ALWAYS_INLINE void correlate_chunked(const float* table, const double
 // (test: CorrelatorEngine.IntegerKernelFollowsDirichletAndLosesUnder0p01Db), ~1e-6 dB in noise.
 // Code: chip index of tap t at sample i of a chunk = whole_t + ((F_t + S i) >> 22), F_t the 22-bit fraction of
 // the tap's code phase at the chunk start, S = round(step * 2^22) <= 0.99 * 2^22, so F_t + S i < 2^22 (1 + 0.99 *
-// 1023) < 2^32 over a 1024-sample chunk (index error < 1024 * 2^-23 = 1.2e-4 chips, reset each chunk). Taps a whole number of chips
-// apart (early/late at +-0.5; prompt and the noise tap) have the same F_t and share one index computation.
-// Sums: w * chip with |w| <= 32767 per component (saturating wipe-off), so one chunk's int32 lane sums stay
-// below 64 * 2 * 32768 = 2^22 (AVX2: 64 pmaddwd per lane per chunk) and the int64 totals below 2^25: no
-// overflow. Integer sums are exact, so both copies give bit-identical results (the double finish is shared).
+// 1023) < 2^32 over a 1024-sample chunk (index error < 1024 * 2^-23 = 1.2e-4 chips, reset each chunk). Taps a whole
+// number of chips apart (early/late at +-0.5; prompt and the noise tap) have the same F_t and share one index
+// computation. Sums: w * chip with |w| <= 32767 per component (saturating wipe-off), so one chunk's int32 lane sums
+// stay below 64 * 2 * 32768 = 2^22 (AVX2: 64 pmaddwd per lane per chunk) and the int64 totals below 2^25: no overflow.
+// Integer sums are exact, so both copies give bit-identical results (the double finish is shared).
 
 constexpr int kChunkI16 = CorrelatorEngine::Rotation::kChunk;
 constexpr int kFracBits = 22;
-constexpr double kQ24 = 4194304.0;  // 2^kFracBits
+constexpr double kQ24 = 4194304.0;                     // 2^kFracBits
 constexpr std::uint32_t kTableStepQuantum = 1u << 13;  // 2^-19 cycles per sample, in 2^-32 units
 
 inline std::uint32_t table_step(std::uint32_t step_q32) {
@@ -166,7 +168,6 @@ inline std::uint32_t chunk_phase(const ReplicaSegment& rep, std::uint32_t table_
   return phase0 + static_cast<std::uint32_t>((delta * (n - 1)) / 2);
 }
 
-
 __attribute__((noinline)) void build_rotation(std::uint32_t step_q32, CorrelatorEngine::Rotation& r);
 // Per chunk and tap: the whole chip index (into the table) and the 22-bit fraction at the chunk's first sample.
 __attribute__((noinline)) void chunk_taps(const ReplicaSegment& rep, const double* offsets, int num_taps, int start,
@@ -179,18 +180,24 @@ ULTRATRACK_ALWAYS_INLINE std::int32_t mulhrs(std::int32_t a, std::int32_t b) { r
 ULTRATRACK_ALWAYS_INLINE std::int32_t sat16(std::int32_t v) { return v > 32767 ? 32767 : v < -32768 ? -32768 : v; }
 
 // One sample's wipe-off and tap products, the portable copy's loop body (also the AVX2 copy's tail).
-ULTRATRACK_ALWAYS_INLINE void mac_sample(std::int32_t xr, std::int32_t xi, std::int32_t rr, std::int32_t ri, const std::int8_t* table,
-                                         const int* whole, const std::uint32_t* frac, std::uint32_t step_q24, int i,
-                                         int num_taps, std::int64_t* re, std::int64_t* im) {
+ULTRATRACK_ALWAYS_INLINE void mac_sample(std::int32_t xr, std::int32_t xi, std::int32_t rr, std::int32_t ri,
+                                         const std::int8_t* table, const int* whole, const std::uint32_t* frac,
+                                         std::uint32_t step_q24, int i, int num_taps, std::int64_t* re,
+                                         std::int64_t* im) {
   const std::int32_t wr = sat16(mulhrs(xr, rr) + mulhrs(xi, ri));  // x * conj(r)
   const std::int32_t wi = sat16(mulhrs(xi, rr) - mulhrs(xr, ri));
   for (int t = 0; t < num_taps; ++t) {
-    const std::int32_t chip = table[whole[t] + static_cast<int>((std::uint64_t{frac[t]} + std::uint64_t{step_q24} * static_cast<std::uint64_t>(i)) >> kFracBits)];  // 64-bit: any step
+    const std::int32_t chip =
+        table[whole[t] +
+              static_cast<int>((std::uint64_t{frac[t]} + std::uint64_t{step_q24} * static_cast<std::uint64_t>(i)) >>
+                               kFracBits)];  // 64-bit: any step
     re[t] += wr * chip;
     im[t] += wi * chip;
   }
 }
-inline std::uint32_t step_q24(const ReplicaSegment& rep) { return static_cast<std::uint32_t>(std::lround(rep.code_step_chips * kQ24)); }
+inline std::uint32_t step_q24(const ReplicaSegment& rep) {
+  return static_cast<std::uint32_t>(std::lround(rep.code_step_chips * kQ24));
+}
 
 // The portable integer copy (also the vector copies' fallback for steps above 0.99 chips per sample).
 void correlate_i16_portable(const std::int8_t* table, const std::int16_t* table16, const double* offsets, int num_taps,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tracking-loop discriminators on complex correlator sums (I + jQ). Each returns the error in the loop's own
 // unit with unit gain near lock (the closed-form gain is applied here), so loop filters need no extra scaling:
 // carrier phase in cycles, frequency in Hz, code in chips. Sign: positive = the signal leads the replica.
@@ -23,15 +24,19 @@ inline double pll_atan2_cycles(std::complex<float> p) { return std::atan2(p.imag
 // atan2(cross, dot) / (2 pi dt) Hz, cross = I1 Q2 - I2 Q1, dot = I1 I2 + Q1 Q2. Range +-1/(2 dt). Gain 1.
 // No data bit may change between the two (use the halves of one code period before bit sync).
 inline double fll_atan2_hz(std::complex<float> first, std::complex<float> second, double dt_s) {
-  const double cross = static_cast<double>(first.real()) * second.imag() - static_cast<double>(second.real()) * first.imag();
-  const double dot = static_cast<double>(first.real()) * second.real() + static_cast<double>(first.imag()) * second.imag();
+  const double cross =
+      static_cast<double>(first.real()) * second.imag() - static_cast<double>(second.real()) * first.imag();
+  const double dot =
+      static_cast<double>(first.real()) * second.real() + static_cast<double>(first.imag()) * second.imag();
   return std::atan2(cross, dot) / (kTwoPi * dt_s);
 }
 
 // Bit-tolerant variant: atan(cross / dot) / (2 pi dt), Hz in +-1/(4 dt); a sign flip between the sums is harmless.
 inline double fll_atan_hz(std::complex<float> first, std::complex<float> second, double dt_s) {
-  const double cross = static_cast<double>(first.real()) * second.imag() - static_cast<double>(second.real()) * first.imag();
-  const double dot = static_cast<double>(first.real()) * second.real() + static_cast<double>(first.imag()) * second.imag();
+  const double cross =
+      static_cast<double>(first.real()) * second.imag() - static_cast<double>(second.real()) * first.imag();
+  const double dot =
+      static_cast<double>(first.real()) * second.real() + static_cast<double>(first.imag()) * second.imag();
   if (dot == 0.0) return 0.0;
   return std::atan(cross / dot) / (kTwoPi * dt_s);
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/epoch_solver.hpp"
 
 #include <algorithm>
@@ -12,14 +13,16 @@ namespace ultratrack::receiver {
 
 EpochSolver::EpochSolver(const ReceiverOptions& options)
     : options_(options),
-      smoothing_(std::max(1, static_cast<int>(std::lround(options_.smoothing_window_s / options_.observation_interval_s)))) {
+      smoothing_(
+          std::max(1, static_cast<int>(std::lround(options_.smoothing_window_s / options_.observation_interval_s)))) {
   epoch_.observations.reserve(32);
   measured_.reserve(32);
   pvt_input_.reserve(32);
 }
 
 void EpochSolver::observation_epoch(std::int64_t sample, std::vector<std::unique_ptr<ReceiverChannel>>& channels,
-                                    const NavigationStore& navigation, ReceiverStats& run_stats, ReceiverObserver& observer) {
+                                    const NavigationStore& navigation, ReceiverStats& run_stats,
+                                    ReceiverObserver& observer) {
   ++epoch_index_;
   measured_.clear();
   for (auto& channel : channels)
@@ -58,7 +61,8 @@ void EpochSolver::observation_epoch(std::int64_t sample, std::vector<std::unique
     const ScalarTrackingOptions& to = options_.tracking;
     const double code_sigma_m =
         std::isfinite(o.cn0_dbhz) && o.cn0_dbhz > 0.0
-            ? dll_thermal_jitter_chips(to.dll_bw_coherent_hz, std::min(1.0, 2.0 * to.early_late_offset_chips), 0.02, o.cn0_dbhz) *
+            ? dll_thermal_jitter_chips(to.dll_bw_coherent_hz, std::min(1.0, 2.0 * to.early_late_offset_chips), 0.02,
+                                       o.cn0_dbhz) *
                   signals::kSpeedOfLight_mps / signals::kCaChipRate_hz
             : 0.0;
     const double smoothed =
@@ -84,9 +88,11 @@ void EpochSolver::antenna_phases(std::int64_t sample, std::vector<std::unique_pt
   antenna_epoch_.master_position_e = last_fix_->r_e_m;
   antenna_epoch_.satellites.clear();
   for (const Observation& o : epoch_.observations) {
-    auto channel = std::find_if(channels.begin(), channels.end(), [&](const auto& c) { return c && c->prn() == o.prn; });
+    auto channel =
+        std::find_if(channels.begin(), channels.end(), [&](const auto& c) { return c && c->prn() == o.prn; });
     if (channel == channels.end() || !(*channel)->antenna_phases()) continue;
-    const auto eph = signals::select_ephemeris(navigation.ephemerides(), o.prn, epoch_.receive_time, {.include_unhealthy = true});
+    const auto eph =
+        signals::select_ephemeris(navigation.ephemerides(), o.prn, epoch_.receive_time, {.include_unhealthy = true});
     if (!eph) continue;
     antenna_epoch_.satellites.push_back(make_antenna_observation(
         *(*channel)->antenna_phases(), o.prn, o.carrier_phase_cycles, o.cn0_dbhz, o.loss_of_lock, o.pseudorange_m, *eph,
@@ -99,7 +105,8 @@ void EpochSolver::solve(const ObservationEpoch& epoch, const NavigationStore& na
                         ReceiverObserver& observer) {
   pvt_input_.clear();
   for (const Observation& o : epoch.observations) {
-    const auto eph = signals::select_ephemeris(navigation.ephemerides(), o.prn, epoch.receive_time, {.include_unhealthy = true});
+    const auto eph =
+        signals::select_ephemeris(navigation.ephemerides(), o.prn, epoch.receive_time, {.include_unhealthy = true});
     if (!eph) continue;
     SatelliteMeasurement m;
     m.prn = o.prn;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receiver's epochs: at each common receive epoch (every observation_interval_s, in samples) the channels'
 // measurements become observables (pseudorange from the receiver clock, carrier phase, Doppler, C/N0; the
 // clock itself started from the first measurements), carrier-smoothed pseudoranges go to PVT with the known
@@ -49,8 +50,8 @@ class EpochSolver final {
   std::optional<ReceiverClock> clock_;
   std::optional<PvtSolution> last_fix_;
   CarrierSmoothing smoothing_;
-  std::array<double, 33> smoothed_m_{};  // this epoch's smoothed pseudorange per PRN
-  std::int64_t epoch_index_ = 0;  // observation epochs since the start (for the smoothing's gap test)
+  std::array<double, 33> smoothed_m_{};       // this epoch's smoothed pseudorange per PRN
+  std::int64_t epoch_index_ = 0;              // observation epochs since the start (for the smoothing's gap test)
   ObservationEpoch epoch_;                    // reused every epoch
   std::vector<ChannelMeasurement> measured_;  // reused
   std::vector<SatelliteMeasurement> pvt_input_;

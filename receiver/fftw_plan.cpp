@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/fftw_plan.hpp"
 
 #include <cassert>
@@ -5,8 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <string>
 #include <new>
+#include <string>
 #include <utility>
 
 namespace ultratrack::receiver {
@@ -24,7 +25,8 @@ const std::string& wisdom_path() {
     const char* p = std::getenv("ULTRATRACK_FFTW_WISDOM");
     std::string s = p ? p : "";
     std::error_code ec;
-    if (!s.empty() && std::filesystem::exists(s, ec)) fftwf_import_wisdom_from_filename(s.c_str());  // bad file: ignored
+    if (!s.empty() && std::filesystem::exists(s, ec))
+      fftwf_import_wisdom_from_filename(s.c_str());  // bad file: ignored
     return s;
   }();
   return path;

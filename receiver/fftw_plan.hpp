@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // FFTW single-precision 1-D complex transforms with FFTW-aligned buffers. FFTW's planner (plan creation
 // and destruction) is not thread-safe: every plan in the receiver is made and destroyed under the one
 // process-wide mutex fftw_planner_mutex(); executing a plan on other buffers (new-array execute) is safe.
@@ -38,8 +39,8 @@ class FftwBuffer {
 
 // An unnormalised forward (e^{-j...}) or backward (e^{+j...}) DFT of n points, planned with
 // FFTW_ESTIMATE (no measuring, so plans are cheap to make), or, when the environment variable
-// ULTRATRACK_FFTW_WISDOM names a wisdom file, with FFTW_PATIENT from that file (measured and added on first use). execute() may be called on any pair of
-// FftwBuffers of size n (out of place: in and out distinct), from any thread.
+// ULTRATRACK_FFTW_WISDOM names a wisdom file, with FFTW_PATIENT from that file (measured and added on first use).
+// execute() may be called on any pair of FftwBuffers of size n (out of place: in and out distinct), from any thread.
 class FftwPlan {
  public:
   enum class Direction { forward, backward };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/ionosphere_model.hpp"
 
 #include <fmt/format.h>
@@ -6,9 +7,12 @@ namespace ultratrack::receiver {
 
 std::string ionosphere_source_name(IonosphereSource source) {
   switch (source) {
-    case IonosphereSource::kDefault: return "default";
-    case IonosphereSource::kNavigationFile: return "nav file";
-    case IonosphereSource::kBroadcast: return "broadcast";
+    case IonosphereSource::kDefault:
+      return "default";
+    case IonosphereSource::kNavigationFile:
+      return "nav file";
+    case IonosphereSource::kBroadcast:
+      return "broadcast";
   }
   return "unknown";
 }
@@ -25,7 +29,8 @@ signals::KlobucharParameters default_klobuchar() {
   return p;
 }
 
-IonosphereModel::IonosphereModel() : in_use_(default_klobuchar()), history_{{IonosphereSource::kDefault, std::nullopt}} {}
+IonosphereModel::IonosphereModel()
+    : in_use_(default_klobuchar()), history_{{IonosphereSource::kDefault, std::nullopt}} {}
 
 void IonosphereModel::set(const signals::KlobucharParameters& params, IonosphereSource source,
                           std::optional<std::int64_t> sample) {

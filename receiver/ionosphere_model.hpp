@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Which Klobuchar ionosphere parameters the receiver applies, and since when. Before subframe 4 page 18
 // (broadcast once every 12.5 minutes) a receiver without a navigation file has no broadcast parameters; like
 // common receivers it then applies a default set rather than none, and switches to the broadcast (or the

@@ -1,10 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/lambda.hpp"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-
-#include <Eigen/LU>
 
 namespace ultratrack::receiver {
 

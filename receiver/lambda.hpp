@@ -1,13 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Integer least squares by the LAMBDA method (Teunissen 1995; de Jonge & Tiberius 1996): L^T D L decomposition of
 // the float ambiguity covariance, decorrelation by integer Gauss transformations and permutations (Z, |det Z| = 1),
 // then a depth-first search of the decorrelated ellipsoid with zig-zag enumeration that shrinks as the best
 // candidates are found (the search order of Chang, Yang & Zhou 2005, MLAMBDA). Units: cycles, cycles^2.
 #pragma once
 
+#include <Eigen/Core>
 #include <limits>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace ultratrack::receiver {
 
@@ -28,8 +28,8 @@ struct LambdaReduction {
 LambdaReduction lambda_reduce(const Eigen::MatrixXd& Q);
 
 struct IntegerCandidate {
-  Eigen::VectorXd a;           // integer-valued, in the original (not decorrelated) ambiguities
-  double squared_norm = 0.0;   // (a_float - a)^T Q^-1 (a_float - a)
+  Eigen::VectorXd a;          // integer-valued, in the original (not decorrelated) ambiguities
+  double squared_norm = 0.0;  // (a_float - a)^T Q^-1 (a_float - a)
 };
 
 // The `count` integer vectors nearest to a_float in the metric of Q (best first) among those with squared norm

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/lock_detectors.hpp"
 
 #include <algorithm>
@@ -40,7 +41,8 @@ std::optional<double> Cn0Estimator::add(std::complex<float> prompt, std::complex
     noise_power = pn_tap;
     signal = m2 - pn_tap;
   }
-  if (signal <= 0.0 || noise_power <= 0.0 || t_s <= 0.0) return signal > 0.0 && noise_power <= 0.0 ? 99.0 : kNoSignalDbHz;
+  if (signal <= 0.0 || noise_power <= 0.0 || t_s <= 0.0)
+    return signal > 0.0 && noise_power <= 0.0 ? 99.0 : kNoSignalDbHz;
   return std::max(kNoSignalDbHz, 10.0 * std::log10(signal / (noise_power * t_s)));
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Lock detectors on prompt (and noise-tap) correlator sums: the phase lock indicator cos(2 dphi) from low-passed
 // narrow-band difference and wide-band power, and C/N0 estimators (moments method; noise-tap power ratio) averaged
 // over a window of epochs. Pure algorithms: no knowledge of channels or loops. C/N0 in dB-Hz at this edge.
@@ -17,7 +18,11 @@ class PhaseLockIndicator final {
   // prompt: one epoch's prompt sum; noise_power: E|noise sum|^2 for the same epoch length; t_s: epoch length.
   double update(std::complex<float> prompt, double noise_power, double t_s);
   double value() const { return value_; }
-  void reset() { narrow_ = wide_ = 0.0; value_ = 0.0; started_ = false; }
+  void reset() {
+    narrow_ = wide_ = 0.0;
+    value_ = 0.0;
+    started_ = false;
+  }
   // A new low-pass time constant (e.g. for longer epochs); the state is kept.
   void set_time_constant(double time_constant_s) { tau_s_ = time_constant_s; }
 
@@ -38,7 +43,10 @@ class Cn0Estimator final {
   Cn0Estimator(Cn0Method method, int window_epochs) : method_(method), window_(window_epochs) {}
   // Returns an estimate (dB-Hz) when a window completes. A window with no measurable signal gives kNoSignalDbHz.
   std::optional<double> add(std::complex<float> prompt, std::complex<float> noise, double t_s);
-  void reset() { n_ = 0; m2_ = m4_ = noise_ = 0.0; }
+  void reset() {
+    n_ = 0;
+    m2_ = m4_ = noise_ = 0.0;
+  }
   static constexpr double kNoSignalDbHz = 0.0;
 
  private:

@@ -1,5 +1,5 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/long_coherent.hpp"
-#include "io/units.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::receiver {
@@ -90,8 +91,9 @@ void LongCoherentIntegration::add_cn0(double cn0_dbhz, bool bit_synced) {
   // The choice follows each estimate (the hysteresis absorbs its ~1 dB spread; a fade must reach the longer
   // integration before the 20 ms loop fails); the loss test in long mode reads the slow one (in dB: it
   // follows a loss of signal, whose estimates read 0 dB-Hz, within about a second).
-  cn0_slow_dbhz_ = have_slow_cn0_ ? cn0_slow_dbhz_ + std::min(1.0, opt_.cn0_window_s / kCn0Slow_s) * (cn0_dbhz - cn0_slow_dbhz_)
-                                  : cn0_dbhz;
+  cn0_slow_dbhz_ = have_slow_cn0_
+                       ? cn0_slow_dbhz_ + std::min(1.0, opt_.cn0_window_s / kCn0Slow_s) * (cn0_dbhz - cn0_slow_dbhz_)
+                       : cn0_dbhz;
   have_slow_cn0_ = true;
   if (bit_synced) target_epochs_ = choose_coherent_epochs(opt_, cn0_dbhz, target_epochs_);
 }
@@ -106,7 +108,8 @@ bool LongCoherentIntegration::bridging(bool bit_synced, double time_s) const {
 
 // The PLI restarts (its sums' scale changes with the length) with a time constant of at least 3 updates, and
 // keeps that of the chosen length while 20 ms updates bridge unknown bits.
-void LongCoherentIntegration::set_loop_epochs(int epochs, bool bridging, CarrierLoopFilter& carrier, PhaseLockIndicator& pli) {
+void LongCoherentIntegration::set_loop_epochs(int epochs, bool bridging, CarrierLoopFilter& carrier,
+                                              PhaseLockIndicator& pli) {
   const int pli_epochs = epochs > 1 || bridging ? std::max(epochs, target_epochs_) : 1;
   const double tau = pli_epochs == 1 ? opt_.pli_time_constant_s
                                      : std::max(opt_.pli_time_constant_s, kPliUpdates * pli_epochs * kBitPeriod_s);

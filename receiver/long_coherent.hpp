@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Long coherent integration with data wipe-off (ScalarTrackingOptions, long coherent integration): the choice of
 // N (1, 2, 5, 10, 20 epochs of 20 ms) from the C/N0, the block of N sign-corrected 20 ms epochs summed, the
 // loops' settings for updates every N x 20 ms, and the carrier loop's frequency state re-referenced when N
@@ -83,10 +84,10 @@ class LongCoherentIntegration final {
 
  private:
   ScalarTrackingOptions opt_;
-  int target_epochs_ = 1;   // chosen from the C/N0
-  int loop_epochs_ = 1;     // of the loops' settings in effect
-  int state_epochs_ = 1;    // the update length (x 20 ms) the carrier loop's frequency state is referenced to
-  double pli_tau_s_ = 0.0;  // PLI time constant set by set_loop_epochs (0: the option's)
+  int target_epochs_ = 1;       // chosen from the C/N0
+  int loop_epochs_ = 1;         // of the loops' settings in effect
+  int state_epochs_ = 1;        // the update length (x 20 ms) the carrier loop's frequency state is referenced to
+  double pli_tau_s_ = 0.0;      // PLI time constant set by set_loop_epochs (0: the option's)
   double cn0_slow_dbhz_ = 0.0;  // C/N0 estimates low-passed over 1 s
   bool have_slow_cn0_ = false;
   bool have_long_update_ = false;

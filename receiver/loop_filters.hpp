@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Digital loop filters for carrier and code tracking in Kaplan's standard form (Understanding GPS, 2nd ed.,
 // Table 5.6 and Fig. 5.16: analogue prototypes with natural frequency w0 from the one-sided noise bandwidth Bn,
 // integrators discretised by the bilinear (trapezoidal) rule). Inputs are discriminator outputs in cycles (PLL),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The loss-of-lock test of a scalar channel (ScalarTrackingOptions, lock detection): the time a loss condition
 // (low C/N0, low PLI) has held, against loss_of_lock_time_s; and, for a filter-driven channel (ultra-tight),
 // the presence test on its 20 ms epochs (receiver/presence_test.hpp), whose absent run is the loss and whose
@@ -18,8 +19,8 @@ class LossOfLockTest final {
   // One 20 ms epoch for the presence test while `run` (filter-driven, bit-synced or coasting); otherwise the
   // test restarts. A completed window sets presence_absent() (bit_synced: its run of absent windows is a loss)
   // or presence_found() (coasting: the signal is back); both are false after any other epoch.
-  void presence_epoch(bool run, bool bit_synced, bool coasting, std::complex<float> prompt,
-                      std::complex<float> noise, double t_s);
+  void presence_epoch(bool run, bool bit_synced, bool coasting, std::complex<float> prompt, std::complex<float> noise,
+                      double t_s);
   bool presence_absent() const { return presence_absent_; }
   bool presence_found() const { return presence_found_; }
   void reset_presence() { presence_.reset(); }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/multi_sample_source.hpp"
 
 #include <fmt/core.h>
@@ -17,10 +18,10 @@ MultiSampleSource::MultiSampleSource(const std::vector<std::filesystem::path>& p
     const SampleSource& first = *sources_.front();
     if (s.total_samples() != first.total_samples())
       throw signals::InputError(
-          p.string(), fmt::format("holds {} samples of {} but {} holds {}: the antenna files must be recorded "
-                                  "sample-synchronously (same format, same length)",
-                                  s.total_samples(), signals::to_string(format), first.path().string(),
-                                  first.total_samples()));
+          p.string(),
+          fmt::format("holds {} samples of {} but {} holds {}: the antenna files must be recorded "
+                      "sample-synchronously (same format, same length)",
+                      s.total_samples(), signals::to_string(format), first.path().string(), first.total_samples()));
   }
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The sample source of a multi-antenna receiver: one IF file per antenna, recorded on one clock, read
 // sample-synchronously (the same sample indices from every file) and converted to complex baseband by one
 // SampleSource each (same format, rate, IF and fix-ups). Files of different lengths are an InputError: they

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The running check of predicted navigation bits against the signal, and the counts summary.json reports per
 // satellite. Each 20 ms epoch wiped by a predicted bit is compared with the prompt's sign (the bit as received,
 // the Costas half cycle resolved by the frame polarity); over each 30-bit LNAV word the disagreements d among the
@@ -21,16 +22,16 @@ namespace ultratrack::receiver {
 
 // Per satellite (channels on the same PRN add up): epochs are 20 ms bits.
 struct NavBitCounts {
-  long long bits_wiped = 0;         // epochs that asked for their bit and were wiped by a predicted one
-  long long bits_unknown = 0;       // epochs that asked and got none (integrated in the Costas form)
-  long long bits_checked = 0;       // predicted bits compared with the prompt's sign
-  long long bits_contradicted = 0;  // of those, where the prompt's sign disagreed
-  long long words_contradicted = 0; // words over their C/N0's threshold (see above)
-  int sources_stopped = 0;          // times the check stopped the source (decoded mode only)
+  long long bits_wiped = 0;          // epochs that asked for their bit and were wiped by a predicted one
+  long long bits_unknown = 0;        // epochs that asked and got none (integrated in the Costas form)
+  long long bits_checked = 0;        // predicted bits compared with the prompt's sign
+  long long bits_contradicted = 0;   // of those, where the prompt's sign disagreed
+  long long words_contradicted = 0;  // words over their C/N0's threshold (see above)
+  int sources_stopped = 0;           // times the check stopped the source (decoded mode only)
   // A nav file's subframe 1-3 words compared with the channel's decoded copy (same subframe, same issue of data):
   // agreed words may be used, disagreeing ones never.
   int nav_words_agreed = 0, nav_words_disagreed = 0;
-  bool oracle = false;              // the bits came from the oracle source (a nav file re-encoded)
+  bool oracle = false;  // the bits came from the oracle source (a nav file re-encoded)
 
   NavBitCounts& operator+=(const NavBitCounts& o);
 };
@@ -41,10 +42,10 @@ double bit_error_probability(double cn0_dbhz, double bit_s = 0.02);
 int word_contradiction_threshold(int n, double p, double false_alarm);
 
 struct NavBitCheckOptions {
-  double min_cn0_dbhz = 25.0;       // bits are checked at or above this C/N0 estimate
-  double cn0_margin_db = 3.0;       // p at the estimate minus this
-  double word_false_alarm = 1e-6;   // a clean word's contradiction probability, (0, 0.1]
-  int trip_words = 2;               // contradicted words (since arming) that stop the source, >= 1
+  double min_cn0_dbhz = 25.0;      // bits are checked at or above this C/N0 estimate
+  double cn0_margin_db = 3.0;      // p at the estimate minus this
+  double word_false_alarm = 1e-6;  // a clean word's contradiction probability, (0, 0.1]
+  int trip_words = 2;              // contradicted words (since arming) that stop the source, >= 1
 };
 
 class NavBitCheck {
@@ -55,7 +56,10 @@ class NavBitCheck {
   // True exactly once per arming: when a word just completed made the trip_words-th contradiction.
   bool add(std::int64_t word, bool agrees, double cn0_dbhz);
   // Counting toward the next trip restarts (the source has new data).
-  void rearm() { since_arm_ = 0; tripped_ = false; }
+  void rearm() {
+    since_arm_ = 0;
+    tripped_ = false;
+  }
   NavBitCounts& counts() { return counts_; }
   const NavBitCounts& counts() const { return counts_; }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/nav_bit_predictor.hpp"
 
 #include <cmath>
@@ -59,8 +60,8 @@ void NavBitPredictor::add_word(const signals::GpsTime& start, int index, std::ui
   if (!transmitter_ || id > 3 || index < 2 || index > 9 || !nav_file_subframe(start)) return;
   const auto w = static_cast<std::size_t>(index);
   const std::uint32_t mask = index == 9 ? 0xFFFFFCu : 0xFFFFFFu;  // word 10's last two bits solve its parity
-  const bool agrees = ((nav_data_[w] ^ data24) & mask) == 0 && nav_bits_[30 * w - 2] == prev_d29 &&
-                      nav_bits_[30 * w - 1] == prev_d30;
+  const bool agrees =
+      ((nav_data_[w] ^ data24) & mask) == 0 && nav_bits_[30 * w - 2] == prev_d29 && nav_bits_[30 * w - 1] == prev_d30;
   auto& trusted = trusted_[static_cast<std::size_t>(id - 1)];
   auto& rejected = rejected_[static_cast<std::size_t>(id - 1)];
   if (agrees && !trusted[w]) {
@@ -137,7 +138,8 @@ void NavBitPredictor::build(const signals::GpsTime& start) {
   const bool data_known = stored && stored->start.week == start.week;
   // Else the nav file's words the signal confirmed (their bits depend on the words before them only through the
   // preceding D29*, D30*, which were confirmed with them).
-  const bool nav_words = !data_known && id <= 3 && transmitter_ && issue_of_data_trusted(id) && nav_file_subframe(start);
+  const bool nav_words =
+      !data_known && id <= 3 && transmitter_ && issue_of_data_trusted(id) && nav_file_subframe(start);
   if (data_known) w = stored->words;
   if (nav_words) w = nav_data_;
   w[0] = *tlm_;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Navigation bit prediction for data wipe-off: the LNAV bit (0/1) a satellite transmits at a GPS transmit time,
 // where it can be known. The source (receiver/nav_bit_source.hpp):
 // kDecoded (default): the channel's own decoded subframes. Subframes 1-3 repeat every 30 s while IODE/IODC stay
@@ -37,7 +38,10 @@ class NavBitPredictor {
  public:
   explicit NavBitPredictor(NavBitSource source = NavBitSource::kDecoded) : source_(source) {}
   NavBitSource source() const { return source_; }
-  void set_source(NavBitSource source) { source_ = source; ++version_; }
+  void set_source(NavBitSource source) {
+    source_ = source;
+    ++version_;
+  }
 
   // The transmitter of `prn` built from the broadcast sets as the simulator builds it, selecting at time `at`
   // (ephemeris of each PRN: signals::select_ephemeris). False (and nothing changes) when no set qualifies.
@@ -77,7 +81,7 @@ class NavBitPredictor {
 
   NavBitSource source_;
   std::optional<signals::LnavTransmitter> transmitter_;
-  std::optional<std::uint32_t> tlm_;  // word 1 data bits (preamble, TLM message, integrity, reserved)
+  std::optional<std::uint32_t> tlm_;          // word 1 data bits (preamble, TLM message, integrity, reserved)
   std::uint32_t alert_ = 0, anti_spoof_ = 0;  // HOW flags
   struct Stored {
     signals::LnavDataWords words{};

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Which navigation bits data wipe-off may use (receive --nav-bits, ReceiverOptions::nav_bits).
 // kDecoded (the default): what a real receiver can know, bits decoded from the signal itself (subframes 1-3 of
 // the next frames while their issue of data stays, the TLM and HOW of every subframe), a nav file's subframe

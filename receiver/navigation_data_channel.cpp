@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/navigation_data_channel.hpp"
 
 #include <algorithm>
@@ -25,7 +26,8 @@ void NavigationDataChannel::read_word(float soft, std::int64_t first_code_period
   // The bit's middle in GPS time (robust to the tag's code-period arithmetic in double).
   const signals::GpsTime mid = signals::add_seconds(
       tag_->transmit_time, 1e-3 * static_cast<double>(first_code_period - tag_->code_period) + 0.01);
-  const std::int64_t n = static_cast<std::int64_t>(mid.week) * kBitsPerWeek + static_cast<std::int64_t>(std::floor(mid.tow_s / 0.02));
+  const std::int64_t n =
+      static_cast<std::int64_t>(mid.week) * kBitsPerWeek + static_cast<std::int64_t>(std::floor(mid.tow_s / 0.02));
   word_fill_ = n == last_bit_number_ + 1 ? std::min(word_fill_ + 1, 32) : 1;
   last_bit_number_ = n;
   std::copy(word_bits_.begin() + 1, word_bits_.end(), word_bits_.begin());
@@ -33,14 +35,15 @@ void NavigationDataChannel::read_word(float soft, std::int64_t first_code_period
   const std::int64_t in_week = n % kBitsPerWeek;
   if (in_week % 30 != 29 || word_fill_ < 32) return;
   // Parity is polarity-blind: an inverted word with inverted D29*, D30* checks and gives the same data.
-  const auto data = signals::check_word(std::span<const std::uint8_t, 30>(word_bits_.data() + 2, 30), word_bits_[0],
-                                        word_bits_[1]);
+  const auto data =
+      signals::check_word(std::span<const std::uint8_t, 30>(word_bits_.data() + 2, 30), word_bits_[0], word_bits_[1]);
   if (!data) return;
   const std::int64_t subframe_bit = in_week - in_week % 300;
   const signals::GpsTime start{static_cast<int>(n / kBitsPerWeek), 0.02 * static_cast<double>(subframe_bit)};
   // D29*, D30* as transmitted: the received pair when upright; the word's own polarity is in its parity.
   const int invert = polarity_ < 0 ? 1 : 0;
-  predictor_.add_word(start, static_cast<int>(in_week % 300 / 30), *data, word_bits_[0] ^ invert, word_bits_[1] ^ invert);
+  predictor_.add_word(start, static_cast<int>(in_week % 300 / 30), *data, word_bits_[0] ^ invert,
+                      word_bits_[1] ^ invert);
 }
 
 bool NavigationDataChannel::take_new_ephemeris() {

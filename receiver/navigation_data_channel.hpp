@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One channel's navigation-data chain after bit sync: LNAV frame sync and decoding (signals/), plus the
 // tie between the channel's code-period count and GPS transmit time. After sync, the code period at which
 // the latest subframe began is known together with the GPS time that subframe left the satellite; that
@@ -37,7 +38,9 @@ class NavigationDataChannel {
 
   // While held (the channel coasts on a vector loop's replica, whose code-period count keeps the bit timing),
   // the time tag survives failed subframes and a dropped frame lock; the next good subframe renews it.
-  void hold_time_tag(bool hold) { if (hold) holding_ = true; }
+  void hold_time_tag(bool hold) {
+    if (hold) holding_ = true;
+  }
   bool synchronised() const { return (frame_sync_.locked() || holding_) && tag_.has_value(); }
   const std::optional<TransmitTimeTag>& time_tag() const { return tag_; }
   // +1 if the received bits are upright, -1 if inverted (resolves the Costas loop's half-cycle ambiguity).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // What the receiver knows of the navigation message: every ephemeris (supplied and decoded, each set once), the
 // decoded ones apart, the latest almanac per PRN, the Klobuchar parameters in use and UTC parameters, and the supplied
 // sets shared with the channels as known bits (data wipe-off). Filled on the engine's caller thread only.
@@ -41,7 +42,7 @@ class NavigationStore final {
   std::vector<signals::Ephemeris> ephemerides_;  // all known: supplied + decoded
   std::vector<signals::Ephemeris> decoded_;
   std::array<std::optional<signals::Almanac>, 33> almanacs_{};
-  IonosphereModel ionosphere_;  // Klobuchar in use (default, nav file, broadcast)
+  IonosphereModel ionosphere_;                                     // Klobuchar in use (default, nav file, broadcast)
   std::shared_ptr<const SuppliedNavigation> supplied_navigation_;  // the nav file's sets: known bits (issue 7)
   signals::UtcParameters utc_;
 };

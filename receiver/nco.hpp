@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Phase-accurate numerically controlled oscillator: a phase (carrier cycles or code chips) accumulated per
 // sample in 128-bit fixed point, so that minutes of accumulation add no drift beyond the quantisation of the
 // per-sample step (2^-kFracBits units): < 1e-6 cycles after hours. Used by the tracking channel for its replica.
@@ -36,8 +37,8 @@ class FixedPointPhase {
   double value() const { return static_cast<double>(whole()) + fraction(); }
   // Fraction of a unit as 32-bit fixed point (2^-32 units), rounded: the form the correlator's carrier uses.
   std::uint32_t fraction_q32() const {
-    return static_cast<std::uint32_t>(static_cast<std::uint64_t>((phase_ + (static_cast<Int128>(1) << (kFracBits - 33))) >>
-                                                                 (kFracBits - 32)));
+    return static_cast<std::uint32_t>(
+        static_cast<std::uint64_t>((phase_ + (static_cast<Int128>(1) << (kFracBits - 33))) >> (kFracBits - 32)));
   }
   std::uint32_t step_q32() const {
     return static_cast<std::uint32_t>((step_ + (std::int64_t{1} << (kFracBits - 33))) >> (kFracBits - 32));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // NcoCommand: what any closed loop (scalar DLL/PLL, vector filter, ultra-tight filter) tells a tracking channel
 // about its replica for the next epoch. Rates in chips/s and Hz at baseband (after IF removal); jumps in chips and
 // cycles. The channel applies a command at the start of its next epoch and keeps it until the next command.

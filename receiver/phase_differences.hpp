@@ -1,11 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Between-antenna single differences and between-satellite double differences of carrier phase for a rigid antenna
 // array, with the full (correlated) DD covariance. Units: cycles of L1; geometry rows in cycles per metre of ECEF
 // baseline. Sign: RINEX phase (grows with range), so SD_k^s = -(u_s . b_k) / lambda + N_k^s + line bias_k.
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "receiver/antenna_phase.hpp"
 
@@ -29,9 +29,9 @@ struct DdRow {
 // Rows are grouped by baseline (antenna 1 first); within one, satellites in input order, the reference left out.
 struct DoubleDifferences {
   std::vector<DdRow> rows;
-  Eigen::VectorXd dd_cycles;     // SD_k^s - SD_k^ref
-  Eigen::MatrixXd geometry;      // rows x 3: d DD / d b_k (ECEF), cycles per metre
-  Eigen::MatrixXd covariance;    // rows x rows, cycles^2: the master's and the reference's noise correlate rows
+  Eigen::VectorXd dd_cycles;   // SD_k^s - SD_k^ref
+  Eigen::MatrixXd geometry;    // rows x 3: d DD / d b_k (ECEF), cycles per metre
+  Eigen::MatrixXd covariance;  // rows x rows, cycles^2: the master's and the reference's noise correlate rows
   std::vector<int> baseline_begin, baseline_count;  // per antenna (index 0 unused): first row, number of rows
   int num_antennas = 0;
 };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Signal-presence test for a channel whose replica an external filter drives (ultra-tight): over non-overlapping
 // windows of n epochs, the prompt's power against the noise tap's, SNR_hat = sum|P|^2 / sum|N|^2 - 1 (per epoch);
 // "absent" when SNR_hat < 10^(threshold_dbhz / 10) T. Energy only (no phase lock needed: the filter, not the
@@ -19,7 +20,11 @@ class SignalPresenceTest final {
   // present), nothing otherwise. Epochs of another length (by more than 1 %: the sample count of one length varies
   // with the code Doppler) than the window's first restart the window.
   std::optional<bool> add(std::complex<float> prompt, std::complex<float> noise, double t_s);
-  void reset() { n_ = 0; prompt_power_ = noise_power_ = 0.0; t_s_ = 0.0; }
+  void reset() {
+    n_ = 0;
+    prompt_power_ = noise_power_ = 0.0;
+    t_s_ = 0.0;
+  }
   // The latest completed window's SNR per epoch, as C/N0 (dB-Hz; -inf-like -100 when not positive).
   double last_cn0_dbhz() const { return last_cn0_dbhz_; }
   int window_epochs() const { return window_; }
@@ -39,9 +44,9 @@ double presence_absent_probability(double cn0_dbhz, int n, double t_s, double th
 double run_probability(double p, int k, int trials);
 
 struct PresenceMonitorOptions {
-  int window_epochs = 50;          // one window (50 x 20 ms = 1 s)
-  double epoch_s = 0.020;          // the epochs' length, for the error rates
-  double threshold_dbhz = 12.0;    // a window below this says absent
+  int window_epochs = 50;        // one window (50 x 20 ms = 1 s)
+  double epoch_s = 0.020;        // the epochs' length, for the error rates
+  double threshold_dbhz = 12.0;  // a window below this says absent
   // Loss: k consecutive absent windows, k the smallest in [1, max_windows] whose probability of a false loss in
   // a minute (run_probability of the exact per-window rate) at the channel's level less margin_db is at most
   // false_loss_per_min. The level: the C/N0 of the present windows before the run that read at least

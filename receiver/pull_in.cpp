@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/pull_in.hpp"
 
 #include <algorithm>
@@ -114,7 +115,8 @@ double PullIn::search_frequency_offset_hz() const {
   return (best + delta) * kStep_hz;
 }
 
-double PullIn::fine_fll(std::complex<float> prompt, double t_s, CarrierLoopFilter& carrier, double* frequency_error_hz) {
+double PullIn::fine_fll(std::complex<float> prompt, double t_s, CarrierLoopFilter& carrier,
+                        double* frequency_error_hz) {
   constexpr int kFineSumEpochs = 5;  // 5 ms sums: +-50 Hz range, at most one bit edge inside (bit-tolerant)
   fine_sum_ += std::complex<double>(prompt);
   fine_time_s_ += t_s;

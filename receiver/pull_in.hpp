@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Pull-in of a scalar channel from the acquisition's frequency to the Costas PLL's lock-in range
 // (ScalarTrackingOptions, pull-in): either a frequency search on the first 1 ms prompts with the carrier held,
 // or a wide FLL (halves of each code period) then a narrow one (successive prompts); then a fine FLL on 5 ms

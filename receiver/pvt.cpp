@@ -1,13 +1,13 @@
-#include "receiver/chi_square.hpp"
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/pvt.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
-
 #include <Eigen/Dense>
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "receiver/chi_square.hpp"
 #include "signals/atmosphere.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/satellite_state.hpp"
@@ -24,11 +24,11 @@ constexpr double kPositionKnownRadius_m = 6.0e6;
 
 struct Geometry {
   int prn = 0;
-  Eigen::Vector3d u_e;          // unit line of sight receiver -> satellite
-  double residual_m = 0.0;      // measured minus predicted pseudorange
+  Eigen::Vector3d u_e;      // unit line of sight receiver -> satellite
+  double residual_m = 0.0;  // measured minus predicted pseudorange
   double rate_residual_mps = 0.0;
   bool has_rate = false;
-  double weight = 1.0;          // 1 / sigma^2 (pseudorange)
+  double weight = 1.0;  // 1 / sigma^2 (pseudorange)
   double rate_weight = 1.0;
   double elevation_rad = 0.0, azimuth_rad = 0.0;
   double cn0_dbhz = 0.0;
@@ -60,9 +60,8 @@ double sigma_scale(double elevation_rad, double cn0_dbhz) {
 
 // Builds the linearised system at x = (r_e, clock bias) for the usable satellites.
 std::vector<Geometry> linearise(const std::vector<SatelliteMeasurement>& meas, const signals::GpsTime& receive_time,
-                                const signals::KlobucharParameters& iono, const PvtOptions& opt,
-                                const Vector4& x, const Eigen::Vector3d& v_e, double drift_mps,
-                                const std::vector<bool>& active) {
+                                const signals::KlobucharParameters& iono, const PvtOptions& opt, const Vector4& x,
+                                const Eigen::Vector3d& v_e, double drift_mps, const std::vector<bool>& active) {
   std::vector<Geometry> rows;
   const Eigen::Vector3d r_rx = x.head<3>();
   const bool position_known = r_rx.norm() > kPositionKnownRadius_m;
@@ -93,8 +92,8 @@ std::vector<Geometry> linearise(const std::vector<SatelliteMeasurement>& meas, c
       const double azimuth = std::atan2(enu.x(), enu.y());
       g.azimuth_rad = azimuth < 0.0 ? azimuth + 2.0 * M_PI : azimuth;
       if (opt.ionosphere && iono.valid)
-        delay_m += kSpeedOfLight_mps * signals::klobuchar_delay_s(iono, frame.lat_rad, frame.lon_rad, azimuth,
-                                                                  g.elevation_rad, t_tx.tow_s);
+        delay_m += kSpeedOfLight_mps *
+                   signals::klobuchar_delay_s(iono, frame.lat_rad, frame.lon_rad, azimuth, g.elevation_rad, t_tx.tow_s);
       if (opt.troposphere) delay_m += signals::troposphere_delay_m(frame.lat_rad, frame.height_m, g.elevation_rad);
       sigma *= sigma_scale(g.elevation_rad, m.cn0_dbhz);
     }
@@ -178,8 +177,10 @@ bool iterate_position(const std::vector<SatelliteMeasurement>& meas, const signa
 
 bool PvtOptions::IsValid(std::string* why) const {
   const std::string problem = [&]() -> std::string {
-    if (!(elevation_mask_rad >= -M_PI / 2 && elevation_mask_rad < M_PI / 2)) return "elevation mask outside [-90, 90) deg";
-    if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0)) return "false-alarm probability not in (0, 1)";
+    if (!(elevation_mask_rad >= -M_PI / 2 && elevation_mask_rad < M_PI / 2))
+      return "elevation mask outside [-90, 90) deg";
+    if (!(false_alarm_probability > 0.0 && false_alarm_probability < 1.0))
+      return "false-alarm probability not in (0, 1)";
     if (!(sigma_zenith_m > 0.0) || !(sigma_doppler_mps > 0.0)) return "measurement sigmas must be positive";
     if (max_iterations < 1) return "max_iterations must be at least 1";
     return {};

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Position, velocity and time from one epoch of pseudoranges and Doppler: iterated weighted least squares
 // in ECEF (WGS-84) with the satellite clock, relativity, TGD, Sagnac, broadcast ionosphere and troposphere
 // corrections, an elevation mask, a chi-square residual test that excludes one faulty satellite, velocity
@@ -26,13 +27,13 @@ struct SatelliteMeasurement {
 
 struct PvtOptions {
   double elevation_mask_rad = 10.0 * 3.14159265358979 / 180.0;
-  bool ionosphere = true;    // broadcast Klobuchar (needs valid parameters)
-  bool troposphere = true;   // standard troposphere model
+  bool ionosphere = true;   // broadcast Klobuchar (needs valid parameters)
+  bool troposphere = true;  // standard troposphere model
   bool exclude_unhealthy = true;
-  bool fault_exclusion = true;         // chi-square residual test, excludes at most one satellite
+  bool fault_exclusion = true;            // chi-square residual test, excludes at most one satellite
   double false_alarm_probability = 1e-3;  // of the residual test
-  double sigma_zenith_m = 1.0;         // pseudorange 1-sigma at zenith and 45 dB-Hz; grows with 1/sin(el), lower C/N0
-  double sigma_doppler_mps = 0.05;     // range-rate 1-sigma at zenith and 45 dB-Hz
+  double sigma_zenith_m = 1.0;      // pseudorange 1-sigma at zenith and 45 dB-Hz; grows with 1/sin(el), lower C/N0
+  double sigma_doppler_mps = 0.05;  // range-rate 1-sigma at zenith and 45 dB-Hz
   int max_iterations = 10;
 
   // Empty when valid, else the reason.
@@ -50,19 +51,19 @@ struct UsedSatellite {
 
 struct PvtSolution {
   bool valid = false;
-  std::string failure;                 // why no solution (when !valid)
-  signals::GpsTime time;               // receive time corrected by the clock bias (GPS system time)
+  std::string failure;    // why no solution (when !valid)
+  signals::GpsTime time;  // receive time corrected by the clock bias (GPS system time)
   Eigen::Vector3d r_e_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d v_e_mps = Eigen::Vector3d::Zero();
   bool velocity_valid = false;
-  double clock_bias_m = 0.0;           // c * receiver clock offset (receiver clock - GPS time)
-  double clock_drift_mps = 0.0;        // c * receiver clock drift
+  double clock_bias_m = 0.0;     // c * receiver clock offset (receiver clock - GPS time)
+  double clock_drift_mps = 0.0;  // c * receiver clock drift
   double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
   Eigen::Vector3d v_enu_mps = Eigen::Vector3d::Zero();
   double gdop = 0.0, pdop = 0.0, hdop = 0.0, vdop = 0.0, tdop = 0.0;
   std::vector<int> used_prns;
   std::vector<UsedSatellite> satellites;  // the used ones, same order as used_prns
-  std::optional<int> excluded_prn;     // removed by the residual test
+  std::optional<int> excluded_prn;        // removed by the residual test
   double residual_rms_m = 0.0;
   int iterations = 0;
   // A-priori covariances of the weighted solutions (the inverse normal matrices with the elevation and C/N0
@@ -77,6 +78,5 @@ struct PvtSolution {
 PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& measurements, const signals::GpsTime& receive_time,
                       const signals::KlobucharParameters& iono, const PvtOptions& options,
                       const Eigen::Vector3d& initial_r_e_m = Eigen::Vector3d::Zero());
-
 
 }  // namespace ultratrack::receiver

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/receiver_channel.hpp"
 
 #include <algorithm>
@@ -112,8 +113,8 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   // 1023 chips are one code period, 1 ms of transmit time, whatever the Doppler).
   const double tag_age_s = signals::seconds_between(clock.base(), tag.transmit_time);
   const auto pseudorange = [&](std::int64_t sample, std::int64_t period, double chips) {
-    const double since_tag = static_cast<double>(period - tag.code_period) * signals::kCaCodePeriod_s +
-                             chips / signals::kCaChipRate_hz;
+    const double since_tag =
+        static_cast<double>(period - tag.code_period) * signals::kCaCodePeriod_s + chips / signals::kCaChipRate_hz;
     return signals::kSpeedOfLight_mps * (tag_age_s + clock.seconds_since_base(sample) - since_tag);
   };
   const ReplicaState replica = channel_.replica();
@@ -133,16 +134,18 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   in.measurement_sample = e.first_sample + half;
   in.integration_time_s = e.num_samples / fs_hz_;
   in.code_error_chips = e.code_error_chips;
-  in.replica_pseudorange_mid_m =
-      pseudorange(in.measurement_sample, e.first_code_period, e.code_phase_start_chips + e.code_rate_chips_per_s * half / fs_hz_);
+  in.replica_pseudorange_mid_m = pseudorange(in.measurement_sample, e.first_code_period,
+                                             e.code_phase_start_chips + e.code_rate_chips_per_s * half / fs_hz_);
   constexpr double kChip_m = signals::kSpeedOfLight_mps / signals::kCaChipRate_hz;
   in.measured_pseudorange_m = in.replica_pseudorange_mid_m - e.code_error_chips * kChip_m;
   in.measurement_first_sample = e.first_sample;
-  in.replica_carrier_frequency_hz = (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * fs_hz_ / e.num_samples;
+  in.replica_carrier_frequency_hz =
+      (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * fs_hz_ / e.num_samples;
   in.replica_carrier_phase_mid_cycles =
       e.carrier_phase_start_cycles + (e.carrier_phase_end_cycles - e.carrier_phase_start_cycles) * half / e.num_samples;
   in.replica_carrier_phase_next_cycles =
-      replica.carrier_phase_cycles + in.carrier_frequency_hz * static_cast<double>(in.next_epoch_sample - replica.sample_index) / fs_hz_;
+      replica.carrier_phase_cycles +
+      in.carrier_frequency_hz * static_cast<double>(in.next_epoch_sample - replica.sample_index) / fs_hz_;
   if (e.noise_power > 0.0) {
     const double scale = 1.0 / std::sqrt(0.5 * e.noise_power);  // noise tap: variance 2 sigma^2 (I and Q)
     in.iq_scale = scale;
@@ -157,13 +160,14 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
       p.first_sample + p.num_samples == e.first_sample) {
     const int p_half = p.num_samples / 2;
     const auto middle_phase = [](const EpochSummary& s, int h) {
-      return s.carrier_phase_start_cycles + (s.carrier_phase_end_cycles - s.carrier_phase_start_cycles) * h / s.num_samples;
+      return s.carrier_phase_start_cycles +
+             (s.carrier_phase_end_cycles - s.carrier_phase_start_cycles) * h / s.num_samples;
     };
     // Costas phases are bit-insensitive, within +-1/4 cycle: their change is taken within +-1/4 cycle. A channel
     // whose carrier a filter commands and drives, with both bits known, has them wiped: the full phase change
     // (+-1/2 cycle), which at 20-22 dB-Hz stays unbiased where the Costas change reads 0.56-0.78 of the offset.
-    const bool wipe = vector_.vector && vector_.filter_driven && vector_.carrier != CarrierControl::kAided && e.bit_sign != 0 &&
-                      p.bit_sign != 0;
+    const bool wipe = vector_.vector && vector_.filter_driven && vector_.carrier != CarrierControl::kAided &&
+                      e.bit_sign != 0 && p.bit_sign != 0;
     const double dphi = wipe ? wiped_phase_change_cycles(p.prompt, e.prompt, e.bit_sign * p.bit_sign)
                              : costas_phase_change_cycles(p.prompt, e.prompt);
     in.doppler_bits_wiped = wipe;
@@ -282,7 +286,8 @@ KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
   NavBitPredictor& predictor = nav_.bit_predictor();
   if (supplied_ && !supplied_tried_) {
     supplied_tried_ = true;  // selected once, near the channel's start (as the simulator selects at its start)
-    const signals::GpsTime start = signals::add_seconds(tag.transmit_time, -1e-3 * static_cast<double>(tag.code_period));
+    const signals::GpsTime start =
+        signals::add_seconds(tag.transmit_time, -1e-3 * static_cast<double>(tag.code_period));
     predictor.supply_navigation(prn(), supplied_->ephemerides, supplied_->klobuchar, supplied_->utc, start);
   }
   for (int i = 0; i < wanted; ++i) {
@@ -291,7 +296,8 @@ KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
     const auto bit = predictor.bit_at(t);
     if (i == 0) {  // the bit's word, from its middle (t may be a hair before its edge)
       const signals::GpsTime mid = signals::add_seconds(t, 0.01);
-      epoch_bit_word_ = static_cast<std::int64_t>(mid.week) * 1008000 + static_cast<std::int64_t>(std::floor(mid.tow_s / 0.6));
+      epoch_bit_word_ =
+          static_cast<std::int64_t>(mid.week) * 1008000 + static_cast<std::int64_t>(std::floor(mid.tow_s / 0.6));
     }
     if (!bit) break;
     if (i == 0) k.sign = (*bit != 0 ? -1 : 1) * nav_.polarity() * polarity_fix_;
@@ -323,8 +329,7 @@ std::optional<ChannelMeasurement> ReceiverChannel::measure() {
   m.carrier_phase_cycles = -(replica.carrier_phase_cycles + half);
   m.doppler_hz = channel_.current_command().carrier_frequency_hz;
   m.cn0_dbhz = loop_.cn0_dbhz().value_or(0.0);
-  m.lock_time_s =
-      lock_start_sample_ ? static_cast<double>(replica.sample_index - *lock_start_sample_) / fs_hz_ : 0.0;
+  m.lock_time_s = lock_start_sample_ ? static_cast<double>(replica.sample_index - *lock_start_sample_) / fs_hz_ : 0.0;
   m.new_track = !reported_;
   // Vector FLL: the phase is the NCO's accumulated Doppler, which drifts from the signal's by the integral of the
   // filter's frequency error (no phase lock): every epoch carries the loss-of-lock flag. A vector PLL's phase is

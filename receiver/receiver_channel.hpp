@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One receiver channel: a satellite's TrackingChannel closed by ScalarTracking (which assembles the 20 ms
 // navigation bits) and its NavigationDataChannel (frame sync, LNAV decoding, transmit-time tag). At any
 // sample the channel has reached it gives the observables' raw material: the transmit time of the replica
@@ -44,7 +45,7 @@ struct TrackingRecord {
   double pli = 0.0;
   bool phase_locked = false;
   bool frame_synced = false;
-  int coherent_ms = 1;            // the loops' integration time (N x 20 ms with data wipe-off)
+  int coherent_ms = 1;  // the loops' integration time (N x 20 ms with data wipe-off)
 };
 
 // Broadcast navigation supplied to the receiver (a nav file): the source of known bits for data wipe-off
@@ -64,8 +65,9 @@ struct ChannelMeasurement {
   double doppler_hz = 0.0;            // positive when approaching
   double cn0_dbhz = 0.0;
   double lock_time_s = 0.0;
-  bool new_track = false;             // first measurement of this track (RINEX loss of lock)
-  bool phase_unlocked = false;        // the carrier phase is not phase-locked (vector FLL), or is the first locked one after such (vector PLL re-lock): RINEX loss of lock
+  bool new_track = false;       // first measurement of this track (RINEX loss of lock)
+  bool phase_unlocked = false;  // the carrier phase is not phase-locked (vector FLL), or is the first locked one after
+                                // such (vector PLL re-lock): RINEX loss of lock
 };
 
 class ReceiverChannel {
@@ -177,9 +179,9 @@ class ReceiverChannel {
   bool vector_carrier_jump_pending_ = false;  // vector PLL: carrier_phase_jump_cycles not applied yet
   bool last_phase_unlocked_ = false;          // the previous measurement's carrier phase was not phase-locked
   bool carrier_slip_pending_ = false;         // a vector command said carrier_slip since the last measurement
-  double previous_aid_hz_ = NAN;  // the last command's predicted Doppler (carrier aiding)
+  double previous_aid_hz_ = NAN;              // the last command's predicted Doppler (carrier aiding)
   NcoCommand last_scalar_;
-  int epoch_bit_sign_ = 0;  // the known bit of the epoch being updated (known_bits)
+  int epoch_bit_sign_ = 0;           // the known bit of the epoch being updated (known_bits)
   std::int64_t epoch_bit_word_ = 0;  // its LNAV word number (transmit time / 0.6 s)
   NavBitCheck bit_check_;
   bool oracle_used_ = false;  // the oracle source gave this channel's bits

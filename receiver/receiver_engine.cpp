@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/receiver_engine.hpp"
-#include "io/why_invalid.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -37,7 +39,8 @@ void ReceiverEngine::add_navigation(const std::vector<signals::Ephemeris>& ephem
 }
 
 int ReceiverEngine::channels_in_use() const {
-  return static_cast<int>(std::count_if(channels_.begin(), channels_.end(), [](const auto& c) { return c != nullptr; }));
+  return static_cast<int>(
+      std::count_if(channels_.begin(), channels_.end(), [](const auto& c) { return c != nullptr; }));
 }
 
 int ReceiverEngine::channels_synchronised() const {
@@ -91,7 +94,8 @@ void ReceiverEngine::finish_acquisition(std::int64_t start_sample) {
   for (const AcquisitionResult* r : detected) {
     auto free = std::find(channels_.begin(), channels_.end(), nullptr);
     if (free == channels_.end()) break;
-    const ChannelStart start = channel_start_from_acquisition(*r, acquisition_.snapshot_first(), start_sample, options_.fs_hz);
+    const ChannelStart start =
+        channel_start_from_acquisition(*r, acquisition_.snapshot_first(), start_sample, options_.fs_hz);
     *free = std::make_unique<ReceiverChannel>(r->prn, start, options_.fs_hz, options_.tracking, options_.reference_week,
                                               options_.reference_week_is_signal_week, record_periods_,
                                               options_.num_antennas);
@@ -114,7 +118,8 @@ void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples,
   view_.num_antennas = options_.num_antennas;
   view_.antenna[0] = samples.data();
   for (int a = 1; a < options_.num_antennas; ++a)
-    view_.antenna[static_cast<std::size_t>(a)] = antenna_block_[static_cast<std::size_t>(a)] + (first_sample - antenna_block_first_);
+    view_.antenna[static_cast<std::size_t>(a)] =
+        antenna_block_[static_cast<std::size_t>(a)] + (first_sample - antenna_block_first_);
   view_.i16_gain = i16_gain_;
   if (i16_gain_ > 0.0f) {
     if (given_i16_.re && given_i16_gain_ == i16_gain_) {
@@ -199,7 +204,8 @@ void ReceiverEngine::process(std::span<const std::complex<float>> samples, std::
   given_i16_ = {};
 }
 
-void ReceiverEngine::process(std::span<const std::span<const std::complex<float>>> antennas, std::int64_t first_sample) {
+void ReceiverEngine::process(std::span<const std::span<const std::complex<float>>> antennas,
+                             std::int64_t first_sample) {
   if (antennas.size() != static_cast<std::size_t>(options_.num_antennas))
     throw std::invalid_argument("ReceiverEngine: one span per antenna is needed");
   for (const auto& a : antennas)
@@ -222,7 +228,8 @@ void ReceiverEngine::process_master(std::span<const std::complex<float>> samples
   const std::int64_t end = first_sample + static_cast<std::int64_t>(samples.size());
   std::int64_t s = first_sample;
   while (s < end) {
-    if (acquisition_.pending() && acquisition_.apply_at() <= s) finish_acquisition(s);  // only after a gap in the samples
+    if (acquisition_.pending() && acquisition_.apply_at() <= s)
+      finish_acquisition(s);  // only after a gap in the samples
     std::int64_t stop = std::min(end, next_observation_);
     if (vector_.attached()) stop = std::min(stop, vector_.next_epoch_after(s));
     if (acquisition_.snapshot_active()) stop = std::min(stop, s + acquisition_.snapshot_missing());

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The scalar receiver as a processing object: fed with contiguous blocks of complex baseband samples (any
 // size), it acquires satellites on a snapshot of the first samples (assisted by ephemeris and the last fix once
 // they exist; satellites predicted below the horizon by an ephemeris or a decoded almanac are searched only
@@ -115,7 +116,7 @@ class ReceiverEngine {
   ReceiverObserver& observer_;
   std::vector<std::unique_ptr<ReceiverChannel>> channels_;  // nullptr = free
   std::vector<std::vector<TrackingRecord>> records_;        // per channel slot, one block's records (reused)
-  SampleBlockView view_;                                     // the block the channels are fed
+  SampleBlockView view_;                                    // the block the channels are fed
   WorkerPool pool_;
   AcquisitionScheduler acquisition_;  // after pool_: its destructor waits for a background search
   NavigationStore navigation_;
@@ -134,7 +135,7 @@ class ReceiverEngine {
   // the part being fed (I then Q per antenna; grown once to the largest part).
   float i16_gain_ = 0.0f;
   std::vector<std::int16_t> i16_block_;
-  PlanarI16 given_i16_{};            // the current block's int16 copy from the caller, if usable
+  PlanarI16 given_i16_{};  // the current block's int16 copy from the caller, if usable
   std::int64_t given_i16_first_ = 0;
   float given_i16_gain_ = 0.0f;
 };

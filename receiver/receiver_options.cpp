@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/receiver_options.hpp"
-#include "io/why_invalid.hpp"
 
 #include <fmt/core.h>
 
 #include <cmath>
+
+#include "io/why_invalid.hpp"
 
 namespace ultratrack::receiver {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/receiver_outputs.hpp"
 
 #include <fmt/format.h>
@@ -60,7 +61,7 @@ void ReceiverOutputs::on_fix(const PvtSolution& fix, const ObservationEpoch&) {
 void ReceiverOutputs::finish(const ReceiverEngine& engine, const RunDescription& run) {
   if (!nmea_) nmea_.emplace(dir_ / "solution.nmea", 18);  // no fix: an empty NMEA file
   obs_.set_comments(ionosphere_comment_lines(engine.ionosphere(), engine.stats().first_sample, fs_hz_,
-                                              engine.options().pvt.ionosphere));
+                                             engine.options().pvt.ionosphere));
   obs_.finish(fixes_ > 0 ? Eigen::Vector3d(sum_r_e_m_ / fixes_) : Eigen::Vector3d::Zero());
   signals::RinexNavData nav;
   nav.ephemerides = engine.decoded_ephemerides();

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receiver's files in one output folder, fed as a ReceiverObserver: solution.csv, solution.nmea,
 // solution.kml (solution_writer.hpp), observations.rnx (RINEX 3.04 obs), tracking.csv (one row per channel
 // every tracking_record_interval_s), and at finish() navigation.rnx (RINEX 3.04 nav from the decoded
@@ -9,11 +10,11 @@
 #include <filesystem>
 #include <optional>
 
+#include "io/atomic_file.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "receiver/rinex_obs_writer.hpp"
 #include "receiver/solution_writer.hpp"
-#include "io/atomic_file.hpp"
 
 namespace ultratrack::receiver {
 

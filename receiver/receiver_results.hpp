@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // What the receiver engine reports: the observer it calls with its results as they happen, and the counts it
 // keeps over a run (per satellite and overall). Units: samples, seconds, metres, radians, dB-Hz.
 #pragma once
@@ -31,21 +32,21 @@ class ReceiverObserver {
 
 // Per-satellite counts over the run (index = PRN).
 struct SatelliteStats {
-  int acquisitions = 0;          // times detected and given a channel
-  int losses = 0;                // times its channel lost lock and was released
-  double tracked_s = 0.0;        // time phase-locked
-  double cn0_sum_dbhz = 0.0;     // over observation epochs
+  int acquisitions = 0;                // times detected and given a channel
+  int losses = 0;                      // times its channel lost lock and was released
+  double tracked_s = 0.0;              // time phase-locked
+  double cn0_sum_dbhz = 0.0;           // over observation epochs
   double tracking_cn0_sum_dbhz = 0.0;  // over tracking records with an estimate (every 20 ms)
   int tracking_cn0_count = 0;
-  int observations = 0;          // observation epochs with a pseudorange
+  int observations = 0;  // observation epochs with a pseudorange
   int used_in_fixes = 0;
   bool frame_synced = false;
   bool ephemeris_decoded = false;
-  NavBitCounts nav_bits;         // of its released channels (ReceiverEngine::nav_bit_counts adds the live one)
+  NavBitCounts nav_bits;  // of its released channels (ReceiverEngine::nav_bit_counts adds the live one)
 };
 
 struct ReceiverStats {
-  std::int64_t first_sample = 0;        // first sample processed
+  std::int64_t first_sample = 0;  // first sample processed
   std::int64_t samples_processed = 0;
   std::optional<std::int64_t> first_fix_sample;
   int fixes = 0;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/receiver_summary.hpp"
 
 #include <fmt/format.h>
@@ -49,7 +50,8 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
   fmt::print(out, "  \"interrupted\": {},\n", run.interrupted);
   fmt::print(out, "  \"coupling\": \"{}\",\n", run.coupling);
   const bool fix = s.fixes > 0;
-  fmt::print(out, "  \"fix\": {},\n  \"ttff_s\": {},\n", fix, fix ? fmt::format("{:.3f}", ttff_seconds(engine)) : "null");
+  fmt::print(out, "  \"fix\": {},\n  \"ttff_s\": {},\n", fix,
+             fix ? fmt::format("{:.3f}", ttff_seconds(engine)) : "null");
   fmt::print(out, "  \"fixes\": {},\n  \"observation_epochs\": {},\n  \"clock_jumps\": {},\n", s.fixes,
              s.observation_epochs, s.clock_jumps);
   fmt::print(out, "  \"satellites_acquired\": {},\n  \"satellites_tracked\": {},\n  \"satellites_used\": {},\n",
@@ -59,8 +61,8 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
     fmt::print(out,
                "  \"mean_llh\": {{\"lat_deg\": {:.9f}, \"lon_deg\": {:.9f}, \"height_m\": {:.3f}}},\n"
                "  \"mean_ecef_m\": [{:.3f}, {:.3f}, {:.3f}],\n",
-               s.sum_lat_rad / n * io::kDegPerRad, s.sum_lon_rad / n * io::kDegPerRad, s.sum_height_m / n, s.sum_r_e_m.x() / n,
-               s.sum_r_e_m.y() / n, s.sum_r_e_m.z() / n);
+               s.sum_lat_rad / n * io::kDegPerRad, s.sum_lon_rad / n * io::kDegPerRad, s.sum_height_m / n,
+               s.sum_r_e_m.x() / n, s.sum_r_e_m.y() / n, s.sum_r_e_m.z() / n);
   } else {
     fmt::print(out, "  \"mean_llh\": null,\n  \"mean_ecef_m\": null,\n");
   }
@@ -93,15 +95,16 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
   for (int prn = 1; prn <= 32; ++prn) {
     const SatelliteStats& sat = s.satellites[static_cast<std::size_t>(prn)];
     if (sat.acquisitions == 0) continue;
-    fmt::print(out,
-               "{}\n    {{\"prn\": {}, \"acquisitions\": {}, \"losses\": {}, \"tracked_s\": {:.3f}, "
-               "\"mean_cn0_dbhz\": {}, \"tracking_cn0_dbhz\": {}, \"observations\": {}, \"used_in_fixes\": {}, \"frame_synced\": {}, "
-               "\"ephemeris_decoded\": {}}}",
-               first ? "" : ",", prn, sat.acquisitions, sat.losses, engine.tracked_time_s(prn),
-               sat.observations ? fmt::format("{:.2f}", sat.cn0_sum_dbhz / sat.observations) : "null",
-               sat.tracking_cn0_count ? fmt::format("{:.2f}", sat.tracking_cn0_sum_dbhz / sat.tracking_cn0_count)
-                                      : "null",
-               sat.observations, sat.used_in_fixes, sat.frame_synced, sat.ephemeris_decoded);
+    fmt::print(
+        out,
+        "{}\n    {{\"prn\": {}, \"acquisitions\": {}, \"losses\": {}, \"tracked_s\": {:.3f}, "
+        "\"mean_cn0_dbhz\": {}, \"tracking_cn0_dbhz\": {}, \"observations\": {}, \"used_in_fixes\": {}, "
+        "\"frame_synced\": {}, "
+        "\"ephemeris_decoded\": {}}}",
+        first ? "" : ",", prn, sat.acquisitions, sat.losses, engine.tracked_time_s(prn),
+        sat.observations ? fmt::format("{:.2f}", sat.cn0_sum_dbhz / sat.observations) : "null",
+        sat.tracking_cn0_count ? fmt::format("{:.2f}", sat.tracking_cn0_sum_dbhz / sat.tracking_cn0_count) : "null",
+        sat.observations, sat.used_in_fixes, sat.frame_synced, sat.ephemeris_decoded);
     first = false;
   }
   fmt::print(out, "\n  ]{}\n}}\n", run.extra_json.empty() ? std::string() : ",\n  " + run.extra_json);

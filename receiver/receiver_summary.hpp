@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // summary.json of a receiver run: what was processed (input description, duration, wall time, realtime factor),
 // time to first fix (seconds of signal from the first processed sample), satellites acquired / tracked / used,
 // fixes, the mean position (LLH, degrees and metres) and per-satellite statistics. Written as an AtomicFile.
@@ -11,14 +12,14 @@
 namespace ultratrack::receiver {
 
 struct RunDescription {
-  std::string input;          // file path
-  std::string format;         // sample format name
+  std::string input;   // file path
+  std::string format;  // sample format name
   double fs_hz = 0.0, if_hz = 0.0;
-  double skip_s = 0.0;        // signal skipped at the file's start
+  double skip_s = 0.0;  // signal skipped at the file's start
   double wall_time_s = 0.0;
-  bool interrupted = false;   // stopped by SIGINT before the end
+  bool interrupted = false;         // stopped by SIGINT before the end
   std::string coupling = "scalar";  // how the loops are closed: scalar, vector, loose, tight
-  std::string extra_json;     // further top-level members, formatted ("\"name\": value"), written last
+  std::string extra_json;           // further top-level members, formatted ("\"name\": value"), written last
 };
 
 // Seconds of signal processed by the engine.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/rinex_obs_writer.hpp"
 
 #include <fmt/format.h>
@@ -42,8 +43,8 @@ void RinexObsWriter::write(const ObservationEpoch& epoch) {
     // LLI bit 0: lock lost since the previous epoch; bit 1: half-cycle ambiguity not yet resolved.
     const int lli = (o.loss_of_lock ? 1 : 0) | (o.half_cycle_resolved ? 0 : 2);
     out << fmt::format("G{:02d}", o.prn) << obs_field(o.pseudorange_m, 0, ssi)
-        << obs_field(o.carrier_phase_cycles, lli, ssi) << obs_field(o.doppler_hz, 0, 0)
-        << obs_field(o.cn0_dbhz, 0, 0) << '\n';
+        << obs_field(o.carrier_phase_cycles, lli, ssi) << obs_field(o.doppler_hz, 0, 0) << obs_field(o.cn0_dbhz, 0, 0)
+        << '\n';
   }
   ++epochs_;
 }
@@ -70,9 +71,9 @@ void RinexObsWriter::finish(const Eigen::Vector3d& approx_r_e_m) {
   out << header_line(fmt::format("{:10.3f}", info_.interval_s), "INTERVAL");
   if (first_epoch_) {
     const signals::CalendarTime c = signals::calendar_from_gps_time(*first_epoch_);
-    out << header_line(fmt::format("{:6d}{:6d}{:6d}{:6d}{:6d}{:13.7f}     GPS", c.year, c.month, c.day, c.hour,
-                                   c.minute, c.second),
-                       "TIME OF FIRST OBS");
+    out << header_line(
+        fmt::format("{:6d}{:6d}{:6d}{:6d}{:6d}{:13.7f}     GPS", c.year, c.month, c.day, c.hour, c.minute, c.second),
+        "TIME OF FIRST OBS");
   }
   out << header_line("G L1C", "SYS / PHASE SHIFT");
   out << header_line("", "END OF HEADER");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // RINEX 3.04 GPS observation files (C1C pseudorange m, L1C carrier phase cycles, D1C Doppler Hz,
 // S1C C/N0 dB-Hz) from ObservationEpochs. Epoch times are receiver-clock times, as RINEX requires.
 // The body is streamed to a side file and the header (which needs the first epoch and the approximate
@@ -11,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "receiver/observables.hpp"
 #include "io/atomic_file.hpp"
+#include "receiver/observables.hpp"
 
 namespace ultratrack::receiver {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/sample_prefetcher.hpp"
 
 #include <algorithm>
@@ -7,7 +8,9 @@
 namespace ultratrack::receiver {
 
 SamplePrefetcher::SamplePrefetcher(SampleSource& source, std::size_t block_size, std::int64_t limit, bool threaded)
-    : source_(source), block_size_(std::max<std::size_t>(1, block_size)), left_(std::max<std::int64_t>(0, limit)),
+    : source_(source),
+      block_size_(std::max<std::size_t>(1, block_size)),
+      left_(std::max<std::int64_t>(0, limit)),
       threaded_(threaded) {
   for (Slot& s : slots_) {
     s.samples.resize(block_size_);

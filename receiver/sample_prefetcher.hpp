@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Read-ahead of a SampleSource: while the receiver processes one block, a reader thread reads (and converts)
 // the next, so reading the file is off the engine's caller thread. Once told the engine's int16 gain
 // (ReceiverEngine::i16_gain), it also converts each block it reads to the planar int16 the integer correlator

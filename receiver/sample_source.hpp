@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receiver's source of complex baseband samples: reads an IF file (signals::SampleReader) and
 // removes the intermediate frequency, so that every later stage sees a signal centred at 0 Hz with
 // Doppler as the only carrier offset. This is the one place IF handling lives. Units: Hz, samples.
@@ -72,8 +73,9 @@ class SampleSource {
 
   // Gain from the file's sample scale to the int16 output, options.int16_gain when given. Automatic:
   // i8/r8 64 and i16/r16 1/4 (full scale to ~11500, headroom for the sqrt(2) growth of the mixing
-  // rotation); r2/i2 1024 (levels +-1, +-3: RMS ~1900 at the 1-sigma threshold, as i8 at full scale / 4); f32, which has no full scale, 2048 / RMS of the first 2^16 samples (Gaussian peaks at
-  // 6 sigma stay below 32767; quantisation noise is 66 dB below the input noise; 1 for an all-zero head).
+  // rotation); r2/i2 1024 (levels +-1, +-3: RMS ~1900 at the 1-sigma threshold, as i8 at full scale / 4); f32, which
+  // has no full scale, 2048 / RMS of the first 2^16 samples (Gaussian peaks at 6 sigma stay below 32767; quantisation
+  // noise is 66 dB below the input noise; 1 for an all-zero head).
   float int16_gain() const { return int16_gain_; }
   std::int64_t next_sample() const { return converter_.next_sample(); }
   std::int64_t total_samples() const { return reader_.total_samples(); }

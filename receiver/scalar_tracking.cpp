@@ -1,12 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/scalar_tracking.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
+#include "io/why_invalid.hpp"
 #include "receiver/discriminators.hpp"
 #include "signals/gps_constants.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -32,11 +33,16 @@ const ScalarTrackingOptions& valid(const ScalarTrackingOptions& o) {
 
 const char* to_string(TrackingState s) {
   switch (s) {
-    case TrackingState::kPullIn: return "pull-in";
-    case TrackingState::kPhaseLocked: return "phase-locked";
-    case TrackingState::kBitSynced: return "bit-synced";
-    case TrackingState::kLost: return "lost";
-    case TrackingState::kCoasting: return "coasting";
+    case TrackingState::kPullIn:
+      return "pull-in";
+    case TrackingState::kPhaseLocked:
+      return "phase-locked";
+    case TrackingState::kBitSynced:
+      return "bit-synced";
+    case TrackingState::kLost:
+      return "lost";
+    case TrackingState::kCoasting:
+      return "coasting";
   }
   return "?";
 }
@@ -76,7 +82,7 @@ ScalarTrackingControl ScalarTracking::control() const {
   ScalarTrackingControl c;
   c.coasting_allowed = coasting_allowed_;
   c.filter_driven = filter_driven_;
-  c.carrier = !carrier_commanded_      ? CarrierControl::kAided
+  c.carrier = !carrier_commanded_     ? CarrierControl::kAided
               : carrier_phase_locked_ ? CarrierControl::kFrequencyAndPhase
                                       : CarrierControl::kFrequency;
   return c;
@@ -159,8 +165,9 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   const bool long_ready =
       long_.enabled() && state_ == TrackingState::kBitSynced && e.num_code_periods == 20 && !carrier_commanded_;
   if (long_.block_count() > 0 && (!long_ready || known.sign == 0 || !long_.continues_block(e))) long_.drop_block();
-  const bool long_path = long_ready && known.sign != 0 &&
-                         (long_.block_count() > 0 || (long_.target_epochs() > 1 && known.ahead >= long_.target_epochs()));
+  const bool long_path =
+      long_ready && known.sign != 0 &&
+      (long_.block_count() > 0 || (long_.target_epochs() > 1 && known.ahead >= long_.target_epochs()));
 
   // Lock detectors. Their statistics depend on the epoch length: restart them when it changes.
   if (e.num_code_periods != cn0_epoch_periods_) {
@@ -188,7 +195,8 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   // coasting it looks for the signal's return.
   loss_.presence_epoch(filter_driven_ && (state_ == TrackingState::kBitSynced || state_ == TrackingState::kCoasting) &&
                            e.num_code_periods == 20,
-                       state_ == TrackingState::kBitSynced, state_ == TrackingState::kCoasting, taps.prompt, taps.noise, t);
+                       state_ == TrackingState::kBitSynced, state_ == TrackingState::kCoasting, taps.prompt, taps.noise,
+                       t);
 
   r.phase_error_cycles = costas_atan_cycles(taps.prompt);
   r.frequency_error_hz = pull_in_.frequency_error_hz(e, time_s_);
@@ -244,9 +252,9 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   // (While weak enough for long coherent integration, 20 ms updates bridging unknown bits between long updates
   // judge the C/N0 as the long updates do; with no long update for 10 s, the plain 20 ms test holds.)
   const bool weak_bridge = bridging();
-  const bool low_cn0 = weak_bridge
-                           ? long_.slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(long_.target_epochs()))
-                           : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
+  const bool low_cn0 =
+      weak_bridge ? long_.slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(long_.target_epochs()))
+                  : cn0_dbhz_ && *cn0_dbhz_ < opt_.cn0_loss_threshold_dbhz;
   // (A carrier the vector FLL commands is not phase-locked: its PLI says nothing about the signal.)
   const bool fll = carrier_commanded_ && state_ == TrackingState::kBitSynced;
   const bool low_pli = ever_locked_ && r.pli < opt_.pli_loss_threshold && !fll;
@@ -325,8 +333,10 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
     // (the first epoch already ran on the previous command). The previous command carries the last shorter
     // update's proportional term, noise there (+-0.5-1 Hz on 20 ms updates at 30 dB-Hz), 5x as much phase
     // when held 100 ms: a 30-45 deg excursion before the first long update.
-    const double f = carrier_.frequency_hz() - 0.5 * carrier_.frequency_rate_hzps() * long_.block_epochs() * kBitPeriod_s;
-    command_.code_rate_chips_per_s += signals::kCaChipRate_hz * (f - command_.carrier_frequency_hz) / signals::kL1Frequency_hz;
+    const double f =
+        carrier_.frequency_hz() - 0.5 * carrier_.frequency_rate_hzps() * long_.block_epochs() * kBitPeriod_s;
+    command_.code_rate_chips_per_s +=
+        signals::kCaChipRate_hz * (f - command_.carrier_frequency_hz) / signals::kL1Frequency_hz;
     command_.carrier_frequency_hz = f;
   }
   const bool complete = long_.add(e, sign);
@@ -350,8 +360,8 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
   // Bits wiped: a filter-driven channel's PLL takes the full phase (atan2, +-1/2 cycle, no squaring loss).
   r.phase_error_cycles = filter_driven_ ? pll_atan2_cycles(prompt) : costas_atan_cycles(prompt);
   r.frequency_error_hz = 0.0;
-  r.code_error_chips = dll_nelp_chips(std::complex<float>(block.early), std::complex<float>(block.late),
-                                      opt_.early_late_offset_chips);
+  r.code_error_chips =
+      dll_nelp_chips(std::complex<float>(block.early), std::complex<float>(block.late), opt_.early_late_offset_chips);
   const bool low_cn0 = long_.slow_cn0_below(opt_.cn0_loss_threshold_dbhz - 10.0 * std::log10(n));
   const bool low_pli = r.pli < opt_.pli_loss_threshold;
   if (loss_.long_update_lost(low_cn0 || low_pli, filter_driven_, t, long_.pli_time_constant_s()))
@@ -433,7 +443,8 @@ TrackingReport ScalarTracking::coast_epoch(const CorrelationEpoch& e, TrackingRe
       f = carrier_.update_fll_only(r.frequency_error_hz, opt_.relock_fll_bw_hz, t);
       if (relock_s_ + t > opt_.relock_fll_time_s) pli_.reset();
     } else {
-      if (carrier_.fll_bw_hz() != opt_.relock_assist_bw_hz) carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, opt_.relock_assist_bw_hz);
+      if (carrier_.fll_bw_hz() != opt_.relock_assist_bw_hz)
+        carrier_.set_bandwidths(opt_.pll_bw_coherent_hz, opt_.relock_assist_bw_hz);
       f = carrier_.update(r.phase_error_cycles, r.frequency_error_hz, t);
     }
     // locked: the PLI holds and the frequency discriminator agrees (a PLL can hold a Costas lock 1 / t off)

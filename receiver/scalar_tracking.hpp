@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scalar tracking: the classic per-channel closure of the NcoCommand/CorrelationEpoch seam. Pull-in (a frequency
 // search on the first prompts, or wide and narrow FLL stages; then a fine FLL) handing over to the Costas PLL
 // (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
@@ -11,8 +12,8 @@
 #include <cstdint>
 #include <optional>
 
-#include "receiver/carrier_control.hpp"
 #include "receiver/bit_sync.hpp"
+#include "receiver/carrier_control.hpp"
 #include "receiver/correlation_epoch.hpp"
 #include "receiver/discriminators.hpp"
 #include "receiver/lock_detectors.hpp"
@@ -39,8 +40,8 @@ enum class TrackingState {
   kBitSynced,    // 20 ms (coherent_ms) epochs, bits flowing
   kLost,         // lock lost: the command only coasts; re-acquire
   // Lock lost while an external (vector) loop drives the replica: the carrier follows the loop's predicted
-  // Doppler (ScalarTrackingControl::aid), the code its commands; bits keep their timing; when the C/N0 returns a Costas PLL
-  // with a frequency-error assist re-locks from the predicted frequency and the state goes back to kBitSynced.
+  // Doppler (ScalarTrackingControl::aid), the code its commands; bits keep their timing; when the C/N0 returns a Costas
+  // PLL with a frequency-error assist re-locks from the predicted frequency and the state goes back to kBitSynced.
   kCoasting,
 };
 const char* to_string(TrackingState state);
@@ -55,10 +56,10 @@ struct TrackingReport {
   std::optional<double> cn0_dbhz;  // latest estimate (none before the first window)
   double pli = 0.0;
   bool phase_locked = false;
-  double phase_error_cycles = 0.0;   // discriminator outputs of this epoch
+  double phase_error_cycles = 0.0;  // discriminator outputs of this epoch
   double frequency_error_hz = 0.0;
   double code_error_chips = 0.0;
-  std::optional<NavBit> bit;         // a completed 20 ms navigation bit
+  std::optional<NavBit> bit;  // a completed 20 ms navigation bit
   // The integration time of the loops' latest update, ms: the epoch's length, or N x 20 ms with data wipe-off
   // (the loops then update once per N epochs and the other epochs give the previous command).
   int loop_integration_ms = 1;
@@ -95,8 +96,8 @@ struct ScalarTrackingControl {
   // kFrequencyAndPhase (vector PLL): the external loop closes the phase too, so the bits are detected coherently
   // (Costas sign, polarity from the preamble) rather than differentially; everything else as kFrequency.
   CarrierControl carrier = CarrierControl::kAided;
-  // The commanded carrier frequency (Hz) for the next command, with kFrequency or kFrequencyAndPhase; ignored unless bit-synced
-  // or coasting, or when not finite.
+  // The commanded carrier frequency (Hz) for the next command, with kFrequency or kFrequencyAndPhase; ignored unless
+  // bit-synced or coasting, or when not finite.
   double carrier_frequency_hz = NAN;
   // Carrier aiding (vector tracking, with kAided): only while bit-synced (kShift: or coasting);
   // ignored otherwise. aid_delta_hz (kShift) not finite: ignored.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scalar-tracking options: every setting of the per-channel loops (pull-in, PLL, DLL, coherent integration, lock
 // detection, coasting, long coherent integration, the filter-driven presence test) with its unit, range and
 // default for L1 C/A, and their one validation. Units: Hz, chips, seconds, ms; C/N0 in dB-Hz.
@@ -15,16 +16,16 @@ namespace ultratrack::receiver {
 // IsValid() at the edge (config file, command line) before constructing anything.
 struct ScalarTrackingOptions {
   // Carrier loop
-  int pll_order = 3;                   // 2 or 3
-  double pll_bw_hz = 15.0;             // PLL noise bandwidth with 1 ms epochs; (0, 50]
+  int pll_order = 3;        // 2 or 3
+  double pll_bw_hz = 15.0;  // PLL noise bandwidth with 1 ms epochs; (0, 50]
   // On 1 ms epochs after phase lock while the measured C/N0 is below weak_cn0_dbhz: a narrower PLL (thermal
   // phase jitter sqrt(Bn / (C/N0) (1 + 1 / (2 T C/N0))): 14 deg at 15 Hz, 27 dB-Hz, against 9 deg at 6 Hz), for
   // the second or two before bit sync; a static or vehicle receiver's line-of-sight dynamics (< 1 g) stay within
   // a 3rd-order 6 Hz loop's reach.
-  double pll_bw_weak_hz = 6.0;         // (0, 50]
-  double weak_cn0_dbhz = 33.0;         // [0, 60]
-  double pll_bw_coherent_hz = 5.0;     // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
-                                       // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
+  double pll_bw_weak_hz = 6.0;      // (0, 50]
+  double weak_cn0_dbhz = 33.0;      // [0, 60]
+  double pll_bw_coherent_hz = 5.0;  // with 20 ms epochs after bit sync; (0, 15]. Design (analogue) value: at
+                                    // Bn*T = 0.1 the digital loop's true Bn is ~20 % higher, at 0.2 ~55 %
   // Pull-in: (1) a wide FLL alone on the two halves of each code period (range +-1 kHz, bit-edge safe); (2) a
   // narrow FLL alone on successive 1 ms prompts (bit-tolerant, range +-250 Hz, 8x less noise); (3) the PLL alone
   // (2nd order while pulling in) until the phase lock indicator holds, then the PLL of pll_order. Both FLLs are
@@ -36,36 +37,36 @@ struct ScalarTrackingOptions {
   // wander +-20-130 Hz below ~32 dB-Hz (frequency jitter of a 1st-order FLL on 0.5-1 ms cross products): the
   // FLL stages suit a 1 ms acquisition on strong signals (pullin_search_hz = 0), the search any acquisition
   // whose Doppler is good to +-pullin_search_hz (refined 4-10 ms acquisitions: a few tens of Hz at worst).
-  double pullin_search_hz = 300.0;     // [0, 500]; 0 = FLL stages (1), (2)
-  double pullin_search_time_s = 0.2;   // [0.05, 0.5]
-  double fll_bw_hz = 10.0;             // wide FLL; (0, 50]
-  double fll_wide_time_s = 0.25;       // stage (1) length; [0.01, 5]
-  double fll_narrow_bw_hz = 2.0;       // narrow FLL; (0, 20]
-  double fll_narrow_time_s = 0.25;     // stage (2) length; [0, 5]
+  double pullin_search_hz = 300.0;    // [0, 500]; 0 = FLL stages (1), (2)
+  double pullin_search_time_s = 0.2;  // [0.05, 0.5]
+  double fll_bw_hz = 10.0;            // wide FLL; (0, 50]
+  double fll_wide_time_s = 0.25;      // stage (1) length; [0.01, 5]
+  double fll_narrow_bw_hz = 2.0;      // narrow FLL; (0, 20]
+  double fll_narrow_time_s = 0.25;    // stage (2) length; [0, 5]
   // (2b) a fine FLL on successive 5 ms prompt sums (bit-tolerant, range +-50 Hz, 5x the SNR per measurement):
   // brings the frequency within the PLL's few-Hz lock-in range at low C/N0.
-  double fll_fine_bw_hz = 2.0;         // fine FLL; (0, 10]
-  double fll_fine_time_s = 0.3;        // stage (2b) length; [0, 5]
-  double pullin_lock_time_s = 0.1;     // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
-  double pullin_timeout_s = 2.0;       // pull-in that never locks is declared lost; [0.1, 30] and longer than
-                                       // the FLL stages plus pli_time_constant_s plus pullin_lock_time_s
+  double fll_fine_bw_hz = 2.0;      // fine FLL; (0, 10]
+  double fll_fine_time_s = 0.3;     // stage (2b) length; [0, 5]
+  double pullin_lock_time_s = 0.1;  // PLI above pli_lock_threshold this long ends pull-in; [0.01, 2]
+  double pullin_timeout_s = 2.0;    // pull-in that never locks is declared lost; [0.1, 30] and longer than
+                                    // the FLL stages plus pli_time_constant_s plus pullin_lock_time_s
   // Code loop
-  double dll_bw_hz = 2.0;              // DLL noise bandwidth with 1 ms epochs; (0, 10]
-  double dll_bw_coherent_hz = 1.0;     // after bit sync; (0, 5]
-  double early_late_offset_chips = 0.5;  // E and L at +- this (E-L spacing twice it); (0, 0.5]; narrow: 0.1
-  bool very_early_late = false;          // extra VE/VL taps in the epochs
+  double dll_bw_hz = 2.0;                     // DLL noise bandwidth with 1 ms epochs; (0, 10]
+  double dll_bw_coherent_hz = 1.0;            // after bit sync; (0, 5]
+  double early_late_offset_chips = 0.5;       // E and L at +- this (E-L spacing twice it); (0, 0.5]; narrow: 0.1
+  bool very_early_late = false;               // extra VE/VL taps in the epochs
   double very_early_late_offset_chips = 1.0;  // (early_late_offset_chips, 2]
   // Integration
-  int coherent_ms = 20;                // coherent integration after bit sync, ms; 1, 2, 4, 5, 10 or 20
+  int coherent_ms = 20;  // coherent integration after bit sync, ms; 1, 2, 4, 5, 10 or 20
   BitSyncOptions bit_sync;
   // Lock detection
   Cn0Method cn0_method = Cn0Method::kNoiseTap;  // kMoments works without the noise tap (windows >= 50 epochs)
-  double cn0_window_s = 0.2;           // C/N0 averaging window; [0.02, 5] (a multiple of the epoch length)
-  double cn0_loss_threshold_dbhz = 25.0;  // C/N0 below this counts toward loss of lock; [0, 45]
-  double pli_time_constant_s = 0.1;    // phase lock indicator low-pass; [0.005, 5]
-  double pli_lock_threshold = 0.7;     // PLI (cos 2 dphi) above this = phase locked; (0, 1)
-  double pli_loss_threshold = 0.3;     // PLI below this (after lock) counts toward loss; [-1, pli_lock_threshold)
-  double loss_of_lock_time_s = 0.3;    // continuous time with a loss condition before kLost; [0.02, 10]
+  double cn0_window_s = 0.2;                    // C/N0 averaging window; [0.02, 5] (a multiple of the epoch length)
+  double cn0_loss_threshold_dbhz = 25.0;        // C/N0 below this counts toward loss of lock; [0, 45]
+  double pli_time_constant_s = 0.1;             // phase lock indicator low-pass; [0.005, 5]
+  double pli_lock_threshold = 0.7;              // PLI (cos 2 dphi) above this = phase locked; (0, 1)
+  double pli_loss_threshold = 0.3;   // PLI below this (after lock) counts toward loss; [-1, pli_lock_threshold)
+  double loss_of_lock_time_s = 0.3;  // continuous time with a loss condition before kLost; [0.02, 10]
   // Coasting (allow_coasting): re-lock starts when the C/N0 estimate is this far above cn0_loss_threshold_dbhz;
   // a first-order FLL of relock_fll_bw_hz (cross/dot of each epoch's two halves: +-50 Hz at 20 ms) alone for
   // relock_fll_time_s, then the PLL assisted by that FLL at relock_assist_bw_hz until the PLI holds, with the
@@ -91,17 +92,17 @@ struct ScalarTrackingOptions {
   // (0.5 Hz) below 23.17; back to a shorter time 2 dB above its threshold. A 1 Hz 3rd-order loop at 100 ms (Bn T
   // = 0.1) tracked a 0.5 Hz/s Doppler ramp with ~30 deg slow swings (its rate state's noise from the 5 Hz loop):
   // hence 0.2. adaptive_coherent = false: always max_coherent_ms while bits are known.
-  int max_coherent_ms = 100;           // 20 (off), 40, 100, 200 or 400
+  int max_coherent_ms = 100;  // 20 (off), 40, 100, 200 or 400
   bool adaptive_coherent = true;
   // The front end's oscillator (Allan coefficients, signals/oscillator_allan.hpp; 0 = a perfect clock): its phase
   // noise passes a PLL as jitter that grows as the bandwidth narrows (receiver/long_coherent.hpp), so with it the
   // choice of N minimises the total jitter, thermal and oscillator: a TCXO's random-walk frequency (Brown & Hwang,
   // h-2 2e-20) puts 48 deg into the 2 Hz loop of 100 ms integration and 12 deg into the 5 Hz one of 20 ms.
-  double oscillator_h0 = 0.0;          // white frequency, s; [0, 1e-17]
-  double oscillator_h_minus2 = 0.0;    // random-walk frequency, 1/s; [0, 1e-17]
-  double coherent_jitter_deg = 4.0;    // (0, 30]
-  double coherent_hysteresis_db = 2.0; // [0, 10]
-  double coherent_max_bn_t = 0.2;      // (0, 0.25]
+  double oscillator_h0 = 0.0;           // white frequency, s; [0, 1e-17]
+  double oscillator_h_minus2 = 0.0;     // random-walk frequency, 1/s; [0, 1e-17]
+  double coherent_jitter_deg = 4.0;     // (0, 30]
+  double coherent_hysteresis_db = 2.0;  // [0, 10]
+  double coherent_max_bn_t = 0.2;       // (0, 0.25]
   // Lock test of a channel whose replica a filter drives (ultra-tight: set_filter_driven): the scalar loss test
   // above (0.2 s C/N0 below cn0_loss_threshold_dbhz or PLI below pli_loss_threshold for loss_of_lock_time_s)
   // is replaced by receiver/presence_test.hpp on the 20 ms epochs: prompt power over the noise tap's over
@@ -119,11 +120,11 @@ struct ScalarTrackingOptions {
   // 0.95, at 15 dB-Hz 1.9e-3, at 14 0.039; receiver/presence_test.hpp). A coasting
   // filter-driven channel re-locks when two consecutive windows read at least presence_relock_dbhz (noise does
   // so with probability 5.6e-5 per pair, a 16 dB-Hz signal with 0.48), as well as by the C/N0 rule above.
-  double presence_window_s = 1.0;        // [0.1, 5]
-  double presence_threshold_dbhz = 12.0; // [0, 30]
-  int presence_max_windows = 5;          // [1, 10]
+  double presence_window_s = 1.0;             // [0.1, 5]
+  double presence_threshold_dbhz = 12.0;      // [0, 30]
+  int presence_max_windows = 5;               // [1, 10]
   double presence_false_loss_per_min = 1e-3;  // (0, 1)
-  double presence_relock_dbhz = 15.0;    // [presence_threshold_dbhz, 40]
+  double presence_relock_dbhz = 15.0;         // [presence_threshold_dbhz, 40]
 
   // True when the options fit together; otherwise false and *why (when given) says which setting and why.
   bool IsValid(std::string* why) const;
@@ -132,6 +133,7 @@ struct ScalarTrackingOptions {
 // Empty when the options are valid, else a message naming the first bad field, its value and its range.
 
 // The channel configuration these options need (correlator layout with the noise tap when kNoiseTap).
-ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz, int num_antennas = 1);
+ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz,
+                             int num_antennas = 1);
 
 }  // namespace ultratrack::receiver

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/snapshot_measurement.hpp"
 
 #include <algorithm>
@@ -80,7 +81,8 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
   const std::size_t blocks = samples.size() / block;
   if (blocks < 2) throw std::invalid_argument("measure_snapshot: the snapshot is shorter than 2 coherent blocks");
   // The search runs at about 4 MHz: sums of `decimation` samples (a boxcar low-pass: a few tenths of a dB of
-  // the code's main lobe) centred (decimation - 1) / 2 samples after each group's first. The fine loop uses every sample.
+  // the code's main lobe) centred (decimation - 1) / 2 samples after each group's first. The fine loop uses every
+  // sample.
   const int decimation = std::max(1, static_cast<int>(options.fs_hz / 4.0e6));
   std::vector<std::complex<float>> reduced;
   std::span<const std::complex<float>> searched = samples;
@@ -88,7 +90,8 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
     reduced.resize(samples.size() / static_cast<std::size_t>(decimation));
     for (std::size_t i = 0; i < reduced.size(); ++i) {
       std::complex<float> sum = 0.0f;
-      for (int k = 0; k < decimation; ++k) sum += samples[i * static_cast<std::size_t>(decimation) + static_cast<std::size_t>(k)];
+      for (int k = 0; k < decimation; ++k)
+        sum += samples[i * static_cast<std::size_t>(decimation) + static_cast<std::size_t>(k)];
       reduced[i] = sum;
     }
     searched = reduced;
@@ -115,8 +118,8 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
     const bool near_strongest = r.cn0_dbhz >= strongest_dbhz - options.cross_correlation_margin_db;
     if (!r.detected || (!strong && !near_strongest)) continue;
     const signals::CaCodeChips& code = signals::ca_code(r.prn);
-    const double chips_per_sample = signals::kCaChipRate_hz * (1.0 + r.doppler_hz / signals::kL1Frequency_hz) /
-                                    options.fs_hz;
+    const double chips_per_sample =
+        signals::kCaChipRate_hz * (1.0 + r.doppler_hz / signals::kL1Frequency_hz) / options.fs_hz;
     // Noise alone: a replica half a code period away from the peak.
     const double noise = correlation_powers<1>(used, code, {r.code_phase_chips + kCodeLength / 2.0}, chips_per_sample,
                                                r.doppler_hz, options.fs_hz, block)[0];
@@ -140,8 +143,7 @@ std::vector<SnapshotDetection> measure_snapshot(std::span<const std::complex<flo
     det.acquisition_metric = r.metric;
     det.acquisition_threshold = r.threshold;
     const double cn0 = std::pow(10.0, r.cn0_dbhz / 10.0);
-    det.code_sigma_chips =
-        std::sqrt(d / (4.0 * cn0 * total_s) * (1.0 + 2.0 / ((2.0 - d) * cn0 * acq.coherent_s())));
+    det.code_sigma_chips = std::sqrt(d / (4.0 * cn0 * total_s) * (1.0 + 2.0 / ((2.0 - d) * cn0 * acq.coherent_s())));
     // Fine search resolution step / 8 (uniform: / sqrt(12)) and the frequency estimate's thermal floor.
     const double resolution = acq.step_hz() / 8.0 / std::sqrt(12.0);
     const double thermal = 1.0 / (2.0 * kPi * total_s) * std::sqrt(12.0 / (cn0 * total_s));

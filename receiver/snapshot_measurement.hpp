@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Snapshot measurements: every visible satellite's fine code phase and Doppler from one short block of
 // complex baseband samples (tens to hundreds of ms), for coarse-time navigation (receiver/snapshot_navigation.hpp).
 //

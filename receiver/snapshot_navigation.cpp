@@ -1,13 +1,13 @@
-#include "receiver/chi_square.hpp"
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/snapshot_navigation.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
-
 #include <Eigen/Dense>
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "receiver/chi_square.hpp"
 #include "receiver/pvt.hpp"
 #include "signals/atmosphere.hpp"
 #include "signals/gps_constants.hpp"
@@ -48,7 +48,7 @@ struct Sighting {
   double sv_clock_s = 0.0;  // L1 C/A correction: af polynomial + relativistic - TGD
   double delay_m = 0.0;     // ionosphere + troposphere (0 until near the surface)
   double elevation_rad = kPi / 2.0, azimuth_rad = 0.0;
-  bool located = false;     // elevation and delays computed
+  bool located = false;  // elevation and delays computed
   // The modelled pseudorange without receiver clock: range - c dt_sv + delays.
   double pseudorange_m() const { return range_m - kSpeedOfLight_mps * sv_clock_s + delay_m; }
   // Range rate of the satellite's motion alone (the coarse-time column).
@@ -75,8 +75,8 @@ Sighting sight(const SnapshotMeasurement& m, const signals::GpsTime& t_tx_sv, co
     s.located = true;
     if (s.elevation_rad > 0.0) {
       if (opt.ionosphere && opt.klobuchar.valid)
-        s.delay_m += kSpeedOfLight_mps * signals::klobuchar_delay_s(opt.klobuchar, g.lat_rad, g.lon_rad,
-                                                                    s.azimuth_rad, s.elevation_rad, t_tx.tow_s);
+        s.delay_m += kSpeedOfLight_mps * signals::klobuchar_delay_s(opt.klobuchar, g.lat_rad, g.lon_rad, s.azimuth_rad,
+                                                                    s.elevation_rad, t_tx.tow_s);
       if (opt.troposphere) s.delay_m += signals::troposphere_delay_m(g.lat_rad, g.height_m, s.elevation_rad);
     }
   }
@@ -260,7 +260,8 @@ bool SnapshotOptions::IsValid(std::string* why) const {
     if (!(elevation_mask_rad >= -kPi / 2 && elevation_mask_rad < kPi / 2)) return "elevation mask out of range";
     if (!(model_sigma_m > 0.0)) return "model sigma must be > 0";
     if (!(time_sigma_s > 0.0 && time_sigma_s <= 600.0)) return "time sigma must be in (0, 600] s";
-    if (!(false_alarm_probability > 0.0 && false_alarm_probability < 0.5)) return "false-alarm probability out of (0, 0.5)";
+    if (!(false_alarm_probability > 0.0 && false_alarm_probability < 0.5))
+      return "false-alarm probability out of (0, 0.5)";
     if (max_exclusions < 0) return "max exclusions must be >= 0";
     if (!(grid_step_m > 1e3 && grid_radius_m >= 0.0)) return "grid step must be > 1 km, radius >= 0";
     if (max_iterations < 1) return "max iterations must be >= 1";
@@ -344,8 +345,8 @@ SnapshotSolution solve_snapshot_from(const std::vector<SnapshotMeasurement>& mea
   sol.sigma_clock_m = std::sqrt(std::max(e.covariance(3, 3), 0.0));
   // The time correction is time_s - clock / c: its variance includes their covariance.
   const double c = kSpeedOfLight_mps;
-  sol.sigma_time_s = std::sqrt(std::max(
-      e.covariance(4, 4) + e.covariance(3, 3) / (c * c) - 2.0 * e.covariance(3, 4) / c, 0.0));
+  sol.sigma_time_s =
+      std::sqrt(std::max(e.covariance(4, 4) + e.covariance(3, 3) / (c * c) - 2.0 * e.covariance(3, 4) / c, 0.0));
   sol.used = e.used;
   sol.test_statistic = e.statistic;
   sol.test_threshold = threshold_for(e.used, opt);
@@ -375,9 +376,10 @@ SnapshotSolution solve_snapshot_from(const std::vector<SnapshotMeasurement>& mea
   sol.valid = true;
   if (std::fabs(sol.time_correction_s) > 3.0 * opt.time_sigma_s) {
     sol.valid = false;
-    sol.failure = "the solved time is " + std::to_string(sol.time_correction_s) +
-                  " s from the approximate time, beyond the search (3 x time sigma = " +
-                  std::to_string(3.0 * opt.time_sigma_s) + " s)";
+    sol.failure =
+        "the solved time is " + std::to_string(sol.time_correction_s) +
+        " s from the approximate time, beyond the search (3 x time sigma = " + std::to_string(3.0 * opt.time_sigma_s) +
+        " s)";
   } else if (std::fabs(sol.height_m) > opt.max_height_m) {
     sol.valid = false;
     sol.failure = "the solved height " + std::to_string(sol.height_m) + " m is not plausible";
@@ -451,8 +453,8 @@ SnapshotSolution solve_snapshot(const std::vector<SnapshotMeasurement>& meas, co
     if (strong && k < distances.size()) stop_beyond_m = std::min(stop_beyond_m, distances[k] + kStopMargin_m);
     if (s.used < 5 || !(s.residual_rms_m < 1000.0) || std::fabs(s.height_m) > opt.max_height_m) continue;
     if (std::fabs(s.time_correction_s) > 3.0 * opt.time_sigma_s) continue;
-    const bool known = std::any_of(found.begin(), found.end(),
-                                   [&](const auto& f) { return (f.r_e_m - s.r_e_m).norm() < 1000.0; });
+    const bool known =
+        std::any_of(found.begin(), found.end(), [&](const auto& f) { return (f.r_e_m - s.r_e_m).norm() < 1000.0; });
     if (!known) found.push_back(std::move(s));
   }
   // Pass 2: the distinct ones again with fault exclusion, ranked by pseudorange and Doppler cost.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Snapshot (coarse-time) positioning: a position from milliseconds of signal, broadcast ephemerides and an
 // approximate time, without a decoded time of week (van Diggelen, "A-GPS", Artech House 2009, ch. 4).
 //
@@ -41,7 +42,7 @@ struct SnapshotMeasurement {
   double doppler_hz = 0.0;         // carrier Doppler, positive when the range shrinks (receiver drift included)
   double doppler_sigma_hz = 10.0;  // its 1-sigma, > 0
   double cn0_dbhz = 45.0;
-  signals::Ephemeris ephemeris;    // the set valid at the snapshot's time
+  signals::Ephemeris ephemeris;  // the set valid at the snapshot's time
 };
 
 struct SnapshotOptions {
@@ -49,13 +50,13 @@ struct SnapshotOptions {
   bool ionosphere = true;  // Klobuchar with `klobuchar` (caller's choice: a nav file's or the default set)
   signals::KlobucharParameters klobuchar;
   bool troposphere = true;
-  double model_sigma_m = 2.0;            // atmosphere / orbit / clock error at zenith, grows as 1 / sin(el)
-  double time_sigma_s = 10.0;            // a-priori time uncertainty; |time correction| > 3 sigma is a failure
-  double false_alarm_probability = 1e-3; // of the residual test
+  double model_sigma_m = 2.0;             // atmosphere / orbit / clock error at zenith, grows as 1 / sin(el)
+  double time_sigma_s = 10.0;             // a-priori time uncertainty; |time correction| > 3 sigma is a failure
+  double false_alarm_probability = 1e-3;  // of the residual test
   int max_exclusions = 2;
-  double grid_radius_m = 5.0e6;          // a-priori grid around the Doppler fix (no approximate position)
+  double grid_radius_m = 5.0e6;  // a-priori grid around the Doppler fix (no approximate position)
   double grid_step_m = 1.0e5;
-  double max_height_m = 1.0e5;           // |height| beyond this is not a receiver on or above the earth
+  double max_height_m = 1.0e5;  // |height| beyond this is not a receiver on or above the earth
   int max_iterations = 20;
 
   // Empty when valid, else the reason.
@@ -65,22 +66,22 @@ struct SnapshotOptions {
 
 struct SnapshotSatellite {
   int prn = 0;
-  bool used = false;              // false: excluded by the residual test or below the mask
+  bool used = false;  // false: excluded by the residual test or below the mask
   double elevation_rad = 0.0, azimuth_rad = 0.0;
   double cn0_dbhz = 0.0;
-  double residual_m = 0.0;        // measured minus predicted pseudorange at the solution
-  double sigma_m = 0.0;           // its a-priori 1-sigma
+  double residual_m = 0.0;           // measured minus predicted pseudorange at the solution
+  double sigma_m = 0.0;              // its a-priori 1-sigma
   double doppler_residual_hz = 0.0;  // after the velocity + drift solve at the solution
 };
 
 struct SnapshotSolution {
   bool valid = false;
-  std::string failure;            // why not (when !valid)
-  signals::GpsTime time;          // GPS time of the reference sample: t0 + time_correction_s
-  double time_correction_s = 0.0; // true minus approximate time
+  std::string failure;             // why not (when !valid)
+  signals::GpsTime time;           // GPS time of the reference sample: t0 + time_correction_s
+  double time_correction_s = 0.0;  // true minus approximate time
   Eigen::Vector3d r_e_m = Eigen::Vector3d::Zero();
   double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
-  double clock_bias_m = 0.0;      // b: c (receiver time tag - true receive time) modulo the millisecond choice
+  double clock_bias_m = 0.0;  // b: c (receiver time tag - true receive time) modulo the millisecond choice
   Eigen::Vector3d v_e_mps = Eigen::Vector3d::Zero();  // from the Doppler at the solution (7+ satellites: ok)
   double clock_drift_mps = 0.0;
   bool velocity_valid = false;
@@ -96,10 +97,10 @@ struct SnapshotSolution {
   // "pass": residual test passed with >= 1 degree of freedom and the fix is unambiguous; "unverified": 5
   // satellites (no redundancy); "fail": residual test failed or a second, different solution fits about as well.
   std::string quality = "fail";
-  std::string a_priori;           // "approximate position" or "doppler"
+  std::string a_priori;                              // "approximate position" or "doppler"
   std::optional<Eigen::Vector3d> doppler_fix_r_e_m;  // the Doppler-only a-priori position when one was made
   int candidates_tried = 0;
-  int distinct_solutions = 0;     // passing solutions further apart than 1 km (grid search)
+  int distinct_solutions = 0;  // passing solutions further apart than 1 km (grid search)
 };
 
 // A-priori position from Doppler alone: ECEF position and clock drift of a static receiver (4 unknowns, needs
@@ -116,7 +117,7 @@ SnapshotSolution solve_snapshot_from(const std::vector<SnapshotMeasurement>& mea
 // The snapshot fix: from approx_r_e_m when given, else the Doppler fix and the grid search. Needs 5
 // measurements with valid ephemerides (failure otherwise, with the reason).
 SnapshotSolution solve_snapshot(const std::vector<SnapshotMeasurement>& measurements,
-                                const signals::GpsTime& approx_time,
-                                const std::optional<Eigen::Vector3d>& approx_r_e_m, const SnapshotOptions& options);
+                                const signals::GpsTime& approx_time, const std::optional<Eigen::Vector3d>& approx_r_e_m,
+                                const SnapshotOptions& options);
 
 }  // namespace ultratrack::receiver

@@ -1,9 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/solution_writer.hpp"
-#include "io/units.hpp"
 
 #include <fmt/format.h>
 
 #include <cmath>
+
+#include "io/units.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -40,9 +42,10 @@ SolutionCsvWriter::SolutionCsvWriter(const std::filesystem::path& path) : file_(
 
 void SolutionCsvWriter::write(const PvtSolution& f) {
   file_.stream() << fmt::format(
-      "{},{:.4f},{:.9f},{:.9f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.3f},{:.3f},{:.3f},{}\n",
-      f.time.week, f.time.tow_s, f.lat_rad * io::kDegPerRad, f.lon_rad * io::kDegPerRad, f.height_m, f.r_e_m.x(), f.r_e_m.y(),
-      f.r_e_m.z(), f.v_enu_mps.x(), f.v_enu_mps.y(), f.v_enu_mps.z(), f.clock_bias_m, f.clock_drift_mps,
+      "{},{:.4f},{:.9f},{:.9f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{:.4f},{},{:.3f},{:.3f},{:.3f},{"
+      "}\n",
+      f.time.week, f.time.tow_s, f.lat_rad * io::kDegPerRad, f.lon_rad * io::kDegPerRad, f.height_m, f.r_e_m.x(),
+      f.r_e_m.y(), f.r_e_m.z(), f.v_enu_mps.x(), f.v_enu_mps.y(), f.v_enu_mps.z(), f.clock_bias_m, f.clock_drift_mps,
       f.used_prns.size(), f.pdop, f.hdop, f.vdop, f.excluded_prn ? std::to_string(*f.excluded_prn) : std::string());
 }
 
@@ -107,9 +110,10 @@ void KmlWriter::finish() {
     out << "<Placemark><name>track</name><LineString><altitudeMode>absolute</altitudeMode><coordinates>\n";
     for (const auto& c : coordinates_) out << c << '\n';
     out << "</coordinates></LineString></Placemark>\n";
-    out << fmt::format("<Placemark><name>mean position</name><Point><altitudeMode>absolute</altitudeMode>"
-                       "<coordinates>{:.9f},{:.9f},{:.3f}</coordinates></Point></Placemark>\n",
-                       sum_lon_deg_ / n, sum_lat_deg_ / n, sum_h_m_ / n);
+    out << fmt::format(
+        "<Placemark><name>mean position</name><Point><altitudeMode>absolute</altitudeMode>"
+        "<coordinates>{:.9f},{:.9f},{:.3f}</coordinates></Point></Placemark>\n",
+        sum_lon_deg_ / n, sum_lat_deg_ / n, sum_h_m_ / n);
   }
   out << "</Document>\n</kml>\n";
   file_.commit();

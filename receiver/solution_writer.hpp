@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receiver's standard outputs for navigation solutions, each streamed to an AtomicFile and made
 // visible only by finish():
 //   solution.csv  one row per fix (columns in kSolutionCsvHeader; lat/lon in degrees, heights ellipsoidal)
@@ -11,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "receiver/pvt.hpp"
 #include "io/atomic_file.hpp"
+#include "receiver/pvt.hpp"
 
 namespace ultratrack::receiver {
 

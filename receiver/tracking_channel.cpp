@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/tracking_channel.hpp"
 
 #include <algorithm>
@@ -41,13 +42,16 @@ std::vector<double> tap_offsets(const CorrelatorLayout& l, int prn, int* ve, int
 }
 
 const ChannelConfig& checked(const ChannelConfig& c) {
-  if (c.prn < signals::kMinPrn || c.prn > signals::kMaxPrn) throw std::invalid_argument("TrackingChannel: PRN out of 1..32");
-  if (!(c.sample_rate_hz > 1.1e6 && c.sample_rate_hz < 1e9)) throw std::invalid_argument("TrackingChannel: sample rate");
+  if (c.prn < signals::kMinPrn || c.prn > signals::kMaxPrn)
+    throw std::invalid_argument("TrackingChannel: PRN out of 1..32");
+  if (!(c.sample_rate_hz > 1.1e6 && c.sample_rate_hz < 1e9))
+    throw std::invalid_argument("TrackingChannel: sample rate");
   if (c.num_antennas < 1 || c.num_antennas > kMaxAntennas) throw std::invalid_argument("TrackingChannel: antennas");
   const auto& l = c.layout;
   if (!(l.early_late_offset_chips > 0.0 && l.early_late_offset_chips <= 1.0))
     throw std::invalid_argument("TrackingChannel: early_late_offset_chips outside (0, 1]");
-  if (l.very_early_late && !(l.very_early_late_offset_chips > l.early_late_offset_chips && l.very_early_late_offset_chips <= 2.0))
+  if (l.very_early_late &&
+      !(l.very_early_late_offset_chips > l.early_late_offset_chips && l.very_early_late_offset_chips <= 2.0))
     throw std::invalid_argument("TrackingChannel: very_early_late_offset_chips outside (early_late_offset_chips, 2]");
   return c;
 }
@@ -68,14 +72,16 @@ ChannelStart start_from_code_start(std::int64_t first_sample, double samples_to_
 
 TrackingChannel::TrackingChannel(const ChannelConfig& config, const ChannelStart& start)
     : config_(checked(config)),
-      engine_(config.prn, tap_offsets(config.layout, config.prn, &tap_ve_, &tap_e_, &tap_p_, &tap_l_, &tap_vl_, &tap_n_)) {
+      engine_(config.prn,
+              tap_offsets(config.layout, config.prn, &tap_ve_, &tap_e_, &tap_p_, &tap_l_, &tap_vl_, &tap_n_)) {
   if (!(start.code_phase_chips >= 0.0 && start.code_phase_chips < signals::kCaCodeLength_chips))
     throw std::invalid_argument("TrackingChannel: start code phase outside [0, 1023)");
   NcoCommand cmd;
   cmd.carrier_frequency_hz = start.carrier_frequency_hz;
-  cmd.code_rate_chips_per_s = start.code_rate_chips_per_s > 0.0
-                                  ? start.code_rate_chips_per_s
-                                  : signals::kCaChipRate_hz * (1.0 + start.carrier_frequency_hz / signals::kL1Frequency_hz);
+  cmd.code_rate_chips_per_s =
+      start.code_rate_chips_per_s > 0.0
+          ? start.code_rate_chips_per_s
+          : signals::kCaChipRate_hz * (1.0 + start.carrier_frequency_hz / signals::kL1Frequency_hz);
   apply(cmd);
   code_.set(start.code_phase_chips);
   carrier_.set(start.carrier_phase_cycles);
@@ -223,7 +229,8 @@ TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, 
   const std::int64_t limit = half == 0 ? epoch_mid_ : epoch_end_;
   // A segment covers at most one code period so that the engine's code table spans every tap.
   const auto max_per_segment = static_cast<std::int64_t>(kPeriodRaw / code_.raw_step());
-  const int m = static_cast<int>(std::min<std::int64_t>({static_cast<std::int64_t>(remaining), limit - nco_sample_, max_per_segment}));
+  const int m = static_cast<int>(
+      std::min<std::int64_t>({static_cast<std::int64_t>(remaining), limit - nco_sample_, max_per_segment}));
 
   const Int128 raw = code_.raw();
   const Int128 period_start = floor_div(raw, kPeriodRaw) * kPeriodRaw;
@@ -237,7 +244,8 @@ TrackingChannel::FeedResult TrackingChannel::feed(const SampleBlockView& block, 
   const auto slaves = static_cast<std::size_t>(config_.num_antennas - 1);
   if (block.i16_gain > 0.0) {
     std::array<PlanarI16, kMaxAntennas> ptr{};
-    for (int a = 0; a < config_.num_antennas; ++a) ptr[a] = {block.antenna_i16[a].re + offset, block.antenna_i16[a].im + offset};
+    for (int a = 0; a < config_.num_antennas; ++a)
+      ptr[a] = {block.antenna_i16[a].re + offset, block.antenna_i16[a].im + offset};
     const double scale = 1.0 / block.i16_gain;
     engine_.correlate_i16(std::span(ptr.data(), engine_antennas), m, rep, scale,
                           std::span(sums_[half].data(), engine_antennas));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tracking channel: one satellite's replica (code and carrier NCOs in fixed point) plus the correlator engine and
 // the epoch boundary logic. Epochs start where the replica code crosses a code-period start and span 1 period
 // (1 ms), or N periods aligned to a given period (20 ms after bit sync). The channel never decides where its
@@ -19,19 +20,19 @@ namespace ultratrack::receiver {
 
 // Which correlators the channel runs. Offsets are from prompt in chips; early taps lead, late taps lag.
 struct CorrelatorLayout {
-  double early_late_offset_chips = 0.5;  // E and L at +-this; (0, 1]. 0.5 = 1 chip E-L spacing; narrow: 0.1
-  bool very_early_late = false;          // VE/VL taps (multipath monitoring, BOC-style discriminators)
+  double early_late_offset_chips = 0.5;       // E and L at +-this; (0, 1]. 0.5 = 1 chip E-L spacing; narrow: 0.1
+  bool very_early_late = false;               // VE/VL taps (multipath monitoring, BOC-style discriminators)
   double very_early_late_offset_chips = 1.0;  // (early_late_offset_chips, 2]
-  bool noise = true;                     // off-peak noise tap (noise_tap_offset_chips), for C/N0 and lock tests
+  bool noise = true;                          // off-peak noise tap (noise_tap_offset_chips), for C/N0 and lock tests
   // Antennas 1.. (slaves) get only the prompt and the noise tap (what the between-antenna phase and its C/N0 need),
   // from a second engine over the same replica; their other taps read zero. false: every antenna every tap.
   bool slaves_prompt_and_noise_only = true;
 };
 
 struct ChannelConfig {
-  int prn = 1;                    // 1..32
-  double sample_rate_hz = 4e6;    // complex baseband sample rate, Hz; > 1.1 MHz (the code must fit Nyquist)
-  int num_antennas = 1;           // 1..kMaxAntennas, sampled on one clock; antenna 0 is the master
+  int prn = 1;                  // 1..32
+  double sample_rate_hz = 4e6;  // complex baseband sample rate, Hz; > 1.1 MHz (the code must fit Nyquist)
+  int num_antennas = 1;         // 1..kMaxAntennas, sampled on one clock; antenna 0 is the master
   CorrelatorLayout layout;
 };
 
@@ -40,8 +41,8 @@ struct ChannelConfig {
 // starting), so the next period starts (1023 - code_phase_chips) / rate seconds later. An acquisition that reports
 // the delay to the next code start instead converts with code_phase_chips = 1023 - delay_chips.
 struct ChannelStart {
-  std::int64_t sample_index = 0;  // receiver sample index at which code_phase_chips holds
-  double code_phase_chips = 0.0;  // [0, 1023): replica code phase at that sample
+  std::int64_t sample_index = 0;      // receiver sample index at which code_phase_chips holds
+  double code_phase_chips = 0.0;      // [0, 1023): replica code phase at that sample
   double carrier_frequency_hz = 0.0;  // Doppler at baseband, Hz
   double carrier_phase_cycles = 0.0;
   // Code rate, chips/s; 0 means derived from the carrier (1.023e6 * (1 + f / f_L1), carrier-aided).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/vector_frequency_discriminator.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The carrier frequency discriminator a vector loop reads from a channel (vector DLL/FLL, issue 7): two
 // contiguous correlation epochs of length T (20 ms after bit sync) whose middles are dt apart; the change of their
 // Costas phases (bit-insensitive) over dt, plus the replica's mean frequency, is the signal's mean frequency over

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The seam for an external (vector) loop: at fixed sample boundaries (the vector epochs) the receiver engine hands
 // a VectorLoop every channel's latest correlation results, as pseudorange and Doppler measurements on the
 // receiver's clock, and the replica's state; the loop answers one VectorChannelCommand per channel, which the
@@ -31,7 +32,7 @@ struct VectorChannelInput {
   // Lock lost in vector mode: the replica follows the loop's commands alone (no measurements) until the signal
   // returns and the channel re-locks, or the loop stops commanding it (it is then released as lost).
   bool coasting = false;
-  double cn0_dbhz = NAN;     // NaN before the first estimate
+  double cn0_dbhz = NAN;  // NaN before the first estimate
 
   // The replica at the epoch's sample: its pseudorange c (t_rx - t_tx) by the receiver clock and its code rate.
   double replica_pseudorange_m = 0.0;
@@ -45,9 +46,9 @@ struct VectorChannelInput {
   bool has_measurement = false;
   std::int64_t measurement_sample = 0;  // the middle of that correlation epoch
   double integration_time_s = 0.0;
-  double code_error_chips = 0.0;         // early-minus-late discriminator: signal minus replica code phase
+  double code_error_chips = 0.0;           // early-minus-late discriminator: signal minus replica code phase
   double replica_pseudorange_mid_m = 0.0;  // the replica's pseudorange at measurement_sample
-  double measured_pseudorange_m = 0.0;   // replica - code error x chip length
+  double measured_pseudorange_m = 0.0;     // replica - code error x chip length
   // Carrier Doppler over the two latest contiguous epochs (middle to middle): the replica's mean frequency plus
   // the Costas phase change, or, for a filter-driven channel whose carrier the loop commands with both epochs'
   // bits known, the phase change with the bits wiped (doppler_bits_wiped; wiped_phase_change_cycles: twice the
@@ -55,7 +56,7 @@ struct VectorChannelInput {
   bool has_doppler = false;
   double measured_doppler_hz = 0.0;
   std::int64_t doppler_sample = 0;
-  double doppler_interval_s = 0.0;       // middle-to-middle time of the two epochs
+  double doppler_interval_s = 0.0;  // middle-to-middle time of the two epochs
   bool doppler_bits_wiped = false;
   // The same correlation epoch for a loop that updates from correlations (ultra-tight): its first sample, the
   // replica carrier's mean frequency over it (Hz), and the early/prompt/late I and Q of the master antenna
@@ -81,15 +82,15 @@ struct VectorChannelInput {
 };
 
 struct VectorEpochInput {
-  std::int64_t sample = 0;           // the vector epoch, receiver sample index
+  std::int64_t sample = 0;  // the vector epoch, receiver sample index
   double fs_hz = 0.0;
-  signals::GpsTime receive_time;     // by the receiver clock at `sample`
+  signals::GpsTime receive_time;  // by the receiver clock at `sample`
   // Sum of the clock jumps the engine applied so far (ReceiverClock::correct): pseudoranges of later epochs are
   // c x this shorter than before the jumps.
   double clock_corrections_s = 0.0;
   const std::vector<signals::Ephemeris>* ephemerides = nullptr;  // all known (supplied + decoded)
   const signals::KlobucharParameters* iono = nullptr;
-  const PvtSolution* last_fix = nullptr;  // nullptr before the first fix
+  const PvtSolution* last_fix = nullptr;      // nullptr before the first fix
   double last_fix_clock_corrections_s = 0.0;  // clock_corrections_s when last_fix was solved (before its jump)
   std::span<const VectorChannelInput> channels;
   // The sample at which the engine hands the answered commands to the channels: `sample` (the loop runs between

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/vector_loop_port.hpp"
 
 #include <algorithm>
@@ -8,7 +9,8 @@ namespace ultratrack::receiver {
 
 void VectorLoopPort::set(VectorLoop* loop, double interval_s, bool pipelined, double fs_hz, std::int64_t from_sample,
                          std::vector<std::unique_ptr<ReceiverChannel>>& channels) {
-  if (!(interval_s >= 0.001 && interval_s <= 1.0)) throw std::invalid_argument("ReceiverEngine: vector interval outside [0.001, 1] s");
+  if (!(interval_s >= 0.001 && interval_s <= 1.0))
+    throw std::invalid_argument("ReceiverEngine: vector interval outside [0.001, 1] s");
   if (!loop)
     for (auto& channel : channels)
       if (channel) channel->set_vector_command({});

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The engine's port to a vector loop (receiver/vector_loop.hpp): every interval (in samples) the loop gets every
 // channel's state and latest measurements in slot order and its commands go back to the channels; pipelined,
 // the epoch's inputs are copied (the engine changes the ephemerides, Klobuchar, last fix and the channels while

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receiver/worker_pool.hpp"
 
 #include <algorithm>
@@ -114,7 +115,8 @@ void WorkerPool::wait(BackgroundTask& task) {
     if (queued_ == &task) queued_ = nullptr;
     run_task(task, lock);
   }
-  done_.wait(lock, [&] { return task.state_ == BackgroundTask::State::done || task.state_ == BackgroundTask::State::idle; });
+  done_.wait(lock,
+             [&] { return task.state_ == BackgroundTask::State::done || task.state_ == BackgroundTask::State::idle; });
   task.state_ = BackgroundTask::State::idle;
   if (task.error_) std::rethrow_exception(std::exchange(task.error_, nullptr));
 }

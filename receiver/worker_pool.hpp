@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A fixed pool of worker threads for the receiver: parallel_for over a handful of independent jobs (one per
 // tracking channel and sample block; the calling thread works too, so N threads = the caller + N - 1 workers)
 // and one background task at a time (a re-acquisition search) that runs beside them. Nothing is allocated

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Klobuchar (IS-GPS-200 20.3.3.5.2.5, Figure 20-4) and Saastamoinen troposphere with a standard atmosphere.
 #include "signals/atmosphere.hpp"
 
@@ -8,8 +9,8 @@
 
 namespace ultratrack::signals {
 
-double klobuchar_delay_s(const KlobucharParameters& params, double lat_rad, double lon_rad,
-                         double azimuth_rad, double elevation_rad, double tow_s) {
+double klobuchar_delay_s(const KlobucharParameters& params, double lat_rad, double lon_rad, double azimuth_rad,
+                         double elevation_rad, double tow_s) {
   if (!params.valid) return 0.0;
   // The algorithm works in semicircles (with the IS-GPS-200 value of pi).
   const double E = elevation_rad / kPi;
@@ -19,7 +20,7 @@ double klobuchar_delay_s(const KlobucharParameters& params, double lat_rad, doub
   const double phi_i = std::clamp(phi_u + psi * std::cos(azimuth_rad), -0.416, 0.416);
   const double lambda_i = lambda_u + psi * std::sin(azimuth_rad) / std::cos(phi_i * kPi);
   const double phi_m = phi_i + 0.064 * std::cos((lambda_i - 1.617) * kPi);  // geomagnetic latitude
-  double t = std::fmod(4.32e4 * lambda_i + tow_s, 86400.0);                  // local time at the pierce point
+  double t = std::fmod(4.32e4 * lambda_i + tow_s, 86400.0);                 // local time at the pierce point
   if (t < 0.0) t += 86400.0;
   const double F = 1.0 + 16.0 * std::pow(0.53 - E, 3);  // obliquity factor
   double amp = 0.0, per = 0.0, phi_n = 1.0;
@@ -46,11 +47,9 @@ double troposphere_delay_m(double lat_rad, double height_m, double elevation_rad
   const double temperature_k = std::max(288.15 - 6.5e-3 * h, 216.65);
   constexpr double kRelativeHumidity = 0.5;
   // Partial pressure of water vapour (hPa) from the saturation pressure at the temperature.
-  const double e_hpa =
-      6.108 * kRelativeHumidity * std::exp((17.15 * temperature_k - 4684.0) / (temperature_k - 38.45));
+  const double e_hpa = 6.108 * kRelativeHumidity * std::exp((17.15 * temperature_k - 4684.0) / (temperature_k - 38.45));
   // Saastamoinen zenith delays: hydrostatic with the gravity correction for latitude and height, wet.
-  const double zhd_m =
-      0.0022768 * pressure_hpa / (1.0 - 0.00266 * std::cos(2.0 * lat_rad) - 0.00028 * h / 1000.0);
+  const double zhd_m = 0.0022768 * pressure_hpa / (1.0 - 0.00266 * std::cos(2.0 * lat_rad) - 0.00028 * h / 1000.0);
   const double zwd_m = 0.002277 * (1255.0 / temperature_k + 0.05) * e_hpa;
   // Mapping to the elevation: 1/sin(el) with a curvature term that keeps it finite at the horizon
   // (1.001 / sqrt(0.002001 + sin^2 el), the RTCA DO-229 form).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GPS L1 C/A (coarse/acquisition) Gold codes for PRN 1-32, IS-GPS-200 section 3.3.2.3 and Table 3-Ia:
 // G1 = 1 + x^3 + x^10, G2 = 1 + x^2 + x^3 + x^6 + x^8 + x^9 + x^10, the PRN selecting two G2 phase taps.
 // Chips are stored as +1/-1 with logic 0 -> +1 and logic 1 -> -1 (the modulation's sign convention),

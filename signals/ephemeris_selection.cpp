@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ephemeris selection: validity filters, then nearest toe (see the header for the tie rules).
 #include "signals/ephemeris_selection.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Choosing the broadcast ephemeris to use for a satellite at a time, from all the sets received or read
 // (IS-GPS-200 20.3.4.4): healthy, IODE equal to the low 8 bits of IODC, inside its curve-fit interval,
 // and then the one whose toe is closest to the time.

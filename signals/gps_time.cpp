@@ -1,8 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "signals/gps_time.hpp"
+
+#include <fmt/core.h>
 
 #include <array>
 #include <cmath>
-#include <fmt/core.h>
 
 #include "signals/gps_constants.hpp"
 
@@ -39,10 +41,24 @@ struct LeapEntry {
   int gpst_minus_utc_s;
 };
 constexpr std::array<LeapEntry, 18> kLeapTable{{
-    {1981, 7, 1, 1},  {1982, 7, 1, 2},  {1983, 7, 1, 3},  {1985, 7, 1, 4},  {1988, 1, 1, 5},
-    {1990, 1, 1, 6},  {1991, 1, 1, 7},  {1992, 7, 1, 8},  {1993, 7, 1, 9},  {1994, 7, 1, 10},
-    {1996, 1, 1, 11}, {1997, 7, 1, 12}, {1999, 1, 1, 13}, {2006, 1, 1, 14}, {2009, 1, 1, 15},
-    {2012, 7, 1, 16}, {2015, 7, 1, 17}, {2017, 1, 1, 18},
+    {1981, 7, 1, 1},
+    {1982, 7, 1, 2},
+    {1983, 7, 1, 3},
+    {1985, 7, 1, 4},
+    {1988, 1, 1, 5},
+    {1990, 1, 1, 6},
+    {1991, 1, 1, 7},
+    {1992, 7, 1, 8},
+    {1993, 7, 1, 9},
+    {1994, 7, 1, 10},
+    {1996, 1, 1, 11},
+    {1997, 7, 1, 12},
+    {1999, 1, 1, 13},
+    {2006, 1, 1, 14},
+    {2009, 1, 1, 15},
+    {2012, 7, 1, 16},
+    {2015, 7, 1, 17},
+    {2017, 1, 1, 18},
 }};
 
 }  // namespace
@@ -75,8 +91,7 @@ GpsTime gps_time_from_calendar(const CalendarTime& c) {
   const long days = days_from_civil(c.year, c.month, c.day) - kGpsEpochDays;
   const long week = days >= 0 ? days / 7 : (days - 6) / 7;
   const long day_of_week = days - week * 7;
-  return normalised({static_cast<int>(week),
-                     day_of_week * 86400.0 + c.hour * 3600.0 + c.minute * 60.0 + c.second});
+  return normalised({static_cast<int>(week), day_of_week * 86400.0 + c.hour * 3600.0 + c.minute * 60.0 + c.second});
 }
 
 CalendarTime calendar_from_gps_time(const GpsTime& t_in) {
@@ -117,8 +132,7 @@ int resolve_week_rollover(int week_mod_1024, int reference_full_week) {
 }
 
 std::string to_string(const CalendarTime& c) {
-  return fmt::format("{:04d}-{:02d}-{:02d} {:02d}:{:02d}:{:06.3f}", c.year, c.month, c.day, c.hour, c.minute,
-                     c.second);
+  return fmt::format("{:04d}-{:02d}-{:02d} {:02d}:{:02d}:{:06.3f}", c.year, c.month, c.day, c.hour, c.minute, c.second);
 }
 
 }  // namespace ultratrack::signals

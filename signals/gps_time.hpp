@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GPS system time as (week, seconds of week) and conversions to the calendar (GPST and UTC) for RINEX.
 // Week numbers here are full (continuous) weeks since 1980-01-06; the 10-bit broadcast week is resolved
 // against a reference full week explicitly (resolve_week_rollover). Absolute time is never a single float.

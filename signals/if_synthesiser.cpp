@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "signals/if_synthesiser.hpp"
 
 #include <Eigen/Geometry>
@@ -9,12 +10,12 @@
 #include <set>
 #include <stdexcept>
 
+#include "io/why_invalid.hpp"
 #include "signals/atmosphere.hpp"
 #include "signals/ca_code.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/satellite_state.hpp"
 #include "signals/synth_kernels.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::signals {
 namespace {
@@ -109,8 +110,8 @@ struct IfSynthesiser::Impl {
   RxGeo rx_geo(int antenna, double tau_s, bool noisy_clock = true) {
     RxGeo g;
     g.tau_s = tau_s;
-    g.clock = noisy_clock ? clock.at(tau_s) : ReceiverClockState{opt.clock.bias_s + opt.clock.drift_sps * tau_s,
-                                                                    opt.clock.drift_sps};
+    g.clock = noisy_clock ? clock.at(tau_s)
+                          : ReceiverClockState{opt.clock.bias_s + opt.clock.drift_sps * tau_s, opt.clock.drift_sps};
     g.t_r_s = tau_s - (g.clock.bias_s - opt.clock.bias_s);
     g.state = motion.antenna_state(antenna, g.t_r_s);
     double lat_deg = 0, lon_deg = 0, h = 0;
@@ -360,7 +361,7 @@ struct IfSynthesiser::Impl {
 };
 
 bool SynthesiserOptions::IsValid(std::string* why) const {
-    const SynthesiserOptions& o = *this;
+  const SynthesiserOptions& o = *this;
   const std::string problem = [&]() -> std::string {
     if (!(o.sample_rate_hz >= 1e5 && o.sample_rate_hz <= 1e9)) return "sample rate must be between 100 kHz and 1 GHz";
     if (!(std::abs(o.if_hz) < 0.5 * o.sample_rate_hz)) return "|if_hz| must be below half the sample rate";
@@ -424,11 +425,14 @@ IfSynthesiser::IfSynthesiser(SynthesiserOptions options, std::vector<Ephemeris> 
     if (options_.antenna_impairments[a].line_bias_cycles != 0.0 || options_.antenna_impairments[a].phase_noise_m != 0.0)
       throw std::invalid_argument("impairments for antenna " + std::to_string(a) + ": no such antenna");
   for (const auto& e : options_.cycle_slips)
-    if (e.antenna >= antennas) throw std::invalid_argument("cycle slip on antenna " + std::to_string(e.antenna) + ": no such antenna");
+    if (e.antenna >= antennas)
+      throw std::invalid_argument("cycle slip on antenna " + std::to_string(e.antenna) + ": no such antenna");
   for (const auto& b : options_.blockages)
-    if (b.antenna >= antennas) throw std::invalid_argument("blockage of antenna " + std::to_string(b.antenna) + ": no such antenna");
+    if (b.antenna >= antennas)
+      throw std::invalid_argument("blockage of antenna " + std::to_string(b.antenna) + ": no such antenna");
   for (const auto& c : options_.cn0_steps)
-    if (c.antenna >= antennas) throw std::invalid_argument("C/N0 step on antenna " + std::to_string(c.antenna) + ": no such antenna");
+    if (c.antenna >= antennas)
+      throw std::invalid_argument("C/N0 step on antenna " + std::to_string(c.antenna) + ": no such antenna");
   impl_ = std::make_unique<Impl>(options_, *motion_);
   Impl& m = *impl_;
   m.block_samples = std::max<std::int64_t>(1, std::llround(options_.sample_rate_hz * kNodeInterval_s));

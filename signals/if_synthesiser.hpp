@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The IF signal synthesiser: GPS L1 C/A signals of a set of satellites as N antennas sampled on one
 // receiver clock would record them (one sample stream per antenna, sample-synchronous), plus the exact
 // truth of every signal. Times are seconds relative to the scenario start (options.start, true GPS time of
@@ -127,7 +128,7 @@ std::int64_t cn0_step_first_sample(const Cn0StepEvent& step, double sample_rate_
 struct SatelliteView {
   int prn = 0;
   double elevation_rad = 0.0, azimuth_rad = 0.0;
-  double cn0_dbhz = 0.0;           // at that sample (C/N0 steps applied)
+  double cn0_dbhz = 0.0;          // at that sample (C/N0 steps applied)
   double doppler_hz = 0.0;        // d(carrier phase)/d(receiver time), IF removed; includes the rx clock drift
   double code_phase_chips = 0.0;  // chip of the code received at that sample, [0, 1023)
 };

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Reads the LNAV message back (IS-GPS-200 20.3): LnavDecoder collects one satellite's parity-checked
 // subframes (lnav_subframe.hpp) into an Ephemeris (SI units, full weeks), the Klobuchar and UTC
 // parameters, the almanacs of subframes 4 and 5 (any satellite's, signals/almanac.hpp), and the GPS time of
@@ -86,7 +87,7 @@ class LnavDecoder {
   void count(LnavStatus status);
 
   int prn_;
-  int week_;                           // current full week of transmission
+  int week_;  // current full week of transmission
   bool week_known_ = false;
   std::optional<LnavSubframe> sf_[3];  // latest subframes 1, 2, 3
   int sf1_week_ = 0;                   // full transmission week of the stored subframe 1

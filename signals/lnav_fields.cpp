@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "signals/lnav_fields.hpp"
 
 #include <fmt/format.h>
@@ -84,7 +85,8 @@ std::uint32_t lnav_angle(double radians, int scale_log2, int bits, FieldRounding
   double sc = radians / kPi;
   sc -= 2.0 * std::floor((sc + 1.0) / 2.0);  // [-1, 1)
   const double scaled = std::ldexp(sc, -scale_log2);
-  const auto r = static_cast<std::int64_t>(rounding == FieldRounding::nearest ? std::round(scaled) : std::trunc(scaled));
+  const auto r =
+      static_cast<std::int64_t>(rounding == FieldRounding::nearest ? std::round(scaled) : std::trunc(scaled));
   // +1 semicircle after rounding is the same angle as -1: the mask wraps it.
   return static_cast<std::uint32_t>(r) & low_mask(bits);
 }

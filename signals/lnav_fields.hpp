@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Field access inside the data bits of one LNAV subframe (ten 24-bit words, parity stripped) by the
 // subframe bit numbers of IS-GPS-200 Figure 20-1 (bit 1 = first bit of the TLM word, 30 bits per word),
 // and the fixed-point scalings of Tables 20-I/20-III/20-VI. Shared by the LNAV transmitter and decoder.

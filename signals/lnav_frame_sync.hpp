@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Frame synchronisation of the 50 bit/s LNAV stream: takes bits one at a time (0/1 as received, either
 // polarity) from a channel's bit synchroniser, finds subframe starts by preamble search confirmed with
 // the parity of all ten words, then hands over every following 300-bit subframe with its position in the

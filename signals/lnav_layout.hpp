@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Where each LNAV field sits: subframe bit numbers (1-based, parity bits counted, IS-GPS-200 Figure 20-1)
 // and fixed-point scale factors (Tables 20-I, 20-III, 20-VI) of the TLM/HOW, subframes 1-3 and the
 // subframe 4/5 pages used here. One table for the transmitter and the decoder.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LNAV word parity (IS-GPS-200 20.3.5, Table 20-XIV): the (32,26) extended Hamming code that protects each
 // 30-bit word, with the previous word's last two transmitted bits D29*, D30* chained in. Words are held
 // right-aligned in a uint32: bit 29 is D1 (first transmitted), bit 0 is D30; data words are 24 bits, d1 = bit 23.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "signals/lnav_subframe.hpp"
 
 #include "signals/gps_constants.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // One LNAV subframe read back from 300 received bits (IS-GPS-200 20.3): preamble and polarity, the parity
 // of all ten words (20.3.5), the TLM/HOW fields and the 24-bit data words with polarity restored.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // What a GPS satellite broadcasts on LNAV: the 50 bit/s data stream of 5-subframe frames built from one
 // satellite's ephemeris and clock, the ionosphere/UTC parameters and (optionally) an almanac made from a
 // set of ephemerides, with TLM, HOW (TOW count of the next subframe) and IS-GPS-200 20.3.5 parity.

@@ -1,8 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Look angles via GeographicLib's geodetic latitude/longitude of the receiver and the ENU rotation.
 #include "signals/look_angles.hpp"
 
 #include <GeographicLib/Geocentric.hpp>
-
 #include <cmath>
 
 namespace ultratrack::signals {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Azimuth and elevation of a satellite seen from a receiver, both in the same ECEF (WGS-84) frame,
 // in the receiver's local east-north-up frame on the WGS-84 ellipsoid. Radians; azimuth from north
 // through east in [0, 2 pi).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The nominal 24-slot constellation as broadcast ephemerides.
 //
 // Slots: GPS SPS Performance Standard (4th ed., 2001) Table 3-1, "Reference Orbit Slot Assignments as of
@@ -61,7 +62,7 @@ NominalConstellation nominal_constellation(const GpsTime& t_in) {
   const double node_rate_ecef = kOmegaDot_radps - kEarthRotationRate_radps;  // rad/s, negative
   const double repeat_s = kTwoPi / -node_rate_ecef;
   const double dt = std::fmod(seconds_between(toe, epoch), repeat_s);  // same geometry as the full span
-  const double n = 2.0 * -node_rate_ecef;                             // argument-of-latitude rate
+  const double n = 2.0 * -node_rate_ecef;                              // argument-of-latitude rate
   const double n0 = std::sqrt(kGM_m3ps2 / (kSemiMajorAxis_m * kSemiMajorAxis_m * kSemiMajorAxis_m));
 
   NominalConstellation c;

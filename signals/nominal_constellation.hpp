@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A built-in GPS constellation so that simulations run without data files: the 24 slots of the GPS SPS
 // Performance Standard's nominal constellation (6 planes A-F, 55 deg, A = 26559.7 km, near-circular) as
 // broadcast ephemerides valid at a chosen time, with typical Klobuchar and UTC parameters. Deterministic.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A receiver oscillator described by its power-law (Allan variance) coefficients, and the typical values of
 // Brown & Hwang's table ("Introduction to Random Signals and Applied Kalman Filtering", the two-state clock
 // model): the fractional-frequency PSD S_y(f) = h0 + h-2 / f^2 (h0 in s, h-2 in 1/s); the flicker term h-1 is

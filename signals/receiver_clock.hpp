@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receiver's oscillator as the synthesiser models it: clock error b (receiver clock minus GPS time,
 // seconds) as a function of receiver time tau (seconds since the first sample = sample index / fs):
 // b(tau) = bias + drift * tau + random walks (white frequency noise on b, random-walk frequency on the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // How the receiver's antennas move: the synthesiser asks for each antenna's ECEF (WGS-84) position (m) and
 // velocity (m/s) at a true GPS time, given as seconds since the scenario start. Anything can drive it:
 // a fixed point, a trajectory file (cubic Hermite through ECEF position/velocity samples), or later the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // RINEX navigation reader (2.xx GPS, 3.00-3.05 GPS/mixed) and RINEX 3.04 GPS writer.
 // Column positions follow the RINEX 2.11 and 3.04 format tables; every problem is reported with the
 // file, the line number and what is wrong.
@@ -25,9 +26,8 @@ namespace ultratrack::signals {
 namespace {
 
 // Upper bounds of the URA ranges, IS-GPS-200 20.3.3.3.1.3 (index 0..14).
-constexpr std::array<double, 15> kUraUpperBound_m = {2.4,   3.4,   4.85,  6.85,   9.65,
-                                                     13.65, 24.0,  48.0,  96.0,   192.0,
-                                                     384.0, 768.0, 1536.0, 3072.0, 6144.0};
+constexpr std::array<double, 15> kUraUpperBound_m = {2.4,  3.4,   4.85,  6.85,  9.65,   13.65,  24.0,  48.0,
+                                                     96.0, 192.0, 384.0, 768.0, 1536.0, 3072.0, 6144.0};
 
 std::string trim(std::string_view s) {
   size_t b = 0, e = s.size();
@@ -71,8 +71,8 @@ class LineReader {
     char* end = nullptr;
     const double v = std::strtod(text.c_str(), &end);
     if (end != text.c_str() + text.size() || errno == ERANGE || !std::isfinite(v))
-      fail(fmt::format("cannot parse {} from '{}' (columns {}-{})", what, field(line, first, width),
-                       first + 1, first + width));
+      fail(fmt::format("cannot parse {} from '{}' (columns {}-{})", what, field(line, first, width), first + 1,
+                       first + width));
     return v;
   }
 
@@ -110,22 +110,19 @@ struct HeaderInfo {
 HeaderInfo read_header(LineReader& r, RinexNavData& out) {
   std::string line;
   if (!r.next(line)) throw InputError(r.name(), "empty file: not a RINEX navigation file");
-  if (header_label(line) != "RINEX VERSION / TYPE")
-    r.fail("bad header: the first line must be 'RINEX VERSION / TYPE'");
+  if (header_label(line) != "RINEX VERSION / TYPE") r.fail("bad header: the first line must be 'RINEX VERSION / TYPE'");
   HeaderInfo h;
   h.version = r.number(line, 0, 9, "RINEX version", std::nullopt);
   h.major = static_cast<int>(std::floor(h.version + 1e-9));
   const char type = line.size() > 20 ? line[20] : ' ';
   if (h.major == 2) {
-    if (type != 'N')
-      r.fail(fmt::format("wrong file type '{}': a RINEX 2 GPS navigation file has type 'N'", type));
+    if (type != 'N') r.fail(fmt::format("wrong file type '{}': a RINEX 2 GPS navigation file has type 'N'", type));
   } else if (h.major == 3) {
     if (h.version > 3.05 + 1e-9) r.fail(fmt::format("unsupported RINEX version {:.2f}", h.version));
     h.system = line.size() > 40 ? line[40] : ' ';
     if (type != 'N') r.fail(fmt::format("wrong file type '{}': not a navigation file", type));
     if (h.system != 'G' && h.system != 'M')
-      r.fail(fmt::format("navigation file for system '{}': only GPS ('G') or mixed ('M') are read",
-                         h.system));
+      r.fail(fmt::format("navigation file for system '{}': only GPS ('G') or mixed ('M') are read", h.system));
   } else {
     r.fail(fmt::format("unsupported RINEX version {:.2f} (2.xx and 3.00-3.05 are read)", h.version));
   }
@@ -178,9 +175,12 @@ HeaderInfo read_header(LineReader& r, RinexNavData& out) {
 // GLONASS line).
 int continuation_lines(char system, double version) {
   switch (system) {
-    case 'R': return version >= 3.05 - 1e-9 ? 4 : 3;
-    case 'S': return 3;
-    default: return 7;  // G, E, J, C, I
+    case 'R':
+      return version >= 3.05 - 1e-9 ? 4 : 3;
+    case 'S':
+      return 3;
+    default:
+      return 7;  // G, E, J, C, I
   }
 }
 
@@ -231,8 +231,8 @@ Ephemeris parse_gps_record(LineReader& r, const std::string& epoch_line, int maj
                                    e.prn, record_start, k),
                        r.line_no());
     if (is_blank(line) || !trim(std::string_view(line).substr(0, std::min(line.size(), orbit0))).empty())
-      r.fail(fmt::format("truncated record for G{:02d} (started on line {}): expected orbit line {} of 7",
-                         e.prn, record_start, k + 1));
+      r.fail(fmt::format("truncated record for G{:02d} (started on line {}): expected orbit line {} of 7", e.prn,
+                         record_start, k + 1));
     for (int j = 0; j < 4; ++j) v[k][j] = r.number(line, orbit0 + 19 * j, 19, "orbit parameter");
   }
   e.iode = static_cast<int>(std::lround(v[0][0]));
@@ -330,8 +330,7 @@ RinexNavData read_rinex_nav(std::istream& in, const std::string& name) {
       const int start = r.line_no();
       for (int k = 0; k < continuation_lines(sys, h.version); ++k) {
         if (!r.next(line) || is_blank(line) || !std::isspace(static_cast<unsigned char>(line[0])))
-          throw InputError(name,
-                           fmt::format("truncated record for system '{}' (started on line {})", sys, start),
+          throw InputError(name, fmt::format("truncated record for system '{}' (started on line {})", sys, start),
                            r.line_no());
       }
       continue;
@@ -357,8 +356,7 @@ void write_rinex_nav_304(const std::filesystem::path& path, const RinexNavData& 
   const auto header = [&s](const std::string& body, const char* label) {
     s += fmt::format("{:<60}{:<20}\n", body, label);
   };
-  header(fmt::format("{:9.2f}{:11}{:<20}{:<20}", 3.04, "", "N: GNSS NAV DATA", "G: GPS"),
-         "RINEX VERSION / TYPE");
+  header(fmt::format("{:9.2f}{:11}{:<20}{:<20}", 3.04, "", "N: GNSS NAV DATA", "G: GPS"), "RINEX VERSION / TYPE");
   const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
   std::tm utc{};
   gmtime_r(&now, &utc);
@@ -367,16 +365,15 @@ void write_rinex_nav_304(const std::filesystem::path& path, const RinexNavData& 
   header(fmt::format("{:<20}{:<20}{:<20}", "ultratrack", "", date), "PGM / RUN BY / DATE");
   if (data.klobuchar.valid) {
     const KlobucharParameters& k = data.klobuchar;
-    header(fmt::format("GPSA {:12.4E}{:12.4E}{:12.4E}{:12.4E}", k.alpha[0], k.alpha[1], k.alpha[2],
-                       k.alpha[3]),
+    header(fmt::format("GPSA {:12.4E}{:12.4E}{:12.4E}{:12.4E}", k.alpha[0], k.alpha[1], k.alpha[2], k.alpha[3]),
            "IONOSPHERIC CORR");
     header(fmt::format("GPSB {:12.4E}{:12.4E}{:12.4E}{:12.4E}", k.beta[0], k.beta[1], k.beta[2], k.beta[3]),
            "IONOSPHERIC CORR");
   }
   if (data.utc.valid)
-    header(fmt::format("GPUT {:17.10E}{:16.9E} {:6d} {:4d}", data.utc.a0_s, data.utc.a1_sps, data.utc.tot_s,
-                       data.utc.wnt),
-           "TIME SYSTEM CORR");
+    header(
+        fmt::format("GPUT {:17.10E}{:16.9E} {:6d} {:4d}", data.utc.a0_s, data.utc.a1_sps, data.utc.tot_s, data.utc.wnt),
+        "TIME SYSTEM CORR");
   if (data.utc.valid && data.utc.wn_lsf > 0)
     header(fmt::format("{:6d}{:6d}{:6d}{:6d}", data.utc.delta_t_ls_s, data.utc.delta_t_lsf_s, data.utc.wn_lsf,
                        data.utc.dn),
@@ -391,12 +388,12 @@ void write_rinex_nav_304(const std::filesystem::path& path, const RinexNavData& 
   for (size_t i = 0; i < data.ephemerides.size(); ++i) {
     const Ephemeris& e = data.ephemerides[i];
     if (e.prn < kMinPrn || e.prn > kMaxPrn || e.week < 0)
-      throw InputError(path.string(), fmt::format("cannot write ephemeris {} (PRN {}, week {}): out of range", i,
-                                                  e.prn, e.week));
+      throw InputError(path.string(),
+                       fmt::format("cannot write ephemeris {} (PRN {}, week {}): out of range", i, e.prn, e.week));
     const CalendarTime c = calendar_from_gps_time(normalised(e.toc()));
     const int sec = static_cast<int>(std::lround(c.second));
-    s += fmt::format("G{:02d} {:04d} {:02d} {:02d} {:02d} {:02d} {:02d}{:19.12E}{:19.12E}{:19.12E}\n", e.prn,
-                     c.year, c.month, c.day, c.hour, c.minute, sec, e.af0_s, e.af1_sps, e.af2_sps2);
+    s += fmt::format("G{:02d} {:04d} {:02d} {:02d} {:02d} {:02d} {:02d}{:19.12E}{:19.12E}{:19.12E}\n", e.prn, c.year,
+                     c.month, c.day, c.hour, c.minute, sec, e.af0_s, e.af1_sps, e.af2_sps2);
     orbit(e.iode, e.crs_m, e.delta_n_radps, e.m0_rad);
     orbit(e.cuc_rad, e.e, e.cus_rad, e.sqrt_a_sqrtm);
     orbit(e.toe_s, e.cic_rad, e.omega0_rad, e.cis_rad);

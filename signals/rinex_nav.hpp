@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // RINEX GPS navigation files: a reader for versions 2.xx (GPS 'N' files) and 3.00-3.05 (GPS or mixed:
 // only 'G' records are kept, other systems are skipped by their record lengths), and a writer of RINEX
 // 3.04 GPS navigation. Ephemerides come out in SI units (RINEX already uses radians and rad/s).
@@ -14,11 +15,11 @@ namespace ultratrack::signals {
 
 struct RinexNavData {
   double version = 3.04;
-  std::vector<Ephemeris> ephemerides;     // GPS records in file order
-  std::vector<double> transmit_tow_s;     // per record: transmission time of message (s of week), as read
-  KlobucharParameters klobuchar;          // ION ALPHA/BETA (2.xx) or IONOSPHERIC CORR GPSA/GPSB (3.xx)
-  UtcParameters utc;                      // DELTA-UTC (2.xx) or TIME SYSTEM CORR GPUT (3.xx); leap seconds
-  bool has_leap_seconds = false;          // a LEAP SECONDS line was present (value in utc.delta_t_ls_s)
+  std::vector<Ephemeris> ephemerides;  // GPS records in file order
+  std::vector<double> transmit_tow_s;  // per record: transmission time of message (s of week), as read
+  KlobucharParameters klobuchar;       // ION ALPHA/BETA (2.xx) or IONOSPHERIC CORR GPSA/GPSB (3.xx)
+  UtcParameters utc;                   // DELTA-UTC (2.xx) or TIME SYSTEM CORR GPUT (3.xx); leap seconds
+  bool has_leap_seconds = false;       // a LEAP SECONDS line was present (value in utc.delta_t_ls_s)
 };
 
 // Reads a RINEX navigation file. Throws InputError (file, line, problem) on a missing/empty file, bad

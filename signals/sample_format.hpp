@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IF sample file formats: how complex baseband (or real IF) samples are laid out in a recording.
 //   i8  interleaved int8 I/Q        i16 interleaved int16 I/Q (little endian)
 //   f32 interleaved float32 I/Q (GNU Radio gr_complex)

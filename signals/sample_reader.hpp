@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Streaming reader of IF sample files (formats in sample_format.hpp). Samples come out as complex float
 // in the file's own scale (real formats give imag = 0); IF removal, I/Q swap and Q negation belong to
 // the receiver's SampleSource. The whole-file checks happen at open: a missing or empty file, or a size

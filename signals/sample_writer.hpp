@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Writes IF sample files (formats in sample_format.hpp) from complex float samples, already scaled to
 // the format's integer range by the caller (values are rounded and saturated; real formats keep only
 // the real part). The file is written under a temporary name and renamed by finish(): an unfinished

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IS-GPS-200 Table 20-IV user algorithm for position, with velocity by analytic differentiation of the
 // same equations, the SV clock polynomial with its relativistic term, and the Sagnac-corrected range.
 #include "signals/satellite_state.hpp"
@@ -62,11 +63,10 @@ SatelliteState satellite_state(const Ephemeris& eph, const GpsTime& t) {
   const double idot = eph.idot_radps + 2.0 * vdot * (eph.cis_rad * c2 - eph.cic_rad * s2);
   const double xpdot = rdot * std::cos(u) - r * udot * std::sin(u);
   const double ypdot = rdot * std::sin(u) + r * udot * std::cos(u);
-  s.v_e_mps = {xpdot * cosO - ypdot * cosi * sinO + yp * sini * idot * sinO -
-                   omega_dot_k * (xp * sinO + yp * cosi * cosO),
-               xpdot * sinO + ypdot * cosi * cosO - yp * sini * idot * cosO +
-                   omega_dot_k * (xp * cosO - yp * cosi * sinO),
-               ypdot * sini + yp * cosi * idot};
+  s.v_e_mps = {
+      xpdot * cosO - ypdot * cosi * sinO + yp * sini * idot * sinO - omega_dot_k * (xp * sinO + yp * cosi * cosO),
+      xpdot * sinO + ypdot * cosi * cosO - yp * sini * idot * cosO + omega_dot_k * (xp * cosO - yp * cosi * sinO),
+      ypdot * sini + yp * cosi * idot};
 
   // Clock: IS-GPS-200 20.3.3.3.3.1, with dt = t - toc wrapped like t_k.
   const double dt = wrap_half_week(seconds_between(t, eph.toc()));
@@ -87,16 +87,14 @@ Eigen::Vector3d rotate_to_receive_frame(const Eigen::Vector3d& r_e_transmit, dou
   // The receive-time ECEF axes have turned by omega_e * tau about z: coordinates rotate by -omega_e*tau.
   const double a = kEarthRotationRate_radps * travel_time_s;
   const double c = std::cos(a), s = std::sin(a);
-  return {c * r_e_transmit.x() + s * r_e_transmit.y(), -s * r_e_transmit.x() + c * r_e_transmit.y(),
-          r_e_transmit.z()};
+  return {c * r_e_transmit.x() + s * r_e_transmit.y(), -s * r_e_transmit.x() + c * r_e_transmit.y(), r_e_transmit.z()};
 }
 
 double geometric_range_m(const Eigen::Vector3d& r_sat_e_transmit, const Eigen::Vector3d& r_rx_e_receive) {
   double range = (r_sat_e_transmit - r_rx_e_receive).norm();
   // Fixed-point iteration on the travel time: contracts by omega_e*|r_sat|/c ~ 6e-6 per step.
   for (int i = 0; i < 5; ++i) {
-    const double next =
-        (rotate_to_receive_frame(r_sat_e_transmit, range / kSpeedOfLight_mps) - r_rx_e_receive).norm();
+    const double next = (rotate_to_receive_frame(r_sat_e_transmit, range / kSpeedOfLight_mps) - r_rx_e_receive).norm();
     const bool done = std::abs(next - range) < 1e-9;
     range = next;
     if (done) break;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Satellite position, velocity and clock from the broadcast ephemeris (IS-GPS-200 Table 20-IV),
 // and the Sagnac-corrected geometric range. Frames: ECEF (WGS-84) at the instant named in each function.
 #pragma once
@@ -12,10 +13,10 @@ namespace ultratrack::signals {
 struct SatelliteState {
   Eigen::Vector3d r_e_m = Eigen::Vector3d::Zero();    // ECEF position at transmit time, ECEF axes of that time
   Eigen::Vector3d v_e_mps = Eigen::Vector3d::Zero();  // ECEF velocity (includes the earth-rotation term)
-  double clock_bias_s = 0.0;      // af0 + af1 dt + af2 dt^2 + relativistic term (TGD not included)
-  double clock_drift_sps = 0.0;   // af1 + 2 af2 dt + d(relativistic)/dt
-  double relativistic_s = 0.0;    // F e sqrt(A) sin(E_k), already in clock_bias_s
-  double tgd_s = 0.0;             // copied from the ephemeris; an L1 C/A user subtracts it
+  double clock_bias_s = 0.0;                          // af0 + af1 dt + af2 dt^2 + relativistic term (TGD not included)
+  double clock_drift_sps = 0.0;                       // af1 + 2 af2 dt + d(relativistic)/dt
+  double relativistic_s = 0.0;                        // F e sqrt(A) sin(E_k), already in clock_bias_s
+  double tgd_s = 0.0;                                 // copied from the ephemeris; an L1 C/A user subtracts it
 };
 
 // State at GPS system time t (the satellite's transmit time, corrected for the SV clock by the caller

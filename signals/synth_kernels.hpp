@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The per-sample inner loops of the IF synthesiser, kept apart so they can be benchmarked and reasoned
 // about alone: code x carrier accumulation with a fixed-point code phase and a 4096-entry carrier table,
 // Gaussian noise, and seeded random engines. No allocation, no exceptions.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Drives the IF synthesiser from the INS trajectory simulator: antennas fixed on the vehicle at body
 // lever arms (m, body axes), moving with the interpolated truth (ins/truth_interpolator.hpp). The
 // synthesiser's time (true GPS time since the scenario start) maps to the run's time line as t + t0_s.

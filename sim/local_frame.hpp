@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The local NED frame at a geodetic position, for the simulator's truth rows and static antenna offsets.
 #pragma once
 

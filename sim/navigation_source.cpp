@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/navigation_source.hpp"
 
 #include <fmt/core.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The broadcast data a scenario transmits: one ephemeris per PRN selected for the start time (healthy only
 // unless the scenario includes unhealthy ones) from its RINEX nav file or the built-in nominal constellation,
 // with the ionosphere and UTC parameters. A receiver given these ephemerides starts hot.
@@ -6,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "signals/rinex_nav.hpp"
 #include "signals/ephemeris.hpp"
+#include "signals/rinex_nav.hpp"
 #include "sim/scenario.hpp"
 
 namespace ultratrack::sim {

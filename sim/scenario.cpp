@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/scenario.hpp"
 
 #include <fmt/core.h>
@@ -19,17 +20,17 @@ bool events_valid(const Scenario& s, std::string* why) {
     return fail(why, "[[cycle_slip]] and [[blockage]] need a [signal] section");
   for (const auto& e : s.cycle_slips)
     if (e.antenna < 0 || static_cast<std::size_t>(e.antenna) >= antennas)
-      return fail(why, fmt::format("key cycle_slip.antenna: antenna {} does not exist ({} antennas)", e.antenna,
-                                   antennas));
+      return fail(why,
+                  fmt::format("key cycle_slip.antenna: antenna {} does not exist ({} antennas)", e.antenna, antennas));
   for (const auto& b : s.blockages)
     if (b.antenna < 0 || static_cast<std::size_t>(b.antenna) >= antennas)
-      return fail(why, fmt::format("key blockage.antenna: antenna {} does not exist ({} antennas)", b.antenna,
-                                   antennas));
+      return fail(why,
+                  fmt::format("key blockage.antenna: antenna {} does not exist ({} antennas)", b.antenna, antennas));
   if (!s.cn0_steps.empty() && !s.signal) return fail(why, "[[cn0_step]] needs a [signal] section");
   for (const auto& c : s.cn0_steps)
     if (c.antenna < 0 || static_cast<std::size_t>(c.antenna) >= antennas)
-      return fail(why, fmt::format("key cn0_step.antenna: antenna {} does not exist ({} antennas)", c.antenna,
-                                   antennas));
+      return fail(why,
+                  fmt::format("key cn0_step.antenna: antenna {} does not exist ({} antennas)", c.antenna, antennas));
   return true;
 }
 
@@ -62,9 +63,10 @@ bool Scenario::IsValid(std::string* why) const {
     return fail(why, "key receiver.antenna_offsets_enu_m: at least one antenna");
   if (!events_valid(*this, why)) return false;
   if (!signals::is_complex(format) && !(if_hz > 0))
-    return fail(why, "key signal.if_hz: real format " + std::string(signals::to_string(format)) +
-                         " needs an IF above 0 Hz");
-  if (!(std::abs(if_hz) < 0.5 * sample_rate_hz)) return fail(why, "key signal.if_hz: must be below half the sample rate");
+    return fail(why,
+                "key signal.if_hz: real format " + std::string(signals::to_string(format)) + " needs an IF above 0 Hz");
+  if (!(std::abs(if_hz) < 0.5 * sample_rate_hz))
+    return fail(why, "key signal.if_hz: must be below half the sample rate");
   return true;
 }
 

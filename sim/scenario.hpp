@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The simulation scenario: plain data that says what `simulate` makes (signal, time, navigation data, receiver,
 // atmosphere, truth rate, and for inertial scenarios the trajectory, IMU and antennas on the body). SI units and
 // degrees at the edges as the names say; relative paths resolve against `source`'s folder. config/scenario_toml.hpp
@@ -17,8 +18,8 @@
 #include <string>
 #include <vector>
 
-#include "ins/odometer.hpp"
 #include "ins/imu_datasheet.hpp"
+#include "ins/odometer.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/sample_format.hpp"
 

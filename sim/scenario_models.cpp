@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/scenario_models.hpp"
 
 #include <fmt/core.h>
@@ -8,10 +9,10 @@
 
 #include "io/input_error.hpp"
 #include "io/units.hpp"
+#include "io/why_invalid.hpp"
 #include "signals/gps_constants.hpp"
 #include "sim/ins_truth_motion.hpp"
 #include "sim/local_frame.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::sim {
 namespace {

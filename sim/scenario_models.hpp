@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A scenario as the inputs of the models that simulate it: the antennas' motion (signals' ReceiverMotion),
 // the trajectory and IMU errors (ins/), the IF synthesiser's options (signals/). Each throws io::InputError
 // naming the scenario file (or the file it reads) when the scenario is not usable.

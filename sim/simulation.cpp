@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/simulation.hpp"
 
 #include <fmt/core.h>
@@ -22,9 +23,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The inertial part of a run: IMU rows (and odometer samples) to the sink, truth kept for interpolation.
 std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, SimulationSink& sink,
@@ -80,9 +79,7 @@ std::shared_ptr<const ins::TruthInterpolator> run_inertial(const Scenario& s, Si
       samples.back().f_b = C * t.f_b;
     };
   }
-  callbacks.on_progress = [&](int percent) {
-    sink.progress({SimulationProgress::Stage::Imu, percent, 0.0, 0.0, 0.0});
-  };
+  callbacks.on_progress = [&](int percent) { sink.progress({SimulationProgress::Stage::Imu, percent, 0.0, 0.0, 0.0}); };
   const ImuSimulationResult imu = simulate_imu(spec, s.imu_rate_hz, imu_error_spec(s), s.imu_seed, callbacks);
   if (s.odometer) {
     ins::OdometerOptions odo;
@@ -127,15 +124,18 @@ void truth_without_signal(const Scenario& s, const ins::TruthInterpolator& truth
 // The injected events and C/N0 steps as the receiver should detect them.
 void emit_events(const Scenario& s, const NavigationSource& nav, SimulationSink& sink) {
   std::vector<AntennaEventRow> events;
-  for (const auto& e : s.cycle_slips) events.push_back({"slip", e.antenna, e.prn, e.time_s, e.time_s + e.fade_s, e.cycles});
-  for (const auto& b : s.blockages) events.push_back({"blockage", b.antenna, 0, b.start_s, b.start_s + b.duration_s, 0.0});
+  for (const auto& e : s.cycle_slips)
+    events.push_back({"slip", e.antenna, e.prn, e.time_s, e.time_s + e.fade_s, e.cycles});
+  for (const auto& b : s.blockages)
+    events.push_back({"blockage", b.antenna, 0, b.start_s, b.start_s + b.duration_s, 0.0});
   std::vector<Cn0StepRow> steps;
   for (const auto& c : s.cn0_steps) {
     const std::int64_t first = signals::cn0_step_first_sample(c, s.sample_rate_hz);
     for (const auto& eph : nav.ephemerides) {
       if (eph.health != 0 && !s.include_unhealthy) continue;
       if (!c.prns.empty() && std::find(c.prns.begin(), c.prns.end(), eph.prn) == c.prns.end()) continue;
-      steps.push_back({c.antenna, eph.prn, c.start_s, first, static_cast<double>(first) / s.sample_rate_hz, c.cn0_dbhz});
+      steps.push_back(
+          {c.antenna, eph.prn, c.start_s, first, static_cast<double>(first) / s.sample_rate_hz, c.cn0_dbhz});
     }
   }
   sink.events(events, steps);
@@ -181,7 +181,8 @@ class SignalRun {
       if (decile > last_decile) {
         last_decile = decile;
         const double done_s = static_cast<double>(n) / s_.sample_rate_hz;
-        sink_.progress({SimulationProgress::Stage::Signal, decile * 10, done_s, s_.duration_s, seconds_since(wall_start_)});
+        sink_.progress(
+            {SimulationProgress::Stage::Signal, decile * 10, done_s, s_.duration_s, seconds_since(wall_start_)});
       }
     }
     result.samples = n;

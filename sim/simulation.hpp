@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // simulate(): runs a scenario and hands what it makes to a sink, in time order, so that a library user can
 // simulate into memory and `ultratrack simulate` into files (sim/simulation_files.hpp):
 //   begin       first, the run's shape (sample streams, inertial or not)
@@ -43,7 +44,7 @@ struct TruthRow {
   double t_s = 0.0;  // receiver time: sample index / fs (GPS time since the start without a signal)
   signals::GpsTime gps;
   Eigen::Vector3d r_e_m = Eigen::Vector3d::Zero(), v_e_mps = Eigen::Vector3d::Zero();  // ECEF
-  double clock_bias_m = 0.0;    // c * (receiver clock - GPS time)
+  double clock_bias_m = 0.0;  // c * (receiver clock - GPS time)
   double clock_drift_mps = 0.0;
   std::optional<Eigen::Quaterniond> q_nb;  // body to NED, inertial scenarios
 };
@@ -73,8 +74,8 @@ struct Cn0StepRow {
 
 struct SimulationProgress {
   enum class Stage { Imu, Signal } stage = Stage::Signal;
-  int percent = 0;                      // multiples of 10
-  double done_s = 0.0, total_s = 0.0;   // signal seconds (Signal)
+  int percent = 0;                     // multiples of 10
+  double done_s = 0.0, total_s = 0.0;  // signal seconds (Signal)
   double wall_s = 0.0;
 };
 
@@ -82,7 +83,7 @@ struct SimulationResult {
   std::string navigation;                          // the RINEX file or "nominal" ("" without a signal)
   std::vector<signals::SatelliteView> satellites;  // in view at the first sample
   int antennas = 0;
-  std::int64_t samples = 0;                        // per antenna
+  std::int64_t samples = 0;  // per antenna
   double signal_s = 0.0;
   double wall_s = 0.0;
   double noise_sigma = 0.0;  // per output component, file units

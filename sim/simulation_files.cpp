@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/simulation_files.hpp"
 
 #include <fmt/core.h>
@@ -19,7 +20,6 @@
 namespace ultratrack::sim {
 namespace {
 
-
 const char* const kTruthHeader =
     "t_s,gps_week,tow_s,ecef_x_m,ecef_y_m,ecef_z_m,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,"
     "clock_bias_m,clock_drift_mps";
@@ -35,7 +35,8 @@ std::string truth_line(const TruthRow& r) {
                   v_n.z(), r.clock_bias_m, r.clock_drift_mps);
   if (r.q_nb) {
     const ins::EulerAngles e = ins::euler_from_quaternion(*r.q_nb);
-    row += fmt::format(",{:.8f},{:.8f},{:.8f}", e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
+    row += fmt::format(",{:.8f},{:.8f},{:.8f}", e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg,
+                       e.yaw_rad / io::kRadPerDeg);
   }
   return row + "\n";
 }
@@ -87,15 +88,15 @@ void SimulationFiles::events(std::span<const AntennaEventRow> events, std::span<
     events_ += fmt::format("{},{},{},{},{},{}\n", e.kind, e.antenna, e.prn, e.start_s, e.end_s, e.cycles);
   cn0_steps_ = "antenna,prn,start_s,first_sample,first_sample_s,cn0_dbhz\n";
   for (const auto& c : steps)
-    cn0_steps_ += fmt::format("{},{},{},{},{:.9f},{}\n", c.antenna, c.prn, c.start_s, c.first_sample,
-                              c.first_sample_s, c.cn0_dbhz);
+    cn0_steps_ += fmt::format("{},{},{},{},{:.9f},{}\n", c.antenna, c.prn, c.start_s, c.first_sample, c.first_sample_s,
+                              c.cn0_dbhz);
 }
 
 void SimulationFiles::truth(const TruthRow& row) { truth_ += truth_line(row); }
 
 void SimulationFiles::antenna_truth(const AntennaTruthRow& r) {
-  antenna_truth_ += fmt::format("{:.9f},{},{:.4f},{:.4f},{:.4f},{:.5f},{:.5f},{:.5f}\n", r.t_s, r.antenna,
-                                r.r_e_m.x(), r.r_e_m.y(), r.r_e_m.z(), r.v_e_mps.x(), r.v_e_mps.y(), r.v_e_mps.z());
+  antenna_truth_ += fmt::format("{:.9f},{},{:.4f},{:.4f},{:.4f},{:.5f},{:.5f},{:.5f}\n", r.t_s, r.antenna, r.r_e_m.x(),
+                                r.r_e_m.y(), r.r_e_m.z(), r.v_e_mps.x(), r.v_e_mps.y(), r.v_e_mps.z());
 }
 
 void SimulationFiles::samples(int antenna, std::span<const std::complex<float>> block) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The files of `ultratrack simulate` in a folder, written by a SimulationSink; every file under a temporary name,
 // renamed when complete (io::AtomicFile), also after a stop (summary.json then says "interrupted": true).
 //   antenna<k>.<format>.bin  one per antenna, sample-synchronous (signals/sample_writer.hpp)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "sim/truth_csv.hpp"
 
 #include <fmt/core.h>
@@ -9,15 +10,14 @@
 #include <string>
 
 #include "ins/attitude.hpp"
-#include "io/input_error.hpp"
-#include "io/numeric_csv.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
+#include "io/input_error.hpp"
+#include "io/numeric_csv.hpp"
 #include "io/units.hpp"
 
 namespace ultratrack::sim {
 namespace {
-
 
 const std::vector<std::string>& simulate_truth_header() {
   static const std::vector<std::string> h{"t_s",       "gps_week",  "tow_s",        "ecef_x_m",        "ecef_y_m",

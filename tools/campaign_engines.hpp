@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Where a campaign's runs execute (`ultratrack campaign run --engine local|slurm`): threads here, or a Slurm array. The
 // output folder keeps a copy of the campaign file (campaign.toml) and the folder its relative paths resolve against
 // (campaign_base.txt), so that `campaign run-one DIR INDEX` on any node and `campaign report DIR` read the same

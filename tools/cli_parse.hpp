@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Command-line values parsed as text so that a malformed one is an InputError (exit 2) like any other bad
 // input: numbers, integers, PRN lists ("1-32", "3,7,12-15") and two-valued switches; the build date's GPS week.
 #pragma once

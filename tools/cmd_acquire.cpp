@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack acquire`: FFT acquisition of the first K x T_coh of a recording (receiver/acquisition.hpp
 // on receiver/sample_source.hpp); one row per detected PRN as a table, or JSON with --json.
 // Every bad input (numbers, format, PRN list, file, options out of range) is an InputError (exit 2).

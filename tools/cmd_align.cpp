@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack align`: the stationary fine alignment of seed 000 from an IMU CSV and a multi-antenna receiver's
 // attitude.csv (pipelines/alignment_run.hpp): writes DIR/alignment.json (attitude, 1-sigma, biases, the array's
 // mounting estimate, observability rank, warnings) and DIR/alignment.csv (one row per filter epoch). --imu-pps maps
@@ -49,13 +50,15 @@ void run_align_command(const AlignCommandOptions& o) {
       throw io::InputError("command line", "--position takes LAT_DEG LON_DEG HEIGHT_M");
     s.config.position_deg_m = Eigen::Vector3d(o.position[0], o.position[1], o.position[2]);
   }
-  if (!o.attitude_origin.empty()) s.config.attitude_gps_time_at_imu_zero = parse_gps_time_option("--attitude-origin", o.attitude_origin);
+  if (!o.attitude_origin.empty())
+    s.config.attitude_gps_time_at_imu_zero = parse_gps_time_option("--attitude-origin", o.attitude_origin);
   if (!o.reference.empty()) {
     const double d = io::kRadPerDeg;
     const auto& v = o.reference;
     if (!(std::abs(v[0]) <= 180.0 && std::abs(v[1]) < 90.0 && std::abs(v[2]) <= 360.0 && v[3] > 0.0 && v[4] > 0.0 &&
           v[5] > 0.0 && std::isfinite(v[3] + v[4] + v[5])))
-      throw io::InputError("command line", "--reference-attitude takes ROLL PITCH YAW and their positive 1-sigmas, deg");
+      throw io::InputError("command line",
+                           "--reference-attitude takes ROLL PITCH YAW and their positive 1-sigmas, deg");
     s.reference_attitude = ins::EulerAngles{v[0] * d, v[1] * d, v[2] * d};
     s.reference_sigma_rad = Eigen::Vector3d(v[3], v[4], v[5]) * d;
   }
@@ -63,7 +66,8 @@ void run_align_command(const AlignCommandOptions& o) {
   const auto attitude = pipelines::read_attitude_csv(o.attitude_file);
   auto imu = ins::read_imu_csv(o.imu_file, {s.config.imu_max_gap_s});
   if (!o.pps_file.empty()) {
-    auto mapped = pipelines::imu_on_gps_time_by_pps(imu, o.imu_file, o.pps_file, s.config.attitude_gps_time_at_imu_zero);
+    auto mapped =
+        pipelines::imu_on_gps_time_by_pps(imu, o.imu_file, o.pps_file, s.config.attitude_gps_time_at_imu_zero);
     // Without an origin the IMU time line starts at the first PPS edge.
     s.config.attitude_gps_time_at_imu_zero = mapped.origin;
     imu = std::move(mapped.imu);
@@ -73,8 +77,8 @@ void run_align_command(const AlignCommandOptions& o) {
     s.time_note = "IMU t_s on the attitude time line by the GPS time origin";
   }
   if (!o.quiet)
-    fmt::print("align: {} IMU rows ({:.3f}-{:.3f} s), {} attitude rows, {} filter, {} s\n", imu.size(),
-               imu.front().t_s, imu.back().t_s, attitude.size(), o.filter, o.duration_s);
+    fmt::print("align: {} IMU rows ({:.3f}-{:.3f} s), {} attitude rows, {} filter, {} s\n", imu.size(), imu.front().t_s,
+               imu.back().t_s, attitude.size(), o.filter, o.duration_s);
 
   const pipelines::AlignRunResult r = pipelines::run_alignment(imu, attitude, s);
   fs::create_directories(o.out_dir);
@@ -84,15 +88,18 @@ void run_align_command(const AlignCommandOptions& o) {
   const auto& a = r.alignment;
   const ins::EulerAngles e = ins::euler_from_quaternion(a.nav.q_nb);
   const double d = io::kRadPerDeg;
-  fmt::print("align: {:.1f}-{:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg, 1-sigma {:.4f} / {:.4f} / {:.4f} deg; "
-             "{} attitude updates ({} rejected), observability rank {}\n",
-             a.start_s, a.end_s, e.roll_rad / d, e.pitch_rad / d, e.yaw_rad / d, a.sigma_euler_rad.x() / d,
-             a.sigma_euler_rad.y() / d, a.sigma_euler_rad.z() / d, a.attitude_updates, a.attitude_rejected,
-             r.observability.rank);
-  fmt::print("align: array mounting (GPS mean against {}) roll {:.3f} pitch {:.3f} yaw {:.3f} "
-             "deg, 1-sigma {:.3f} / {:.3f} / {:.3f} deg\n",
-             s.reference_attitude ? "the reference attitude" : "the IMU's levelling/gyrocompassing", r.mounting.angles.roll_rad / d, r.mounting.angles.pitch_rad / d, r.mounting.angles.yaw_rad / d,
-             r.mounting.sigma_rad.x() / d, r.mounting.sigma_rad.y() / d, r.mounting.sigma_rad.z() / d);
+  fmt::print(
+      "align: {:.1f}-{:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg, 1-sigma {:.4f} / {:.4f} / {:.4f} deg; "
+      "{} attitude updates ({} rejected), observability rank {}\n",
+      a.start_s, a.end_s, e.roll_rad / d, e.pitch_rad / d, e.yaw_rad / d, a.sigma_euler_rad.x() / d,
+      a.sigma_euler_rad.y() / d, a.sigma_euler_rad.z() / d, a.attitude_updates, a.attitude_rejected,
+      r.observability.rank);
+  fmt::print(
+      "align: array mounting (GPS mean against {}) roll {:.3f} pitch {:.3f} yaw {:.3f} "
+      "deg, 1-sigma {:.3f} / {:.3f} / {:.3f} deg\n",
+      s.reference_attitude ? "the reference attitude" : "the IMU's levelling/gyrocompassing",
+      r.mounting.angles.roll_rad / d, r.mounting.angles.pitch_rad / d, r.mounting.angles.yaw_rad / d,
+      r.mounting.sigma_rad.x() / d, r.mounting.sigma_rad.y() / d, r.mounting.sigma_rad.z() / d);
   for (const auto& w : r.warnings) fmt::print("align: warning: {}\n", w);
   fmt::print("align: wrote {}/alignment.json and alignment.csv\n", o.out_dir);
 }
@@ -113,11 +120,13 @@ void add_align_command(CLI::App& app) {
                   "PPS CSV (local_s,gps_week,gps_tow_s): IMU stamps are a local clock, mapped to GPS time")
       ->check(CLI::ExistingFile);
   cmd->add_option("--position", o->position, "LAT_DEG LON_DEG HEIGHT_M (else [initial] position_deg_m)")->expected(3);
-  cmd->add_option("--reference-attitude", o->reference,
-                  "R P Y SR SP SY (deg): the body's attitude from a reference and its 1-sigma, for the mounting estimate "
-                  "(else the IMU's own levelling and gyrocompassing)")
+  cmd->add_option(
+         "--reference-attitude", o->reference,
+         "R P Y SR SP SY (deg): the body's attitude from a reference and its 1-sigma, for the mounting estimate "
+         "(else the IMU's own levelling and gyrocompassing)")
       ->expected(6);
-  cmd->add_option("--duration", o->duration_s, "seconds of alignment from the first GPS attitude (default 100; 0: all)");
+  cmd->add_option("--duration", o->duration_s,
+                  "seconds of alignment from the first GPS attitude (default 100; 0: all)");
   cmd->add_option("--filter-interval", o->interval_s, "seconds between filter updates (default 1)");
   cmd->add_option("--config", o->config_file, "TOML with `fuse`'s keys ([imu] [initial] [attitude] [filter])")
       ->check(CLI::ExistingFile);

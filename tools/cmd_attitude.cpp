@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack attitude`: the multi-antenna receiver end to end (pipelines/attitude_file.hpp). N IF files recorded on
 // one clock (antenna 0 the master); the scalar receiver acquires and tracks each satellite on the master and
 // correlates every antenna against the master's replica (ReceiverOptions::num_antennas), each antenna's phase
@@ -12,16 +13,16 @@
 #include <string>
 #include <vector>
 
-#include "config/antenna_config_toml.hpp"
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "config/antenna_config_toml.hpp"
 #include "interrupt_guard.hpp"
+#include "io/why_invalid.hpp"
 #include "pipelines/attitude_file.hpp"
 #include "receiver/receiver_summary.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::tools {
 namespace {
@@ -34,7 +35,9 @@ struct AttitudeArgs {
 
 void run_attitude(const AttitudeArgs& args) {
   const auto format = signals::parse_sample_format(args.format);
-  if (!format) throw signals::InputError("command line", "--format: unknown sample format '" + args.format + "' (i8, i16, f32, r8, r16)");
+  if (!format)
+    throw signals::InputError("command line",
+                              "--format: unknown sample format '" + args.format + "' (i8, i16, f32, r8, r16)");
   const config::AntennaConfig antennas = config::read_antenna_config(args.antennas);
   const auto n_ant = antennas.solver.array.lever_arm_body_m.size();
   if (args.inputs.size() != n_ant)
@@ -88,13 +91,17 @@ void run_attitude(const AttitudeArgs& args) {
 }  // namespace
 
 void add_attitude_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("attitude", "Multi-antenna carrier-phase attitude (roll, pitch, yaw) from N recordings");
+  auto* cmd =
+      app.add_subcommand("attitude", "Multi-antenna carrier-phase attitude (roll, pitch, yaw) from N recordings");
   auto args = std::make_shared<AttitudeArgs>();
-  cmd->add_option("--input", args->inputs, "IF sample files, one per antenna, master first")->required()->expected(2, 4);
+  cmd->add_option("--input", args->inputs, "IF sample files, one per antenna, master first")
+      ->required()
+      ->expected(2, 4);
   cmd->add_option("--format", args->format, "sample format: i8, i16, f32, r8, r16")->required();
   cmd->add_option("--fs", args->fs, "sample rate, Hz")->required();
   cmd->add_option("--if", args->if_hz, "intermediate frequency, Hz (0: complex baseband)")->capture_default_str();
-  cmd->add_option("--antennas", args->antennas, "TOML file: [[antenna]] lever_arm_body_m (master first), [solver]")->required();
+  cmd->add_option("--antennas", args->antennas, "TOML file: [[antenna]] lever_arm_body_m (master first), [solver]")
+      ->required();
   cmd->add_option("--nav", args->nav, "RINEX navigation file: ephemerides known from the start (hot start)");
   cmd->add_option("--reference-week", args->reference_week, "full GPS week of the recording (without --nav)");
   cmd->add_option("--out", args->out, "output folder (created when missing)")->required();

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack campaign`: many runs from one campaign file (config/campaign_toml.hpp), and their report.
 //   campaign run C.toml --out DIR [--engine local|slurm] [--jobs N] [--no-wait]   runs what is not complete yet
 //   campaign run-one DIR INDEX                                                    one run (a Slurm array task)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack compare --solution S --truth T [--skip S] [--json]`: a receiver's solution.csv against a
 // simulation's truth.csv (pipelines/solution_compare.hpp): position errors (3-D, horizontal, vertical RMS, max,
 // mean ENU bias) and velocity errors, over the fixes the truth covers. Exit 3 when no fix could be compared.
@@ -34,10 +35,11 @@ void run_compare(const CompareArgs& args) {
   } else {
     fmt::print("compare: {} fixes (tow {:.1f} .. {:.1f} s){}\n", c.fixes, c.first_tow_s, c.last_tow_s,
                c.fixes_outside_truth ? fmt::format(", {} outside the truth's span", c.fixes_outside_truth) : "");
-    fmt::print("position error: 3-D RMS {:.3f} m (horizontal {:.3f}, vertical {:.3f}), max {:.3f} m, "
-               "mean ENU [{:.3f}, {:.3f}, {:.3f}] m\n",
-               c.rms_3d_m, c.rms_horizontal_m, c.rms_vertical_m, c.max_3d_m, c.mean_enu_m.x(), c.mean_enu_m.y(),
-               c.mean_enu_m.z());
+    fmt::print(
+        "position error: 3-D RMS {:.3f} m (horizontal {:.3f}, vertical {:.3f}), max {:.3f} m, "
+        "mean ENU [{:.3f}, {:.3f}, {:.3f}] m\n",
+        c.rms_3d_m, c.rms_horizontal_m, c.rms_vertical_m, c.max_3d_m, c.mean_enu_m.x(), c.mean_enu_m.y(),
+        c.mean_enu_m.z());
     fmt::print("velocity error: 3-D RMS {:.4f} m/s (horizontal {:.4f}, vertical {:.4f}), max {:.4f} m/s\n",
                c.rms_velocity_mps, c.rms_velocity_horizontal_mps, c.rms_velocity_vertical_mps, c.max_velocity_mps);
   }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack covariance`: the seed 001 covariance analysis of tightly or ultra-tightly coupled GPS/INS (17
 // states, eq. 38 noise; ultra-tight: I&Q taps or their discriminators every coherent integration, noise from
 // C/N0) on a named trajectory with an EKF or a UKF; prints position 1-sigma (north, east, down) at 30 s and
@@ -18,7 +19,6 @@
 
 namespace ultratrack::tools {
 namespace {
-
 
 struct CovarianceCommandOptions {
   std::string trajectory, coupling = "tight", filter = "ekf", nav_file, csv_file, iq_measurement = "iq";
@@ -81,12 +81,13 @@ void run_covariance_command(const CovarianceCommandOptions& c) {
   const std::string source = c.nav_file.empty() ? "nominal constellation" : c.nav_file;
   if (ultra) {
     const fusion::DiscriminatorNoise n = fusion::discriminator_noise(o.iq);
-    fmt::print("covariance: {} trajectory, ultra-tight {} ({}), {} satellites ({}), eq. 38 noise, {:.1f} dB-Hz, "
-               "T {:g} ms, E-L {:g} chip, A {:.2f}{}\n",
-               c.trajectory, c.filter, c.iq_measurement, nsat, source, c.cn0_dbhz, c.integration_ms, c.spacing_chips,
-               fusion::iq_amplitude(o.iq),
-               (c.filter == "ukf" ? fmt::format(", alpha {:g}", c.ukf_alpha) : "") +
-                   (c.absolute_phase ? ", absolute carrier phase" : ""));
+    fmt::print(
+        "covariance: {} trajectory, ultra-tight {} ({}), {} satellites ({}), eq. 38 noise, {:.1f} dB-Hz, "
+        "T {:g} ms, E-L {:g} chip, A {:.2f}{}\n",
+        c.trajectory, c.filter, c.iq_measurement, nsat, source, c.cn0_dbhz, c.integration_ms, c.spacing_chips,
+        fusion::iq_amplitude(o.iq),
+        (c.filter == "ukf" ? fmt::format(", alpha {:g}", c.ukf_alpha) : "") +
+            (c.absolute_phase ? ", absolute carrier phase" : ""));
     if (form == fusion::IqForm::Discriminator)
       fmt::print("discriminator 1-sigma per interval: range {:.3f} m, rate {:.4f} m/s\n", n.range_sigma_m,
                  n.rate_sigma_mps);

@@ -1,29 +1,30 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack demo`: the built-in default scenario (scenarios/default.toml, compiled in) end to end, as far
 // as the receiver goes: simulate it, acquire the satellites and compare with the simulator's truth, receive it
-// (receiver/receiver_engine.hpp) and print the fix error against the true position. Writes into --out (default ./ultratrack-demo); a re-run overwrites it.
-#include <CLI/CLI.hpp>
+// (receiver/receiver_engine.hpp) and print the fix error against the true position. Writes into --out (default
+// ./ultratrack-demo); a re-run overwrites it.
 #include <fmt/core.h>
+#include <unistd.h>
 
+#include <CLI/CLI.hpp>
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <GeographicLib/Geocentric.hpp>
-#include <chrono>
-#include <unistd.h>
-
 #include "commands.hpp"
+#include "config/scenario_toml.hpp"
 #include "demo_scenario.hpp"
+#include "interrupt_guard.hpp"
 #include "io/input_error.hpp"
 #include "receiver/acquisition.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/receiver_outputs.hpp"
 #include "receiver/sample_source.hpp"
-#include "config/scenario_toml.hpp"
-#include "interrupt_guard.hpp"
 #include "simulation_run.hpp"
 
 namespace ultratrack::tools {
@@ -124,8 +125,9 @@ void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario,
   fmt::print("  first fix after {:.2f} s of signal; mean fix {:.2f} m from the true position (3-D)\n",
              receiver::ttff_seconds(engine), (mean - truth).norm());
   if (scenario.ionosphere && !engine.ionosphere().known().valid)
-    fmt::print("  (the simulated ionosphere is corrected with a default Klobuchar set: the broadcast parameters come\n"
-               "   only every 12.5 min, in subframe 4 page 18; give them with `receive --nav`)\n");
+    fmt::print(
+        "  (the simulated ionosphere is corrected with a default Klobuchar set: the broadcast parameters come\n"
+        "   only every 12.5 min, in subframe 4 page 18; give them with `receive --nav`)\n");
 }
 
 void run_demo(const DemoArgs& args) {
@@ -133,11 +135,11 @@ void run_demo(const DemoArgs& args) {
   if (args.duration_s > 0.0) scenario.duration_s = args.duration_s;
   const fs::path out(args.out_dir);
   fs::create_directories(out);
-  fmt::print("ultratrack demo: a static receiver at {:.6f} N {:.6f} E, {:.0f} m, GPS week {} TOW {:.0f} s,\n"
-             "  the built-in nominal 24-satellite constellation, {:.0f} s of {} samples at {:.1f} MHz, {:.0f} dB-Hz\n",
-             scenario.llh_deg_m[0], scenario.llh_deg_m[1], scenario.llh_deg_m[2], scenario.gps_week, scenario.tow_s,
-             scenario.duration_s, signals::to_string(scenario.format), scenario.sample_rate_hz / 1e6,
-             scenario.cn0_dbhz);
+  fmt::print(
+      "ultratrack demo: a static receiver at {:.6f} N {:.6f} E, {:.0f} m, GPS week {} TOW {:.0f} s,\n"
+      "  the built-in nominal 24-satellite constellation, {:.0f} s of {} samples at {:.1f} MHz, {:.0f} dB-Hz\n",
+      scenario.llh_deg_m[0], scenario.llh_deg_m[1], scenario.llh_deg_m[2], scenario.gps_week, scenario.tow_s,
+      scenario.duration_s, signals::to_string(scenario.format), scenario.sample_rate_hz / 1e6, scenario.cn0_dbhz);
 
   fmt::print("\n1. simulate -> {}\n", (out / "simulation").string());
   const InterruptGuard interrupt;

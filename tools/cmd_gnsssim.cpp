@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack gnsssim`: external GNSS fixes (gnss.csv for `ultratrack fuse`) sampled from a truth/nav CSV at
 // any rate and start time (e.g. 5 Hz at t = 0.137 + 0.2 k), with seeded Gauss-Markov position errors and white
 // velocity errors.
@@ -9,9 +10,9 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "io/input_error.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
 #include "pipelines/gnss_fix_simulation.hpp"
-#include "io/input_error.hpp"
 #include "sim/truth_csv.hpp"
 
 namespace ultratrack::tools {

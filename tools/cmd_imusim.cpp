@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack imusim`: a trajectory (named profile or segment file) to DIR/imu.csv (with an IMU error preset),
 // DIR/truth.csv (nav columns at the IMU rate), optionally DIR/odometer.csv, and DIR/summary.json.
 #include <fmt/core.h>
@@ -9,7 +10,6 @@
 #include <numbers>
 #include <string>
 
-#include "interrupt_guard.hpp"
 #include "commands.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
@@ -18,6 +18,7 @@
 #include "ins/odometer.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
+#include "interrupt_guard.hpp"
 #include "io/atomic_file.hpp"
 #include "io/units.hpp"
 #include "sim/imu_simulation.hpp"
@@ -51,7 +52,8 @@ void run_imusim(const ImuSimOptions& o) {
   ins::TrajectorySpec spec;
   if (!o.profile.empty()) {
     if (!(o.duration_s > 0.0)) throw InputError("command line", "--duration must be positive");
-    spec = ins::profile_spec(o.profile, o.duration_s, o.lat_deg * io::kRadPerDeg, o.lon_deg * io::kRadPerDeg, o.height_m);
+    spec =
+        ins::profile_spec(o.profile, o.duration_s, o.lat_deg * io::kRadPerDeg, o.lon_deg * io::kRadPerDeg, o.height_m);
   } else {
     ins::TrajectorySpec start;
     start.lat0_rad = o.lat_deg * io::kRadPerDeg;
@@ -89,8 +91,8 @@ void run_imusim(const ImuSimOptions& o) {
   std::string json = "{\n";
   json += fmt::format("  \"trajectory\": \"{}\",\n  \"duration_s\": {},\n  \"imu_rate_hz\": {},\n  \"imu_rows\": {},\n",
                       o.profile.empty() ? o.segments_file : o.profile, spec.duration_s(), o.rate_hz, rows);
-  json += fmt::format("  \"preset\": \"{}\",\n  \"seed\": {},\n  \"interrupted\": {},\n", o.preset, o.seed,
-                      r.interrupted);
+  json +=
+      fmt::format("  \"preset\": \"{}\",\n  \"seed\": {},\n  \"interrupted\": {},\n", o.preset, o.seed, r.interrupted);
   json += sim::turn_on_bias_json(r.turn_on);
   json += fmt::format("  \"distance_m\": {:.3f}\n}}\n", r.distance_m);
   io::AtomicFile summary(fs::path(o.out_dir) / "summary.json");
@@ -113,7 +115,9 @@ void add_imusim_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--duration", o->duration_s, "seconds (profiles)");
   cmd->add_option("--rate", o->rate_hz, "IMU rate in Hz (50-1000, default 100)");
-  cmd->add_option("--preset", o->preset, "IMU errors: ideal, hg1700ae, dmu6x, navigation, mems, adis16405, adis16465, bmi088, stim300 (default ideal)");
+  cmd->add_option(
+      "--preset", o->preset,
+      "IMU errors: ideal, hg1700ae, dmu6x, navigation, mems, adis16405, adis16465, bmi088, stim300 (default ideal)");
   cmd->add_option("--seed", o->seed, "random seed of the IMU errors (default 1)");
   cmd->add_option("--lat-deg", o->lat_deg, "start latitude (default 36.37)");
   cmd->add_option("--lon-deg", o->lon_deg, "start longitude (default 127.36)");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack ins`: free inertial navigation from an IMU CSV file, started from a given state (first row of a
 // truth/nav CSV) or from a coarse alignment over the first seconds of stationary data. Writes DIR/nav.csv
 // and DIR/summary.json; when the --init file is a whole truth trajectory, the summary compares against it.
@@ -69,8 +70,8 @@ std::string state_json(const ins::NavState& s) {
       "{{\"t_s\": {}, \"lat_deg\": {:.10f}, \"lon_deg\": {:.10f}, \"height_m\": {:.4f}, \"vel_n_mps\": {:.6f}, "
       "\"vel_e_mps\": {:.6f}, \"vel_d_mps\": {:.6f}, \"roll_deg\": {:.6f}, \"pitch_deg\": {:.6f}, \"yaw_deg\": "
       "{:.6f}}}",
-      s.t_s, s.lat_rad / io::kRadPerDeg, s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(), e.roll_rad / io::kRadPerDeg,
-      e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
+      s.t_s, s.lat_rad / io::kRadPerDeg, s.lon_rad / io::kRadPerDeg, s.height_m, s.v_n.x(), s.v_n.y(), s.v_n.z(),
+      e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
 }
 
 void run_ins(const InsOptions& o) {
@@ -169,13 +170,14 @@ void run_ins(const InsOptions& o) {
 
   const ins::EulerAngles e = ins::euler_from_quaternion(nav.state().q_nb);
   fmt::print("ins: {} steps from t = {:.3f} s to {:.3f} s ({})\n", steps, init.t_s, nav.state().t_s,
-             alignment ? fmt::format("aligned over {:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg",
-                                     alignment->duration_s, alignment->euler.roll_rad / io::kRadPerDeg,
-                                     alignment->euler.pitch_rad / io::kRadPerDeg, alignment->euler.yaw_rad / io::kRadPerDeg)
-                       : "initial state from " + o.init_file);
+             alignment
+                 ? fmt::format("aligned over {:.1f} s: roll {:.4f} pitch {:.4f} yaw {:.4f} deg", alignment->duration_s,
+                               alignment->euler.roll_rad / io::kRadPerDeg, alignment->euler.pitch_rad / io::kRadPerDeg,
+                               alignment->euler.yaw_rad / io::kRadPerDeg)
+                 : "initial state from " + o.init_file);
   fmt::print("ins: final lat {:.8f} lon {:.8f} deg, h {:.2f} m, attitude {:.4f} {:.4f} {:.4f} deg\n",
-             nav.state().lat_rad / io::kRadPerDeg, nav.state().lon_rad / io::kRadPerDeg, nav.state().height_m, e.roll_rad / io::kRadPerDeg,
-             e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
+             nav.state().lat_rad / io::kRadPerDeg, nav.state().lon_rad / io::kRadPerDeg, nav.state().height_m,
+             e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
   if (cmp.matched > 0)
     fmt::print("ins: against truth ({} rows): max horizontal {:.3f} m, vertical {:.3f} m, attitude {:.2e} deg\n",
                cmp.matched, cmp.max_horizontal_m, cmp.max_vertical_m, cmp.max_attitude_deg);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive`: the receiver end to end on a recording (pipelines/receive_file.hpp), writing solution.csv,
 // NMEA, KML, RINEX 3.04 obs + nav, tracking.csv and summary.json into --out, and the coupling's logs.
 // Options: command-line flags over --config (TOML, config/receive_config_toml.hpp) over the defaults; the coupling's in
@@ -20,16 +21,16 @@
 #include "cli_parse.hpp"
 #include "command_exit.hpp"
 #include "commands.hpp"
+#include "config/receive_config_toml.hpp"
 #include "format_options.hpp"
 #include "interrupt_guard.hpp"
+#include "io/why_invalid.hpp"
 #include "pipelines/receive_file.hpp"
-#include "config/receive_config_toml.hpp"
 #include "receive_fusion_options.hpp"
 #include "receive_progress.hpp"
 #include "receiver/sample_source.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::tools {
 
@@ -63,11 +64,14 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.config.empty()) config::apply_receive_config(args.config, options);
   if (!args.elevation_mask.empty())
     options.pvt.elevation_mask_rad = parse_double_option("--elevation-mask-deg", args.elevation_mask) * M_PI / 180.0;
-  if (!args.troposphere.empty()) options.pvt.troposphere = parse_on_off_option("--troposphere", args.troposphere, "on", "off");
-  if (!args.ionosphere.empty()) options.pvt.ionosphere = parse_on_off_option("--ionosphere", args.ionosphere, "broadcast", "off");
+  if (!args.troposphere.empty())
+    options.pvt.troposphere = parse_on_off_option("--troposphere", args.troposphere, "on", "off");
+  if (!args.ionosphere.empty())
+    options.pvt.ionosphere = parse_on_off_option("--ionosphere", args.ionosphere, "broadcast", "off");
   if (!args.channels.empty()) options.channels = parse_int_option("--channels", args.channels);
   if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
-  if (!args.nav_bits.empty()) options.nav_bits = receiver::parse_nav_bit_source("command line: --nav-bits", args.nav_bits);
+  if (!args.nav_bits.empty())
+    options.nav_bits = receiver::parse_nav_bit_source("command line: --nav-bits", args.nav_bits);
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   if (!args.nav.empty()) job.navigation = signals::read_rinex_nav(args.nav);
   if (!args.reference_week.empty()) {
@@ -78,7 +82,8 @@ void run_receive(const ReceiveArgs& args) {
   job.duration_s = args.duration.empty() ? 0.0 : parse_double_option("--duration", args.duration);
   if (job.duration_s < 0.0) throw signals::InputError("command line", "--duration: must not be negative");
   if (args.out.empty()) throw signals::InputError("command line", "--out: an output folder is required");
-  if (const std::string why = io::why_invalid(options); !why.empty()) throw signals::InputError(args.config.empty() ? "command line" : args.config, why);
+  if (const std::string why = io::why_invalid(options); !why.empty())
+    throw signals::InputError(args.config.empty() ? "command line" : args.config, why);
   apply_receive_coupling_args(args.fusion, job.options);
   if (std::string why; !job.options.IsValid(&why)) throw signals::InputError("command line", why);
   const bool fused = pipelines::uses_imu(job.options.coupling);
@@ -123,10 +128,14 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "output folder (created when missing)")->required();
   cmd->add_option("--config", args->config, "TOML file with [receiver], [acquisition], [tracking], [pvt] settings");
   cmd->add_option("--nav", args->nav, "RINEX navigation file: ephemerides known from the start (hot start)");
-  cmd->add_option("--nav-bits", args->nav_bits, "decoded|oracle: bits for data wipe-off (default decoded: from the signal; oracle: --nav re-encoded as `simulate` does, for simulation studies)");
+  cmd->add_option("--nav-bits", args->nav_bits,
+                  "decoded|oracle: bits for data wipe-off (default decoded: from the signal; oracle: --nav re-encoded "
+                  "as `simulate` does, for simulation studies)");
   cmd->add_option("--elevation-mask-deg", args->elevation_mask, "PVT elevation mask, degrees (default 10)");
   cmd->add_option("--troposphere", args->troposphere, "on|off (default on)");
-  cmd->add_option("--ionosphere", args->ionosphere, "broadcast|off (default broadcast: a default Klobuchar set until the nav file's or the broadcast one is known)");
+  cmd->add_option(
+      "--ionosphere", args->ionosphere,
+      "broadcast|off (default broadcast: a default Klobuchar set until the nav file's or the broadcast one is known)");
   cmd->add_option("--channels", args->channels, "tracking channels (default 12)");
   cmd->add_option("--threads", args->threads, "worker threads including the main one (default: all cores)");
   cmd->add_option("--prn", args->prns, "PRNs to search, e.g. 1-32 or 3,7,12-15 (default all)");

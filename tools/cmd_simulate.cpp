@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate --scenario S.toml --out DIR`: synthesise IF samples and truth from a scenario
 // (config/scenario_toml.hpp for the keys, sim/simulation_files.hpp for the outputs). Ctrl-C stops the run
 // early and still finishes the files.

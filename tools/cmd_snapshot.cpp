@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack snapshot`: a position from a short recording (tens to hundreds of ms) with broadcast ephemerides and
 // an approximate time: acquisition and fine code/Doppler of every satellite (receiver/snapshot_measurement.hpp),
 // then coarse-time navigation (receiver/snapshot_navigation.hpp), run by pipelines/snapshot_file.hpp. Writes
@@ -6,8 +7,8 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
-#include <GeographicLib/Geocentric.hpp>
 #include <Eigen/Core>
+#include <GeographicLib/Geocentric.hpp>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -19,15 +20,14 @@
 #include "commands.hpp"
 #include "format_options.hpp"
 #include "io/units.hpp"
+#include "io/why_invalid.hpp"
 #include "pipelines/snapshot_file.hpp"
 #include "signals/input_error.hpp"
 #include "signals/rinex_nav.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::tools {
 
 namespace {
-
 
 struct SnapshotArgs {
   std::string input, fs, if_hz = "0", nav, time, time_sigma = "10", approx_llh, ms = "100", out;
@@ -59,7 +59,8 @@ Eigen::Vector3d parse_llh(const std::string& text) {
     start = comma + 1;
   }
   if (v.size() != 3 || std::fabs(v[0]) > 90.0 || std::fabs(v[1]) > 360.0)
-    throw signals::InputError("command line", "--approx-llh: expected LAT,LON,H in degrees and metres, got '" + text + "'");
+    throw signals::InputError("command line",
+                              "--approx-llh: expected LAT,LON,H in degrees and metres, got '" + text + "'");
   double x = 0, y = 0, z = 0;
   GeographicLib::Geocentric::WGS84().Forward(v[0], v[1], v[2], x, y, z);
   return {x, y, z};
@@ -102,8 +103,8 @@ void run_snapshot(const SnapshotArgs& args) {
   if (args.quiet) return;
   fmt::print("{} satellites detected, {} used; ", result.detections.size(), solution.used);
   fmt::print("fix {:.7f} {:.7f} {:.1f} m, time correction {:+.3f} s, quality {} (residual rms {:.1f} m)\n",
-             solution.lat_rad * io::kDegPerRad, solution.lon_rad * io::kDegPerRad, solution.height_m, solution.time_correction_s,
-             solution.quality, solution.residual_rms_m);
+             solution.lat_rad * io::kDegPerRad, solution.lon_rad * io::kDegPerRad, solution.height_m,
+             solution.time_correction_s, solution.quality, solution.residual_rms_m);
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A command that ran to its end but produced nothing useful (e.g. `receive` on a file with no fix) leaves with
 // this exception: main prints the message and exits with `code` (3 for "no result"), after the command has
 // written whatever outputs it could.

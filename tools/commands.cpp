@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The one list of `ultratrack`'s subcommands (main.cpp and the command tests register them all from here).
 #include "commands.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The subcommands of `ultratrack`. Each add_*_command registers its options and its callback on the
 // CLI11 app; the callback does the work and throws on bad input (main turns that into one message).
 #pragma once

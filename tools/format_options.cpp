@@ -1,7 +1,7 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "format_options.hpp"
 
 #include "cli_parse.hpp"
-
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The sample-format options every command shares (--format, --2bit-coding, --2bit-order), declared and
 // parsed in this one place so that names, help and messages stay the same (signals/sample_format.hpp).
 #pragma once

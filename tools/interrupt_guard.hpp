@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The one SIGINT and SIGTERM handler of the program: while an InterruptGuard lives, Ctrl-C (or a scheduler's
 // SIGTERM, as Slurm sends at a time limit) requests a stop on its std::stop_token instead of killing the process,
 // so that a command's loop (a pipeline's, the simulator's) can end early and still finish every output. Guards may

@@ -1,8 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack`: one program, one subcommand per job (docs/cli.md lists every flag).
 // Errors from the edges arrive here as exceptions and leave as one line on stderr and a non-zero exit.
-#include <CLI/CLI.hpp>
 #include <fmt/core.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
 

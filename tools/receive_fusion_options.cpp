@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "receive_fusion_options.hpp"
 
 #include <filesystem>
@@ -26,7 +27,8 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
                   "GNSS/INS integration with --imu: loose (PVT fixes), tight (pseudoranges and rates) or "
                   "ultra-tight (the INS-predicted replica drives the channels, the filter updates from correlations)");
   cmd->add_option("--filter", a.filter, "with --coupling: ekf (default) or ukf");
-  cmd->add_option("--align", a.align, "with --coupling: static, motion (default), config or file:ALIGNMENT.json (`ultratrack align`)");
+  cmd->add_option("--align", a.align,
+                  "with --coupling: static, motion (default), config or file:ALIGNMENT.json (`ultratrack align`)");
   cmd->add_option("--fusion-config", a.config,
                   "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
   cmd->add_option("--odometer", a.odometer,
@@ -63,7 +65,8 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
                          "--coupling must be scalar, vector, loose, tight or ultra-tight, got '" + a.coupling + "'");
   s.coupling = *coupling;
   if (!a.vector_carrier.empty()) {
-    if (s.coupling != Coupling::kVector) throw io::InputError("command line", "--vector-carrier needs --coupling vector");
+    if (s.coupling != Coupling::kVector)
+      throw io::InputError("command line", "--vector-carrier needs --coupling vector");
     if (a.vector_carrier == "aided-pll") {
       s.vector_carrier = fusion::VectorCarrier::kAidedPll;
     } else if (a.vector_carrier == "fll") {
@@ -71,23 +74,28 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     } else if (a.vector_carrier == "pll") {
       s.vector_carrier = fusion::VectorCarrier::kPll;
     } else {
-      throw io::InputError("command line", "--vector-carrier must be aided-pll, fll or pll, got '" + a.vector_carrier + "'");
+      throw io::InputError("command line",
+                           "--vector-carrier must be aided-pll, fll or pll, got '" + a.vector_carrier + "'");
     }
   }
   if (!pipelines::uses_imu(s.coupling)) {
     if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty() ||
         !a.imu_pps.empty())
-      throw io::InputError("command line", "--imu, --filter, --align, --fusion-config, --imu-time-origin and "
-                                           "--imu-pps need --coupling loose, tight or ultra-tight");
-    if (!a.ut_measurement.empty()) throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
+      throw io::InputError("command line",
+                           "--imu, --filter, --align, --fusion-config, --imu-time-origin and "
+                           "--imu-pps need --coupling loose, tight or ultra-tight");
+    if (!a.ut_measurement.empty())
+      throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
     if (!a.odometer.empty()) throw io::InputError("command line", "--odometer needs --coupling loose and --imu");
     if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
     if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
     return;
   }
   if (!a.odometer.empty() && s.coupling != Coupling::kLoose)
-    throw io::InputError("command line", "--odometer works with --coupling loose only (tight and ultra-tight do not "
-                                         "carry the odometer states yet); got --coupling " + a.coupling);
+    throw io::InputError("command line",
+                         "--odometer works with --coupling loose only (tight and ultra-tight do not "
+                         "carry the odometer states yet); got --coupling " +
+                             a.coupling);
   if (!a.ut_measurement.empty() && s.coupling != Coupling::kUltraTight)
     throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
   if (a.ut_serial && s.coupling != Coupling::kUltraTight)
@@ -102,7 +110,8 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   } else if (a.ut_measurement == "discriminator") {
     s.ut_form = fusion::UltraTightForm::Discriminator;
   } else {
-    throw io::InputError("command line", "--ut-measurement must be iq or discriminator, got '" + a.ut_measurement + "'");
+    throw io::InputError("command line",
+                         "--ut-measurement must be iq or discriminator, got '" + a.ut_measurement + "'");
   }
   if (a.imu.empty()) throw io::InputError("command line", "--coupling " + a.coupling + " needs --imu FILE");
   s.imu_name = a.imu;
@@ -118,7 +127,8 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   const bool from_file = align.starts_with("file:");  // `ultratrack align`'s result: a configured attitude
   const auto mode = from_file ? std::optional(pipelines::AlignMode::Config) : pipelines::align_mode_from_string(align);
   if (!mode || *mode == pipelines::AlignMode::Attitude)  // attitude alignment is `fuse`'s
-    throw io::InputError("command line", "--align must be static, motion, config or file:ALIGNMENT.json, got '" + align + "'");
+    throw io::InputError("command line",
+                         "--align must be static, motion, config or file:ALIGNMENT.json, got '" + align + "'");
   s.align = *mode;
   if (!a.config.empty()) s.navigation = config::read_fuse_config(a.config);
   if (from_file) pipelines::apply_alignment_file(s.navigation, align.substr(5));
@@ -133,8 +143,9 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
       throw io::InputError(a.config.empty() ? "command line" : a.config, why);
   }
   if (!a.imu_pps.empty() && !a.time_origin.empty())
-    throw io::InputError("command line", "--imu-pps and --imu-time-origin exclude each other (the PPS record sets "
-                                         "the IMU's time origin)");
+    throw io::InputError("command line",
+                         "--imu-pps and --imu-time-origin exclude each other (the PPS record sets "
+                         "the IMU's time origin)");
   if (a.time_origin.empty() || a.time_origin == "sample0") {
     s.imu_time_origin.kind = pipelines::ImuTimeOrigin::Kind::Sample0;
   } else if (a.time_origin == "tow") {

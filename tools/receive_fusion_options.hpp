@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The command-line options of `receive` that choose the coupling and its GNSS/INS settings (--coupling, --imu,
 // --filter, --align, --fusion-config, --imu-time-origin, --imu-pps, --ut-measurement, --ut-serial, --ut-pipelined,
 // --vector-carrier, --odometer), parsed into pipelines::ReceiveOptions, and the IMU file's reader. Errors are
@@ -17,8 +18,8 @@ namespace ultratrack::tools {
 // The command-line text of the coupling options (parsed by apply_receive_coupling_args).
 struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement, vector_carrier;
-  std::string odometer;  // --odometer FILE (loose)
-  std::string imu_pps;  // --imu-pps: the PPS record of the IMU's local clock
+  std::string odometer;    // --odometer FILE (loose)
+  std::string imu_pps;     // --imu-pps: the PPS record of the IMU's local clock
   bool ut_serial = false;  // --ut-serial
   // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
   bool ut_pipelined = true;

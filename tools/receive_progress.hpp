@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `receive`'s progress display on stderr: a bar redrawn every 250 ms on a terminal, a plain line every 10 s of
 // signal otherwise; nothing with --quiet.
 #pragma once

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The two commands of the README, and a plain build:
 #   tools/run.sh demo   install missing Debian packages, build (Release, 2 jobs), run `ultratrack demo`
 #   tools/run.sh test   the same build, then the whole test suite through ctest

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate`'s run of a scenario into a folder (sim/simulation_files.hpp lists the files):
 // sim::simulate_to_folder with scenario.toml = to_toml(scenario), progress lines on a stream, and a stop
 // token (the command's tools/interrupt_guard.hpp).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Runs GNSS-SDR (Debian package gnss-sdr) on an IF file with settings equivalent to ultratrack's defaults,
 # and prints its realtime factor, peak memory and last position. Used by the synthesiser cross-check and
 # by the throughput comparison. Skips (exit 0, message) when gnss-sdr is not installed.

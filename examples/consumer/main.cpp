@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The library from outside the tree: 10 s of the built-in constellation simulated into a folder (sim/), then received
 // from that file with a hot start (pipelines/receive_file.hpp); prints the mean fix and its distance from the truth.
 #include <GeographicLib/LocalCartesian.hpp>
@@ -21,7 +22,7 @@ int main() {
   job.input = dir / "antenna0.i8.bin";
   job.out = dir / "receiver";
   job.source.fs_hz = job.options.receiver.fs_hz = scenario.sample_rate_hz;
-  job.options.receiver.pvt.troposphere = scenario.troposphere;  // correct what the scenario simulates
+  job.options.receiver.pvt.troposphere = scenario.troposphere;         // correct what the scenario simulates
   job.navigation = sim::to_rinex_nav(sim::load_navigation(scenario));  // as a nav file of the day would give it
   pipelines::date_recording(job.options.receiver, job.navigation, scenario.gps_week);
   const pipelines::ReceiveSummary fix = pipelines::receive_file(job).summary;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Ultratrack from Python: the library's runs (simulate, receive, acquire, fuse, attitude) and readers that return
 numpy structured arrays for the files a run writes (readers.py). Every run writes the same files as the
 `ultratrack` command of the same name with the same settings; option names are the command line's with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Readers of the files a run writes, as numpy structured arrays (one field per CSV column, named by the header).
 
 Every reader takes the file itself or the run's folder (then the file's usual name in it; an attitude run's position

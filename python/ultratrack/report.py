@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """A run's results on one HTML page: python3 -m ultratrack.report RUN_DIR [--truth truth.csv] [--out DIR] [--prn N]
 
 Figures (matplotlib, Agg) from the files the run wrote, each skipped when its file is absent: C/N0 per satellite

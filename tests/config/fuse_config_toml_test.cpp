@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The fuse configuration's datasheet IMU keys, lock-out recovery and land-vehicle keys: values reach the
 // FuseConfig, the filter's model is the preset with them put in, and bad values name the file, line and key.
 #include "config/fuse_config_toml.hpp"
@@ -52,10 +53,11 @@ TEST(FuseConfigToml, RecoveryAndVehicleKeys) {
 }
 
 TEST(FuseConfigToml, OdometerKeys) {
-  const auto p = write("odometer.toml",
-                       "[odometer]\nmode = \"always\"\nyaw_rate_threshold_dps = 1.25\nmin_speed_mps = 4\n"
-                       "update_rate_hz = 2\nrate_hz = 10\nlever_arm_body_m = [-1.2, 0, 0.6]\nsigma_scale_factor = 0.02\n"
-                       "sigma_misalignment_deg = 2\nsigma_delay_s = 0.1\nsigma_forward_mps = 0.08\n");
+  const auto p =
+      write("odometer.toml",
+            "[odometer]\nmode = \"always\"\nyaw_rate_threshold_dps = 1.25\nmin_speed_mps = 4\n"
+            "update_rate_hz = 2\nrate_hz = 10\nlever_arm_body_m = [-1.2, 0, 0.6]\nsigma_scale_factor = 0.02\n"
+            "sigma_misalignment_deg = 2\nsigma_delay_s = 0.1\nsigma_forward_mps = 0.08\n");
   const FuseConfig c = read_fuse_config(p);
   EXPECT_EQ(c.odometer.mode, fusion::OdometerMode::kAlways);
   EXPECT_NEAR(c.odometer.yaw_rate_threshold_rad_s, 1.25 * std::numbers::pi / 180.0, 1e-15);

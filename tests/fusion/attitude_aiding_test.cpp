@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GPS attitude aiding (seed 003; seed 000 eqs. 10-17): the measurement model against numerical
 // differentiation and seed 000's published H_G, the innovation across yaw +-180 deg, and closed-loop runs on the
 // trajectory simulator's truth with GPS attitudes simulated from it (truth + Gaussian Euler-angle noise):
@@ -27,7 +28,6 @@
 namespace ultratrack::fusion {
 namespace {
 
-
 Eigen::Matrix3d dcm(const ins::EulerAngles& e) { return ins::quaternion_from_euler(e).toRotationMatrix(); }
 
 // Rotation vector of Ca Cb^T from a DCM pair (independent of ins/ quaternion helpers).
@@ -37,8 +37,9 @@ Eigen::Vector3d rotation_between(const Eigen::Matrix3d& Ca, const Eigen::Matrix3
 }
 
 TEST(AttitudeMeasurement, EulerToRotationMapMatchesNumericalDifferentiation) {
-  for (const ins::EulerAngles e : {ins::EulerAngles{20 * io::kRadPerDeg, -35 * io::kRadPerDeg, 150 * io::kRadPerDeg},
-                                   ins::EulerAngles{-170 * io::kRadPerDeg, 70 * io::kRadPerDeg, -60 * io::kRadPerDeg}}) {
+  for (const ins::EulerAngles e :
+       {ins::EulerAngles{20 * io::kRadPerDeg, -35 * io::kRadPerDeg, 150 * io::kRadPerDeg},
+        ins::EulerAngles{-170 * io::kRadPerDeg, 70 * io::kRadPerDeg, -60 * io::kRadPerDeg}}) {
     const Eigen::Matrix3d M = euler_rate_to_rotation_n(e);
     const double h = 1e-6;
     for (int j = 0; j < 3; ++j) {
@@ -79,7 +80,8 @@ TEST(AttitudeMeasurement, InnovationIsTheInsErrorAcrossYawWrap) {
   StateVector<15> e = StateVector<15>::Zero();
   e << 4, -3, 2, 0.3, -0.2, 0.1, 1e-3, -2e-3, -0.2 * io::kRadPerDeg, 0, 0, 0, 0, 0, 0;
   const NominalState nom = corrected<15>(truth, StateVector<15>(-e));
-  EXPECT_LT(ins::euler_from_quaternion(nom.nav.q_nb).yaw_rad, -179.8 * io::kRadPerDeg);  // INS yaw past 180, truth +179.95
+  EXPECT_LT(ins::euler_from_quaternion(nom.nav.q_nb).yaw_rad,
+            -179.8 * io::kRadPerDeg);  // INS yaw past 180, truth +179.95
   AttitudeAidingOptions o;
   o.q_ba = ins::quaternion_from_euler({1 * io::kRadPerDeg, -0.5 * io::kRadPerDeg, 2 * io::kRadPerDeg});
   GnssAttitude a;
@@ -92,10 +94,11 @@ TEST(AttitudeMeasurement, InnovationIsTheInsErrorAcrossYawWrap) {
   // Noise: a pure yaw sigma maps to the down axis only, a pure roll sigma to the body x axis in NED.
   const Eigen::Matrix3d R = m.R();
   const Eigen::Vector3d roll_axis = dcm(a.euler_a).col(0);
-  const Eigen::Matrix3d Rexp = 0.01 * io::kRadPerDeg * io::kRadPerDeg * (roll_axis * roll_axis.transpose()) +
-                               0.01 * io::kRadPerDeg * io::kRadPerDeg * euler_rate_to_rotation_n(a.euler_a).col(1) *
-                                   euler_rate_to_rotation_n(a.euler_a).col(1).transpose() +
-                               0.04 * io::kRadPerDeg * io::kRadPerDeg * Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
+  const Eigen::Matrix3d Rexp =
+      0.01 * io::kRadPerDeg * io::kRadPerDeg * (roll_axis * roll_axis.transpose()) +
+      0.01 * io::kRadPerDeg * io::kRadPerDeg * euler_rate_to_rotation_n(a.euler_a).col(1) *
+          euler_rate_to_rotation_n(a.euler_a).col(1).transpose() +
+      0.04 * io::kRadPerDeg * io::kRadPerDeg * Eigen::Vector3d::UnitZ() * Eigen::Vector3d::UnitZ().transpose();
   EXPECT_LT((R - Rexp).cwiseAbs().maxCoeff(), 1e-15);
 }
 
@@ -171,7 +174,8 @@ struct AttitudeRun {
 };
 
 AttitudeRun run_attitude_sim(const AttitudeSim& c) {
-  const ins::TrajectorySpec spec = ins::profile_spec(c.profile, c.duration_s, 36.4 * io::kRadPerDeg, 127.4 * io::kRadPerDeg, 80.0);
+  const ins::TrajectorySpec spec =
+      ins::profile_spec(c.profile, c.duration_s, 36.4 * io::kRadPerDeg, 127.4 * io::kRadPerDeg, 80.0);
   const ins::SimulatedRun run = ins::simulate(spec, 100.0);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(c.preset);
@@ -277,11 +281,12 @@ void check_static_heading(FilterKind filter) {
   const std::size_t last_minute = with.t_s.size() - 60;
   const double yaw_rms = rms_axis(with.att_err_rad, 2, last_minute);
   const double yaw_sigma = with.att_sigma_rad.back().z();
-  std::printf("static MEMS %s: with GPS attitude yaw RMS (last 60 s) %.6f deg, final error %.4f deg, 1-sigma %.4f deg"
-              " (GPS yaw sigma %.2f deg); without: final error %.2f deg, 1-sigma %.1f deg\n",
-              filter == FilterKind::Ekf ? "EKF" : "UKF", yaw_rms / io::kRadPerDeg, with.att_err_rad.back().z() / io::kRadPerDeg,
-              yaw_sigma / io::kRadPerDeg, c.sigma_euler_rad.z() / io::kRadPerDeg, without.att_err_rad.back().z() / io::kRadPerDeg,
-              without.att_sigma_rad.back().z() / io::kRadPerDeg);
+  std::printf(
+      "static MEMS %s: with GPS attitude yaw RMS (last 60 s) %.6f deg, final error %.4f deg, 1-sigma %.4f deg"
+      " (GPS yaw sigma %.2f deg); without: final error %.2f deg, 1-sigma %.1f deg\n",
+      filter == FilterKind::Ekf ? "EKF" : "UKF", yaw_rms / io::kRadPerDeg, with.att_err_rad.back().z() / io::kRadPerDeg,
+      yaw_sigma / io::kRadPerDeg, c.sigma_euler_rad.z() / io::kRadPerDeg,
+      without.att_err_rad.back().z() / io::kRadPerDeg, without.att_sigma_rad.back().z() / io::kRadPerDeg);
   EXPECT_LT(yaw_rms, c.sigma_euler_rad.z());
   EXPECT_LE(yaw_sigma, c.sigma_euler_rad.z());
   EXPECT_LT(std::abs(with.att_err_rad.back().z()), 4.0 * yaw_sigma);
@@ -322,11 +327,12 @@ TEST(AttitudeAiding, DropoutsStayConsistentAndAreCounted) {
       inside3 += ratio <= 3.0;
       ++n;
     }
-  std::printf("dropouts: %lld attitudes given, %lld dropped, %lld accepted, %lld rejected, %lld fallbacks of %lld "
-              "fixes; worst |error|/sigma %.2f, %.1f %% inside 3 sigma; final yaw error %.4f deg (1-sigma %.4f)\n",
-              r.attitudes_given, r.attitudes_dropped, r.counters.attitude_accepted, r.counters.attitude_rejected,
-              r.counters.fixes_without_attitude, r.counters.epochs, worst, 100.0 * inside3 / n,
-              r.att_err_rad.back().z() / io::kRadPerDeg, r.att_sigma_rad.back().z() / io::kRadPerDeg);
+  std::printf(
+      "dropouts: %lld attitudes given, %lld dropped, %lld accepted, %lld rejected, %lld fallbacks of %lld "
+      "fixes; worst |error|/sigma %.2f, %.1f %% inside 3 sigma; final yaw error %.4f deg (1-sigma %.4f)\n",
+      r.attitudes_given, r.attitudes_dropped, r.counters.attitude_accepted, r.counters.attitude_rejected,
+      r.counters.fixes_without_attitude, r.counters.epochs, worst, 100.0 * inside3 / n,
+      r.att_err_rad.back().z() / io::kRadPerDeg, r.att_sigma_rad.back().z() / io::kRadPerDeg);
   EXPECT_LT(worst, 4.0);
   EXPECT_GE(static_cast<double>(inside3) / n, 0.95);
   EXPECT_GE(r.attitudes_dropped, 10 + 20);  // the gap plus about a fifth of the rest

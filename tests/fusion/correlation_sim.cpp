@@ -1,12 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "correlation_sim.hpp"
 
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
-#include <cstdio>
 
 #include "fusion_sim.hpp"
 #include "ins/imu_error_model.hpp"
@@ -44,7 +45,8 @@ IqTaps ideal_correlation(const std::vector<double>& code, const std::vector<doub
 }
 
 CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg) {
-  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s + 1.0, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
+  const ins::TrajectorySpec spec =
+      ins::profile_spec(cfg.profile, cfg.duration_s + 1.0, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
   const ins::SimulatedRun run = ins::simulate(spec, cfg.imu_rate_hz);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(cfg.imu_preset);
@@ -82,8 +84,8 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
   // The satellites: highest elevation at the start.
   std::vector<signals::Ephemeris> eph;
   {
-    SimulatedEpoch e0 = simulate_epoch(interp, cfg.lever_arm_b, constellation.ephemerides, no_iono, origin, 0.0,
-                                       clock_at(0.0));
+    SimulatedEpoch e0 =
+        simulate_epoch(interp, cfg.lever_arm_b, constellation.ephemerides, no_iono, origin, 0.0, clock_at(0.0));
     auto& obs = e0.epoch.observations;
     std::sort(obs.begin(), obs.end(), [](const auto& a, const auto& b) { return a.cn0_dbhz > b.cn0_dbhz; });
     for (std::size_t i = 0; i < obs.size() && static_cast<int>(i) < cfg.max_satellites; ++i)
@@ -150,9 +152,12 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
         const double t0 = replicas.empty() ? t1 - T : replicas.front().t_start_s;
         const double tm = 0.5 * (t0 + t1);
         const bool blocked = tm >= cfg.blockage_start_s && tm < cfg.blockage_start_s + cfg.blockage_length_s;
-        const SimulatedEpoch s0 = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t0, clock_at(t0), cfg.troposphere);
-        const SimulatedEpoch sm = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, tm, clock_at(tm), cfg.troposphere);
-        const SimulatedEpoch s1 = simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t1, clock_at(t1), cfg.troposphere);
+        const SimulatedEpoch s0 =
+            simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t0, clock_at(t0), cfg.troposphere);
+        const SimulatedEpoch sm =
+            simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, tm, clock_at(tm), cfg.troposphere);
+        const SimulatedEpoch s1 =
+            simulate_epoch(interp, cfg.lever_arm_b, eph, no_iono, origin, t1, clock_at(t1), cfg.troposphere);
         corr.clear();
         double max_code = 0.0, max_freq = 0.0;
         for (const ReplicaCommand& r : replicas) {
@@ -208,8 +213,10 @@ CorrelationRunResult run_correlation_simulation(const CorrelationSimConfig& cfg)
             const double theta = std::atan2(cc.taps.q[1], cc.taps.i[1]);
             pll.integrator_hz += wn * wn * theta * T / (2.0 * M_PI);
             pll.correction_hz = pll.integrator_hz + 2.0 * 0.707 * wn * theta / (2.0 * M_PI);
-            if (!cfg.tell_start_phase) cc.start_phase_var_rad2 = 0.0;
-            else cc.start_phase_var_rad2 = cfg.pll_bw_hz / std::pow(10.0, 0.1 * cfg.cn0_dbhz);
+            if (!cfg.tell_start_phase)
+              cc.start_phase_var_rad2 = 0.0;
+            else
+              cc.start_phase_var_rad2 = cfg.pll_bw_hz / std::pow(10.0, 0.1 * cfg.cn0_dbhz);
           }
           corr.push_back(cc);
         }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Correlation-level simulator for the ultra-tight tests: a true trajectory (ins trajectory simulator, IMU with
 // an ins/imu_error_model preset), a true receiver clock (bias/drift random walks) and the nominal constellation
 // give each satellite's true pseudorange over every integration period (fusion_sim's simulate_epoch at its
@@ -25,7 +26,7 @@ struct CorrelationSimConfig {
   Eigen::Vector3d lever_arm_b{1.0, 0.3, -1.2};
   double integration_time_s = 0.020;
   double cn0_dbhz = 45.0;
-  int max_satellites = 8;  // highest elevation first
+  int max_satellites = 8;                                  // highest elevation first
   double blockage_start_s = 1e9, blockage_length_s = 0.0;  // every signal absent in [start, start + length)
   FilterKind filter = FilterKind::Ekf;
   UltraTightForm form = UltraTightForm::Iq;
@@ -60,11 +61,11 @@ struct CorrelationRunResult {
   std::vector<double> nees;                  // 17-state NEES
   std::vector<double> max_code_err_chips;    // over the satellites, true error of the replica at mid-period
   std::vector<double> max_freq_err_hz;
-  std::vector<int> coasting;                 // satellites reported coasting at the period's start
-  std::vector<double> nis;                   // every satellite update's NIS (accepted or not), in order
+  std::vector<int> coasting;                            // satellites reported coasting at the period's start
+  std::vector<double> nis;                              // every satellite update's NIS (accepted or not), in order
   Eigen::Matrix<double, 17, 1> last_error, last_sigma;  // error state and filter 1-sigma at the end
   int satellites = 0;
-  double cpu_s = 0.0;                        // filter time (start/finish_period + IMU)
+  double cpu_s = 0.0;  // filter time (start/finish_period + IMU)
   UltraTightCounters counters;
 };
 

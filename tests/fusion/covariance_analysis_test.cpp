@@ -1,13 +1,14 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Seed 001 covariance analysis: the tight EKF's position 1-sigma is bracketed by two independent batch
 // bounds built from the same satellite geometry (the single-epoch least-squares fix at that time above, the
 // "frozen" vehicle that has all epochs measuring one constant position below), and the UKF equals the EKF on
 // this (linear dynamics, almost linear range) model.
+#include "fusion/covariance_analysis.hpp"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <cmath>
-
-#include "fusion/covariance_analysis.hpp"
 
 namespace {
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // INS error-state model and measurement Jacobians against numerical differentiation of the full nonlinear
 // functions: the strapdown mechanisation (ins::Strapdown) for F, the antenna position/velocity and the
 // pseudorange/rate predictions for H, each around a nominal INS state that is not the truth.
@@ -22,7 +23,6 @@
 
 namespace ultratrack::fusion {
 namespace {
-
 
 ins::NavState moving_state() {
   ins::NavState s;
@@ -51,9 +51,9 @@ TEST(InsErrorModel, TransitionMatchesNumericalDifferentiationOfMechanisation) {
   truth.nav = moving_state();
   truth.clock_drift_mps = 3.0;
   const NominalState truth1 = step(truth, w_b, f_b, dt);
-  const StateVector<17> eps = (StateVector<17>() << 1, 1, 1, 0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4,
-                               1e-6, 1e-6, 1e-6, 1.0, 0.1)
-                                  .finished();
+  const StateVector<17> eps =
+      (StateVector<17>() << 1, 1, 1, 0.01, 0.01, 0.01, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6, 1.0, 0.1)
+          .finished();
   StateMatrix<17> Phi_num;
   for (int j = 0; j < 17; ++j) {
     StateVector<17> col = StateVector<17>::Zero();
@@ -92,7 +92,7 @@ TEST(InsErrorModel, TransitionMatchesNumericalDifferentiationOfMechanisation) {
     }
   }
   // The sensitive couplings are really there (not a trivially passing zero model).
-  EXPECT_GT(std::abs(F(ix::kVel + 0, ix::kAtt + 1)), 9.0);  // f_D x psi
+  EXPECT_GT(std::abs(F(ix::kVel + 0, ix::kAtt + 1)), 9.0);   // f_D x psi
   EXPECT_GT(std::abs(F(ix::kPos + 0, ix::kPos + 2)), 1e-5);  // v_N / R coupling of height into north
 }
 
@@ -156,8 +156,8 @@ TEST(TightMeasurement, JacobianMatchesNumericalDifferentiation) {
   const ins::SimulatedRun run = ins::simulate(spec, 100.0);
   const ins::TruthInterpolator interp(run.truth);
   const Eigen::Vector3d lever(1.5, -0.4, -2.0), w(0.2, -0.1, 0.3);
-  const auto se = test::simulate_epoch(interp, lever, constellation.ephemerides, constellation.klobuchar, t0, 1.0,
-                                       {1200.0, 15.0});
+  const auto se =
+      test::simulate_epoch(interp, lever, constellation.ephemerides, constellation.klobuchar, t0, 1.0, {1200.0, 15.0});
   TightOptions to;
   const auto sats = prepare_satellites(se.epoch, constellation.ephemerides, constellation.klobuchar,
                                        antenna_position_e(nom.nav, lever), to);
@@ -174,8 +174,7 @@ TEST(TightMeasurement, JacobianMatchesNumericalDifferentiation) {
   EXPECT_EQ(m.size(), 2 * static_cast<int>(sats.size()));
   for (const auto& s : sats) {
     const SatelliteMeasurement17 one(nom, s, lever, w, true);
-    EXPECT_LT((one.H(StateVector<17>::Zero()) - numerical_jacobian<17>(one, steps)).cwiseAbs().maxCoeff(),
-              1e-4);
+    EXPECT_LT((one.H(StateVector<17>::Zero()) - numerical_jacobian<17>(one, steps)).cwiseAbs().maxCoeff(), 1e-4);
   }
 }
 
@@ -204,9 +203,9 @@ TEST(TightMeasurement, SigmaPointFormEqualsCorrectedNominalComposition) {
       for (const double scale : {1e-3, 1.0, 100.0}) {
         for (int trial = 0; trial < 20; ++trial) {
           StateVector<17> dx = StateVector<17>::Random();
-          dx.segment<3>(ix::kPos) *= 10.0 * scale;     // m
-          dx.segment<3>(ix::kVel) *= 1.0 * scale;      // m/s
-          dx.segment<3>(ix::kAtt) *= 1e-3 * scale;     // rad
+          dx.segment<3>(ix::kPos) *= 10.0 * scale;  // m
+          dx.segment<3>(ix::kVel) *= 1.0 * scale;   // m/s
+          dx.segment<3>(ix::kAtt) *= 1e-3 * scale;  // rad
           dx.segment<3>(ix::kAccelBias) *= 1e-2;
           dx.segment<3>(ix::kGyroBias) *= 1e-4 * scale;
           dx(ix::kClockBias) *= 30.0 * scale;
@@ -233,14 +232,14 @@ TEST(TightMeasurement, SigmaPointFormEqualsCorrectedNominalComposition) {
 TEST(TightMeasurement, PredictionAtTruthReproducesSimulatedObservables) {
   const signals::GpsTime t0{2300, 300000.0};
   const auto constellation = signals::nominal_constellation(t0);
-  const ins::TrajectorySpec spec = ins::profile_spec("circle", 20.0, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 300.0);
+  const ins::TrajectorySpec spec =
+      ins::profile_spec("circle", 20.0, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 300.0);
   const ins::SimulatedRun run = ins::simulate(spec, 100.0);
   const ins::TruthInterpolator interp(run.truth);
   const Eigen::Vector3d lever(0.5, 0.2, -1.0);
   const double t = 10.0;
   const test::TruthClock clock{-2500.0, 40.0};
-  const auto se =
-      test::simulate_epoch(interp, lever, constellation.ephemerides, constellation.klobuchar, t0, t, clock);
+  const auto se = test::simulate_epoch(interp, lever, constellation.ephemerides, constellation.klobuchar, t0, t, clock);
   const ins::EcefMotion ant = interp.antenna(t, lever);
   const auto sats = prepare_satellites(se.epoch, constellation.ephemerides, constellation.klobuchar, ant.r_e, {});
   ASSERT_GE(sats.size(), 5u);

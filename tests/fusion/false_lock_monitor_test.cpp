@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // fusion::FalseLockMonitor: both averagings against hand-computed means, and the block averaging with the
 // ultra-tight loop's settings against closed forms on simulated offsets.
 #include "fusion/false_lock_monitor.hpp"
@@ -22,7 +23,7 @@ TEST(FalseLockMonitor, BlockMeansByHand) {
   EXPECT_DOUBLE_EQ(m.recent_hz(), 3.0);
   EXPECT_EQ(m.epochs(), 0);
   m.reset(2);
-  EXPECT_DOUBLE_EQ(m.mean_hz(), 3.0);   // the last block's mean stays until the next one
+  EXPECT_DOUBLE_EQ(m.mean_hz(), 3.0);    // the last block's mean stays until the next one
   EXPECT_DOUBLE_EQ(m.recent_hz(), 3.0);  // no epoch since the reset: the block mean
   EXPECT_FALSE(m.add(100.0, 0.02));
   EXPECT_FALSE(m.add(100.0, 0.02));
@@ -53,12 +54,12 @@ TEST(FalseLockMonitor, RunningMeanByHand) {
   EXPECT_EQ(m.mean_hz(), -7.0);
 }
 
-// The block monitor with the ultra-tight loop's settings (1 s blocks of 20 ms epochs) against closed forms. A locked channel: per-epoch offsets with the 0.46 Hz standard
-// deviation measured at 18 dB-Hz (cn0_18_file_0, 9 locked channels) and a 0.3 Hz bias: every 1 s block mean lies
-// within the bias +- 5 sigma of a 50-epoch mean (0.33 Hz; white, so a bound, not a sampling estimate), far inside
-// the 5 Hz threshold. A runaway: offsets ramping at 8 Hz/s from 0 (runaways seen drift 3-25 Hz/s): a block's mean
-// is the ramp at its middle (4 Hz for the first, 12 Hz for the second, which is caught), and recent_hz the ramp at
-// the middle of the last 5 epochs.
+// The block monitor with the ultra-tight loop's settings (1 s blocks of 20 ms epochs) against closed forms. A locked
+// channel: per-epoch offsets with the 0.46 Hz standard deviation measured at 18 dB-Hz (cn0_18_file_0, 9 locked
+// channels) and a 0.3 Hz bias: every 1 s block mean lies within the bias +- 5 sigma of a 50-epoch mean (0.33 Hz; white,
+// so a bound, not a sampling estimate), far inside the 5 Hz threshold. A runaway: offsets ramping at 8 Hz/s from 0
+// (runaways seen drift 3-25 Hz/s): a block's mean is the ramp at its middle (4 Hz for the first, 12 Hz for the second,
+// which is caught), and recent_hz the ramp at the middle of the last 5 epochs.
 TEST(FalseLockMonitor, BlockMeansOfLockedNoiseStayNearTheBiasAndARampIsCaughtWithItsCurrentOffset) {
   constexpr double kT = 0.020, kAverage = 1.0, kSigma = 0.46, kBias = 0.3;
   std::mt19937 rng(11);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Generic filters: chi-square values, discretisation against closed forms, UKF == linear Kalman filter on a
 // linear-Gaussian model, gating, and NEES consistency of both filters over a 100-run Monte Carlo on a
 // nonlinear (range-bearing) model.
@@ -6,11 +7,11 @@
 #include <cmath>
 #include <random>
 
-#include "receiver/chi_square.hpp"
 #include "fusion/discretisation.hpp"
 #include "fusion/ekf.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/ukf.hpp"
+#include "receiver/chi_square.hpp"
 
 namespace ultratrack::fusion {
 namespace {
@@ -257,8 +258,8 @@ std::vector<double> nees_monte_carlo(int runs, int steps, typename Filter::Matri
   proc.q = 0.01;
   const double dt = 1.0;
   // Exact discrete noise of the truth, same as the filters' model.
-  const DiscreteProcess<4> d = discretise<4>(proc.F({}), proc.G({}) * proc.Qc() * proc.G({}).transpose(), dt,
-                                             Discretisation::VanLoan);
+  const DiscreteProcess<4> d =
+      discretise<4>(proc.F({}), proc.G({}) * proc.Qc() * proc.G({}).transpose(), dt, Discretisation::VanLoan);
   const Eigen::Matrix4d Lq = d.Qd.llt().matrixL();
   const Eigen::Matrix4d L0 = P0.llt().matrixL();
   for (int run = 0; run < runs; ++run) {
@@ -283,7 +284,8 @@ std::vector<double> nees_monte_carlo(int runs, int steps, typename Filter::Matri
 TEST(Filters, NeesOfBothFiltersInChiSquareBandOnNonlinearModel) {
   const int runs = 100, steps = 40, n = 4;
   // Run-averaged NEES: runs * mean ~ chi2(runs * n). 95 % two-sided band.
-  const double lo = receiver::chi_square_lower_quantile(runs * n, 0.025) / runs, hi = receiver::chi_square_lower_quantile(runs * n, 0.975) / runs;
+  const double lo = receiver::chi_square_lower_quantile(runs * n, 0.025) / runs,
+               hi = receiver::chi_square_lower_quantile(runs * n, 0.975) / runs;
   StateMatrix<4> P0 = Eigen::Vector4d(25.0, 25.0, 1.0, 1.0).asDiagonal();
   auto ekf_mean = nees_monte_carlo<Ekf<4>>(runs, steps, P0, [] {
     EkfOptions o;

@@ -1,5 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // In-motion alignment: the levelling equation against random attitudes (closed form, exact), and whole
 // alignments on simulated trajectories against the simulator's truth attitude.
+#include "fusion/fuse_motion_alignment.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,7 +10,6 @@
 #include <random>
 #include <vector>
 
-#include "fusion/fuse_motion_alignment.hpp"
 #include "ins/attitude.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/trajectory.hpp"

@@ -1,8 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "fusion_sim.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
-
 #include <Eigen/Cholesky>
+#include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -67,8 +67,8 @@ double rms(const std::vector<double>& v, std::size_t from) {
 
 SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::Vector3d& lever_arm_b,
                               const std::vector<signals::Ephemeris>& ephemerides,
-                              const signals::KlobucharParameters& iono, const signals::GpsTime& origin,
-                              double t_true_s, const TruthClock& clock, bool troposphere) {
+                              const signals::KlobucharParameters& iono, const signals::GpsTime& origin, double t_true_s,
+                              const TruthClock& clock, bool troposphere) {
   SimulatedEpoch out;
   out.t_true_s = t_true_s;
   out.epoch.receive_time = signals::add_seconds(origin, t_true_s + clock.bias_m / kC);
@@ -109,15 +109,15 @@ SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::
     o.doppler_hz = -rate / signals::kL1Wavelength_m;
     o.cn0_dbhz = 30.0 + 20.0 * std::sin(el);  // for ordering (highest first); the tests weight uniformly
     out.epoch.observations.push_back(o);
-    out.los_ned.emplace_back(std::cos(el) * std::cos(az0), std::cos(el) * std::sin(az0),
-                             -std::sin(el));
+    out.los_ned.emplace_back(std::cos(el) * std::cos(az0), std::cos(el) * std::sin(az0), -std::sin(el));
   }
   return out;
 }
 
 RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion::FilterKind filter) {
   const bool tight = coupling == fusion::Coupling::kTight;
-  const ins::TrajectorySpec spec = ins::profile_spec(cfg.profile, cfg.duration_s, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
+  const ins::TrajectorySpec spec =
+      ins::profile_spec(cfg.profile, cfg.duration_s, 37.0 * io::kRadPerDeg, 127.0 * io::kRadPerDeg, 100.0);
   const ins::SimulatedRun run = ins::simulate(spec, cfg.imu_rate_hz);
   const ins::TruthInterpolator interp(run.truth);
   const ins::ImuErrorSpec imu_spec = ins::imu_preset(cfg.imu_preset);
@@ -217,7 +217,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
         const ins::EcefMotion ant = interp.antenna(t_true, cfg.lever_arm_b);
         if (!tight) {
           Eigen::Vector3d noise = cfg.sigma_pos_ned_m.cwiseProduct(gauss3());
-          if (t_true >= cfg.bias_start_s && t_true < cfg.bias_start_s + cfg.bias_length_s) noise += cfg.bias_offset_ned_m;
+          if (t_true >= cfg.bias_start_s && t_true < cfg.bias_start_s + cfg.bias_length_s)
+            noise += cfg.bias_offset_ned_m;
           double lat, lon, h;
           geodetic(ant.r_e, lat, lon, h);
           const Eigen::Vector3d r_noisy = ant.r_e + ins::C_en(lat, lon) * noise;
@@ -235,7 +236,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
           SimulatedEpoch se = simulate_epoch(interp, cfg.lever_arm_b, constellation.ephemerides,
                                              constellation.klobuchar, origin, t_true, ck);
           auto& obs = se.epoch.observations;
-          if (cfg.max_satellites > 0 && t_true >= cfg.reduce_after_s && static_cast<int>(obs.size()) > cfg.max_satellites) {
+          if (cfg.max_satellites > 0 && t_true >= cfg.reduce_after_s &&
+              static_cast<int>(obs.size()) > cfg.max_satellites) {
             std::vector<std::size_t> order(obs.size());
             for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
             std::sort(order.begin(), order.end(),
@@ -281,12 +283,11 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
           receiver::PvtOptions po;
           po.fault_exclusion = false;
           po.sigma_zenith_m = cfg.sigma_range_m;
-          const receiver::PvtSolution pvt =
-              receiver::solve_pvt(sm, se.epoch.receive_time, constellation.klobuchar, po);
-          if (pvt.valid && t_true >= cfg.reduce_after_s && (cfg.max_satellites > 0 || !cfg.keep_prns.empty())) ++res.pvt_fixes_reduced;
+          const receiver::PvtSolution pvt = receiver::solve_pvt(sm, se.epoch.receive_time, constellation.klobuchar, po);
+          if (pvt.valid && t_true >= cfg.reduce_after_s && (cfg.max_satellites > 0 || !cfg.keep_prns.empty()))
+            ++res.pvt_fixes_reduced;
           if (pvt.valid) {
-            const Eigen::Vector3d d_n =
-                ins::C_en(pvt.lat_rad, pvt.lon_rad).transpose() * (pvt.r_e_m - ant.r_e);
+            const Eigen::Vector3d d_n = ins::C_en(pvt.lat_rad, pvt.lon_rad).transpose() * (pvt.r_e_m - ant.r_e);
             res.gnss_err_h_m.push_back(std::hypot(d_n.x(), d_n.y()));
             res.gnss_err_3d_m.push_back(d_n.norm());
           }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Simulation harness for the fusion tests: an ins/ trajectory with a corrupted IMU (ins/imu_error_model
 // preset), GNSS fixes or pseudoranges/Doppler simulated from the truth with known noise, an integration run
 // and its error statistics against the truth. Independent of the filter code under test.
@@ -55,19 +56,19 @@ struct SimConfig {
 };
 
 struct RunResult {
-  std::vector<double> t_s;                 // at each GNSS epoch (after its update)
-  std::vector<Eigen::Vector3d> pos_err_m;  // INS (IMU point) NED error at those times
-  std::vector<double> nees;                // full error-state NEES at those times
-  std::vector<double> nees_nav;            // position/velocity/attitude (9) NEES
+  std::vector<double> t_s;                          // at each GNSS epoch (after its update)
+  std::vector<Eigen::Vector3d> pos_err_m;           // INS (IMU point) NED error at those times
+  std::vector<double> nees;                         // full error-state NEES at those times
+  std::vector<double> nees_nav;                     // position/velocity/attitude (9) NEES
   std::vector<double> gnss_err_h_m, gnss_err_3d_m;  // GNSS-only solution error (fix noise / PVT)
-  double outage_drift_h_m = 0.0;           // horizontal error at the end of the outage
-  double outage_sigma_h_m = 0.0;           // filter's horizontal 1-sigma there
+  double outage_drift_h_m = 0.0;                    // horizontal error at the end of the outage
+  double outage_sigma_h_m = 0.0;                    // filter's horizontal 1-sigma there
   long long accepted = 0, rejected = 0;
   int state_size = 15;
-  std::vector<Eigen::Vector3d> sigma_pos_m;  // filter's NED 1-sigma at the recorded times
+  std::vector<Eigen::Vector3d> sigma_pos_m;           // filter's NED 1-sigma at the recorded times
   std::vector<std::vector<Eigen::Vector3d>> los_ned;  // tight: unit vectors to the satellites used, per record
   std::vector<std::vector<int>> prns;                 // ... and their PRNs
-  long long pvt_fixes_reduced = 0;           // tight: GNSS-only fixes from reduce_after_s on
+  long long pvt_fixes_reduced = 0;                    // tight: GNSS-only fixes from reduce_after_s on
   fusion::IntegrationCounters counters;
 };
 
@@ -88,11 +89,11 @@ struct TruthClock {
 struct SimulatedEpoch {
   receiver::ObservationEpoch epoch;
   std::vector<Eigen::Vector3d> los_ned;  // receiver -> satellite unit vectors (NED), one per observation
-  double t_true_s = 0.0;  // GPS time of the epoch on the run's time line
+  double t_true_s = 0.0;                 // GPS time of the epoch on the run's time line
 };
 SimulatedEpoch simulate_epoch(const ins::TruthInterpolator& truth, const Eigen::Vector3d& lever_arm_b,
                               const std::vector<signals::Ephemeris>& ephemerides,
-                              const signals::KlobucharParameters& iono, const signals::GpsTime& origin,
-                              double t_true_s, const TruthClock& clock, bool troposphere = true);
+                              const signals::KlobucharParameters& iono, const signals::GpsTime& origin, double t_true_s,
+                              const TruthClock& clock, bool troposphere = true);
 
 }  // namespace ultratrack::fusion::test

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Seed 001 I&Q measurement model: closed forms (amplitude, eq. 7's integral, tap noise correlation from the real
 // C/A code), Jacobians against numerical differentiation, the information of the linearised taps equal to the
 // first-order discriminator variances, a Monte Carlo of the discriminators against their closed-form noise,
@@ -375,9 +376,9 @@ TEST(IqMeasurement17, BadSettingsAreInputErrors) {
 // millisecond, so one start samples each chip at the same 2-3 fractions and the result depends on where the chip
 // transitions fall (off by up to 0.01 from one start, 0.0096 for PRN 8 at x = 0.2). In the receiver code Doppler
 // moves the grid; here the correlation is averaged over M evenly spaced grid offsets (start + j q / M, q = 1023 /
-// 2600 chip the sample step), which together form one uniform grid of spacing h = q / M over the period. Bound (exact, from that grid,
-// for |x| <= 1): the replica is in the neighbouring chip for the samples of chip i that lie in an interval of
-// length |x|, whose count is |x| / h +- less than 1, so the mean differs from 1 - |x| (1 - R1) by less than
+// 2600 chip the sample step), which together form one uniform grid of spacing h = q / M over the period. Bound (exact,
+// from that grid, for |x| <= 1): the replica is in the neighbouring chip for the samples of chip i that lie in an
+// interval of length |x|, whose count is |x| / h +- less than 1, so the mean differs from 1 - |x| (1 - R1) by less than
 // h (1 - R1) (1.6e-3 at M = 256). The ideal triangle is off by 0.031 at the E/L offset for PRN 15 and 24
 // (+63/1023 at one chip), which the bound excludes.
 TEST(IqModel, CodeCorrelationMatchesTheSampledCaCode) {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // No gate lock-out (fusion/lockout_recovery.hpp): the monitor's two triggers, the covariance it opens, and the
 // integration's recovery from a start 50 m and 20 deg off and from a 30 s burst of fixes 200 m off, each beside
 // the same run without recovery to show the lock-out the recovery removes.

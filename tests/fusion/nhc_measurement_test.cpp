@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Non-holonomic constraints (fusion/nhc_measurement.hpp): the Jacobian against central differences of h, and
 // the constraint's zero on a vehicle moving along its own x axis.
 #include "fusion/nhc_measurement.hpp"

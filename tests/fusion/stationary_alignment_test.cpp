@@ -1,8 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Seed 000's stationary alignment: the 12-state model against the 15-state INS error model at rest, H_G (eq. 16)
 // against a numerical derivative of the exact Euler difference, the observability rank (eqs. 18-20: 12 at
 // generic attitudes, less at pitch 90 deg or with one of the two measurements alone), and closed-loop alignments
 // on closed-form IMU increments of a vehicle at rest (HG1700AE errors drawn per run, GPS attitude = truth + white
 // Euler noise): errors inside the filter's sigmas, EKF and UKF alike.
+#include "fusion/stationary_alignment.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +13,6 @@
 
 #include "fusion/alignment_observability.hpp"
 #include "fusion/ins_error_model.hpp"
-#include "fusion/stationary_alignment.hpp"
 #include "fusion/stationary_alignment_model.hpp"
 #include "ins/attitude.hpp"
 #include "ins/earth_model.hpp"
@@ -83,8 +85,10 @@ TEST(AlignmentObservability, RankDropsAtPitch90AndWithOneMeasurementAlone) {
     EXPECT_NEAR(r.weakest_direction.norm(), 1.0, 1e-12);
   }
   const ins::EulerAngles generic{0.1, 0.2, 0.3};
-  EXPECT_LT(alignment_observability(generic, hg1700_model(0.6), {.zero_velocity = true, .gps_attitude = false}).rank, 12);
-  EXPECT_LT(alignment_observability(generic, hg1700_model(0.6), {.zero_velocity = false, .gps_attitude = true}).rank, 12);
+  EXPECT_LT(alignment_observability(generic, hg1700_model(0.6), {.zero_velocity = true, .gps_attitude = false}).rank,
+            12);
+  EXPECT_LT(alignment_observability(generic, hg1700_model(0.6), {.zero_velocity = false, .gps_attitude = true}).rank,
+            12);
 }
 
 // Closed-form increments of a vehicle at rest (earth rate and gravity only), corrupted by an HG1700AE drawn from

@@ -1,9 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tight integration with only 3 satellites for 480 s after a 120 s convergence (land-vehicle profile, HG1700AE,
 // clock truth and model from the same oscillator preset). "Bounded" (docs/validation.md, issue 6): over the last
 // 60 s the horizontal 1-sigma changes by less than 5 % (vertical 10 %) and both stay below the closed-form
-// bound, and the error stays within 3 sigma. The bound: the single-epoch least-squares covariance of (north, east, down, clock) from
-// the 3 pseudoranges (sigma_range) and one height row whose sigma is the terrain model's total (sigma0, the
-// terrain sigma, the held height's sigma): the filter holds at least that information at every epoch (the
+// bound, and the error stays within 3 sigma. The bound: the single-epoch least-squares covariance of (north, east,
+// down, clock) from the 3 pseudoranges (sigma_range) and one height row whose sigma is the terrain model's total
+// (sigma0, the terrain sigma, the held height's sigma): the filter holds at least that information at every epoch (the
 // terrain state's variance never exceeds its stationary value plus the held part), so its horizontal 1-sigma
 // cannot exceed the bound's. Without aiding the 3x4 geometry has a null direction and the error grows; the
 // GNSS-only solver never fixes with 3 satellites (nothing for loose coupling). Also: the clock model's Q.
@@ -142,13 +143,13 @@ std::vector<int> best_triple(std::uint64_t seed) {
 }
 
 void print(const char* what, const Stats& s, const RunResult& r) {
-  std::printf("%s: horizontal 1-sigma %.2f -> %.2f m over the last 60 s (bound %.2f m), max error there %.2f m; "
-              "vertical 1-sigma %.2f -> %.2f m (bound %.2f m), max error %.2f m; "
-              "worst |e_h|/sigma_h %.2f, worst axis |e|/sigma %.2f, height aids %lld/%lld, PVT fixes %lld\n",
-              what, s.sigma_h_prev60_m, s.sigma_h_end_m, s.bound_h_m, s.max_h_last60_m, s.sigma_v_prev60_m,
-              s.sigma_v_end_m, s.bound_v_m, s.max_v_last60_m, s.worst_h_ratio,
-              s.worst_ratio, r.counters.height_accepted, r.counters.height_accepted + r.counters.height_rejected,
-              r.pvt_fixes_reduced);
+  std::printf(
+      "%s: horizontal 1-sigma %.2f -> %.2f m over the last 60 s (bound %.2f m), max error there %.2f m; "
+      "vertical 1-sigma %.2f -> %.2f m (bound %.2f m), max error %.2f m; "
+      "worst |e_h|/sigma_h %.2f, worst axis |e|/sigma %.2f, height aids %lld/%lld, PVT fixes %lld\n",
+      what, s.sigma_h_prev60_m, s.sigma_h_end_m, s.bound_h_m, s.max_h_last60_m, s.sigma_v_prev60_m, s.sigma_v_end_m,
+      s.bound_v_m, s.max_v_last60_m, s.worst_h_ratio, s.worst_ratio, r.counters.height_accepted,
+      r.counters.height_accepted + r.counters.height_rejected, r.pvt_fixes_reduced);
 }
 
 void print_geometry(const char* what, const RunResult& r) {
@@ -156,9 +157,11 @@ void print_geometry(const char* what, const RunResult& r) {
     if (r.t_s[i] < kReduce_s + 1.0 || std::fmod(r.t_s[i], 60.0) > 1.0) continue;
     const Eigen::Vector4d n = null_direction(r.los_ned[i]);
     const Eigen::Matrix4d C = snapshot_covariance(r.los_ned[i], 1.0, 1.0);
-    std::printf("%s, t %.0f s, PRN %d %d %d: null direction (n, e, d, clock) %.3f %.3f %.3f %.3f; with a height "
-                "row (1 m, ranges 1 m) HDOP %.2f VDOP %.2f\n", what, r.t_s[i], r.prns[i][0], r.prns[i][1],
-                r.prns[i][2], n(0), n(1), n(2), n(3), std::sqrt(C(0, 0) + C(1, 1)), std::sqrt(C(2, 2)));
+    std::printf(
+        "%s, t %.0f s, PRN %d %d %d: null direction (n, e, d, clock) %.3f %.3f %.3f %.3f; with a height "
+        "row (1 m, ranges 1 m) HDOP %.2f VDOP %.2f\n",
+        what, r.t_s[i], r.prns[i][0], r.prns[i][1], r.prns[i][2], n(0), n(1), n(2), n(3), std::sqrt(C(0, 0) + C(1, 1)),
+        std::sqrt(C(2, 2)));
   }
 }
 
@@ -179,7 +182,8 @@ TEST(ThreeSatellites, ClosedFormGeometryOfTheHighestAndTheBestTriple) {
   }
   const std::vector<int> best = best_triple(77);
   ASSERT_EQ(best.size(), 3u);
-  const RunResult good = test::run_simulation(three_satellites(77, "tcxo", true, best), Coupling::kTight, FilterKind::Ekf);
+  const RunResult good =
+      test::run_simulation(three_satellites(77, "tcxo", true, best), Coupling::kTight, FilterKind::Ekf);
   print_geometry("best 3", good);
   for (std::size_t i = 0; i < good.t_s.size(); ++i) {
     if (good.t_s[i] < kReduce_s + 1.0) continue;
@@ -261,7 +265,8 @@ TEST(ClockModel, TwoStateClockQMatchesTheClosedForm) {
     InsLinearisation lin;
     lin.f_b = Eigen::Vector3d(0.0, 0.0, -9.8);
     model.set_linearisation(lin);
-    const StateMatrix<17> Qs = model.G(StateVector<17>::Zero()) * model.Qc() * model.G(StateVector<17>::Zero()).transpose();
+    const StateMatrix<17> Qs =
+        model.G(StateVector<17>::Zero()) * model.Qc() * model.G(StateVector<17>::Zero()).transpose();
     for (double dt : {0.05, 1.0, 10.0}) {
       const DiscreteProcess<17> p = discretise<17>(model.F(StateVector<17>::Zero()), Qs, dt, d);
       const Eigen::Matrix2d q = p.Qd.block<2, 2>(ix::kClockBias, ix::kClockBias);

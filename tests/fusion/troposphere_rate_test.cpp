@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The troposphere's rate in the predicted pseudorange rate (fusion/tight_measurements): against the numerical
 // derivative of the same troposphere model along the true geometry, i.e. prepare_satellites (satellite from its
 // ephemeris at its own transmit time, elevation from the antenna) at t - 0.5 s and t + 0.5 s for an antenna moving
@@ -6,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <GeographicLib/Geocentric.hpp>
-
 #include <cmath>
 
 #include "fusion/tight_measurements.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Seed 001 ultra-tight covariance analysis (issue 7): the discriminator form reduces exactly to the tight
 // pseudorange analysis when its noise and rate are those of the tight one; the linearised I&Q taps give the
 // EKF the same covariance as the first-order discriminators (equal information); ultra-tight beats tight on

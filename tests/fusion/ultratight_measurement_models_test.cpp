@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The ultra-tight period measurement models (fusion/ultratight_measurement_models.hpp): h against closed forms (the
 // triangle R(tau) = 1 - |tau| with sinc(pi df T) and the start phase; the replica errors of clock-only states), the
 // analytic H against central differences of h at strong and weak signals, code errors near 0 and near +-d, start
@@ -24,7 +25,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kChip = signals::kSpeedOfLight_mps / signals::kCaChipRate_hz;  // 293.05 m
-constexpr double kLambda = signals::kL1Wavelength_m;                             // 0.1903 m
+constexpr double kLambda = signals::kL1Wavelength_m;                            // 0.1903 m
 constexpr double kEarthRadius_m = 6.37e6;
 
 // A receiver at 210 m/s, climbing, turning at 0.3 rad/s, with a 1.4 m lever arm; one satellite at 20,200 km
@@ -255,7 +256,7 @@ TEST(UltraTightIqPeriod, PredictionIsTheTriangleTimesSincAtOnePoint) {
   x(ix::kClockBias) = 40.0;
   x(ix::kClockDrift) = 1.1;
   const double tau = (40.0 - 1.1 * 0.034 / 2.0 + 12.0) / kChip;  // 0.1774 chip
-  const double df = (1.1 + 0.9) / kLambda;                        // 10.51 Hz
+  const double df = (1.1 + 0.9) / kLambda;                       // 10.51 Hz
   const double xf = kPi * df * 0.02, sinc = std::sin(xf) / xf;
   const double A = std::sqrt(2.0 * std::pow(10.0, 4.2) * 0.02);
   const double offsets[3] = {0.5, 0.0, -0.5};  // E, P, L: the early replica d chips ahead
@@ -303,7 +304,8 @@ TEST(UltraTightIqPeriod, PromptSlopeIsTheExpectedSlopeOverThePrior) {
   const MeasurementJacobian<17> Hw = weighted.H(x), Hp = plain.H(x);
   for (int r = 0; r < 6; ++r) {
     const double factor = (r == 1 || r == 4) ? w : 1.0;
-    EXPECT_NEAR(Hw(r, ix::kClockBias), factor * N(r, ix::kClockBias), 1e-6 * iq_amplitude(iq_settings(45, 0.02, 0.5)) / kChip)
+    EXPECT_NEAR(Hw(r, ix::kClockBias), factor * N(r, ix::kClockBias),
+                1e-6 * iq_amplitude(iq_settings(45, 0.02, 0.5)) / kChip)
         << r;
     if (r != 1 && r != 4) {
       EXPECT_EQ(Hw.row(r), Hp.row(r)) << r;
@@ -365,8 +367,8 @@ TEST(UltraTightDiscriminatorPeriod, JacobianMatchesCentralDifferences) {
   for (const auto& [az, el] : {std::pair{0.3, 1.1}, std::pair{3.5, 0.2}}) {
     const Geometry g = moving_geometry(az, el);
     for (const StateVector<17>& x : {StateVector<17>(StateVector<17>::Zero()), linear_state()}) {
-      const PeriodDiscriminatorMeasurement m(g.nominal, g.sat, g.lever_b, g.w_ib_b, Eigen::Vector2d(3.0, -0.2),
-                                             0.03, Eigen::Vector2d::Zero(), DiscriminatorNoise{}, 0.0, 0.0);
+      const PeriodDiscriminatorMeasurement m(g.nominal, g.sat, g.lever_b, g.w_ib_b, Eigen::Vector2d(3.0, -0.2), 0.03,
+                                             Eigen::Vector2d::Zero(), DiscriminatorNoise{}, 0.0, 0.0);
       const Eigen::MatrixXd N = central_difference([&](const StateVector<17>& y) { return m.h(y); }, x, 2);
       const MeasurementJacobian<17> H = m.H(x);
       std::vector<double> tol(17);
@@ -374,7 +376,8 @@ TEST(UltraTightDiscriminatorPeriod, JacobianMatchesCentralDifferences) {
         tol[j] = ((moves_range(j) ? kRangeRounding_m : 0.0) + kRateRounding_mps) / steps()(j) +
                  replica_truncation(j, g) + position_omission(j, g) +
                  (moves_antenna_velocity(j) ? travel_time_fraction(g.sat) * N.col(j).cwiseAbs().maxCoeff() : 0.0);
-        for (int r = 0; r < 2; ++r) EXPECT_NEAR(H(r, j), N(r, j), tol[j]) << "el " << el << " row " << r << " col " << j;
+        for (int r = 0; r < 2; ++r)
+          EXPECT_NEAR(H(r, j), N(r, j), tol[j]) << "el " << el << " row " << r << " col " << j;
       }
       expect_columns_distinguishable(N, tol, "discriminator el " + std::to_string(el));
     }
@@ -398,12 +401,13 @@ TEST(UltraTightDiscriminatorPeriod, EpochReplicaErrorsJacobianMatchesCentralDiff
       const MeasurementJacobian<17> H = m.H(x);
       std::vector<double> tol(17);
       for (int j = 0; j < 17; ++j) {
-        const double travel = std::max({travel_time_fraction(a.sat), travel_time_fraction(b.sat),
-                                        travel_time_fraction(c.sat)});
+        const double travel =
+            std::max({travel_time_fraction(a.sat), travel_time_fraction(b.sat), travel_time_fraction(c.sat)});
         tol[j] = ((moves_range(j) ? kRangeRounding_m : 0.0) + kRateRounding_mps) / steps()(j) +
                  replica_truncation(j, a) + position_omission(j, a) +
                  (moves_antenna_velocity(j) ? travel * N.col(j).cwiseAbs().maxCoeff() : 0.0);
-        for (int r = 0; r < rows; ++r) EXPECT_NEAR(H(r, j), N(r, j), tol[j]) << "rate " << rate << " row " << r << " col " << j;
+        for (int r = 0; r < rows; ++r)
+          EXPECT_NEAR(H(r, j), N(r, j), tol[j]) << "rate " << rate << " row " << r << " col " << j;
       }
       expect_columns_distinguishable(N, tol, rate ? "epoch with rates" : "epoch, ranges only");
     }
@@ -448,8 +452,8 @@ TEST(UltraTightDiscriminatorPeriod, PredictionAndNoiseInClosedForm) {
 TEST(UltraTightDiscriminatorPeriod, DiscriminatorsReadTheTapsBack) {
   for (const double T : {0.02, 0.005}) {
     const IqSettings s = iq_settings(40.0, T, 0.5);
-    for (const TrackingErrors e : {TrackingErrors{0.12, 4.0, 0.7}, TrackingErrors{-0.3, -9.0, -2.0},
-                                   TrackingErrors{0.02, 0.5, 2.9}}) {
+    for (const TrackingErrors e :
+         {TrackingErrors{0.12, 4.0, 0.7}, TrackingErrors{-0.3, -9.0, -2.0}, TrackingErrors{0.02, 0.5, 2.9}}) {
       const Eigen::Vector2d z = period_discriminator_errors(expected_iq(e, s), s, e.phase_rad);
       EXPECT_NEAR(z(0), e.code_chips * kChip, 1e-6 * kChip) << T;
       EXPECT_NEAR(z(1), e.frequency_hz * kLambda, 1e-9) << T;
@@ -485,8 +489,7 @@ TEST(UltraTightPeriodGeometry, OffsetIsTheMeanRangeErrorAndTheRateErrorAtAThird)
   auto signal_rate = [&](double t) { return rate_u + slope * (t - tu); };
   auto error = [&](double t) { return replica_start + replica_rate * (t - t0) - signal_range(t); };
   const double mean = (error(t0) + 4.0 * error(t0 + T / 2.0) + error(t0 + T)) / 6.0;
-  const Eigen::Vector2d o =
-      period_signal_offset(replica_start, replica_rate, t0, T, tu, rho_u, rate_u, slope);
+  const Eigen::Vector2d o = period_signal_offset(replica_start, replica_rate, t0, T, tu, rho_u, rate_u, slope);
   EXPECT_NEAR(o(0), mean, 1e-7);  // 2.1e7 m ranges: a few ulps
   EXPECT_NEAR(o(1), replica_rate - signal_rate(t0 + T / 3.0), 1e-10);
 }

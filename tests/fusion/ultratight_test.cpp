@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ultra-tight driver closed at the correlation level (correlation_sim: truth = trajectory + clock, I&Q from the
 // ideal correlation of the true signal with the commanded replica, plus noise at the C/N0). Linear region of
 // the code discriminators: |tau| < d = 0.5 chip; frequency pull-in: |df| < 1 / (2 T) (25 Hz at T = 20 ms).
@@ -10,9 +11,9 @@
 #include <map>
 
 #include "correlation_sim.hpp"
-#include "receiver/chi_square.hpp"
 #include "fusion/iq_measurements.hpp"
 #include "fusion/ultratight_integration.hpp"
+#include "receiver/chi_square.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/nominal_constellation.hpp"
 
@@ -307,8 +308,8 @@ TEST(UltraTight, PeriodReplicaErrorsMatchTheCorrelationOfAnAcceleratingSignal) {
     const double phase_truth = std::atan2(truth.q[1], truth.i[1]);
     const double phase_err = std::atan2(model.q[1], model.i[1]) - phase_truth;
     const double phase_err_mid = std::atan2(mid.q[1], mid.i[1]) - phase_truth;
-    std::printf("a %+.2f m/s^2: prompt phase error of the model %.2e rad (mid-period form %.2e rad, expected %.2e)\n", a,
-                phase_err, phase_err_mid, -2.0 * M_PI * a * T * T / (12.0 * lambda));
+    std::printf("a %+.2f m/s^2: prompt phase error of the model %.2e rad (mid-period form %.2e rad, expected %.2e)\n",
+                a, phase_err, phase_err_mid, -2.0 * M_PI * a * T * T / (12.0 * lambda));
     EXPECT_NEAR(phase_err_mid, -2.0 * M_PI * a * T * T / (12.0 * lambda), 0.05 * std::abs(phase_err_mid));
     EXPECT_LT(std::abs(phase_err), 0.01 * std::abs(phase_err_mid));
     // Taps: the linear-phase model misses the quadratic phase's own amplitude loss, second order in its
@@ -330,7 +331,8 @@ double nees_monte_carlo(FilterKind f, int runs, double clock_bias_psd, const cha
   for (int k = 0; k < runs; ++k) {
     CorrelationSimConfig cfg;
     cfg.filter = f;
-    cfg.duration_s = std::getenv("ULTRATRACK_NEES_DURATION_S") ? std::atof(std::getenv("ULTRATRACK_NEES_DURATION_S")) : 4.0;
+    cfg.duration_s =
+        std::getenv("ULTRATRACK_NEES_DURATION_S") ? std::atof(std::getenv("ULTRATRACK_NEES_DURATION_S")) : 4.0;
     cfg.seed = 100 + k;
     cfg.clock_bias_psd_m2_per_s = clock_bias_psd;
     // Diagnostic (docs/validation.md, ultra-tight NEES at the receiver level): a closed PLL of this bandwidth with the
@@ -349,7 +351,8 @@ double nees_monte_carlo(FilterKind f, int runs, double clock_bias_psd, const cha
               rms3(ms_err, 0), rms3(ms_sig, 0), rms3(ms_err, 3), rms3(ms_sig, 3), 1e3 * rms3(ms_err, 6),
               1e3 * rms3(ms_sig, 6));
   const double mean = sum / runs;
-  const double lo = receiver::chi_square_lower_quantile(17 * runs, 0.025) / runs, hi = receiver::chi_square_lower_quantile(17 * runs, 0.975) / runs;
+  const double lo = receiver::chi_square_lower_quantile(17 * runs, 0.025) / runs,
+               hi = receiver::chi_square_lower_quantile(17 * runs, 0.975) / runs;
   std::printf("%s NEES over %d runs: mean %.2f, 95%% band [%.2f, %.2f]; filter time %.2f s\n", what, runs, mean, lo, hi,
               cpu);
   std::printf("  mean (error / sigma)^2 per state (pos, vel, att, ba, bg, clock):");
@@ -401,12 +404,15 @@ double mean_iq_nis(double start_phase_sigma_rad, bool tell, int& count) {
 TEST(UltraTight, ClosedPllStartPhaseInRKeepsIqNisInItsBand) {
   int n = 0;
   const double realigned = mean_iq_nis(0.0, true, n);
-  const double lo = receiver::chi_square_lower_quantile(6 * n, 0.005) / n, hi = receiver::chi_square_lower_quantile(6 * n, 0.995) / n;
+  const double lo = receiver::chi_square_lower_quantile(6 * n, 0.005) / n,
+               hi = receiver::chi_square_lower_quantile(6 * n, 0.995) / n;
   int n1 = 0, n2 = 0;
   const double told = mean_iq_nis(0.05, true, n1);
   const double seed_model = mean_iq_nis(0.05, false, n2);
-  std::printf("mean I&Q NIS over %d updates (99 %% band [%.3f, %.3f]): realigned phase %.3f; PLL start phase "
-              "0.05 rad in R %.3f, left out %.3f\n", n, lo, hi, realigned, told, seed_model);
+  std::printf(
+      "mean I&Q NIS over %d updates (99 %% band [%.3f, %.3f]): realigned phase %.3f; PLL start phase "
+      "0.05 rad in R %.3f, left out %.3f\n",
+      n, lo, hi, realigned, told, seed_model);
   EXPECT_GT(realigned, lo);
   EXPECT_LT(realigned, hi);
   EXPECT_GT(told, lo);
@@ -449,9 +455,10 @@ TEST(UltraTight, ContinuousCarrierStartPhaseRemovesTheVelocityBias) {
   double nis_told, nis_zero, lo, hi;
   run(true, told, nis_told, lo, hi);
   run(false, zero, nis_zero, lo, hi);
-  std::printf("closed 5 Hz PLL, continuous carrier: mean velocity e/sigma (N, E, D) told %.2f %.2f %.2f, start phase "
-              "taken as zero %.2f %.2f %.2f; mean I&Q NIS %.3f / %.3f (99 %% band [%.3f, %.3f])\n",
-              told(0), told(1), told(2), zero(0), zero(1), zero(2), nis_told, nis_zero, lo, hi);
+  std::printf(
+      "closed 5 Hz PLL, continuous carrier: mean velocity e/sigma (N, E, D) told %.2f %.2f %.2f, start phase "
+      "taken as zero %.2f %.2f %.2f; mean I&Q NIS %.3f / %.3f (99 %% band [%.3f, %.3f])\n",
+      told(0), told(1), told(2), zero(0), zero(1), zero(2), nis_told, nis_zero, lo, hi);
   for (int a = 0; a < 3; ++a) EXPECT_LT(std::abs(told(a)), 0.75) << a;
   EXPECT_GT(zero.cwiseAbs().maxCoeff(), 0.75);
   EXPECT_GT(nis_told, lo);
@@ -485,8 +492,9 @@ TEST(UltraTight, CoastingThroughTenSecondBlockageAndRelock) {
     EXPECT_LT(before, 0.05);
     EXPECT_LT(code_after, 0.05);
     EXPECT_LT(max_from(r.max_freq_err_hz, r.t_s, 13.0), 5.0);
-    std::printf("%s blockage 10 s: code error %.4f -> %.4f chip (%.1f m), freq %.2f Hz at the return; after 1 s %.4f chip\n",
-                f == FilterKind::Ekf ? "EKF" : "UKF", before, code_end, code_end * 293.05, freq_end, code_after);
+    std::printf(
+        "%s blockage 10 s: code error %.4f -> %.4f chip (%.1f m), freq %.2f Hz at the return; after 1 s %.4f chip\n",
+        f == FilterKind::Ekf ? "EKF" : "UKF", before, code_end, code_end * 293.05, freq_end, code_after);
   }
 }
 

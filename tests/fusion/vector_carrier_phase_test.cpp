@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The vector PLL's per-channel carrier states (fusion/vector_carrier_phase.hpp) closed around a simulated signal:
 // a carrier whose phase is known exactly (the truth), a prediction that misses its Doppler by a constant, prompt
 // correlations with Gaussian noise at a known C/N0 and random data bits, and a replica run as the vector filter
@@ -105,16 +106,18 @@ TEST(VectorCarrierPhase, CostasDiscriminatorIsBitInsensitiveAndBounded) {
 // from the gains is ~0.1-0.3 Hz: bound 0.5 Hz), and the replica's phase error RMS (1000 settled epochs: the RMS
 // estimate is good to ~3 %) is at most the loop's own prior sigma + 15 % (the replica of an epoch is commanded
 // before that epoch's discriminator, so it carries the prior error; here below it by the modelled frequency noise
-// that this constant miss does not have: 0.0047 vs 0.0056 cycles at 45 dB-Hz). That is larger than the continuous-loop closed form
-// at the same bandwidth (sigma^2 = Bn / C/N0 (1 + 1 / (2 T C/N0))) by the one-epoch delay at Bn T ~ 0.1-0.3:
-// measured 1.3-1.4 x here (printed); bounded by 1.6 x, and no lower than the closed form. Lock kept, no epoch near
-// a slip.
+// that this constant miss does not have: 0.0047 vs 0.0056 cycles at 45 dB-Hz). That is larger than the continuous-loop
+// closed form at the same bandwidth (sigma^2 = Bn / C/N0 (1 + 1 / (2 T C/N0))) by the one-epoch delay at Bn T ~
+// 0.1-0.3: measured 1.3-1.4 x here (printed); bounded by 1.6 x, and no lower than the closed form. Lock kept, no epoch
+// near a slip.
 TEST(VectorCarrierPhase, ClosedLoopJitterIsTheLoopsOwnSigmaAndNearTheClosedForm) {
   for (double cn0 : {45.0, 30.0}) {
     const LoopResult r = run_loop(cn0, 3.0, 2000, true, 7);
     const double closed = jitter_cycles(r.bn_hz, cn0);
-    std::printf("%.0f dB-Hz: RMS %.4f cycles (loop prior sigma %.4f; closed form %.4f at Bn %.1f Hz), max %.4f, nu "
-                "%.3f Hz\n", cn0, r.rms_cycles, r.prior_sigma_cycles, closed, r.bn_hz, r.max_cycles, r.nu_hz);
+    std::printf(
+        "%.0f dB-Hz: RMS %.4f cycles (loop prior sigma %.4f; closed form %.4f at Bn %.1f Hz), max %.4f, nu "
+        "%.3f Hz\n",
+        cn0, r.rms_cycles, r.prior_sigma_cycles, closed, r.bn_hz, r.max_cycles, r.nu_hz);
     EXPECT_TRUE(r.locked);
     EXPECT_NEAR(r.nu_hz, 3.0, 0.5);
     EXPECT_LE(r.rms_cycles, 1.15 * r.prior_sigma_cycles);

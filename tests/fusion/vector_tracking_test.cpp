@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The vector tracking filter's models (fusion/vector_tracking.hpp) against independent truth: its measurement
 // Jacobians against central differences of its own h (the EKF's linearisation), its replica prediction against
 // a pseudorange computed here from the broadcast orbit by light-time iteration (satellite_state, Sagnac) and
@@ -43,8 +44,8 @@ double true_pseudorange(const signals::Ephemeris& eph, const signals::GpsTime& t
 
 // The satellite observable the filter builds, via prepare_satellites (no atmosphere), at receive time t.
 std::optional<fusion::SatelliteObservable> observable(const std::vector<signals::Ephemeris>& ephs, int prn,
-                                                     const signals::GpsTime& t, double pseudorange_m,
-                                                     const Eigen::Vector3d& r) {
+                                                      const signals::GpsTime& t, double pseudorange_m,
+                                                      const Eigen::Vector3d& r) {
   receiver::ObservationEpoch e;
   e.receive_time = t;
   receiver::Observation o;
@@ -108,7 +109,8 @@ TEST(VectorTracking, ReplicaPredictionMatchesLightTimePseudorangeAndItsRate) {
     for (const auto& eph : nc.ephemerides) {
       const double pr = true_pseudorange(eph, kT0, kRx, v, b0, d, 0.0);
       // The filter works on the receiver clock's time, which reads b0 / c ahead of GPS time.
-      const auto found = observable(nc.ephemerides, eph.prn, signals::add_seconds(kT0, b0 / signals::kSpeedOfLight_mps), pr, kRx);
+      const auto found =
+          observable(nc.ephemerides, eph.prn, signals::add_seconds(kT0, b0 / signals::kSpeedOfLight_mps), pr, kRx);
       // Visible satellites only (the others pass through the earth).
       if (!found || found->elevation_rad < 0.1) continue;
       const fusion::SatelliteObservable& sat = *found;
@@ -123,9 +125,11 @@ TEST(VectorTracking, ReplicaPredictionMatchesLightTimePseudorangeAndItsRate) {
       EXPECT_NEAR(p.code_rate_chips_per_s, 1.023e6 * (1.0 - rate / signals::kSpeedOfLight_mps), 1e-5) << eph.prn;
       // The textbook closed form: Doppler = -(u . (v_sat - v_rx) + d - c * SV drift) / lambda (to the 1e-6
       // relative travel-time terms, ~0.01 Hz).
-      const signals::SatelliteState s = signals::satellite_state(eph, signals::add_seconds(kT0, -pr / signals::kSpeedOfLight_mps));
+      const signals::SatelliteState s =
+          signals::satellite_state(eph, signals::add_seconds(kT0, -pr / signals::kSpeedOfLight_mps));
       const Eigen::Vector3d u = (s.r_e_m - kRx).normalized();
-      const double closed = -(u.dot(s.v_e_mps - v) + d - signals::kSpeedOfLight_mps * s.clock_drift_sps) / signals::kL1Wavelength_m;
+      const double closed =
+          -(u.dot(s.v_e_mps - v) + d - signals::kSpeedOfLight_mps * s.clock_drift_sps) / signals::kL1Wavelength_m;
       EXPECT_NEAR(p.doppler_hz, closed, 0.05) << eph.prn;
       ++checked;
     }
@@ -179,10 +183,11 @@ TEST(VectorTracking, DiscriminatorVariancesMatchMonteCarlo) {
 // envelope DLL within +-0.5 chip, the Costas arctangent within +-1/4 cycle). The DLL's gain g (its mean output per
 // chip of true code error, from offsets of +-0.1 chip) falls as the noise fills the E + L normaliser, and its
 // variance with it: the closed form is then the variance of the gain-normalised output (var / g^2) within
-// +4..+27 % (g = 0.63 at 24 dB-Hz, 0.33 at 20; pinned: [0.95, 1.35]), while the raw output's variance is far below it (0.41 at 24 dB-Hz, 0.07 at
-// 18). So the filter's code weights are conservative, and its code update moves the state by g of what the
-// weights imply (a slower code loop, not a wrong one). The Costas formula is within 6 % at 22-24 dB-Hz and
-// overstates from 20 dB-Hz down (the wrap folds the tails: 0.74 at 18): [0.6, 1.1]. 20000 draws per point: sampling sigma of a variance ratio ~1-2 %, of g ~2 %.
+// +4..+27 % (g = 0.63 at 24 dB-Hz, 0.33 at 20; pinned: [0.95, 1.35]), while the raw output's variance is far below it
+// (0.41 at 24 dB-Hz, 0.07 at 18). So the filter's code weights are conservative, and its code update moves the state by
+// g of what the weights imply (a slower code loop, not a wrong one). The Costas formula is within 6 % at 22-24 dB-Hz
+// and overstates from 20 dB-Hz down (the wrap folds the tails: 0.74 at 18): [0.6, 1.1]. 20000 draws per point: sampling
+// sigma of a variance ratio ~1-2 %, of g ~2 %.
 TEST(VectorTracking, WeakSignalDiscriminatorVariancesAgainstMonteCarlo) {
   std::mt19937 rng(11);
   std::normal_distribution<double> g(0.0, 1.0);
@@ -197,7 +202,8 @@ TEST(VectorTracking, WeakSignalDiscriminatorVariancesAgainstMonteCarlo) {
     const auto dll = [&](double offset, double& mean, double& var) {
       double s = 0.0, s2 = 0.0;
       for (int i = 0; i < n; ++i) {
-        const double ea = a * std::max(0.0, 1.0 - std::abs(offset + 0.5)), la = a * std::max(0.0, 1.0 - std::abs(offset - 0.5));
+        const double ea = a * std::max(0.0, 1.0 - std::abs(offset + 0.5)),
+                     la = a * std::max(0.0, 1.0 - std::abs(offset - 0.5));
         const auto e = std::complex<float>(std::complex<double>(ea + g(rng), g(rng)));
         const auto l = std::complex<float>(std::complex<double>(la + g(rng), g(rng)));
         const double c = receiver::dll_nelp_chips(e, l, 0.5);
@@ -219,8 +225,10 @@ TEST(VectorTracking, WeakSignalDiscriminatorVariancesAgainstMonteCarlo) {
     }
     const double code_model = fusion::code_discriminator_variance_chips2(cn0, t, 1.0);
     const double phase_ratio = phase2 / n / fusion::costas_phase_variance_cycles2(cn0, t);
-    std::printf("%.0f dB-Hz: DLL gain %.3f, variance / model %.3f, variance / gain^2 / model %.3f; phase variance / "
-                "model %.3f\n", cn0_dbhz, gain, var0 / code_model, var0 / (gain * gain) / code_model, phase_ratio);
+    std::printf(
+        "%.0f dB-Hz: DLL gain %.3f, variance / model %.3f, variance / gain^2 / model %.3f; phase variance / "
+        "model %.3f\n",
+        cn0_dbhz, gain, var0 / code_model, var0 / (gain * gain) / code_model, phase_ratio);
     // The closed-form gain (first order in the ratio of means) against the Monte Carlo's: its standard error is
     // ~0.01 (two means of 20000 draws with sd <= 0.2 chip, over 0.2 chip); the first-order form is within 0.015
     // of the exact mean at these C/N0 but 0.035 at 20 dB-Hz (0.62 / 0.49 / 0.36 / 0.25 against 0.63 / 0.47 /

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer aiding (fusion/vms_measurement.hpp, fusion/odometer_error_model.hpp): the VMS/NHC Jacobian against
 // central differences of h, h against the closed form for known errors, the gating rule of seed 004 eqs.
 // 16-17, and a short drive where the 19-state filter recovers a simulated scale factor.
@@ -83,9 +84,9 @@ TEST(OdometerGate, FollowsTheHeadingRateAndSpeedRules) {
   const OdometerGate slow = odometer_gate(o, 0.0, 1.0, 4.9);
   EXPECT_TRUE(slow.yaw_rate_ok);
   EXPECT_FALSE(slow.speed_ok);
-  EXPECT_FALSE(odometer_gate(o, -1.6 * kDeg, 1.0, 10.0).yaw_rate_ok);        // either sense of turn
+  EXPECT_FALSE(odometer_gate(o, -1.6 * kDeg, 1.0, 10.0).yaw_rate_ok);                         // either sense of turn
   EXPECT_TRUE(odometer_gate(o, 2.0 * std::numbers::pi + 0.1 * kDeg, 1.0, 10.0).yaw_rate_ok);  // wrapped
-  EXPECT_TRUE(odometer_gate(o, 2.0 * kDeg, 2.0, 10.0).yaw_rate_ok);          // 1 deg/s over a 2 s window
+  EXPECT_TRUE(odometer_gate(o, 2.0 * kDeg, 2.0, 10.0).yaw_rate_ok);  // 1 deg/s over a 2 s window
   o.mode = OdometerMode::kAlways;
   EXPECT_TRUE(odometer_gate(o, 10.0 * kDeg, 1.0, 0.0).update());
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: campaign files (config/campaign_toml.hpp), read as `ultratrack campaign run` reads them. The
 // seeds list recordings (a [simulate] seed would stop at its missing scenario template).
 #include "config/campaign_toml.hpp"

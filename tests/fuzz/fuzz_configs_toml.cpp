@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: the other TOML files a user writes: fuse/receive-fusion configuration, receive configuration
 // and the attitude receiver's antenna file (config/), and `ultratrack align`'s alignment.json as fuse and receive
 // read it back (--align file:). The first byte picks the reader.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Shared by the libFuzzer targets (tests/fuzz/fuzz_*.cpp): the fuzzer's bytes as a file that a reader opens by
 // path (one scratch file per process and target), and the one outcome a reader may have on bad input besides
 // success: io::InputError. Any other exception escapes, and libFuzzer reports it with its input as a finding.
@@ -24,8 +25,8 @@ inline std::filesystem::path as_file(const std::uint8_t* data, std::size_t size,
     return d;
   }();
   const auto path = dir / name;
-  std::ofstream(path, std::ios::binary | std::ios::trunc).write(reinterpret_cast<const char*>(data),
-                                                                 static_cast<std::streamsize>(size));
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   return path;
 }
 

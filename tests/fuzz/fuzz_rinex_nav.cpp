@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: RINEX 2/3 navigation files (signals/rinex_nav.hpp).
 #include "fuzz_input.hpp"
 #include "signals/rinex_nav.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: IF sample files in every format (receiver/sample_source.hpp), the 2-bit packings included. The
 // first two bytes pick the format, the 2-bit coding and order, I/Q swap and Q negation, real or complex; the rest is
 // the file, read to its end in blocks (float and int16 paths alternately).
@@ -11,10 +12,9 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace ultratrack;
   if (size < 2) return 0;
-  constexpr signals::SampleFormat kFormats[] = {signals::SampleFormat::i8, signals::SampleFormat::i16,
-                                                signals::SampleFormat::f32, signals::SampleFormat::r8,
-                                                signals::SampleFormat::r16, signals::SampleFormat::r2,
-                                                signals::SampleFormat::i2};
+  constexpr signals::SampleFormat kFormats[] = {
+      signals::SampleFormat::i8,  signals::SampleFormat::i16, signals::SampleFormat::f32, signals::SampleFormat::r8,
+      signals::SampleFormat::r16, signals::SampleFormat::r2,  signals::SampleFormat::i2};
   const signals::SampleFormat format = kFormats[data[0] % 7];
   receiver::SampleSourceOptions o;
   o.fs_hz = 4.0e6;

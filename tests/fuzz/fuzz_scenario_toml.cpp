@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // libFuzzer target: scenario files (config/scenario_toml.hpp), parsed from text, and the scenario written back
 // and read again when it parses (to_toml must round-trip whatever the reader accepts).
 #include "config/scenario_toml.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The fuzz targets without libFuzzer, for the ordinary build and ctest: every file of the folders (or files) named
 // on the command line goes once through LLVMFuzzerTestOneInput, so the seed corpora and every input that once
 // crashed (tests/fuzz/regressions/) are replayed by the test suite on each run (ctest fuzz.replay.*).

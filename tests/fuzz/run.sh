@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Runs every libFuzzer target of a fuzz build for SECONDS each, starting from the committed seed corpora
 # (tests/fuzz/corpus/<target>/, copied: what a run adds stays in the scratch folder). Exit 1 on any finding; the
 # reproducer is left in the scratch folder and its path printed (keep it as a regression input in tests/fuzz/regressions/).

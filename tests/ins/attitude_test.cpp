@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Attitude helpers: Euler angles against the explicit DCM of seed 002 eq. (12) (transposed: C_bn),
 // rotation vectors against Eigen's AngleAxis, and the psi-angle error convention.
 #include "ins/attitude.hpp"

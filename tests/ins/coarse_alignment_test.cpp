@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Coarse alignment: exact with an error-free IMU; with the HG1700AE preset the level and heading errors
 // equal the closed-form values from the unit's realised biases (psi_N = b_E/g, psi_E = -b_N/g,
 // psi_D = eps_E/(W cos L) - psi_N tan L) within the noise the closed form predicts, over several seeds.
@@ -33,7 +34,8 @@ std::vector<ImuIncrement> rest_data(const Eigen::Quaterniond& q_nb, double lat, 
 TEST(CoarseAlignment, ExactWithErrorFreeSimulatorData) {
   // On the ellipsoid (h = 0) normal gravity is along the ellipsoid normal; above it, it leans north by
   // ~8e-10 rad per metre, which levelling reads as tilt.
-  const TrajectorySpec spec = profile_spec("static", 60.0, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 0.0);
+  const TrajectorySpec spec =
+      profile_spec("static", 60.0, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 0.0);
   const SimulatedRun run = simulate(spec, 100.0);
   const AlignmentResult a = coarse_align(run.imu, 0.0, spec.lat0_rad);
   EXPECT_LT(attitude_error_n(a.q_nb, run.truth.back().q_nb).norm(), 1e-9);
@@ -51,7 +53,8 @@ TEST(CoarseAlignment, ExactAtArbitraryAttitudes) {
 
 TEST(CoarseAlignment, Hg1700aeErrorsMatchClosedFormFromBiases) {
   const double lat = 36.37 * ultratrack::io::kRadPerDeg, h = 100.0, T = 600.0, rate = 100.0;
-  const Eigen::Quaterniond q_true = quaternion_from_euler({1.5 * ultratrack::io::kRadPerDeg, -2.0 * ultratrack::io::kRadPerDeg, 40.0 * ultratrack::io::kRadPerDeg});
+  const Eigen::Quaterniond q_true = quaternion_from_euler(
+      {1.5 * ultratrack::io::kRadPerDeg, -2.0 * ultratrack::io::kRadPerDeg, 40.0 * ultratrack::io::kRadPerDeg});
   const auto ideal = rest_data(q_true, lat, h, rate, T);
   const ImuErrorSpec spec = imu_preset("hg1700ae");
   const double g = gravity_n(lat, h).z();
@@ -80,9 +83,11 @@ TEST(CoarseAlignment, Hg1700aeErrorsMatchClosedFormFromBiases) {
     std::printf(
         "[ alignment ] seed %llu: psi N/E/D = %+.5f %+.5f %+.3f deg, closed form %+.5f %+.5f %+.3f deg "
         "(noise 1 sigma %.5f %.5f %.3f deg)\n",
-        static_cast<unsigned long long>(seed), psi.x() / ultratrack::io::kRadPerDeg, psi.y() / ultratrack::io::kRadPerDeg, psi.z() / ultratrack::io::kRadPerDeg, predicted.x() / ultratrack::io::kRadPerDeg,
-        predicted.y() / ultratrack::io::kRadPerDeg, predicted.z() / ultratrack::io::kRadPerDeg, sigma_noise.x() / ultratrack::io::kRadPerDeg, sigma_noise.y() / ultratrack::io::kRadPerDeg,
-        sigma_noise.z() / ultratrack::io::kRadPerDeg);
+        static_cast<unsigned long long>(seed), psi.x() / ultratrack::io::kRadPerDeg,
+        psi.y() / ultratrack::io::kRadPerDeg, psi.z() / ultratrack::io::kRadPerDeg,
+        predicted.x() / ultratrack::io::kRadPerDeg, predicted.y() / ultratrack::io::kRadPerDeg,
+        predicted.z() / ultratrack::io::kRadPerDeg, sigma_noise.x() / ultratrack::io::kRadPerDeg,
+        sigma_noise.y() / ultratrack::io::kRadPerDeg, sigma_noise.z() / ultratrack::io::kRadPerDeg);
     // 4 sigma of noise plus the second-order terms the closed form drops (tilt^2, ~2e-6 rad here).
     const double second_order = predicted.head<2>().squaredNorm();
     for (int i = 0; i < 3; ++i)

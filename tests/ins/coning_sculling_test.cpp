@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Classic coning and sculling motions superimposed on a vehicle at rest. Increments come from the exact
 // body rate / specific force by 8-point Gauss-Legendre quadrature. The measured drift of the mechanisation
 // with and without the correction terms is compared with the closed forms (derived for these motions):

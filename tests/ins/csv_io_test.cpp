@@ -1,7 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IMU and navigation CSV files: exact round trips, and every kind of bad input rejected with a typed
 // error that names the file and the line. Also the segment-file reader of the trajectory description.
-#include <gtest/gtest.h>
 #include <fmt/core.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
@@ -32,7 +33,6 @@ fs::path write_text(const fs::path& dir, const std::string& name, const std::str
   std::ofstream(p) << text;
   return p;
 }
-
 
 }  // namespace
 

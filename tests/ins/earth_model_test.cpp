@@ -1,7 +1,7 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Earth model against published WGS-84 values and against geometry computed by GeographicLib's Geocentric
 // (independent of our closed forms): radii from the ECEF position's derivative, gravity at equator/pole.
 #include "ins/earth_model.hpp"
-#include "io/units.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,11 @@
 #include <cmath>
 #include <numbers>
 
+#include "io/units.hpp"
+
 using namespace ultratrack::ins;
 
-namespace {
-}
+namespace {}
 
 TEST(EarthModel, RadiiMatchPublishedWgs84Values) {
   // NIMA TR8350.2: a = 6378137 m, b^2/a... R_M(0) = a(1-e^2) = 6335439.327 m, R_N(0) = a,
@@ -29,7 +30,8 @@ TEST(EarthModel, RadiiMatchPublishedWgs84Values) {
 TEST(EarthModel, RadiiAreTheDerivativesOfTheEcefPosition) {
   for (double lat_deg : {-60.0, -10.0, 0.0, 36.37, 71.0}) {
     // Central differences over 2e-5 rad: chord and rounding errors below 1e-9 relative.
-    const double lat = lat_deg * ultratrack::io::kRadPerDeg, lon = 127.0 * ultratrack::io::kRadPerDeg, h = 250.0, d = 1e-5;
+    const double lat = lat_deg * ultratrack::io::kRadPerDeg, lon = 127.0 * ultratrack::io::kRadPerDeg, h = 250.0,
+                 d = 1e-5;
     const Radii r = radii_of_curvature(lat);
     const double north = (ecef_from_geodetic(lat + d, lon, h) - ecef_from_geodetic(lat - d, lon, h)).norm() / (2 * d);
     const double east = (ecef_from_geodetic(lat, lon + d, h) - ecef_from_geodetic(lat, lon - d, h)).norm() / (2 * d);
@@ -57,7 +59,9 @@ TEST(EarthModel, NormalGravityMatchesWgs84EquatorAndPole) {
   EXPECT_NEAR(gravity_n(90.0 * ultratrack::io::kRadPerDeg, 0.0).z(), 9.8321849378, 1e-9);
   EXPECT_NEAR(gravity_n(45.0 * ultratrack::io::kRadPerDeg, 0.0).x(), 0.0, 1e-12);  // normal to the ellipsoid on it
   // Free-air gradient about -3.086e-6 s^-2.
-  const double grad = (gravity_n(45.0 * ultratrack::io::kRadPerDeg, 1000.0).z() - gravity_n(45.0 * ultratrack::io::kRadPerDeg, 0.0).z()) / 1000.0;
+  const double grad = (gravity_n(45.0 * ultratrack::io::kRadPerDeg, 1000.0).z() -
+                       gravity_n(45.0 * ultratrack::io::kRadPerDeg, 0.0).z()) /
+                      1000.0;
   EXPECT_NEAR(grad, -3.086e-6, 0.01e-6);
 }
 

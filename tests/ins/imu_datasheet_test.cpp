@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The datasheet description of an IMU: units against closed forms, overrides over a preset, and the round trip
 // datasheet -> spec -> datasheet.
 #include "ins/imu_datasheet.hpp"
@@ -13,13 +14,13 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 
 TEST(ImuDatasheet, UnitsAreTheDatasheetsOnes) {
   ImuDatasheet d;
-  d.gyro_bias_dph = 3600.0;              // 1 deg/s
-  d.accel_bias_mg = 1000.0;              // 1 g
-  d.gyro_bias_instability_dph = 36.0;    // 0.01 deg/s
+  d.gyro_bias_dph = 3600.0;            // 1 deg/s
+  d.accel_bias_mg = 1000.0;            // 1 g
+  d.gyro_bias_instability_dph = 36.0;  // 0.01 deg/s
   d.accel_bias_instability_mg = 0.5;
   d.bias_correlation_time_s = 250.0;
-  d.gyro_arw_dpsh = 60.0;                // 1 deg/sqrt(s)
-  d.accel_vrw_mpspsh = 0.6;              // 0.01 m/s/sqrt(s)
+  d.gyro_arw_dpsh = 60.0;    // 1 deg/sqrt(s)
+  d.accel_vrw_mpspsh = 0.6;  // 0.01 m/s/sqrt(s)
   d.gyro_scale_factor_ppm = 500.0;
   d.accel_scale_factor_ppm = 300.0;
   const ImuErrorSpec s = apply_datasheet(ImuErrorSpec{}, d);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // IMU error model: statistics of each error term against its definition, presets against their sources
 // (seed 000 Table 1, seed 003 Table 1, the navigation grade), determinism of the seed, and
 // IMU data at rest (simulator + preset) whose |f| and |w| equal normal gravity and earth rate within the
@@ -32,18 +33,18 @@ double sample_std(const std::vector<double>& x) {
 
 TEST(ImuPresets, MatchTheirSources) {
   const ImuErrorSpec hg = imu_preset("hg1700ae");
-  EXPECT_NEAR(hg.gyro.bias_sigma, 1.0 * ultratrack::io::kRadPerDeg / 3600.0, 1e-15);      // 1 deg/h
-  EXPECT_NEAR(hg.gyro.random_walk, 0.125 * ultratrack::io::kRadPerDeg / 60.0, 1e-15);     // 0.125 deg/sqrt(h)
-  EXPECT_NEAR(hg.gyro.output_white_noise, 80e-6, 1e-15);            // 80 urad
-  EXPECT_NEAR(hg.accel.bias_sigma, 9.80665e-3, 1e-12);              // 1 mg
-  EXPECT_NEAR(hg.accel.output_white_noise, 0.008 * 0.3048, 1e-12);  // 0.008 ft/s
-  EXPECT_NEAR(hg.accel.random_walk, 0.065 * 0.3048 / 60.0, 1e-12);  // 0.065 ft/s/sqrt(h)
+  EXPECT_NEAR(hg.gyro.bias_sigma, 1.0 * ultratrack::io::kRadPerDeg / 3600.0, 1e-15);   // 1 deg/h
+  EXPECT_NEAR(hg.gyro.random_walk, 0.125 * ultratrack::io::kRadPerDeg / 60.0, 1e-15);  // 0.125 deg/sqrt(h)
+  EXPECT_NEAR(hg.gyro.output_white_noise, 80e-6, 1e-15);                               // 80 urad
+  EXPECT_NEAR(hg.accel.bias_sigma, 9.80665e-3, 1e-12);                                 // 1 mg
+  EXPECT_NEAR(hg.accel.output_white_noise, 0.008 * 0.3048, 1e-12);                     // 0.008 ft/s
+  EXPECT_NEAR(hg.accel.random_walk, 0.065 * 0.3048 / 60.0, 1e-12);                     // 0.065 ft/s/sqrt(h)
   const ImuErrorSpec dmu = imu_preset("dmu6x");
-  EXPECT_NEAR(dmu.gyro.bias_sigma, 1.0 * ultratrack::io::kRadPerDeg, 1e-15);        // 1 deg/s
-  EXPECT_NEAR(dmu.accel.bias_sigma, 10e-3 * 9.80665, 1e-12);  // 10 mg
+  EXPECT_NEAR(dmu.gyro.bias_sigma, 1.0 * ultratrack::io::kRadPerDeg, 1e-15);  // 1 deg/s
+  EXPECT_NEAR(dmu.accel.bias_sigma, 10e-3 * 9.80665, 1e-12);                  // 10 mg
   const ImuErrorSpec nav = imu_preset("navigation");
   EXPECT_NEAR(nav.gyro.bias_sigma, 0.01 * ultratrack::io::kRadPerDeg / 3600.0, 1e-18);  // 0.01 deg/h
-  EXPECT_NEAR(nav.accel.bias_sigma, 25e-6 * 9.80665, 1e-12);      // 25 ug
+  EXPECT_NEAR(nav.accel.bias_sigma, 25e-6 * 9.80665, 1e-12);                            // 25 ug
   const ImuErrorSpec ideal = imu_preset("ideal");
   EXPECT_EQ(ideal.gyro.bias_sigma + ideal.gyro.random_walk + ideal.accel.bias_sigma + ideal.accel.random_walk, 0.0);
   EXPECT_GT(imu_preset("mems").gyro.bias_sigma, dmu.gyro.bias_sigma / 10);

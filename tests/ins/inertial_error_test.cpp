@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Stationary INS with one injected error, against the closed-form error analysis of a local-level INS
 // at the equator (where the north and east channels decouple from earth rate, so the textbook solutions
 // are exact to first order). The IMU data at rest are built analytically: dtheta = C_bn w_ie^n dt,

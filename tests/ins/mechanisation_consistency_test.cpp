@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Simulator/mechanisation consistency: error-free IMU increments from every profile, integrated by the
 // strapdown mechanisation from the true initial state, must reproduce the truth (issue 4: position < 1 m,
 // attitude < 1e-4 deg after 10 min; static for 1 h).
@@ -18,7 +19,6 @@ using namespace ultratrack::ins;
 
 namespace {
 
-
 struct Errors {
   double max_pos_m = 0.0;
   double max_att_deg = 0.0;
@@ -32,7 +32,8 @@ double position_error_m(const NavState& a, const TruthSample& b) {
 
 Errors run_profile(const std::string& name, double duration_s, double rate_hz, double roll0_rad = 0.0,
                    double pitch0_rad = 0.0) {
-  TrajectorySpec spec = profile_spec(name, duration_s, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 100.0);
+  TrajectorySpec spec =
+      profile_spec(name, duration_s, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 100.0);
   spec.roll0_rad = roll0_rad;
   spec.pitch0_rad = pitch0_rad;
   TrajectoryGenerator gen(spec, rate_hz);
@@ -43,7 +44,8 @@ Errors run_profile(const std::string& name, double duration_s, double rate_hz, d
     const TruthSample& t = gen.truth();
     e.max_pos_m = std::max(e.max_pos_m, position_error_m(ins.state(), t));
     e.max_vel_mps = std::max(e.max_vel_mps, (ins.state().v_n - t.v_n).norm());
-    e.max_att_deg = std::max(e.max_att_deg, attitude_error_n(ins.state().q_nb, t.q_nb).norm() / ultratrack::io::kRadPerDeg);
+    e.max_att_deg =
+        std::max(e.max_att_deg, attitude_error_n(ins.state().q_nb, t.q_nb).norm() / ultratrack::io::kRadPerDeg);
   }
   std::printf(
       "[ consistency ] %-8s %6.0f s @ %4.0f Hz: max position error %.3e m, velocity %.3e m/s, attitude %.3e deg\n",
@@ -82,11 +84,13 @@ TEST(ProfileConsistency, HoldsAt50HzAnd400Hz) {
 // increments consistent with the attitude, and the attitude carries the offsets.
 TEST(ProfileConsistency, HoldsWithRollAndPitchOffsets) {
   for (const char* name : {"static", "land"}) {
-    const Errors e = run_profile(name, 600.0, 100.0, 12.0 * ultratrack::io::kRadPerDeg, -7.0 * ultratrack::io::kRadPerDeg);
+    const Errors e =
+        run_profile(name, 600.0, 100.0, 12.0 * ultratrack::io::kRadPerDeg, -7.0 * ultratrack::io::kRadPerDeg);
     EXPECT_LT(e.max_pos_m, 1.0) << name;
     EXPECT_LT(e.max_att_deg, 1e-4) << name;
   }
-  TrajectorySpec spec = profile_spec("static", 1.0, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 100.0);
+  TrajectorySpec spec =
+      profile_spec("static", 1.0, 36.37 * ultratrack::io::kRadPerDeg, 127.36 * ultratrack::io::kRadPerDeg, 100.0);
   spec.roll0_rad = 12.0 * ultratrack::io::kRadPerDeg;
   spec.pitch0_rad = -7.0 * ultratrack::io::kRadPerDeg;
   spec.heading0_rad = 63.0 * ultratrack::io::kRadPerDeg;

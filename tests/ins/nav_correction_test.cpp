@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Error-state corrections: errors measured independently (ECEF differences, psi-angle of the two
 // quaternions) and fed back must return the estimate onto the truth.
 #include "ins/nav_correction.hpp"

@@ -1,5 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The odometer: simulated pulses against closed forms (scale factor, delay, slips, misalignment rotation), the
 // simulator's file read back, and every kind of bad odometer.csv rejected naming the file and the line.
+#include "ins/odometer.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +12,6 @@
 
 #include "ins/attitude.hpp"
 #include "ins/ins_error.hpp"
-#include "ins/odometer.hpp"
 #include "ins/odometer_csv.hpp"
 #include "support/expect_input_error.hpp"
 #include "support/test_data.hpp"
@@ -26,7 +28,6 @@ fs::path write_text(const std::string& name, const std::string& text) {
   std::ofstream(p) << text;
   return p;
 }
-
 
 // 20 s at a constant 10 m/s, truth at 100 Hz.
 std::vector<TruthSample> straight_truth() {

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # The installed package works outside the tree: `cmake --install` of the build into a scratch prefix, then
 # examples/consumer configured with only that prefix, built, run; it must print a fix within 30 m of the truth.
 #   cmake -DBUILD_DIR=... -DCONSUMER_SOURCE=... -DWORK_DIR=... [-DLAUNCHER=ccache] -P consumer_test.cmake

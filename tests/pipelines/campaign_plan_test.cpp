@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Campaign expansion (pipelines/campaign_plan.hpp) and campaign files (config/campaign_toml.hpp): the product's
 // count and order, zipped and linear columns, template substitution, and malformed files as InputErrors naming
 // the file and the key.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Campaign runs and their report (pipelines/campaign_run.hpp, campaign_report.hpp) on a tiny simulated campaign
 // (2 s static files on the shipped ephemeris): a run writes its folder and marker, a complete run is not redone,
 // a failed run is reported with its message, a missing one is named; the reductions against hand-computed tables.

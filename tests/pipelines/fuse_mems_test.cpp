@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fusion on a datasheet MEMS unit through the library: the ADIS16405-class drive of
 // scenarios/mems_drive_adis16405.toml (turn-on gyro bias 3 deg/s, 50 mg), 5 Hz position-only fixes at non-integer
 // times, the filter told only the datasheet values (scenarios/mems_datasheet_fuse.toml) with in-motion alignment
@@ -79,7 +80,11 @@ Errors run_fuse(bool nhc) {
                     double in_run) {
     return ((estimate - truth).array() / (sigma.array().square() + in_run * in_run).sqrt()).abs().maxCoeff();
   };
-  return {std::sqrt(h2 / n), std::sqrt(v2 / n), std::sqrt(r2 / n), std::sqrt(p2 / n), std::sqrt(y2 / n),
+  return {std::sqrt(h2 / n),
+          std::sqrt(v2 / n),
+          std::sqrt(r2 / n),
+          std::sqrt(p2 / n),
+          std::sqrt(y2 / n),
           worst_z(result.gyro_bias_b, simulated.imu_turn_on.gyro.bias, result.sigma_gyro_bias_b,
                   spec.gyro.bias_instability_sigma),
           worst_z(result.accel_bias_b, simulated.imu_turn_on.accel.bias, result.sigma_accel_bias_b,

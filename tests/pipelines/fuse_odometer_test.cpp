@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer (VMS) aiding through the library (seed 004): a 6-minute simulated drive (turns, a slope, a lane
 // change, a stop, a locked-wheel skid) whose odometer has every error the 19-state filter models; GNSS only for the
 // first 90 s. Checked against the simulator's truth: the estimated scale factor, misalignment and delay within

@@ -1,8 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Data wipe-off end to end (issue 27): 36 s of a static receiver at 45 dB-Hz simulated in process (the shipped
-// brdc3540 file, 2 MHz i8); the receiver starts hot from a nav file whose every ephemeris has Crs one unit (2^-5 m) off in the
-// last place, as a generator that quantises differently makes it, so subframe 2's word 3 differs from the signal's.
-// The scalar loops sum 100 ms coherently whenever 5 bits are known (adaptive_coherent off), so the bits are asked
-// for at 45 dB-Hz, where every wrong wiped word shows in the prompt's signs. Default (decoded): the nav file's
+// brdc3540 file, 2 MHz i8); the receiver starts hot from a nav file whose every ephemeris has Crs one unit (2^-5 m) off
+// in the last place, as a generator that quantises differently makes it, so subframe 2's word 3 differs from the
+// signal's. The scalar loops sum 100 ms coherently whenever 5 bits are known (adaptive_coherent off), so the bits are
+// asked for at 45 dB-Hz, where every wrong wiped word shows in the prompt's signs. Default (decoded): the nav file's
 // words are compared with the decoded copy and the disagreeing ones never wiped: no word contradicted. Oracle: the
 // nav file re-encoded, its wrong words wiped and contradicted (counted, not acted on). summary.json's nav_bits line
 // says the same.
@@ -91,11 +92,12 @@ TEST(NavBitsEndToEnd, DefaultNeverWipesWithANavFilesWrongWordsWhileTheOracleDoes
 
   ASSERT_GE(oracle.satellites, 6);
   EXPECT_GE(oracle.all.words_contradicted, oracle.satellites);  // subframe 2 word 3 of each, at least
-  EXPECT_EQ(oracle.all.sources_stopped, 0);  // the oracle is never stopped
+  EXPECT_EQ(oracle.all.sources_stopped, 0);                     // the oracle is never stopped
   EXPECT_GT(oracle.all.bits_wiped, decoded.all.bits_wiped);
   EXPECT_EQ(oracle.all.bits_unknown, 0);
 
-  EXPECT_NE(decoded.summary.find("\"nav_bits\": {\"mode\": \"decoded\", \"per_satellite\": [{\"prn\": "), std::string::npos);
+  EXPECT_NE(decoded.summary.find("\"nav_bits\": {\"mode\": \"decoded\", \"per_satellite\": [{\"prn\": "),
+            std::string::npos);
   EXPECT_NE(oracle.summary.find("\"nav_bits\": {\"mode\": \"oracle\""), std::string::npos);
   EXPECT_NE(oracle.summary.find("\"source\": \"oracle\""), std::string::npos);
   EXPECT_EQ(decoded.summary.find("\"source\": \"oracle\""), std::string::npos);

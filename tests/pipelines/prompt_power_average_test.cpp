@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // pipelines::PromptPowerAverage, the ultra-tight I&Q model's amplitude estimate, against closed forms on simulated
 // prompt taps.
 #include "pipelines/prompt_power_average.hpp"
@@ -60,4 +61,3 @@ TEST(PromptPowerAverage, UnbiasedOneSecondMeanOfSimulatedTapsAndFollowsAStep) {
   for (int k = 0; k < 100; ++k) e = avg.update(raw_power(std::sqrt(weak2)), kScale2);
   EXPECT_NEAR(e, weak2, 3.0 * std::sqrt((4.0 + 4.0 * weak2) * 0.1 / 1.9));
 }
-

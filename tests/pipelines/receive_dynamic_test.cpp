@@ -1,8 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The scalar receiver on a moving antenna (the dynamic check, shortened for CI), through the library: the simulator
 // drives the antenna round a circle of radius 100 m at 30 km/h (centripetal 0.69 m/s^2, line-of-sight
-// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with tests/data's brdc3540; pipelines::receive_file starts hot
-// (the same nav file) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the truth by
-// pipelines/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
+// accelerations up to that, i.e. Doppler rates to 3.6 Hz/s) with tests/data's brdc3540; pipelines::receive_file starts
+// hot (the same nav file) on 2.0 MHz i8 (1.96 samples per chip: a non-integer rate) and the fixes are compared with the
+// truth by pipelines/solution_compare. The full 300 s run at 2.6 MHz is in docs/validation.md.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -61,8 +62,10 @@ TEST(ReceiveDynamic, CircleOf100mAt30kmhHotStartWithinTheIssuesTolerances) {
   const SolutionComparison c =
       compare_solution(read_solution_csv(rx / "solution.csv"), read_simulation_truth_csv(sim / "truth.csv"));
   const double ttff = json_number(rx / "summary.json", "ttff_s");
-  std::printf("circle 100 m, 30 km/h, 25 s hot: TTFF %.2f s, %d fixes, 3-D RMS %.3f m (max %.3f), velocity RMS "
-              "%.4f m/s\n", ttff, c.fixes, c.rms_3d_m, c.max_3d_m, c.rms_velocity_mps);
+  std::printf(
+      "circle 100 m, 30 km/h, 25 s hot: TTFF %.2f s, %d fixes, 3-D RMS %.3f m (max %.3f), velocity RMS "
+      "%.4f m/s\n",
+      ttff, c.fixes, c.rms_3d_m, c.max_3d_m, c.rms_velocity_mps);
   EXPECT_GE(ttff, 6.07);
   EXPECT_LE(ttff, 18.2);
   EXPECT_GE(c.fixes, 60);  // at least 6 s of 10 Hz fixes
@@ -113,7 +116,8 @@ TEST(ReceiveDynamic, Static35DbHzHotStartTracksEverySatelliteAndFixes) {
     const auto at = summary.str().find("{\"prn\": " + prn + ",");
     ASSERT_NE(at, std::string::npos) << "PRN " << prn << " not acquired";
     EXPECT_NE(summary.str().find("\"losses\": 0,", at), std::string::npos);
-    EXPECT_EQ(summary.str().find("\"losses\": 0,", at), summary.str().find("\"losses\":", at)) << "PRN " << prn << " lost";
+    EXPECT_EQ(summary.str().find("\"losses\": 0,", at), summary.str().find("\"losses\":", at))
+        << "PRN " << prn << " lost";
     ++satellites;
   }
   EXPECT_GE(satellites, 8);

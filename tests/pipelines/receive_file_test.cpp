@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The library's receive path end to end, without the command line and without shared data: scenarios on the
 // nominal constellation (sim/, read from TOML text by config/) simulated into a scratch folder in process, then
 // received through pipelines::receive_file (scalar: the summary against the simulator's truth and against the files
@@ -9,9 +10,9 @@
 #include <gtest/gtest.h>
 
 #include <GeographicLib/LocalCartesian.hpp>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <algorithm>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -61,10 +62,11 @@ pipelines::ReceiveFileJob job_for(const Simulated& s, const fs::path& out) {
 }
 
 const Simulated& static_run() {
-  static const Simulated s = simulate("static", "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 14.0\n"
-                                                "cn0_dbhz = 45.0\nseed = 11\n[time]\ngps_week = 2190\ntow_s = 518398.0\n"
-                                                "[navigation]\nconstellation = \"nominal\"\n"
-                                                "[receiver]\nllh_deg_m = [48.1, 11.6, 520.0]\n");
+  static const Simulated s = simulate("static",
+                                      "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 14.0\n"
+                                      "cn0_dbhz = 45.0\nseed = 11\n[time]\ngps_week = 2190\ntow_s = 518398.0\n"
+                                      "[navigation]\nconstellation = \"nominal\"\n"
+                                      "[receiver]\nllh_deg_m = [48.1, 11.6, 520.0]\n");
   return s;
 }
 
@@ -89,9 +91,9 @@ TEST(ReceiveFile, ScalarHotStartOnTheNominalConstellation) {
   // Every satellite the simulator put in view (above its 5 deg mask; 12 channels by default) is tracked, and those
   // above the PVT's 10 deg mask are used.
   const int in_view = static_cast<int>(s.result.satellites.size());
-  const int above_pvt_mask = static_cast<int>(std::count_if(
-      s.result.satellites.begin(), s.result.satellites.end(),
-      [](const signals::SatelliteView& v) { return v.elevation_rad > 10.0 * std::numbers::pi / 180.0; }));
+  const int above_pvt_mask = static_cast<int>(
+      std::count_if(s.result.satellites.begin(), s.result.satellites.end(),
+                    [](const signals::SatelliteView& v) { return v.elevation_rad > 10.0 * std::numbers::pi / 180.0; }));
   ASSERT_GE(above_pvt_mask, 5);
   EXPECT_EQ(summary.satellites_tracked, std::min(in_view, 12));
   EXPECT_EQ(summary.satellites_used, above_pvt_mask);
@@ -107,8 +109,8 @@ TEST(ReceiveFile, ScalarHotStartOnTheNominalConstellation) {
   // Against the simulator's truth: at 45 dB-Hz a single fix is good to a few metres (code noise ~0.5 m per
   // pseudorange, PDOP < 3 here, ionosphere simulated and removed with the same Klobuchar set); 10 m is > 3 sigma.
   double e, n, u;
-  GeographicLib::LocalCartesian(48.1, 11.6, 520.0).Forward(summary.mean_lat_deg, summary.mean_lon_deg,
-                                                          summary.mean_height_m, e, n, u);
+  GeographicLib::LocalCartesian(48.1, 11.6, 520.0)
+      .Forward(summary.mean_lat_deg, summary.mean_lon_deg, summary.mean_height_m, e, n, u);
   EXPECT_LT(std::hypot(e, n, u), 10.0) << "mean fix " << e << " " << n << " " << u << " m ENU";
   const auto c = pipelines::compare_solution(pipelines::read_solution_csv(out / "solution.csv"),
                                              pipelines::read_simulation_truth_csv(s.dir / "sim" / "truth.csv"));
@@ -137,7 +139,8 @@ struct RecordingSink final : pipelines::ReceiveSink {
 // A car on a 100 m circle at 30 km/h (HG1700AE IMU), 45 dB-Hz: tight pull-in, alignment in motion, hand-over to the
 // ultra-tight loop; the sink sees every navigation row and channel-epoch the summary counts.
 TEST(ReceiveFile, UltraTightHandsOverAndTheSinkSeesEveryEpoch) {
-  const std::string circle = "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n16.0,0.0,4.774648,0.0,0.0\n";
+  const std::string circle =
+      "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n16.0,0.0,4.774648,0.0,0.0\n";
   const fs::path dir = test::scratch_dir();
   std::ofstream(dir / "circle.csv") << circle;
   const Simulated s = [&] {
@@ -192,8 +195,7 @@ TEST(ReceiveFile, UltraTightHandsOverAndTheSinkSeesEveryEpoch) {
       << "nav t_s " << last.t_s << ", truth " << truth.front().tow_s << ".." << truth.back().tow_s;
   const double w = (tow - (it - 1)->tow_s) / (it->tow_s - (it - 1)->tow_s);
   const Eigen::Vector3d p_truth = (it - 1)->r_e_m + w * (it->r_e_m - (it - 1)->r_e_m);
-  const double error_m =
-      (ins::ecef_from_geodetic(last.lat_rad, last.lon_rad, last.height_m) - p_truth).norm();
+  const double error_m = (ins::ecef_from_geodetic(last.lat_rad, last.lon_rad, last.height_m) - p_truth).norm();
   EXPECT_LT(error_m, 4.0 * last_sigma.position_ned_m.norm() + 0.01)
       << "at t_s " << last.t_s << ", sigma " << last_sigma.position_ned_m.transpose();
 }
@@ -242,12 +244,13 @@ TEST(ReceiveFile, BadInputIsOneInputErrorNamingTheFileAndNothingIsWritten) {
 // error names the flags that read it (the diagnosis's acquisition finds the simulated satellites with them), and
 // the same file read with them is tracked. (A bit order read backwards alone still tracks at 4 MHz, ~8 dB down.)
 TEST(ReceiveFile, AWrongTwoBitLayoutIsDiagnosedWithTheFlagsThatWork) {
-  const Simulated s = simulate("nt1065", "[signal]\nsample_rate_hz = 4.0e6\nif_hz = 1.0e6\nformat = \"r2\"\n"
-                                         "two_bit_coding = \"nt1065\"\ntwo_bit_order = \"msb-first\"\n"
-                                         "duration_s = 1.0\ncn0_dbhz = 45.0\nseed = 3\n"
-                                            "[time]\ngps_week = 2190\ntow_s = 518398.0\n"
-                                            "[navigation]\nconstellation = \"nominal\"\n"
-                                            "[receiver]\nllh_deg_m = [48.1, 11.6, 520.0]\n");
+  const Simulated s = simulate("nt1065",
+                               "[signal]\nsample_rate_hz = 4.0e6\nif_hz = 1.0e6\nformat = \"r2\"\n"
+                               "two_bit_coding = \"nt1065\"\ntwo_bit_order = \"msb-first\"\n"
+                               "duration_s = 1.0\ncn0_dbhz = 45.0\nseed = 3\n"
+                               "[time]\ngps_week = 2190\ntow_s = 518398.0\n"
+                               "[navigation]\nconstellation = \"nominal\"\n"
+                               "[receiver]\nllh_deg_m = [48.1, 11.6, 520.0]\n");
   pipelines::ReceiveFileJob job;
   job.input = s.dir / "sim" / "antenna0.r2.bin";
   job.format = signals::SampleFormat::r2;

@@ -1,8 +1,9 @@
-// GNSS/INS from IF samples (loose and tight coupling) end to end through the library: one simulation (a land vehicle on a circle of
-// radius 100 m at 30 km/h, HG1700AE IMU at 100 Hz, nominal constellation, 2.0 MHz i8, a few seconds) writes the IF
-// samples, imu.csv and truth.csv from ONE trajectory; the receiver starts hot from a RINEX file of the scenario's
-// own ephemerides (no ../shared needed). Checked against the simulator's truth: the fused position (nav.csv, IMU =
-// antenna here: no lever arm) against the PVT fixes (solution.csv) at the same epochs; tight coupling with only
+// SPDX-License-Identifier: GPL-3.0-or-later
+// GNSS/INS from IF samples (loose and tight coupling) end to end through the library: one simulation (a land vehicle on
+// a circle of radius 100 m at 30 km/h, HG1700AE IMU at 100 Hz, nominal constellation, 2.0 MHz i8, a few seconds) writes
+// the IF samples, imu.csv and truth.csv from ONE trajectory; the receiver starts hot from a RINEX file of the
+// scenario's own ephemerides (no ../shared needed). Checked against the simulator's truth: the fused position (nav.csv,
+// IMU = antenna here: no lever arm) against the PVT fixes (solution.csv) at the same epochs; tight coupling with only
 // three satellites (no PVT fix at all) stays on the truth. Bad IMU input on the command line:
 // tests/tools/receive_fusion_cli_test.cpp.
 #include <gtest/gtest.h>
@@ -16,19 +17,19 @@
 #include <string>
 #include <vector>
 
-#include "pipelines/fused_nav_csv.hpp"
-#include "ins/earth_model.hpp"
-#include "io/input_error.hpp"
 #include "config/fuse_config_toml.hpp"
 #include "config/receive_config_toml.hpp"
 #include "config/scenario_toml.hpp"
+#include "ins/earth_model.hpp"
 #include "ins/imu_csv.hpp"
+#include "io/input_error.hpp"
+#include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/receive_file.hpp"
+#include "pipelines/solution_compare.hpp"
 #include "signals/rinex_nav.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
 #include "sim/simulation_files.hpp"
-#include "pipelines/solution_compare.hpp"
 #include "support/fusion_circle_scenario.hpp"
 #include "support/test_data.hpp"
 
@@ -128,7 +129,7 @@ Rms compare(const fs::path& rx) {
   int n_since_start = 0;
   for (const auto& f : fixes) {
     const double tow = f.tow_s - f.clock_bias_m / kC;  // true GPS time of the fix
-    const double t = tow - kStartTow_s;                 // IMU time (sample 0 = the scenario start)
+    const double t = tow - kStartTow_s;                // IMU time (sample 0 = the scenario start)
     if (nav.empty() || t < nav.front().nav.t_s - 1e-6 || t > nav.back().nav.t_s) continue;
     const Eigen::Vector3d truth = truth_at(s.truth, tow);
     since_start += (f.r_e_m - truth).squaredNorm();
@@ -278,10 +279,11 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
     ++rows;
   }
   const double sigma_h_end = nav.back().sigma.position_ned_m.head<2>().norm();
-  std::printf("tight, 3 satellites: horizontal error over the last 5 s at most %.2f m (start 20 m), final "
-              "horizontal 1-sigma %.2f m, vertical %.2f m\n", worst_late_m, sigma_h_end,
-              nav.back().sigma.position_ned_m.z());
-  EXPECT_LT(worst_late_m, 5.0);   // the 20 m start error removed to the pseudorange noise level
-  EXPECT_LT(sigma_h_end, 10.0);   // and the filter knows it: bounded, not growing like a free INS
+  std::printf(
+      "tight, 3 satellites: horizontal error over the last 5 s at most %.2f m (start 20 m), final "
+      "horizontal 1-sigma %.2f m, vertical %.2f m\n",
+      worst_late_m, sigma_h_end, nav.back().sigma.position_ned_m.z());
+  EXPECT_LT(worst_late_m, 5.0);  // the 20 m start error removed to the pseudorange noise level
+  EXPECT_LT(sigma_h_end, 10.0);  // and the filter knows it: bounded, not growing like a free INS
   EXPECT_EQ(outside_3sigma, 0) << "of " << rows << " rows";
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer (VMS) aiding in `receive --coupling loose --odometer` from IF samples end to end through the library
 // (issue 19, seed 004): one simulation of a car at 20 m/s (HG1700AE IMU at 100 Hz, a 10 Hz odometer with a +0.3 %
 // scale factor, 20 ms delay and a 0.2 / -0.3 deg mounting misalignment, nominal constellation, 2.0 MHz i8 at
@@ -42,31 +43,33 @@ struct Sim {
 };
 
 const Sim& simulated() {
-  static Sim s = [] {
-    Sim r;
-    r.dir = test::scratch_dir();
-    r.sim = r.dir / "sim";
-    std::ofstream(r.dir / "route.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
-                                           "12,0,0,0,0\n10,0,4,0,0\n8,0,0,0,0\n15,0,0,0,0\n15,0,1,0,0\n20,0,0,0,0\n";
-    std::ofstream(r.dir / "tunnel.toml")
-        << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 80.0\ncn0_dbhz = 45.0\nseed = 4\n"
-           "[time]\ngps_week = 2190\ntow_s = " << kStartTow_s
-        << "\n[navigation]\nconstellation = \"nominal\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
-           "[trajectory]\nfile = \"route.csv\"\nspeed_mps = " << kSpeed_mps
-        << "\nheading_deg = 0.0\nimu_rate_hz = 100.0\nodometer = true\nodometer_scale_factor_error = "
-        << kScaleFactorError << "\nodometer_delay_s = 0.02\nodometer_misalignment_pitch_deg = 0.2\n"
-        << "odometer_misalignment_yaw_deg = " << kYawMisalignment_deg
-        << "\n[output]\ntruth_rate_hz = 100.0\n[imu]\npreset = \"hg1700ae\"\nseed = 7\n"
-           "[atmosphere]\nionosphere = true\ntroposphere = true\n"
-           "[[blockage]]\nantenna = 0\nstart_s = " << kBlockStart_s << "\nduration_s = " << kBlockEnd_s - kBlockStart_s
-        << "\n";
-    const auto scenario = config::read_scenario(r.dir / "tunnel.toml");
-    sim::simulate_to_folder(scenario, r.sim, "");
-    r.nav = r.dir / "nominal.rnx";  // the scenario's own broadcast data: the receiver's hot start
-    signals::write_rinex_nav_304(r.nav, sim::to_rinex_nav(sim::load_navigation(scenario)));
-    r.truth = sim::read_truth_csv(r.sim / "truth.csv");
-    return r;
-  }();
+  static Sim s =
+      [] {
+        Sim r;
+        r.dir = test::scratch_dir();
+        r.sim = r.dir / "sim";
+        std::ofstream(r.dir / "route.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
+                                              "12,0,0,0,0\n10,0,4,0,0\n8,0,0,0,0\n15,0,0,0,0\n15,0,1,0,0\n20,0,0,0,0\n";
+        std::ofstream(r.dir / "tunnel.toml")
+            << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 80.0\ncn0_dbhz = 45.0\nseed = 4\n"
+               "[time]\ngps_week = 2190\ntow_s = "
+            << kStartTow_s
+            << "\n[navigation]\nconstellation = \"nominal\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+               "[trajectory]\nfile = \"route.csv\"\nspeed_mps = "
+            << kSpeed_mps << "\nheading_deg = 0.0\nimu_rate_hz = 100.0\nodometer = true\nodometer_scale_factor_error = "
+            << kScaleFactorError << "\nodometer_delay_s = 0.02\nodometer_misalignment_pitch_deg = 0.2\n"
+            << "odometer_misalignment_yaw_deg = " << kYawMisalignment_deg
+            << "\n[output]\ntruth_rate_hz = 100.0\n[imu]\npreset = \"hg1700ae\"\nseed = 7\n"
+               "[atmosphere]\nionosphere = true\ntroposphere = true\n"
+               "[[blockage]]\nantenna = 0\nstart_s = "
+            << kBlockStart_s << "\nduration_s = " << kBlockEnd_s - kBlockStart_s << "\n";
+        const auto scenario = config::read_scenario(r.dir / "tunnel.toml");
+        sim::simulate_to_folder(scenario, r.sim, "");
+        r.nav = r.dir / "nominal.rnx";  // the scenario's own broadcast data: the receiver's hot start
+        signals::write_rinex_nav_304(r.nav, sim::to_rinex_nav(sim::load_navigation(scenario)));
+        r.truth = sim::read_truth_csv(r.sim / "truth.csv");
+        return r;
+      }();
   return s;
 }
 
@@ -136,13 +139,14 @@ TEST(ReceiveOdometer, LooseCouplingWithTheOdometerBridgesATunnel) {
   const Horizontal entry_with = horizontal_at(with, kBlockStart_s), end_with = horizontal_at(with, kBlockEnd_s);
   constexpr double kRadPerDeg = M_PI / 180.0;
   const double distance_m = kSpeed_mps * (kBlockEnd_s - kBlockStart_s);
-  const double bound_m = entry_with.error_m + distance_m * (std::abs(kScaleFactorError) +
-                                                            std::abs(kYawMisalignment_deg) * kRadPerDeg +
-                                                            std::abs(entry_with.heading_error_rad) + 0.05 * kRadPerDeg);
-  std::printf("45 s tunnel, loose EKF: horizontal error at the entry %.2f m / %.2f m, at the exit %.2f m without "
-              "the odometer (1-sigma %.2f m), %.2f m with it (1-sigma %.2f m, physics bound %.2f m)\n",
-              entry_without.error_m, entry_with.error_m, end_without.error_m, end_without.sigma_m, end_with.error_m,
-              end_with.sigma_m, bound_m);
+  const double bound_m =
+      entry_with.error_m + distance_m * (std::abs(kScaleFactorError) + std::abs(kYawMisalignment_deg) * kRadPerDeg +
+                                         std::abs(entry_with.heading_error_rad) + 0.05 * kRadPerDeg);
+  std::printf(
+      "45 s tunnel, loose EKF: horizontal error at the entry %.2f m / %.2f m, at the exit %.2f m without "
+      "the odometer (1-sigma %.2f m), %.2f m with it (1-sigma %.2f m, physics bound %.2f m)\n",
+      entry_without.error_m, entry_with.error_m, end_without.error_m, end_without.sigma_m, end_with.error_m,
+      end_with.sigma_m, bound_m);
   EXPECT_LT(entry_with.error_m, 3.0);  // both enter on GNSS
   EXPECT_LT(entry_without.error_m, 3.0);
   EXPECT_LE(end_with.error_m, bound_m);

@@ -1,9 +1,10 @@
-// The ultra-tight receive end to end through the library (pipelines::receive_file), short for CI: the simulator writes 21 s of a
-// car on a 100 m circle at 30 km/h (45 dB-Hz, 2 MHz, the shipped brdc3540_0000-0200.14n from TOW 518476, 4 s into a
-// subframe, when no satellite is within 1 deg of the 10 deg measurement mask; IF samples, imu.csv (HG1700) and
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The ultra-tight receive end to end through the library (pipelines::receive_file), short for CI: the simulator writes
+// 21 s of a car on a 100 m circle at 30 km/h (45 dB-Hz, 2 MHz, the shipped brdc3540_0000-0200.14n from TOW 518476, 4 s
+// into a subframe, when no satellite is within 1 deg of the 10 deg measurement mask; IF samples, imu.csv (HG1700) and
 // truth.csv from one trajectory) with every signal absent from 14.0 to 18.0 s (a short tunnel; 4 s: the filter-driven
-// channels' presence test declares a loss 1-2 s after it, within 3 s with probability 1 - 0.085^2). The receiver starts hot,
-// pulls in scalar, the tight integration aligns in motion, and ~2 s later the ultra-tight loop takes the channels
+// channels' presence test declares a loss 1-2 s after it, within 3 s with probability 1 - 0.085^2). The receiver starts
+// hot, pulls in scalar, the tight integration aligns in motion, and ~2 s later the ultra-tight loop takes the channels
 // over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
 // loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
 // signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
@@ -24,15 +25,15 @@
 #include <vector>
 
 #include "config/scenario_toml.hpp"
+#include "ins/earth_model.hpp"
 #include "ins/imu_csv.hpp"
+#include "io/input_error.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/receive_file.hpp"
+#include "pipelines/solution_compare.hpp"
+#include "pipelines/ultratight_loop.hpp"
 #include "signals/rinex_nav.hpp"
 #include "sim/simulation_files.hpp"
-#include "ins/earth_model.hpp"
-#include "io/input_error.hpp"
-#include "pipelines/ultratight_loop.hpp"
-#include "pipelines/solution_compare.hpp"
 #include "support/test_data.hpp"
 #include "support/ultratight_tunnel_scenario.hpp"
 
@@ -318,7 +319,8 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
   }
   const NavError e = nav_error(rx, handover_s + 0.5);
   std::printf("ultra-tight %s %s %s: hand-over %.2f s, %zu channels, nav 3-D RMS %.3f m (stated %.3f m) over %d rows\n",
-              filter.c_str(), form.c_str(), serial ? "serial" : "pipelined", handover_s, handed.size(), e.rms_m, e.sigma_m, e.rows);
+              filter.c_str(), form.c_str(), serial ? "serial" : "pipelined", handover_s, handed.size(), e.rms_m,
+              e.sigma_m, e.rows);
   EXPECT_GE(e.rows, 500);
   EXPECT_LT(e.rms_m, 2.0);
   EXPECT_LT(e.rms_m, 3.0 * e.sigma_m);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --coupling vector --vector-carrier fll` end to end (issue 7, vector FLL): the filter commands
 // every vector channel's carrier NCO from its predicted Doppler and closes the carrier through the channels'
 // frequency discriminators. Against the simulator's truth (truth.csv's trajectory and clock, the broadcast orbits):
@@ -15,7 +16,6 @@
 #include <string>
 #include <vector>
 
-#include "support/vector_carrier_runs.hpp"
 #include "pipelines/solution_compare.hpp"
 #include "signals/ephemeris_selection.hpp"
 #include "signals/gps_constants.hpp"
@@ -23,6 +23,7 @@
 #include "signals/satellite_state.hpp"
 #include "support/receive_output_readers.hpp"
 #include "support/test_data.hpp"
+#include "support/vector_carrier_runs.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack::pipelines;
@@ -63,7 +64,8 @@ std::vector<TruthRow> read_truth(const fs::path& path) {
 // rows): -(u . (v_sat - v) + clock drift - c SV clock drift) / lambda, the satellite at its transmit time in the
 // receive-time frame (two travel-time iterations). Neglected: the frame rotation's effect on the velocity and
 // the receiver acceleration within 50 ms, both below 0.02 m/s (0.1 Hz) even in the 2 g turn.
-double true_doppler_hz(const std::vector<TruthRow>& truth, const std::vector<signals::Ephemeris>& ephs, int prn, double t) {
+double true_doppler_hz(const std::vector<TruthRow>& truth, const std::vector<signals::Ephemeris>& ephs, int prn,
+                       double t) {
   const auto it = std::lower_bound(truth.begin(), truth.end(), t, [](const TruthRow& r, double x) { return r.t < x; });
   const std::size_t k = std::clamp<std::size_t>(static_cast<std::size_t>(it - truth.begin()), 1, truth.size() - 1);
   const TruthRow& a = truth[k - 1];
@@ -127,8 +129,10 @@ std::map<int, bool> kept_in_vector_mode(const fs::path& vector_csv) {
   while (std::getline(in, line)) {
     const auto f = ultratrack::test::split_csv_line(line);
     const int prn = std::stoi(f[2]);
-    if (f[3] == "1") in_vector[prn] = true;
-    else if (in_vector[prn]) dropped[prn] = true;
+    if (f[3] == "1")
+      in_vector[prn] = true;
+    else if (in_vector[prn])
+      dropped[prn] = true;
   }
   std::map<int, bool> kept;
   for (const auto& [prn, v] : in_vector) kept[prn] = v && !dropped[prn];
@@ -165,8 +169,10 @@ TEST(ReceiveVectorFll, StaticKeepsEveryChannelWithTheCommandedDopplerOnTheTruth)
   const auto ephs = signals::read_rinex_nav(brdc).ephemerides;
   const DopplerErrors f = doppler_errors(fll / "tracking.csv", truth, ephs, 13.5, 16.0);
   const DopplerErrors p = doppler_errors(pll / "tracking.csv", truth, ephs, 13.5, 16.0);
-  std::printf("static 45 dB-Hz: NCO Doppler - truth, FLL: RMS %.3f Hz, max %.3f Hz over %d epochs; aided PLL: RMS "
-              "%.3f Hz, max %.3f Hz over %d epochs\n", f.rms_hz, f.max_hz, f.epochs, p.rms_hz, p.max_hz, p.epochs);
+  std::printf(
+      "static 45 dB-Hz: NCO Doppler - truth, FLL: RMS %.3f Hz, max %.3f Hz over %d epochs; aided PLL: RMS "
+      "%.3f Hz, max %.3f Hz over %d epochs\n",
+      f.rms_hz, f.max_hz, f.epochs, p.rms_hz, p.max_hz, p.epochs);
   EXPECT_EQ(static_cast<int>(f.per_prn.size()), satellites);
   for (const auto& [prn, n] : f.per_prn) EXPECT_GE(n, 100) << "PRN " << prn;  // 2.5 s of 20 ms epochs
   EXPECT_LE(f.rms_hz, 0.3);
@@ -213,15 +219,16 @@ TEST(ReceiveVectorFll, TwoGTurnKeepsEveryChannelWithTheCommandedDopplerOnTheTrut
   const DopplerErrors f = doppler_errors(fll / "tracking.csv", truth, ephs, 15.0, 20.0);
   const DopplerErrors p = doppler_errors(pll / "tracking.csv", truth, ephs, 15.0, 20.0);
   const DopplerErrors fs_ = doppler_errors(fll / "tracking.csv", truth, ephs, 13.5, 15.0);
-  std::printf("2 g turn (15-20 s): NCO Doppler - truth, FLL: RMS %.3f Hz, max %.3f Hz over %d epochs (straight "
-              "13.5-15 s: RMS %.3f Hz); aided PLL: RMS %.3f Hz, max %.3f Hz over %d epochs\n",
-              f.rms_hz, f.max_hz, f.epochs, fs_.rms_hz, p.rms_hz, p.max_hz, p.epochs);
+  std::printf(
+      "2 g turn (15-20 s): NCO Doppler - truth, FLL: RMS %.3f Hz, max %.3f Hz over %d epochs (straight "
+      "13.5-15 s: RMS %.3f Hz); aided PLL: RMS %.3f Hz, max %.3f Hz over %d epochs\n",
+      f.rms_hz, f.max_hz, f.epochs, fs_.rms_hz, p.rms_hz, p.max_hz, p.epochs);
   EXPECT_EQ(static_cast<int>(f.per_prn.size()), satellites);
   for (const auto& [prn, n] : f.per_prn) EXPECT_GE(n, 240) << "PRN " << prn;  // ~5 s of 20 ms epochs
   EXPECT_LE(f.rms_hz, 4.6);
   EXPECT_LE(f.max_hz, 6.25);
   EXPECT_LE(fs_.rms_hz, 0.3);
-    EXPECT_GE(read_solution_csv(fll / "solution.csv").size(), 75u);
+  EXPECT_GE(read_solution_csv(fll / "solution.csv").size(), 75u);
 }
 
 // Coasting in FLL mode: the blockage scenario of ReceiveVector.ChannelsCoastThroughFadesAndReLockWithoutAcquisition
@@ -238,10 +245,12 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
   const auto dir = ultratrack::test::scratch_dir();
   constexpr double kGapStart = 14.0, kGapEnd = 17.0, kFadeStart = 18.5, kFadeEnd = 20.5;
   constexpr int kFaded = 24;
-  std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 22.0,
-                                              "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
-                                              "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
-                                              "fade_s = 2.0\n", 2190);
+  std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(
+      brdc, 100.0, 22.0,
+      "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
+      "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
+      "fade_s = 2.0\n",
+      2190);
   const auto sim = dir / "sim", fll = dir / "fll";
   ultratrack::test::simulate_scenario(dir / "gap.toml", sim);
   ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
@@ -272,7 +281,7 @@ TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
       EXPECT_LE(w[1].second + 0.02, kFadeEnd + 1.0);
     }
   }
-    const auto fixes = read_solution_csv(fll / "solution.csv");
+  const auto fixes = read_solution_csv(fll / "solution.csv");
   const SolutionComparison v = compare_solution(fixes, read_simulation_truth_csv(sim / "truth.csv"));
   std::printf("3 s blockage, vector FLL: last return %.2f s after the signal; %zu fixes, 3-D RMS %.3f m\n", worst,
               fixes.size(), v.rms_3d_m);
@@ -301,9 +310,9 @@ TEST(ReceiveVectorFll, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 20.0;
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "weak.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, kEnd,
-                                               "[[cn0_step]]\nstart_s = " + std::to_string(kStep) +
-                                                   "\ncn0_dbhz = " + std::to_string(kWeak) + "\n");
+  std::ofstream(dir / "weak.toml") << ultratrack::test::vector_carrier_scenario(
+      brdc, 100.0, kEnd,
+      "[[cn0_step]]\nstart_s = " + std::to_string(kStep) + "\ncn0_dbhz = " + std::to_string(kWeak) + "\n");
   const auto sim = dir / "sim", fll = dir / "fll";
   ultratrack::test::simulate_scenario(dir / "weak.toml", sim);
   ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");
@@ -353,10 +362,11 @@ TEST(ReceiveVectorFll, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   const auto ephs = signals::read_rinex_nav(brdc).ephemerides;
   const DopplerErrors d = doppler_errors(fll / "tracking.csv", truth, ephs, kStep + 2.0, kEnd);
   const auto filter = ultratrack::test::static_filter_position_rms(fll / "vector_state.csv", sim / "truth.csv", kStep);
-  std::printf("FLL, step to %.0f dB-Hz at %.0f s: %d channels kept to the end, lowest mean C/N0 estimate %.2f dB-Hz; "
-              "NCO Doppler - truth RMS %.2f Hz, max %.2f Hz over %d epochs; filter position 3-D RMS %.2f m "
-              "over %d epochs\n", kWeak, kStep, handed, worst_cn0, d.rms_hz, d.max_hz, d.epochs, filter.rms_3d_m,
-              filter.epochs);
+  std::printf(
+      "FLL, step to %.0f dB-Hz at %.0f s: %d channels kept to the end, lowest mean C/N0 estimate %.2f dB-Hz; "
+      "NCO Doppler - truth RMS %.2f Hz, max %.2f Hz over %d epochs; filter position 3-D RMS %.2f m "
+      "over %d epochs\n",
+      kWeak, kStep, handed, worst_cn0, d.rms_hz, d.max_hz, d.epochs, filter.rms_3d_m, filter.epochs);
   EXPECT_GE(d.epochs, 9 * 350);  // 8 s of 20 ms epochs, 9 or more channels
   EXPECT_LE(d.rms_hz, 3.0);
   ASSERT_GT(filter.epochs, 400);  // 10 s of 20 ms vector epochs, the filter never restarted

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --coupling vector --vector-carrier pll` end to end (issue 7, vector PLL): the filter commands
 // every vector channel's carrier NCO in frequency and phase from per-channel carrier states that the channels'
 // Costas discriminators update (fusion/vector_carrier_phase.hpp). Independent truth: the synthesiser that made the
@@ -18,15 +19,15 @@
 #include <string>
 #include <vector>
 
+#include "config/scenario_toml.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
-#include "support/receive_output_readers.hpp"
-#include "support/vector_carrier_runs.hpp"
-#include "config/scenario_toml.hpp"
+#include "signals/if_synthesiser.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
-#include "signals/if_synthesiser.hpp"
+#include "support/receive_output_readers.hpp"
 #include "support/test_data.hpp"
+#include "support/vector_carrier_runs.hpp"
 
 namespace fs = std::filesystem;
 namespace signals = ultratrack::signals;
@@ -120,8 +121,9 @@ std::pair<double, double> doppler_rms_max_hz(const fs::path& tracking, signals::
     const int prn = std::stoi(f[0]);
     const long long mid = std::stoll(f[1]) + static_cast<long long>(0.01 * kFs);
     const long long h = static_cast<long long>(0.001 * kFs);
-    const double truth = (synth.timing(prn, 0, mid + h).carrier_phase_cycles -
-                          synth.timing(prn, 0, mid - h).carrier_phase_cycles) / (2.0 * h / kFs);
+    const double truth =
+        (synth.timing(prn, 0, mid + h).carrier_phase_cycles - synth.timing(prn, 0, mid - h).carrier_phase_cycles) /
+        (2.0 * h / kFs);
     const double e = std::stod(f[7]) - truth;
     sum2 += e * e;
     worst = std::max(worst, std::abs(e));
@@ -170,13 +172,13 @@ Runs run_three(const fs::path& dir, const fs::path& brdc, const std::string& tom
 }
 
 void print(const char* what, const Runs& r) {
-  std::printf("%s: phase - truth, vector PLL: RMS %.4f cycles, max %.4f over %d epochs (%d arcs, median Bn %.1f Hz, "
-              "closed form at 45 dB-Hz %.4f); aided PLL: RMS %.4f, max %.4f over %d epochs. NCO Doppler - truth RMS/max "
-              "Hz: PLL %.3f/%.3f, aided PLL %.3f/%.3f, FLL %.3f/%.3f\n",
-              what, r.pll.rms_cycles, r.pll.max_cycles, r.pll.epochs, r.pll.arcs, r.pll.bn_hz,
-              closed_form_jitter_cycles(r.pll.bn_hz, 45.0, 0.02), r.aided.rms_cycles, r.aided.max_cycles,
-              r.aided.epochs, r.d_pll.first, r.d_pll.second, r.d_aided.first, r.d_aided.second, r.d_fll.first,
-              r.d_fll.second);
+  std::printf(
+      "%s: phase - truth, vector PLL: RMS %.4f cycles, max %.4f over %d epochs (%d arcs, median Bn %.1f Hz, "
+      "closed form at 45 dB-Hz %.4f); aided PLL: RMS %.4f, max %.4f over %d epochs. NCO Doppler - truth RMS/max "
+      "Hz: PLL %.3f/%.3f, aided PLL %.3f/%.3f, FLL %.3f/%.3f\n",
+      what, r.pll.rms_cycles, r.pll.max_cycles, r.pll.epochs, r.pll.arcs, r.pll.bn_hz,
+      closed_form_jitter_cycles(r.pll.bn_hz, 45.0, 0.02), r.aided.rms_cycles, r.aided.max_cycles, r.aided.epochs,
+      r.d_pll.first, r.d_pll.second, r.d_aided.first, r.d_aided.second, r.d_fll.first, r.d_fll.second);
 }
 
 }  // namespace
@@ -253,10 +255,11 @@ TEST(ReceiveVectorPll, TwoGTurnKeepsEveryPhaseArcWithoutSlips) {
 TEST(ReceiveVectorPll, FadedChannelsFallBackToTheFllAndReturnToPhaseLock) {
   const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
-  std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(brdc, 100.0, 22.0,
-                                              "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
-                                              "[[cycle_slip]]\nantenna = 0\nprn = 6\ntime_s = 18.5\ncycles = 0.0\n"
-                                              "fade_s = 2.0\n");
+  std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(
+      brdc, 100.0, 22.0,
+      "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
+      "[[cycle_slip]]\nantenna = 0\nprn = 6\ntime_s = 18.5\ncycles = 0.0\n"
+      "fade_s = 2.0\n");
   const auto sim = dir / "sim", pll = dir / "pll";
   ultratrack::test::simulate_scenario(dir / "gap.toml", sim);
   ultratrack::test::receive_vector_carrier(sim, brdc, pll, "pll");

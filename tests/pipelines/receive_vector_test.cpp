@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Vector tracking without an IMU end to end through the library (pipelines::receive_file), short for CI: the
 // simulator writes 16 s of a static receiver at 45 dB-Hz (10 satellites, brdc0010.22n); both
 // receivers start hot with a nav file from which PRN 20's ephemeris is removed. The scalar run is the reference;
@@ -15,16 +16,15 @@
 #include <string>
 #include <vector>
 
-#include "support/simulated_receive.hpp"
 #include "pipelines/solution_compare.hpp"
 #include "support/receive_output_readers.hpp"
+#include "support/simulated_receive.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
 using namespace ultratrack::pipelines;
 
 namespace {
-
 
 // A RINEX 2 nav file without one PRN's records (8 lines each, the PRN in columns 1-2 of the first).
 void drop_prn(const fs::path& in_path, const fs::path& out_path, int prn) {
@@ -78,19 +78,28 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
   drop_prn(brdc, dir / "nav.22n", kNoEphemeris);
   for (const auto& [out, coupling] : {std::pair{scalar, ultratrack::pipelines::Coupling::kScalar},
                                       std::pair{vector, ultratrack::pipelines::Coupling::kVector}})
-    ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = dir / "nav.22n", .out = out,
-                                         .coupling = coupling, .troposphere = false});
+    ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin",
+                                         .nav = dir / "nav.22n",
+                                         .out = out,
+                                         .coupling = coupling,
+                                         .troposphere = false});
   // The vector loop runs on the caller's thread after the channels' parallel work: one thread gives the same bytes.
   const auto one_thread = dir / "vector1";
-  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = dir / "nav.22n", .out = one_thread,
-                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false,
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin",
+                                       .nav = dir / "nav.22n",
+                                       .out = one_thread,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector,
+                                       .troposphere = false,
                                        .threads = 1});
   fs::remove(sim / "antenna0.i8.bin");
   for (const char* file : {"vector.csv", "vector_state.csv", "solution.csv", "tracking.csv"})
-    EXPECT_EQ(ultratrack::test::read_text_file(vector / file), ultratrack::test::read_text_file(one_thread / file)) << file << " differs between 1 thread and the default";
+    EXPECT_EQ(ultratrack::test::read_text_file(vector / file), ultratrack::test::read_text_file(one_thread / file))
+        << file << " differs between 1 thread and the default";
 
-  EXPECT_NE(ultratrack::test::read_text_file(vector / "summary.json").find("\"coupling\": \"vector\""), std::string::npos);
-  EXPECT_NE(ultratrack::test::read_text_file(scalar / "summary.json").find("\"coupling\": \"scalar\""), std::string::npos);
+  EXPECT_NE(ultratrack::test::read_text_file(vector / "summary.json").find("\"coupling\": \"vector\""),
+            std::string::npos);
+  EXPECT_NE(ultratrack::test::read_text_file(scalar / "summary.json").find("\"coupling\": \"scalar\""),
+            std::string::npos);
 
   // Every satellite of the file acquired once and never lost, in both runs.
   std::vector<int> prns;
@@ -107,7 +116,8 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
     for (int prn : prns) {
       const auto at = summary.find("{\"prn\": " + std::to_string(prn) + ",");
       ASSERT_NE(at, std::string::npos) << out << " PRN " << prn << " not acquired";
-      EXPECT_EQ(summary.find("\"losses\": 0,", at), summary.find("\"losses\":", at)) << out << " PRN " << prn << " lost";
+      EXPECT_EQ(summary.find("\"losses\": 0,", at), summary.find("\"losses\":", at))
+          << out << " PRN " << prn << " lost";
     }
   }
 
@@ -151,7 +161,8 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
   EXPECT_LE(v.rms_3d_m, s.rms_3d_m + 1.0);
 
   // The filter's own position (vector_state.csv) against the static truth.
-  const auto filter = ultratrack::test::static_filter_position_rms(vector / "vector_state.csv", sim / "truth.csv", 13.5);
+  const auto filter =
+      ultratrack::test::static_filter_position_rms(vector / "vector_state.csv", sim / "truth.csv", 13.5);
   ASSERT_GT(filter.epochs, 100);
   std::printf("vector filter position: 3-D RMS %.3f m over %d epochs\n", filter.rms_3d_m, filter.epochs);
   EXPECT_LE(filter.rms_3d_m, 2.0);
@@ -180,8 +191,8 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
   ultratrack::test::simulate_scenario(dir / "turn.toml", sim);
   for (const auto& [out, coupling] : {std::pair{scalar, ultratrack::pipelines::Coupling::kScalar},
                                       std::pair{vector, ultratrack::pipelines::Coupling::kVector}})
-    ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = out,
-                                         .coupling = coupling, .troposphere = false});
+    ultratrack::test::receive_simulated(
+        {.input = sim / "antenna0.i8.bin", .nav = brdc, .out = out, .coupling = coupling, .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
 
   const auto losses = [](const fs::path& out) {
@@ -200,9 +211,10 @@ TEST(ReceiveVector, VectorAidedLoopsKeepLockThroughATwoGTurnThatScalarLoopsLose)
   const auto s_fixes = read_solution_csv(scalar / "solution.csv");
   const auto v_fixes = read_solution_csv(vector / "solution.csv");
   const SolutionComparison v = compare_solution(v_fixes, truth);
-  std::printf("2 g turn step at 15 s: scalar %d losses over %d satellites, %zu fixes; vector %d losses over %d "
-              "satellites, %zu fixes, 3-D RMS %.3f m\n",
-              scalar_losses, scalar_sats, s_fixes.size(), vector_losses, vector_sats, v_fixes.size(), v.rms_3d_m);
+  std::printf(
+      "2 g turn step at 15 s: scalar %d losses over %d satellites, %zu fixes; vector %d losses over %d "
+      "satellites, %zu fixes, 3-D RMS %.3f m\n",
+      scalar_losses, scalar_sats, s_fixes.size(), vector_losses, vector_sats, v_fixes.size(), v.rms_3d_m);
   EXPECT_GE(vector_sats, 8);
   EXPECT_GE(scalar_losses, scalar_sats / 2);  // the case is hard for the scalar loops
   EXPECT_EQ(vector_losses, 0);
@@ -233,8 +245,11 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
                                         "[trajectory]\nprofile = \"circle\"\nduration_s = 20.0\nimu_rate_hz = 100.0\n";
   const auto sim = dir / "sim", vector = dir / "vector";
   ultratrack::test::simulate_scenario(dir / "circle.toml", sim);
-  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = vector,
-                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false});
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin",
+                                       .nav = brdc,
+                                       .out = vector,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector,
+                                       .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
   const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
   int satellites = 0;
@@ -259,29 +274,33 @@ TEST(ReceiveVector, HandOverInATurnKeepsEverySatellite) {
 // test is the presence test (1 s windows, 12 dB-Hz: receiver/presence_test.hpp), which declares an absent signal
 // at the end of the first whole window without it (1-2 s after it goes) with probability 0.915 and by the next
 // with 0.993, so coasting must start 1-3 s into a fade (the scalar loss test took 0.5-0.7 s; the per-epoch fade
-// gate keeps the faded epochs out of the filter from the first one either way). When the signal returns each must re-lock from
-// the predicted replica (leave "coasting") within 1 s (the issue's bound); the fixes, which resume after the
-// blockage and continue through the single fade on the other nine, stay within 2 m 3-D RMS of the truth (issue
-// 3's fix tolerance). Stays on the shared brdc0010.22n: on the shipped file's sky (fading PRN 6) every coasting
-// and re-lock bound holds but the fixes' 3-D RMS is 2.96 m (the short-window spread of the first test).
+// gate keeps the faded epochs out of the filter from the first one either way). When the signal returns each must
+// re-lock from the predicted replica (leave "coasting") within 1 s (the issue's bound); the fixes, which resume after
+// the blockage and continue through the single fade on the other nine, stay within 2 m 3-D RMS of the truth (issue 3's
+// fix tolerance). Stays on the shared brdc0010.22n: on the shipped file's sky (fading PRN 6) every coasting and re-lock
+// bound holds but the fixes' 3-D RMS is 2.96 m (the short-window spread of the first test).
 TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
   ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
   const auto dir = ultratrack::test::scratch_dir();
   constexpr double kGapStart = 14.0, kGapEnd = 17.0, kFadeStart = 18.5, kFadeEnd = 20.5;
   constexpr int kFaded = 24;
-  std::ofstream(dir / "gap.toml") << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 22.0\n"
-                                     "cn0_dbhz = 45.0\nseed = 4\n"
-                                     "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
-                                     "[navigation]\nrinex = \""
-                                  << brdc.generic_string()
-                                  << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
-                                     "[atmosphere]\nionosphere = true\ntroposphere = false\n"
-                                     "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
-                                     "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\nfade_s = 2.0\n";
+  std::ofstream(dir / "gap.toml")
+      << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = 22.0\n"
+         "cn0_dbhz = 45.0\nseed = 4\n"
+         "[time]\ngps_week = 2190\ntow_s = 518772.0\n"
+         "[navigation]\nrinex = \""
+      << brdc.generic_string()
+      << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+         "[atmosphere]\nionosphere = true\ntroposphere = false\n"
+         "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
+         "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\nfade_s = 2.0\n";
   const auto sim = dir / "sim", vector = dir / "vector";
   ultratrack::test::simulate_scenario(dir / "gap.toml", sim);
-  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = vector,
-                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false});
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin",
+                                       .nav = brdc,
+                                       .out = vector,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector,
+                                       .troposphere = false});
   fs::remove(sim / "antenna0.i8.bin");
 
   const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
@@ -323,9 +342,10 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
   using namespace ultratrack::pipelines;
   const auto fixes = read_solution_csv(vector / "solution.csv");
   const SolutionComparison v = compare_solution(fixes, read_simulation_truth_csv(sim / "truth.csv"));
-  std::printf("3 s blockage, vector: %d satellites coasted, last re-lock %.2f s after the return; PRN 24 alone faded "
-              "2 s: re-lock %.2f s after; %zu fixes, 3-D RMS %.3f m\n", satellites, worst, faded_relock, fixes.size(),
-              v.rms_3d_m);
+  std::printf(
+      "3 s blockage, vector: %d satellites coasted, last re-lock %.2f s after the return; PRN 24 alone faded "
+      "2 s: re-lock %.2f s after; %zu fixes, 3-D RMS %.3f m\n",
+      satellites, worst, faded_relock, fixes.size(), v.rms_3d_m);
   EXPECT_GE(fixes.size(), 65u);  // ~19 before the blockage, ~48 after (at 10 Hz)
   EXPECT_LE(v.rms_3d_m, 2.0);
 }
@@ -336,10 +356,11 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
 // lost every vector channel within ~0.5 s of a step to <= 25 dB-Hz, gives way to the presence test (a 60 s run at
 // 22 dB-Hz is falsely lost with probability 4e-11: docs/validation.md), their PLLs integrate 100 ms with the
 // known bits wiped (--nav-bits oracle: every bit of the simulated file; with the default decoded bits, none of
-// subframes 1-3 repeat within 25 s and 2 of 10 channels coasted), and their discriminators keep updating the filter with C/N0-weighted noise. So every
-// channel handed over must stay in vector mode and locked (bit-synced, never coasting or lost) to the end. Against
-// the simulator's truth: the filter's position RMS over the weak part within 5 m (the threshold runs at 22-24
-// dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code loop is slow and its sigma optimistic).
+// subframes 1-3 repeat within 25 s and 2 of 10 channels coasted), and their discriminators keep updating the filter
+// with C/N0-weighted noise. So every channel handed over must stay in vector mode and locked (bit-synced, never
+// coasting or lost) to the end. Against the simulator's truth: the filter's position RMS over the weak part within 5 m
+// (the threshold runs at 22-24 dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code loop is slow and its
+// sigma optimistic).
 TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 22.0;
@@ -355,8 +376,11 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
                                    << kStep << "\ncn0_dbhz = " << kWeak << "\n";
   const auto sim = dir / "sim", vector = dir / "vector";
   ultratrack::test::simulate_scenario(dir / "weak.toml", sim);
-  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = vector,
-                                       .coupling = ultratrack::pipelines::Coupling::kVector, .troposphere = false,
+  ultratrack::test::receive_simulated({.input = sim / "antenna0.i8.bin",
+                                       .nav = brdc,
+                                       .out = vector,
+                                       .coupling = ultratrack::pipelines::Coupling::kVector,
+                                       .troposphere = false,
                                        .nav_bits = ultratrack::receiver::NavBitSource::kOracle});
   fs::remove(sim / "antenna0.i8.bin");
 
@@ -413,12 +437,15 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   }
 
   // The filter's position over the weak part against the static truth.
-  const auto filter = ultratrack::test::static_filter_position_rms(vector / "vector_state.csv", sim / "truth.csv", kStep);
+  const auto filter =
+      ultratrack::test::static_filter_position_rms(vector / "vector_state.csv", sim / "truth.csv", kStep);
   ASSERT_GT(filter.epochs, 400);  // 10 s of 20 ms epochs, the filter never restarted
   const std::string summary = ultratrack::test::read_text_file(vector / "summary.json");
-  std::printf("step to %.0f dB-Hz at %.0f s: %d channels filter-driven kept to the end; filter position 3-D RMS %.2f m "
-              "over %d epochs; %s\n", kWeak, kStep, handed, filter.rms_3d_m, filter.epochs,
-              summary.substr(summary.find("\"frequency_resets\""), 24).c_str());
+  std::printf(
+      "step to %.0f dB-Hz at %.0f s: %d channels filter-driven kept to the end; filter position 3-D RMS %.2f m "
+      "over %d epochs; %s\n",
+      kWeak, kStep, handed, filter.rms_3d_m, filter.epochs,
+      summary.substr(summary.find("\"frequency_resets\""), 24).c_str());
   EXPECT_LE(filter.rms_3d_m, 5.0);
   // The code rows' noise model at 22 dB-Hz: the discriminator's output divided by its gain (~0.49 here) has the
   // closed-form variance times 1.04-1.27 (Monte Carlo, fusion_tests), and the prediction's share of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // pipelines::Receiver in process: `simulate` writes 16 s of a static receiver at 45 dB-Hz (12 satellites, the
 // shipped brdc3540 file, 2 MHz i8); the receiver starts hot. With vector coupling every filter epoch reaches the
 // sink, 20 ms apart, and the summary's counts are those of the sink's epochs; the observer sees the fixes the
@@ -14,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "support/test_data.hpp"
 #include "config/scenario_toml.hpp"
 #include "sim/simulation_files.hpp"
+#include "support/test_data.hpp"
 #include "support/vector_carrier_scenarios.hpp"
 
 namespace fs = std::filesystem;

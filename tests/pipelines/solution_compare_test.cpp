@@ -1,7 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // pipelines/solution_compare: a known error put on a known trajectory comes back. The truth is a 100 m circle at
 // 8.33 m/s in a local tangent plane, turned into ECEF by GeographicLib's LocalCartesian (not by the code under
 // test); the solution is that circle at times between the truth rows plus a fixed ENU position offset and a
 // fixed velocity offset, so every RMS is the offset's norm (to the truth's interpolation error, < 1 mm).
+#include "pipelines/solution_compare.hpp"
+
 #include <gtest/gtest.h>
 
 #include <GeographicLib/Geocentric.hpp>
@@ -11,7 +14,6 @@
 #include <string>
 
 #include "io/input_error.hpp"
-#include "pipelines/solution_compare.hpp"
 #include "support/test_data.hpp"
 
 namespace ultratrack::pipelines {
@@ -46,8 +48,8 @@ void write_truth(const std::filesystem::path& path) {
     lc.Reverse(enu[0], enu[1], enu[2], lat, lon, h);
     GeographicLib::Geocentric::WGS84().Forward(lat, lon, h, X, Y, Z);
     // The truth's NED velocity at its own point (the local frames 100 m apart differ by 1.6e-5 rad: < 0.2 mm/s).
-    out << t << ",2190," << kTow0 + t << "," << X << "," << Y << "," << Z << "," << lat << "," << lon << "," << h
-        << "," << v[1] << "," << v[0] << "," << -v[2] << ",0,0\n";
+    out << t << ",2190," << kTow0 + t << "," << X << "," << Y << "," << Z << "," << lat << "," << lon << "," << h << ","
+        << v[1] << "," << v[0] << "," << -v[2] << ",0,0\n";
   }
 }
 
@@ -81,7 +83,8 @@ TEST(SolutionCompare, AKnownOffsetOnACircleComesBack) {
   // A receiver clock 100 ms ahead: compared at the receiver's time instead of the true one, every fix would be
   // 0.83 m off along the track (3-D RMS 3.11 m); the comparison takes the true time, so 3 m comes back.
   write_solution(dir / "solution.csv", offset, dv, kC * 0.1);
-  const auto c = compare_solution(read_solution_csv(dir / "solution.csv"), read_simulation_truth_csv(dir / "truth.csv"));
+  const auto c =
+      compare_solution(read_solution_csv(dir / "solution.csv"), read_simulation_truth_csv(dir / "truth.csv"));
   EXPECT_EQ(c.fixes, 290);
   EXPECT_EQ(c.fixes_outside_truth, 0);
   EXPECT_NEAR(c.rms_3d_m, 3.0, 1e-3);

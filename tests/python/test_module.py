@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The Python package end to end (ctest python.module): a 12 s static scenario on the shipped broadcast ephemeris is
 simulated and received through the module; the summary dict is checked against the files the run wrote and the
 scenario's truth, the module's files against the program's on the same input (byte for byte), a numpy array of the

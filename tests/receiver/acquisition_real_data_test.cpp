@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Acquisition of real recordings (../shared/data, skipped when absent) through SampleSource: every
 // satellite the data README lists must be found at its Doppler (within one 250 Hz bin of the README's
 // grid) and code phase (within half a chip). Extra detections are printed, not failed: the README lists

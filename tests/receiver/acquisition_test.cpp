@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Acquisition against synthetic signals with known truth, the threshold against chi-square tables,
 // and the false-alarm rate on pure noise against the binomial law of the requested pfa.
 #include "receiver/acquisition.hpp"

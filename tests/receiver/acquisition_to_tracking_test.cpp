@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The seam between acquisition and tracking on a real recording: the acquisition's code phase (at the first
 // searched sample) and Doppler, handed to a TrackingChannel under scalar tracking, must put the replica on the
 // signal: tracked for the file's half second at a C/N0 near the acquisition's estimate (1 ms x 10 acquisition, the

@@ -1,12 +1,14 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // AntennaPhaseTracker on constructed correlation epochs: prompts with a known between-antenna phase (closed
 // form), thermal noise of a known C/N0, fades and phase steps, checked against that construction.
+#include "receiver/antenna_phase_tracker.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <complex>
 #include <random>
 
-#include "receiver/antenna_phase_tracker.hpp"
 #include "signals/ephemeris.hpp"
 
 namespace ultratrack::receiver {
@@ -53,7 +55,8 @@ TEST(AntennaPhaseTracker, FollowsAPhaseRampAcrossManyCyclesWithoutSlips) {
   double max_error = 0.0;
   for (std::int64_t n = 0; n < 1000; ++n) {
     const double t = (static_cast<double>(n) + 0.5) * kSamples / kFs;
-    tracker.update(maker.make(n, {0.0, 0.3 + 0.5 * t, -0.2 - 0.25 * t}, {true, true, true}, data_phase(rng)), true, kFs);
+    tracker.update(maker.make(n, {0.0, 0.3 + 0.5 * t, -0.2 - 0.25 * t}, {true, true, true}, data_phase(rng)), true,
+                   kFs);
     const std::int64_t at = (n + 1) * kSamples;  // end of the epoch: extrapolated half an epoch
     const double t_at = static_cast<double>(at) / kFs;
     for (int k = 1; k < 3; ++k) {
@@ -128,7 +131,8 @@ TEST(AntennaPhaseTracker, PhaseStepIsASlip) {
 TEST(AntennaPhaseTracker, MasterOutOfLockRestarts) {
   AntennaPhaseTracker tracker(2);
   EpochMaker maker;
-  for (std::int64_t n = 0; n < 10; ++n) tracker.update(maker.make(n, {0.0, 0.1, 0.0}, {true, true, true}, 0.0), true, kFs);
+  for (std::int64_t n = 0; n < 10; ++n)
+    tracker.update(maker.make(n, {0.0, 0.1, 0.0}, {true, true, true}, 0.0), true, kFs);
   tracker.report(1, 10 * kSamples, kFs);
   tracker.update(maker.make(10, {0.0, 0.1, 0.0}, {true, true, true}, 0.0), false, kFs);
   EXPECT_FALSE(tracker.report(1, 11 * kSamples, kFs).usable);
@@ -187,11 +191,12 @@ TEST(AntennaObservation, LineOfSightAndPhases) {
   AntennaPhaseTracker tracker(2);
   EpochMaker maker;
   maker.noise = false;
-  for (std::int64_t n = 0; n < 5; ++n) tracker.update(maker.make(n, {0.0, 0.25, 0.0}, {true, true, true}, 0.0), true, kFs);
+  for (std::int64_t n = 0; n < 5; ++n)
+    tracker.update(maker.make(n, {0.0, 0.25, 0.0}, {true, true, true}, 0.0), true, kFs);
   const Eigen::Vector3d r_rx(6378137.0, 0.0, 0.0);
   const double range = 26560e3 - 6378137.0;
-  const auto o = make_antenna_observation(tracker, 3, 1000.0, 45.0, false, range, eph, {2190, 0.0}, 0.0, r_rx,
-                                          5 * kSamples, kFs);
+  const auto o =
+      make_antenna_observation(tracker, 3, 1000.0, 45.0, false, range, eph, {2190, 0.0}, 0.0, r_rx, 5 * kSamples, kFs);
   EXPECT_EQ(o.prn, 3);
   EXPECT_NEAR(o.carrier_phase_cycles[0], 1000.0, 1e-12);
   EXPECT_NEAR(o.carrier_phase_cycles[1], 1000.25, 1e-4);

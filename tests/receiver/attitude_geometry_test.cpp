@@ -1,14 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Double-difference algebra, Wahba's rotation and the attitude frames, against closed forms.
-#include <gtest/gtest.h>
+#include "receiver/attitude_geometry.hpp"
 
-#include <cmath>
-#include <random>
+#include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
 #include <GeographicLib/Geocentric.hpp>
+#include <cmath>
+#include <random>
 
 #include "attitude_phase_simulator.hpp"
-#include "receiver/attitude_geometry.hpp"
 #include "receiver/phase_differences.hpp"
 #include "receiver/wahba_rotation.hpp"
 
@@ -23,7 +24,8 @@ TEST(AttitudeGeometry, DoubleDifferenceCovarianceHasTheSharedTerms) {
     obs[static_cast<std::size_t>(s)].prn = s + 1;
     obs[static_cast<std::size_t>(s)].elevation_rad = el[s];
     obs[static_cast<std::size_t>(s)].los_e = Eigen::Vector3d(std::cos(el[s]), 0.0, std::sin(el[s]));
-    for (int a = 0; a < 3; ++a) obs[static_cast<std::size_t>(s)].carrier_phase_cycles[static_cast<std::size_t>(a)] = 10 * s + a * a;
+    for (int a = 0; a < 3; ++a)
+      obs[static_cast<std::size_t>(s)].carrier_phase_cycles[static_cast<std::size_t>(a)] = 10 * s + a * a;
   }
   std::vector<const AntennaPhaseObservation*> p{&obs[0], &obs[1], &obs[2]};
   const double sigma = 0.1;

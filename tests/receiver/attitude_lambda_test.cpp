@@ -1,16 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LAMBDA against brute-force enumeration (independent truth) on random small integer least-squares problems, and
 // the algebra of its factorisation and decorrelation; chi-square quantiles against published table values.
-#include "receiver/lambda.hpp"
-
 #include <gtest/gtest.h>
-
-#include <cmath>
-#include <random>
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <cmath>
+#include <random>
 
 #include "receiver/chi_square.hpp"
+#include "receiver/lambda.hpp"
 
 using namespace ultratrack::receiver;
 
@@ -133,7 +132,8 @@ TEST(AttitudeLambda, EnumeratesTheWholeEllipsoid) {
     if (bf.size() > 3) {
       const std::vector<IntegerCandidate> c3 = lambda_search(a, Q, 3, bound);
       ASSERT_EQ(c3.size(), 3u);
-      for (int i = 0; i < 3; ++i) EXPECT_NEAR(c3[static_cast<std::size_t>(i)].squared_norm, bf[static_cast<std::size_t>(i)].first, 1e-7);
+      for (int i = 0; i < 3; ++i)
+        EXPECT_NEAR(c3[static_cast<std::size_t>(i)].squared_norm, bf[static_cast<std::size_t>(i)].first, 1e-7);
     }
   }
 }
@@ -147,6 +147,6 @@ TEST(AttitudeLambda, ChiSquareQuantilesMatchTables) {
   EXPECT_NEAR(chi_square_upper_quantile(10, 0.01), 23.209, 0.0005);
   EXPECT_NEAR(chi_square_upper_quantile(20, 0.001), 45.315, 0.0005);
   EXPECT_NEAR(chi_square_upper_tail(2, -2.0 * std::log(1e-12)), 1e-12, 1e-20);  // closed form for 2 dof, deep tail
-  EXPECT_NEAR(chi_square_lower_quantile(5, 0.3) , chi_square_upper_quantile(5, 0.7), 1e-9);
+  EXPECT_NEAR(chi_square_lower_quantile(5, 0.3), chi_square_upper_quantile(5, 0.7), 1e-9);
   EXPECT_NEAR(normal_upper_quantile(0.025), 1.959964, 1e-5);
 }

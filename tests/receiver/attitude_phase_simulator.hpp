@@ -1,15 +1,14 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test-only simulator of multi-antenna carrier phases (independent truth for the attitude solver tests): a rigid
 // array with a known attitude at a known place, satellites on a random sky, per-antenna phase = range / lambda
 // + a random integer per antenna and satellite + a random line bias per antenna + white noise.
 #pragma once
 
+#include <Eigen/Geometry>
 #include <GeographicLib/Geocentric.hpp>
-
 #include <cmath>
 #include <random>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "io/units.hpp"
 #include "receiver/antenna_phase.hpp"
@@ -18,7 +17,6 @@
 #include "signals/satellite_state.hpp"
 
 namespace ultratrack::receiver::testsim {
-
 
 struct Sky {
   int prn;
@@ -49,7 +47,7 @@ struct PhaseSimulator {
   std::mt19937_64 rng;
   std::vector<long> integer_ambiguity;  // [antenna * 64 + prn]
   std::vector<double> line_bias_cycles;
-  std::vector<double> range_offset;     // per prn, cycles (a large common term that must cancel)
+  std::vector<double> range_offset;  // per prn, cycles (a large common term that must cancel)
 
   PhaseSimulator(std::vector<Eigen::Vector3d> lever_arms, std::uint64_t seed, double lat_deg = 36.37,
                  double lon_deg = 127.36, double h_m = 80.0)
@@ -128,8 +126,8 @@ struct PhaseSimulator {
       for (std::size_t a = 0; a < lever.size(); ++a) {
         // The far-field range change of antenna a against the array origin is -u . r_a.
         const Eigen::Vector3d r_a_e = C_en * C_nb * lever[a];
-        const double range_cycles = range_offset[static_cast<std::size_t>(s.prn)] - o.los_e.dot(r_a_e) /
-                                                                                      signals::kL1Wavelength_m;
+        const double range_cycles =
+            range_offset[static_cast<std::size_t>(s.prn)] - o.los_e.dot(r_a_e) / signals::kL1Wavelength_m;
         o.carrier_phase_cycles[a] = range_cycles + static_cast<double>(ambiguity(static_cast<int>(a), s.prn)) +
                                     line_bias_cycles[a] + noise(rng);
         o.cn0_dbhz[a] = 45.0;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // AttitudeSolver against simulator truth (attitude_phase_simulator.hpp): the seed geometry (3 antennas, baselines
 // 1 m on the roll axis and 1.025 m on the pitch axis, 3 mm carrier noise per antenna), random skies, random
 // attitudes, random integer ambiguities and line biases. Single-epoch success rates with and without the
@@ -16,8 +17,8 @@
 #include "io/why_invalid.hpp"
 
 using namespace ultratrack::receiver;
-using ultratrack::io::kRadPerDeg;
 using testsim::PhaseSimulator;
+using ultratrack::io::kRadPerDeg;
 
 namespace {
 
@@ -105,12 +106,12 @@ MonteCarlo run_single_epoch(int num_sats, int trials, bool constrained, std::uin
 }
 
 void print(const char* name, const MonteCarlo& mc) {
-  std::printf("%s: %d trials, fixed %.2f %%, correct %.2f %%, wrong %.3f %%; RMS roll/pitch/yaw %.3f/%.3f/%.3f deg, "
-              "theory %.3f/%.3f/%.3f deg\n",
-              name, mc.trials, 100.0 * mc.fixed / mc.trials, 100.0 * mc.correct / mc.trials,
-              100.0 * mc.wrong / mc.trials, mc.correct ? mc.rms(0) : 0.0, mc.correct ? mc.rms(1) : 0.0,
-              mc.correct ? mc.rms(2) : 0.0, mc.correct ? mc.theory(0) : 0.0, mc.correct ? mc.theory(1) : 0.0,
-              mc.correct ? mc.theory(2) : 0.0);
+  std::printf(
+      "%s: %d trials, fixed %.2f %%, correct %.2f %%, wrong %.3f %%; RMS roll/pitch/yaw %.3f/%.3f/%.3f deg, "
+      "theory %.3f/%.3f/%.3f deg\n",
+      name, mc.trials, 100.0 * mc.fixed / mc.trials, 100.0 * mc.correct / mc.trials, 100.0 * mc.wrong / mc.trials,
+      mc.correct ? mc.rms(0) : 0.0, mc.correct ? mc.rms(1) : 0.0, mc.correct ? mc.rms(2) : 0.0,
+      mc.correct ? mc.theory(0) : 0.0, mc.correct ? mc.theory(1) : 0.0, mc.correct ? mc.theory(2) : 0.0);
 }
 
 }  // namespace
@@ -233,13 +234,14 @@ Sessions run_sessions(int num_sats, int sessions, int max_epochs, bool multi_epo
 
 void print(const char* name, const Sessions& r) {
   const auto pct = [&](int e) { return 100.0 * r.fixed_by[static_cast<std::size_t>(e)] / r.sessions; };
-  std::printf("%s: %d sessions, fixed in the first epoch %.1f %%, within 0.5 s %.1f %%, 1 s %.1f %%, 2 s %.1f %%, "
-              "%zu epochs %.1f %%; wrong %d of %d fix decisions; RMS roll/pitch/yaw %.3f/%.3f/%.3f deg, theory "
-              "%.3f/%.3f/%.3f deg\n",
-              name, r.sessions, 100.0 * r.single_epoch / r.sessions, pct(4), pct(9), pct(19), r.fixed_by.size(),
-              pct(static_cast<int>(r.fixed_by.size()) - 1), r.wrong, r.decisions, r.correct ? r.rms(0) : 0.0,
-              r.correct ? r.rms(1) : 0.0, r.correct ? r.rms(2) : 0.0, r.correct ? r.theory(0) : 0.0,
-              r.correct ? r.theory(1) : 0.0, r.correct ? r.theory(2) : 0.0);
+  std::printf(
+      "%s: %d sessions, fixed in the first epoch %.1f %%, within 0.5 s %.1f %%, 1 s %.1f %%, 2 s %.1f %%, "
+      "%zu epochs %.1f %%; wrong %d of %d fix decisions; RMS roll/pitch/yaw %.3f/%.3f/%.3f deg, theory "
+      "%.3f/%.3f/%.3f deg\n",
+      name, r.sessions, 100.0 * r.single_epoch / r.sessions, pct(4), pct(9), pct(19), r.fixed_by.size(),
+      pct(static_cast<int>(r.fixed_by.size()) - 1), r.wrong, r.decisions, r.correct ? r.rms(0) : 0.0,
+      r.correct ? r.rms(1) : 0.0, r.correct ? r.rms(2) : 0.0, r.correct ? r.theory(0) : 0.0,
+      r.correct ? r.theory(1) : 0.0, r.correct ? r.theory(2) : 0.0);
   std::printf("  within 3 sigma %d of %d, worst %.1f sigma\n", r.within_3sigma, r.correct, r.worst_sigma);
 }
 

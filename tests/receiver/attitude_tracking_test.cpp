@@ -1,9 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // AttitudeSolver over sequences of epochs (1 Hz, nominal constellation, seed geometry, 3 mm noise): ambiguities
 // carried, flagged and unflagged cycle slips, a 5 s blockage of one antenna, a satellite rising, an array turning at
 // 10 deg/s, and the line-bias calibration. Truth from attitude_phase_simulator.hpp. The invariant everywhere: a
 // valid output has the right integers and an attitude within 5 sigma of the truth.
-#include "receiver/attitude_solver.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,10 +10,11 @@
 #include <map>
 
 #include "attitude_phase_simulator.hpp"
+#include "receiver/attitude_solver.hpp"
 
 using namespace ultratrack::receiver;
-using ultratrack::io::kRadPerDeg;
 using testsim::PhaseSimulator;
+using ultratrack::io::kRadPerDeg;
 
 namespace {
 
@@ -76,11 +76,11 @@ TEST(AttitudeTracking, SlipsAndBlockageNeverGiveAWrongAttitudeAndRefixAtOnce) {
     ASSERT_GE(sky.size(), 8u);
     const int a = sky[0].prn, b = sky[1].prn, c = sky[2].prn, d = sky[3].prn;
     std::vector<bool> blocked(3, false);
-    if (i == 10) sim.ambiguity(1, a) += 7;          // flagged below
-    if (i == 20) sim.ambiguity(2, b) += 1;          // not flagged
-    if (i == 30) sim.ambiguity(0, c) -= 3;          // master, flagged
+    if (i == 10) sim.ambiguity(1, a) += 7;                            // flagged below
+    if (i == 20) sim.ambiguity(2, b) += 1;                            // not flagged
+    if (i == 30) sim.ambiguity(0, c) -= 3;                            // master, flagged
     if (i == 40) sim.ambiguity(0, d) += 1, sim.ambiguity(1, c) -= 2;  // two, not flagged
-    if (i >= 45 && i < 50) blocked[2] = true;       // antenna 2 blocked for 5 s, then back with new integers
+    if (i >= 45 && i < 50) blocked[2] = true;  // antenna 2 blocked for 5 s, then back with new integers
     if (i == 50) {
       for (const auto& s : sky) sim.ambiguity(2, s.prn) += 1000 + s.prn;
     }
@@ -141,7 +141,8 @@ TEST(AttitudeTracking, TurningArrayAndARisingSatellite) {
   for (int i = 0; i < 60; ++i) {
     const double t = i;  // 1 Hz: the array turns 10 deg between epochs
     const double yaw = std::fmod(10.0 * kRadPerDeg * t, 2 * M_PI);
-    const double roll = 10 * kRadPerDeg * std::sin(2 * M_PI * t / 20.0), pitch = 5 * kRadPerDeg * std::cos(2 * M_PI * t / 15.0);
+    const double roll = 10 * kRadPerDeg * std::sin(2 * M_PI * t / 20.0),
+                 pitch = 5 * kRadPerDeg * std::cos(2 * M_PI * t / 15.0);
     auto sky = sim.nominal_sky({2300, kT0 + 7200 + t});
     ASSERT_GE(sky.size(), 8u);
     if (i == 0) rising_prn = sky.back().prn;
@@ -161,8 +162,8 @@ TEST(AttitudeTracking, TurningArrayAndARisingSatellite) {
     sum_var_yaw += s.covariance_rad2(2, 2);
     ++n;
   }
-  std::printf("turning array: yaw RMS %.3f deg, theory %.3f deg over %d epochs\n", std::sqrt(sum_sq_yaw / n) / kRadPerDeg,
-              std::sqrt(sum_var_yaw / n) / kRadPerDeg, n);
+  std::printf("turning array: yaw RMS %.3f deg, theory %.3f deg over %d epochs\n",
+              std::sqrt(sum_sq_yaw / n) / kRadPerDeg, std::sqrt(sum_var_yaw / n) / kRadPerDeg, n);
   EXPECT_LE(std::sqrt(sum_sq_yaw / n) / kRadPerDeg, 0.15 * 1.5);  // 60 samples: RMS known to ~10 %
 }
 

@@ -1,14 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Hatch filter against closed forms: a range ramp with white code noise of sigma and a clean carrier must come
 // out with the noise reduced to about sigma / sqrt(n) (exactly: the filter's steady-state gain for n epochs),
 // follow the ramp without lag, restart on a cycle slip or a new track, and shift with a receiver clock jump.
 #include "receiver/carrier_smoothing.hpp"
-#include "receiver/loop_filters.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <random>
 
+#include "receiver/loop_filters.hpp"
 #include "signals/gps_constants.hpp"
 
 using ultratrack::receiver::CarrierSmoothing;
@@ -39,7 +40,8 @@ TEST(CarrierSmoothing, ReducesCodeNoiseWithoutLag) {
 
 TEST(CarrierSmoothing, RestartsOnSlipNewTrackAndGap) {
   CarrierSmoothing filter(100, 20.0);
-  for (int k = 0; k < 50; ++k) filter.update(4, k, range_at(k) + (k % 2 ? 3.0 : -3.0), range_at(k) / kL1Wavelength_m, k == 0);
+  for (int k = 0; k < 50; ++k)
+    filter.update(4, k, range_at(k) + (k % 2 ? 3.0 : -3.0), range_at(k) / kL1Wavelength_m, k == 0);
   // A 1000-cycle slip (190 m) in the carrier: restart, so the output is the raw pseudorange.
   EXPECT_DOUBLE_EQ(filter.update(4, 50, range_at(50) + 3.0, range_at(50) / kL1Wavelength_m + 1000.0, false),
                    range_at(50) + 3.0);

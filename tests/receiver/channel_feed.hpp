@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test support: a TrackingChannel fed with the independent test signal (test_signal.hpp) block by block, and the
 // replica's carrier phase error against that signal's truth. Samples, seconds, cycles.
 #pragma once

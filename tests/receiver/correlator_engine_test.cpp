@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Correlator engine against closed forms: the carrier's sin/cos, the prompt's Dirichlet loss for a frequency
 // error, the code autocorrelation triangle at the early/late offsets, the noise tap, and several antennas.
 #include "receiver/correlator_engine.hpp"
@@ -42,7 +43,8 @@ ReplicaSegment replica_for(const test::TestSatellite& sat, double carrier_hz, do
   r.code_phase_chips = std::fmod(sat.code_phase_chips, 1023.0) + code_offset_chips;
   r.code_step_chips = rate / kFs;
   r.carrier_phase_q32 = 0;
-  r.carrier_step_q32 = static_cast<std::uint32_t>(static_cast<std::int64_t>(std::llround(carrier_hz / kFs * 4294967296.0)));
+  r.carrier_step_q32 =
+      static_cast<std::uint32_t>(static_cast<std::int64_t>(std::llround(carrier_hz / kFs * 4294967296.0)));
   return r;
 }
 }  // namespace
@@ -180,9 +182,12 @@ TEST(CorrelatorEngine, Avx2AndPortableKernelsAgreeOnTheSameInputs) {
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0.0f, 20.0f);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const std::vector<std::vector<double>> layouts = {
-      {0.0}, {0.5, 0.0, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0},
-      {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}, {0.5, 0.0}};
+  const std::vector<std::vector<double>> layouts = {{0.0},
+                                                    {0.5, 0.0, -0.5},
+                                                    {0.5, 0.0, -0.5, noise_tap_offset_chips(9)},
+                                                    {1.0, 0.5, 0.0, -0.5, -1.0},
+                                                    {0.25, 0.1, 0.0, -0.1, -0.25, -400.0},
+                                                    {0.5, 0.0}};
   int compared = 0;
   for (const auto& offsets : layouts) {
     const CorrelatorEngine avx2(9, offsets, CorrelatorIsa::kAvx2), portable(9, offsets, CorrelatorIsa::kBaseline);
@@ -252,7 +257,9 @@ TEST(CorrelatorEngine, PlanarInt16ConversionRoundsAndSaturates) {
   x[6] = {2.5f / 64, -2.5f / 64};  // ties: 2.5 -> 2, -2.5 -> -2
   const Planar p = to_planar(x, 64.0f);
   for (std::size_t i = 0; i < x.size(); ++i) {
-    const auto expect = [](float v) { return static_cast<std::int16_t>(std::nearbyint(std::clamp(v * 64.0f, -32768.0f, 32767.0f))); };
+    const auto expect = [](float v) {
+      return static_cast<std::int16_t>(std::nearbyint(std::clamp(v * 64.0f, -32768.0f, 32767.0f)));
+    };
     ASSERT_EQ(p.re[i], expect(x[i].real())) << i;
     ASSERT_EQ(p.im[i], expect(x[i].imag())) << i;
   }
@@ -294,7 +301,8 @@ TEST(CorrelatorEngine, IntegerKernelFollowsDirichletAndLosesUnder0p01Db) {
         const std::complex<float>* fant[] = {x.data()};
         std::array<TapSums, 1> fsums{};
         engine.correlate(fant, n, rep, fsums);
-        worst_loss_db = std::max(worst_loss_db, std::abs(20.0 * std::log10(std::abs(sums[0][0]) / std::abs(fsums[0][0]))));
+        worst_loss_db =
+            std::max(worst_loss_db, std::abs(20.0 * std::log10(std::abs(sums[0][0]) / std::abs(fsums[0][0]))));
       }
     }
   }
@@ -318,7 +326,8 @@ TEST(CorrelatorEngine, IntegerKernelEarlyLateFollowCodeTriangle) {
     std::array<TapSums, 1> sums{};
     engine.correlate_i16(ant, n, rep, 1.0 / 2048.0, sums);
     for (int t = 0; t < 5; ++t) {
-      EXPECT_NEAR(sums[0][t].real(), n * code_correlation(17, tau - offsets[t]), 0.01 * n) << "tau " << tau << " tap " << t;
+      EXPECT_NEAR(sums[0][t].real(), n * code_correlation(17, tau - offsets[t]), 0.01 * n)
+          << "tau " << tau << " tap " << t;
       EXPECT_NEAR(sums[0][t].imag(), 0.0, 1e-3 * n);
     }
     EXPECT_LT(std::abs(sums[0][5]), 0.01 * n);  // the noise tap
@@ -333,9 +342,12 @@ TEST(CorrelatorEngine, IntegerKernelAvx2AndPortableAreBitIdentical) {
   std::mt19937 rng(11);
   std::normal_distribution<float> noise(0.0f, 20.0f);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  const std::vector<std::vector<double>> layouts = {
-      {0.0}, {0.5, 0.0, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0},
-      {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}, {0.5, 0.0}};
+  const std::vector<std::vector<double>> layouts = {{0.0},
+                                                    {0.5, 0.0, -0.5},
+                                                    {0.5, 0.0, -0.5, noise_tap_offset_chips(9)},
+                                                    {1.0, 0.5, 0.0, -0.5, -1.0},
+                                                    {0.25, 0.1, 0.0, -0.1, -0.25, -400.0},
+                                                    {0.5, 0.0}};
   int compared = 0;
   for (const auto& offsets : layouts) {
     const CorrelatorEngine avx2(9, offsets, CorrelatorIsa::kAvx2), portable(9, offsets, CorrelatorIsa::kBaseline);
@@ -371,7 +383,8 @@ TEST(CorrelatorEngine, IntegerKernelAvx2AndPortableAreBitIdentical) {
       portable.correlate_i16(views, n, rep, 1.0 / gain, sp);
       for (int a = 0; a < antennas; ++a)
         for (int t = 0; t < static_cast<int>(offsets.size()); ++t) {
-          EXPECT_EQ(sa[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)], sp[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)])
+          EXPECT_EQ(sa[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)],
+                    sp[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)])
               << offsets.size() << " taps, tap " << t << ", antenna " << a << ", trial " << trial;
           ++compared;
         }
@@ -395,10 +408,15 @@ TEST(CorrelatorEngine, IntegerKernelEveryCopyIsBitIdenticalToPortable) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   // Tap sets whose taps are whole chips apart share chip indices in the vector copies (compiled patterns:
   // E/P/L, P/E/L, E/P/L/noise, prompt/noise, five taps either order); the rest do not share.
-  const std::vector<std::vector<double>> layouts = {
-      {0.0}, {0.5, 0.0, -0.5}, {0.0, 0.5, -0.5}, {0.5, 0.0, -0.5, noise_tap_offset_chips(9)},
-      {0.0, noise_tap_offset_chips(9)}, {1.0, 0.5, 0.0, -0.5, -1.0}, {0.0, 0.5, -0.5, 1.0, -1.0},
-      {0.1, 0.0, -0.9}, {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}};
+  const std::vector<std::vector<double>> layouts = {{0.0},
+                                                    {0.5, 0.0, -0.5},
+                                                    {0.0, 0.5, -0.5},
+                                                    {0.5, 0.0, -0.5, noise_tap_offset_chips(9)},
+                                                    {0.0, noise_tap_offset_chips(9)},
+                                                    {1.0, 0.5, 0.0, -0.5, -1.0},
+                                                    {0.0, 0.5, -0.5, 1.0, -1.0},
+                                                    {0.1, 0.0, -0.9},
+                                                    {0.25, 0.1, 0.0, -0.1, -0.25, -400.0}};
   const int lengths[] = {1, 7, 31, 32, 33, 100, 1023, 1024, 1025, 1300, 2049, 3001};
   const double steps[] = {1.023e6 / 16e6, 1.023e6 / 4e6, 1.023e6 / 2.6e6, 0.99, 1.2};
   int compared = 0;
@@ -440,15 +458,17 @@ TEST(CorrelatorEngine, IntegerKernelEveryCopyIsBitIdenticalToPortable) {
         engines[e].correlate_i16(views, n, rep, 1.0 / gain, got);
         for (int a = 0; a < antennas; ++a)
           for (int t = 0; t < static_cast<int>(offsets.size()); ++t) {
-            ASSERT_EQ(got[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)], expected[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)])
-                << "copy " << static_cast<int>(copies[e]) << ", " << offsets.size() << " taps, tap " << t << ", antenna " << a
-                << ", n " << n << ", code step " << rep.code_step_chips << ", trial " << trial;
+            ASSERT_EQ(got[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)],
+                      expected[static_cast<std::size_t>(a)][static_cast<std::size_t>(t)])
+                << "copy " << static_cast<int>(copies[e]) << ", " << offsets.size() << " taps, tap " << t
+                << ", antenna " << a << ", n " << n << ", code step " << rep.code_step_chips << ", trial " << trial;
             ++compared;
           }
       }
     }
   }
-  EXPECT_EQ(compared, static_cast<int>(copies.size()) * 60 * 4 * (1 + 3 + 3 + 4 + 2 + 5 + 5 + 3 + 6));  // 60 x 1 + 60 x 3 antennas
+  EXPECT_EQ(compared, static_cast<int>(copies.size()) * 60 * 4 *
+                          (1 + 3 + 3 + 4 + 2 + 5 + 5 + 3 + 6));  // 60 x 1 + 60 x 3 antennas
 }
 
 // A level the CPU lacks is refused, never silently replaced; kAuto resolves to an available level.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Long coherent integration with data wipe-off on the independent test signal: a channel locked on a strong
 // signal that then fades to 20 dB-Hz keeps lock (phase within the Costas range of the truth, code within a
 // tenth of a chip) with known bits and 100 ms coherent, and loses it with 20 ms; the choice of the integration
@@ -11,9 +12,9 @@
 #include <random>
 #include <vector>
 
-#include "receiver/scalar_tracking.hpp"
 #include "channel_feed.hpp"
 #include "io/why_invalid.hpp"
+#include "receiver/scalar_tracking.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -65,35 +66,36 @@ Outcome run(const ScalarTrackingOptions& opt_in, bool known, double weak_dbhz, d
   Outcome out;
   int last_loop_ms = 0;
   const std::int64_t block = 125000;
-  test::feed_generated(channel, {strong, weak}, sig, static_cast<std::int64_t>(duration_s * kFs), block,
-                       [&](const CorrelationEpoch& e) {
-    const double t = e.first_sample / kFs;
-    KnownBits k;
-    const int wanted = loop.known_bits_wanted();
-    if (known && polarity != 0 && wanted > 0 && e.num_code_periods == 20) {
-      k.sign = polarity * true_bit(t + 0.01);
-      k.ahead = wanted;
-    }
-    const TrackingReport r = loop.update(e, k);
-    if (r.state == TrackingState::kBitSynced && polarity == 0 && t < fade_s - 0.1)
-      polarity = (e.master().prompt.real() >= 0.0f ? 1 : -1) * true_bit(t + 0.01);
-    channel.command(r.command);
-    if (r.set_coherent) channel.set_coherent_periods(r.coherent_periods, r.aligned_period);
-    out.max_loop_ms = std::max(out.max_loop_ms, r.loop_integration_ms);
-    if (r.state == TrackingState::kLost) {
-      out.lost = true;
-      out.lost_at_s = t;
-      return false;
-    }
-    if (t > 6.0 && r.state == TrackingState::kBitSynced) {
-      out.switches += last_loop_ms != 0 && r.loop_integration_ms != last_loop_ms;
-      last_loop_ms = r.loop_integration_ms;
-      out.phase_error_cycles.push_back(test::costas_phase_error_cycles(strong, e, kFs));
-      // the epoch starts where the replica crosses a period start: the truth's phase there is the code error
-      out.code_error_chips.push_back(std::remainder(test::true_code_phase_chips(strong, t) - e.code_phase_start_chips, 1023.0));
-    }
-    return true;
-  });
+  test::feed_generated(
+      channel, {strong, weak}, sig, static_cast<std::int64_t>(duration_s * kFs), block, [&](const CorrelationEpoch& e) {
+        const double t = e.first_sample / kFs;
+        KnownBits k;
+        const int wanted = loop.known_bits_wanted();
+        if (known && polarity != 0 && wanted > 0 && e.num_code_periods == 20) {
+          k.sign = polarity * true_bit(t + 0.01);
+          k.ahead = wanted;
+        }
+        const TrackingReport r = loop.update(e, k);
+        if (r.state == TrackingState::kBitSynced && polarity == 0 && t < fade_s - 0.1)
+          polarity = (e.master().prompt.real() >= 0.0f ? 1 : -1) * true_bit(t + 0.01);
+        channel.command(r.command);
+        if (r.set_coherent) channel.set_coherent_periods(r.coherent_periods, r.aligned_period);
+        out.max_loop_ms = std::max(out.max_loop_ms, r.loop_integration_ms);
+        if (r.state == TrackingState::kLost) {
+          out.lost = true;
+          out.lost_at_s = t;
+          return false;
+        }
+        if (t > 6.0 && r.state == TrackingState::kBitSynced) {
+          out.switches += last_loop_ms != 0 && r.loop_integration_ms != last_loop_ms;
+          last_loop_ms = r.loop_integration_ms;
+          out.phase_error_cycles.push_back(test::costas_phase_error_cycles(strong, e, kFs));
+          // the epoch starts where the replica crosses a period start: the truth's phase there is the code error
+          out.code_error_chips.push_back(
+              std::remainder(test::true_code_phase_chips(strong, t) - e.code_phase_start_chips, 1023.0));
+        }
+        return true;
+      });
   return out;
 }
 
@@ -204,7 +206,8 @@ TEST(LongCoherent, OscillatorJitterMatchesTheLoopsErrorResponse) {
       };
       const auto integral = [&](int driver_order) {
         double sum = 0.0;
-        for (double w = 1e-5 * w0; w < 1e5 * w0; w *= 1.001) sum += 0.5 * (response(w, driver_order) + response(w * 1.001, driver_order)) * w * 0.001;
+        for (double w = 1e-5 * w0; w < 1e5 * w0; w *= 1.001)
+          sum += 0.5 * (response(w, driver_order) + response(w * 1.001, driver_order)) * w * 0.001;
         return 2.0 * sum / (2.0 * M_PI);  // both signs of w
       };
       const double h0 = 2e-19, h2 = 2e-20;
@@ -249,7 +252,7 @@ TEST(LongCoherent, DISABLED_FadeSweep) {
       kept_on += !run(on, true, level, 3.0, 15.0, 100 + seed).lost;
       kept_off += !run(off, false, level, 3.0, 15.0, 100 + seed).lost;
     }
-    std::printf("fade to %.0f dB-Hz: kept 12 s with 20 ms %d/%d, with known bits up to 100 ms %d/%d\n", level,
-                kept_off, kSeeds, kept_on, kSeeds);
+    std::printf("fade to %.0f dB-Hz: kept 12 s with 20 ms %d/%d, with known bits up to 100 ms %d/%d\n", level, kept_off,
+                kSeeds, kept_on, kSeeds);
   }
 }

@@ -1,10 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Discriminators, loop filters and lock detectors alone, against their closed forms.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <complex>
+#include <cstdio>
 #include <random>
 
 #include "receiver/bit_sync.hpp"
@@ -15,9 +16,7 @@
 using namespace ultratrack::receiver;
 
 namespace {
-std::complex<float> polar(double a, double cycles) {
-  return std::complex<float>(std::polar(a, 2 * M_PI * cycles));
-}
+std::complex<float> polar(double a, double cycles) { return std::complex<float>(std::polar(a, 2 * M_PI * cycles)); }
 double triangle(double x) { return std::max(0.0, 1.0 - std::abs(x)); }
 
 // The carrier loop closed as the channel closes it: the NCO frequency computed from epoch k's average phase
@@ -150,7 +149,8 @@ TEST(LockDetectors, PhaseLockIndicatorIsCosTwiceThePhaseError) {
   PhaseLockIndicator pli(1.0);
   double mean = 0.0;
   for (int k = 0; k < 20000; ++k) {
-    const auto p = polar(std::sqrt(3.0), 0.05) + std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng)));
+    const auto p =
+        polar(std::sqrt(3.0), 0.05) + std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng)));
     pli.update(p, 1.0, 1e-3);
     if (k >= 10000) mean += pli.value() / 10000;
   }
@@ -169,7 +169,9 @@ TEST(LockDetectors, Cn0EstimatorsAreUnbiasedAt45And35DbHz) {
         double sum = 0.0;
         int n = 0;
         for (int k = 0; k < 200 * 50; ++k) {
-          const auto noise = [&] { return std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))); };
+          const auto noise = [&] {
+            return std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng)));
+          };
           const auto p = polar(bit(rng) ? s : -s, 0.03 * k) + noise();
           if (auto v = est.add(p, noise(), t)) {
             sum += *v;
@@ -195,7 +197,8 @@ TEST(BitSync, HistogramFindsTheEdgeAt35DbHz) {
     for (; k < 6000 && !sync.synchronised(); ++k) {
       if ((k - edge) % 20 == 0) value = bit(rng) ? 1 : -1;
       // a slowly rotating phase: the detector must not need phase lock
-      sync.add(k, polar(value * s, 0.002 * k) + std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))));
+      sync.add(
+          k, polar(value * s, 0.002 * k) + std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))));
     }
     ASSERT_TRUE(sync.synchronised());
     EXPECT_EQ(((sync.edge_period() - edge) % 20 + 20) % 20, 0);
@@ -220,7 +223,8 @@ TEST(BitSync, LeadTestFindsTheEdgeAt27And25DbHz) {
       int k = 1000;
       for (; k < 61000 && !sync.synchronised(); ++k) {
         if ((k - edge) % 20 == 0) value = bit(rng) ? 1 : -1;
-        sync.add(k, polar(value * s, 0.002 * k) + std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))));
+        sync.add(k, polar(value * s, 0.002 * k) +
+                        std::complex<float>(static_cast<float>(g(rng)), static_cast<float>(g(rng))));
       }
       ASSERT_TRUE(sync.synchronised()) << cn0 << " dB-Hz, edge " << edge;
       EXPECT_EQ(((sync.edge_period() - edge) % 20 + 20) % 20, 0) << cn0 << " dB-Hz, edge " << edge;
@@ -253,7 +257,9 @@ struct BitStream {
   double cycles_per_ms;  // residual carrier rotation
   int value = 1;
   BitStream(unsigned seed, double cn0_dbhz, int edge_offset, double rotation_cycles_per_ms = 0.0)
-      : rng(seed), amplitude(std::sqrt(std::pow(10.0, cn0_dbhz / 10.0) * 1e-3)), edge(edge_offset),
+      : rng(seed),
+        amplitude(std::sqrt(std::pow(10.0, cn0_dbhz / 10.0) * 1e-3)),
+        edge(edge_offset),
         cycles_per_ms(rotation_cycles_per_ms) {}
   std::complex<float> prompt(std::int64_t k) {
     if ((k - edge) % 20 == 0) value = bit(rng) ? 1 : -1;
@@ -273,7 +279,10 @@ double q_function(double x) { return 0.5 * std::erfc(x / std::sqrt(2.0)); }
 // so P(E_m > E_0) ~ Q(sqrt(N) mean / sqrt(V_m)) (central limit over N bits). The error probability lies between
 // the largest of these and their sum (union bound). Measured over 3000 trials of N bits at 25 and 28 dB-Hz.
 TEST(BitSync, EnergyTestErrorProbabilityMatchesTheory) {
-  struct Case { double cn0; int bits; };
+  struct Case {
+    double cn0;
+    int bits;
+  };
   for (const Case c : {Case{25.0, 16}, Case{28.0, 6}}) {
     const double s = std::pow(10.0, c.cn0 / 10.0) * 1e-3;
     double largest = 0.0, sum = 0.0;
@@ -306,7 +315,8 @@ TEST(BitSync, EnergyTestErrorProbabilityMatchesTheory) {
     const double sigma = std::sqrt(std::max(sum, 0.01) * (1.0 - std::max(sum, 0.01)) / trials);
     EXPECT_GT(p, largest - 4.0 * sigma) << c.cn0 << " dB-Hz, " << c.bits << " bits";
     EXPECT_LT(p, sum + 4.0 * sigma) << c.cn0 << " dB-Hz, " << c.bits << " bits";
-    std::printf("energy bit sync %.0f dB-Hz, %d bits: P(wrong) %.4f, theory [%.4f, %.4f]\n", c.cn0, c.bits, p, largest, sum);
+    std::printf("energy bit sync %.0f dB-Hz, %d bits: P(wrong) %.4f, theory [%.4f, %.4f]\n", c.cn0, c.bits, p, largest,
+                sum);
   }
 }
 
@@ -317,7 +327,10 @@ TEST(BitSync, EnergyTestErrorProbabilityMatchesTheory) {
 // 25 dB-Hz. Checked: no wrong edge in 60 trials each, mean time within 1.6 times the prediction (the variance is
 // estimated from the data, and the winner must lead all 19 others), every trial within 4 times it.
 TEST(BitSync, EnergyTestDecidesOnTheRightEdgeWithinSeconds) {
-  struct Case { double cn0; double predicted_s; };
+  struct Case {
+    double cn0;
+    double predicted_s;
+  };
   BitSyncOptions options;
   options.min_edges = 1000;  // energy test alone
   options.min_ratio = 100.0;
@@ -372,7 +385,8 @@ TEST(DelayLockLoop, WhiteEquivalentSigmaFactorMatchesTheClosedLoopsBlockMeans) {
     const double var_tau = sum_tau2 / count, var_mean = sum_means2 / blocks;
     const double measured = std::sqrt(var_mean * n / var_tau);
     const double factor = dll_white_equivalent_sigma_factor(bn, t, interval);
-    std::printf("DLL %.0f Hz: white-equivalent sigma factor closed form %.3f, closed loop %.3f\n", bn, factor, measured);
+    std::printf("DLL %.0f Hz: white-equivalent sigma factor closed form %.3f, closed loop %.3f\n", bn, factor,
+                measured);
     EXPECT_NEAR(measured / factor, 1.0, 0.10) << bn;
   }
   EXPECT_NEAR(dll_white_equivalent_sigma_factor(1.0, 0.020, 0.1), 2.21, 0.01);  // rho = 0.92^5 = 0.659

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bit knowledge a real receiver has (receiver/nav_bit_source.hpp, nav_bit_predictor.hpp, nav_bit_check.hpp),
 // against signals' LnavTransmitter as the truth on the air. The signal is encoded from one ephemeris; the nav file
 // holds the same one with Crs one unit (2^-5 m) off in the last place, as another generator's quantisation makes
@@ -87,7 +88,8 @@ TEST(NavBitKnowledge, ANavFileWordThatDisagreesWithTheDecodedCopyIsNeverUsed) {
 
   NavBitPredictor predictor;  // the default source
   EXPECT_EQ(predictor.source(), NavBitSource::kDecoded);
-  ASSERT_TRUE(predictor.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
+  ASSERT_TRUE(
+      predictor.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
   // The nav file alone: nothing predicted.
   for (int b = 0; b < 1500; b += 7) EXPECT_FALSE(predictor.bit_at(signals::add_seconds(frame, 0.02 * b))) << b;
 
@@ -136,7 +138,8 @@ TEST(NavBitKnowledge, NavFileWordsConfirmedOneByOneAreKnownAndOnlyThose) {
   Air signal(prn, test::brdc_2022_001_ephemerides(), frame);
   const auto nav_file = sets_with_crs_offset(prn, std::ldexp(1.0, -5));
   NavBitPredictor predictor;
-  ASSERT_TRUE(predictor.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
+  ASSERT_TRUE(
+      predictor.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
   // Subframe 4 decoded whole (TLM, HOW flags); of subframes 1-3 single words only, subframe 3's word 5 missed.
   const GpsTime sf4 = signals::add_seconds(frame, 18.0);
   predictor.add_subframe(signals::decode_lnav_subframe(signal.tx->subframe_starting_at(sf4)).subframe, sf4);
@@ -148,7 +151,8 @@ TEST(NavBitKnowledge, NavFileWordsConfirmedOneByOneAreKnownAndOnlyThose) {
       if (sf == 3 && w == 4) continue;
       std::uint32_t data = words[static_cast<std::size_t>(w)];
       if (w == 9) data = signals::decode_lnav_subframe(bits).subframe.words[9];  // with its parity-solving bits
-      predictor.add_word(t, w, data, bits[static_cast<std::size_t>(30 * w - 2)], bits[static_cast<std::size_t>(30 * w - 1)]);
+      predictor.add_word(t, w, data, bits[static_cast<std::size_t>(30 * w - 2)],
+                         bits[static_cast<std::size_t>(30 * w - 1)]);
     }
   }
   EXPECT_GE(predictor.nav_words_disagreed(), 1);
@@ -190,7 +194,8 @@ TEST(NavBitKnowledge, OracleReproducesTheNavFilesEveryBitWhateverWasDecoded) {
   Air &signal = c.signal, &nav_file_air = c.nav_file_air;
   const auto& nav_file = c.nav_file;
   NavBitPredictor oracle(NavBitSource::kOracle);
-  ASSERT_TRUE(oracle.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
+  ASSERT_TRUE(
+      oracle.supply_navigation(prn, nav_file, test::brdc_2022_001_klobuchar(), test::brdc_2022_001_utc(), frame));
   decode_frame(oracle, signal, frame);
   int differs_from_signal = 0;
   for (int bit = 0; bit < 25 * 1500 / 10; ++bit) {  // 75 s: every subframe, several pages

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The bit predictor against the simulator's transmitted bits (signals::LnavTransmitter built as `simulate`
 // builds it: ephemeris per PRN selected at the start, the selected set for the almanac pages): from decoded
 // subframes, subframes 1-3 of the next frames and the TLM/HOW of subframes 4-5; from a supplied nav source,
@@ -99,8 +100,9 @@ TEST(NavBitPredictor, NewIssueOfDataReplacesThePredictedSubframes) {
     differ_old += *predictor.bit_at(t) != truth2;
   }
   EXPECT_GT(differ_old, 0);
-  predictor.add_subframe(signals::decode_lnav_subframe(tx2.subframe_starting_at(signals::add_seconds(start, 6.0))).subframe,
-                         signals::add_seconds(start, 6.0));
+  predictor.add_subframe(
+      signals::decode_lnav_subframe(tx2.subframe_starting_at(signals::add_seconds(start, 6.0))).subframe,
+      signals::add_seconds(start, 6.0));
   for (int b = 0; b < 300; ++b) {
     const GpsTime t = signals::add_seconds(next_sf2, 0.02 * b);
     ASSERT_EQ(*predictor.bit_at(t), tx2.data_symbol_at(signals::add_seconds(t, 0.01)) < 0 ? 1 : 0) << b;
@@ -123,7 +125,8 @@ TEST(NavBitPredictor, SuppliedNavigationKnowsEveryBitTheSimulatorSends) {
       const GpsTime t = signals::add_seconds(first_edge, 0.02 * bit);
       const auto predicted = predictor.bit_at(t);
       ASSERT_TRUE(predicted.has_value());
-      ASSERT_EQ(*predicted, tx.data_symbol_at(signals::add_seconds(t, 0.01)) < 0 ? 1 : 0) << "PRN " << prn << " bit " << bit;
+      ASSERT_EQ(*predicted, tx.data_symbol_at(signals::add_seconds(t, 0.01)) < 0 ? 1 : 0)
+          << "PRN " << prn << " bit " << bit;
     }
   }
   NavBitPredictor none;

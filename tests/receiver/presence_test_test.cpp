@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // SignalPresenceTest against its exact error rates. Per epoch, with the noise normalised to E|w|^2 = 1 and
 // SNR rho = C/N0 T: 2|P|^2 ~ noncentral chi^2(2, 2 rho), 2|N|^2 ~ chi^2(2); over a window of n epochs the test
 // says "absent" when X < (1 + r) Y (X = sum|P|^2, Y = sum|N|^2, r the threshold's SNR). 2X is a Poisson(n rho)
@@ -5,13 +6,13 @@
 //   P(absent) = sum_j Pois(j; n rho) I_x(n + j, n),  x = (1 + r) / (2 + r),
 // with the regularised incomplete beta of integer arguments as a binomial tail. Taps are simulated here as
 // complex Gaussians (no code under test involved in making them).
+#include "receiver/presence_test.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <complex>
 #include <random>
-
-#include "receiver/presence_test.hpp"
 
 namespace ultratrack::receiver {
 namespace {
@@ -51,7 +52,8 @@ struct Taps {
   // prompt with SNR rho per epoch and a carrier phase that wanders (energy only is tested).
   std::complex<float> prompt(double rho, double phase) {
     const double a = std::sqrt(rho * 2.0 * sigma * sigma);
-    return std::complex<float>(static_cast<float>(a * std::cos(phase)), static_cast<float>(a * std::sin(phase))) + noise();
+    return std::complex<float>(static_cast<float>(a * std::cos(phase)), static_cast<float>(a * std::sin(phase))) +
+           noise();
   }
 };
 
@@ -115,9 +117,10 @@ TEST(SignalPresenceTest, DetectsAnAbsentSignalWithinTheExpectedTime) {
     const int strong = 3 * n + offset(taps.rng);  // epochs with the signal before it goes
     const double rho = std::pow(10.0, 4.5) * kT;
     int k = 0;
-    for (; k < strong; ++k) ASSERT_NE(test.add(taps.prompt(rho, 0.2 * k), taps.noise(), kT), std::optional<bool>(false));
+    for (; k < strong; ++k)
+      ASSERT_NE(test.add(taps.prompt(rho, 0.2 * k), taps.noise(), kT), std::optional<bool>(false));
     const int rest = (n - strong % n) % n;  // epochs to the end of the window holding the loss (it says present)
-    int epochs = 0;  // noise-only epochs fed until the verdict "absent"
+    int epochs = 0;                         // noise-only epochs fed until the verdict "absent"
     bool detected = false;
     while (!detected && epochs < 20 * n) {
       ++epochs;
@@ -136,7 +139,8 @@ TEST(SignalPresenceTest, DetectsAnAbsentSignalWithinTheExpectedTime) {
   EXPECT_GE(within_two, trials * (1.0 - q * q) - 4.0 * std::sqrt(trials * q * q) - 1.0);
   // Mean delay: rest of the window + n / (1 - q) epochs (geometric number of noise windows).
   // Spread of the geometric part: n T sqrt(q) / (1 - q) per trial; 4 sigma of the mean.
-  EXPECT_NEAR(delay_sum / trials, expected_delay_sum / trials, 4.0 * n * kT * std::sqrt(q) / (1.0 - q) / std::sqrt(trials));
+  EXPECT_NEAR(delay_sum / trials, expected_delay_sum / trials,
+              4.0 * n * kT * std::sqrt(q) / (1.0 - q) / std::sqrt(trials));
 }
 
 // The receiver's own evaluation of the closed form (a recurrence in j) against the direct binomial sums above.

@@ -1,14 +1,15 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // PVT against simulator truth: pseudoranges and Dopplers are generated here from a known receiver
 // position, velocity and clock with an independent light-time iteration, then solved for.
-#include "receiver/chi_square.hpp"
 #include "receiver/pvt.hpp"
+
+#include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <GeographicLib/Geocentric.hpp>
-#include <gtest/gtest.h>
-
 #include <cmath>
 
+#include "receiver/chi_square.hpp"
 #include "signals/atmosphere.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/satellite_state.hpp"
@@ -111,8 +112,8 @@ receiver::SatelliteMeasurement measure(const signals::Ephemeris& eph, const Rece
   m.ephemeris = eph;
   m.pseudorange_m = pseudorange(eph, rx, t_gps, 0.0, iono, atmosphere, &elevation);
   const double h = 0.05;
-  const double rate = (pseudorange(eph, rx, t_gps, h, iono, false) - pseudorange(eph, rx, t_gps, -h, iono, false)) /
-                      (2.0 * h);
+  const double rate =
+      (pseudorange(eph, rx, t_gps, h, iono, false) - pseudorange(eph, rx, t_gps, -h, iono, false)) / (2.0 * h);
   m.doppler_hz = -rate / signals::kL1Wavelength_m;
   m.has_doppler = true;
   return m;
@@ -263,5 +264,6 @@ TEST(Pvt, CovarianceLiesBetweenTheDopBoundsOfItsWeights) {
   EXPECT_LT((sol.covariance_m2 - sol.covariance_m2.transpose()).norm(), 1e-9 * sol.covariance_m2.norm());
   EXPECT_EQ(Eigen::LLT<Eigen::Matrix4d>(sol.covariance_m2).info(), Eigen::Success);  // positive definite
   const double ratio2 = std::pow(opt.sigma_doppler_mps / opt.sigma_zenith_m, 2);
-  EXPECT_LT((sol.velocity_covariance_m2ps2 - ratio2 * sol.covariance_m2).norm(), 1e-6 * ratio2 * sol.covariance_m2.norm());
+  EXPECT_LT((sol.velocity_covariance_m2ps2 - ratio2 * sol.covariance_m2).norm(),
+            1e-6 * ratio2 * sol.covariance_m2.norm());
 }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The receiver engine on the independent test signal (tests/receiver/test_signal.hpp): the acquisition
 // hand-over carries the code phase to a later tracking start, and the engine acquires, allocates and tracks
 // the satellites present (and only those), with tracking records every 20 ms.
@@ -11,11 +12,11 @@
 #include <optional>
 #include <random>
 
+#include "io/why_invalid.hpp"
 #include "receiver/acquisition.hpp"
 #include "receiver/correlator_engine.hpp"
 #include "receiver/receiver_channel.hpp"
 #include "test_signal.hpp"
-#include "io/why_invalid.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -51,7 +52,8 @@ TEST(ReceiverChannel, AcquisitionHandOverCarriesTheCodePhaseForward) {
     opt.fs_hz = kFs;
     opt.noncoherent = 10;
     Acquisition acq(opt);
-    const auto x = test::generate({sat}, test::TestSignal{kFs, true, 3}, 0, static_cast<std::int64_t>(acq.samples_needed()));
+    const auto x =
+        test::generate({sat}, test::TestSignal{kFs, true, 3}, 0, static_cast<std::int64_t>(acq.samples_needed()));
     const AcquisitionResult r = acq.search(x, sat.prn);
     ASSERT_TRUE(r.detected) << sat.prn;
     const std::int64_t target = static_cast<std::int64_t>(1.2 * kFs) + 17;
@@ -77,9 +79,9 @@ struct Recorder : ReceiverObserver {
 };
 }  // namespace
 
-// Four satellites at 45 dB-Hz among six searched PRNs, 2 s in 50 ms blocks (pull-in takes ~1 s). Tolerances: Doppler after the
-// 15 Hz PLL has settled within a few Hz of the truth (the loop's jitter is ~1 Hz; 5 Hz allows the 0.5 Hz/s ramp's
-// lag); C/N0 from the noise tap, averaged over the last 0.8 s (4 windows of 0.2 s), within 2 dB: the scalar
+// Four satellites at 45 dB-Hz among six searched PRNs, 2 s in 50 ms blocks (pull-in takes ~1 s). Tolerances: Doppler
+// after the 15 Hz PLL has settled within a few Hz of the truth (the loop's jitter is ~1 Hz; 5 Hz allows the 0.5 Hz/s
+// ramp's lag); C/N0 from the noise tap, averaged over the last 0.8 s (4 windows of 0.2 s), within 2 dB: the scalar
 // tracking tests hold the long-run mean of one satellite within 1 dB, four windows add ~0.5 dB of spread, and
 // here one of four satellites (PRN 11, -2.5 kHz) reads 1.5 dB low -- a bias of the estimator under study, not
 // of the engine, which passes its values through.
@@ -117,7 +119,8 @@ TEST(ReceiverEngine, AcquiresAndTracksThePresentSatellitesOnly) {
         ++cn0_count;
       }
     ASSERT_GT(cn0_count, 30);
-    std::printf("PRN %d: mean C/N0 %.2f dB-Hz over %d records, last state %s\n", sat.prn, cn0_sum / cn0_count, cn0_count, to_string(last.state));
+    std::printf("PRN %d: mean C/N0 %.2f dB-Hz over %d records, last state %s\n", sat.prn, cn0_sum / cn0_count,
+                cn0_count, to_string(last.state));
     EXPECT_NEAR(cn0_sum / cn0_count, 45.0, 2.0) << sat.prn;
     EXPECT_EQ(engine.stats().satellites[static_cast<std::size_t>(sat.prn)].acquisitions, 1);
     EXPECT_GT(engine.tracked_time_s(sat.prn), 0.5);
@@ -140,7 +143,8 @@ TEST(ReceiverOptions, ValidateNamesTheBadField) {
 
 // A satellite that vanishes at 1.8 s and comes back at 3.5 s: the channel must declare loss of lock (C/N0 and
 // PLI tests over loss_of_lock_time_s = 0.3 s plus the 0.2 s C/N0 window), be released, and the PRN be found
-// again by a re-acquisition snapshot (every 1 s here) and tracked to phase lock by the end at 6.5 s (pull-in takes ~1 s).
+// again by a re-acquisition snapshot (every 1 s here) and tracked to phase lock by the end at 6.5 s (pull-in takes ~1
+// s).
 TEST(ReceiverEngine, ReleasesALostChannelAndReacquiresTheSatellite) {
   test::TestSatellite first = satellite(9, 1800.0, 400.2);
   first.stop_s = 1.8;
@@ -295,8 +299,9 @@ TEST(ReceiverEngine, LowDutyBlindSearchStillFindsALateSatelliteWithinTheBound) {
   Log log;
   ReceiverEngine engine(options, log);
   for (std::int64_t first = 0; first < total; first += 130000)
-    engine.process(std::span(signal.data() + first, static_cast<std::size_t>(std::min<std::int64_t>(130000, total - first))),
-                   first);
+    engine.process(
+        std::span(signal.data() + first, static_cast<std::size_t>(std::min<std::int64_t>(130000, total - first))),
+        first);
   ASSERT_GE(log.acquisitions.size(), 5u);
   EXPECT_EQ(log.acquisitions.front().second.size(), 10u);  // the cold start: every PRN
   // 6 missing, snapshots every 20 ms + 0.5 s + 1 s: ceil(6 * 1.52 / 4) = 3 per snapshot (blind_prns_per_snapshot

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // SamplePrefetcher on a file of known i8 values: with and without the reader thread, blocks come out in file
 // order with the file's values (the limit and the file's end respected), and once a gain is set the planar
 // int16 copy is round(value * gain) (exact for the gains used: integer values times a power of two).
@@ -34,7 +35,8 @@ struct Seen {
 };
 
 // Reads everything through a prefetcher with `limit`, setting the gain after the second block.
-Seen read_all(const std::filesystem::path& path, std::int64_t skip, std::int64_t limit, std::size_t block, bool threaded) {
+Seen read_all(const std::filesystem::path& path, std::int64_t skip, std::int64_t limit, std::size_t block,
+              bool threaded) {
   SampleSourceOptions o;
   o.fs_hz = 2e6;
   o.start_sample = skip;
@@ -46,12 +48,12 @@ Seen read_all(const std::filesystem::path& path, std::int64_t skip, std::int64_t
     const PrefetchedBlock b = reader.next();
     if (b.where.count == 0) break;
     ++seen.blocks;
-    seen.in_order = seen.in_order && b.where.first_sample == expect && b.samples.size() == b.where.count &&
-                    b.where.count <= block;
+    seen.in_order =
+        seen.in_order && b.where.first_sample == expect && b.samples.size() == b.where.count && b.where.count <= block;
     for (std::size_t i = 0; i < b.where.count; ++i) {
       const std::int64_t k = expect + static_cast<std::int64_t>(i);
       seen.values_ok = seen.values_ok && b.samples[i] == std::complex<float>(static_cast<float>(value_i(k)),
-                                                                           static_cast<float>(value_q(k)));
+                                                                             static_cast<float>(value_q(k)));
       if (b.i16_gain > 0.0f)
         seen.i16_ok = seen.i16_ok && b.i16_gain == 64.0f && b.re[i] == value_i(k) * 64 && b.im[i] == value_q(k) * 64;
     }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // SampleSource / BasebandConverter against closed forms: a tone at IF + df comes out at df (complex) or as
 // s/2 at df plus its image at -(2 IF + df) (real), phase-continuous across any block split; I/Q fix-ups
 // on known values; int16 output scaling; bad options are InputErrors naming the file.

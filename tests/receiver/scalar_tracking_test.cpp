@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scalar tracking end to end on the independent test signal: pull-in from an acquisition-grade start, tracking
 // accuracy against Kaplan's thermal-noise jitter formulas, C/N0 accuracy, bit sync and bits, loss of lock.
 #include "receiver/scalar_tracking.hpp"
@@ -10,9 +11,9 @@
 #include <random>
 #include <vector>
 
-#include "signals/gps_constants.hpp"
 #include "channel_feed.hpp"
 #include "io/why_invalid.hpp"
+#include "signals/gps_constants.hpp"
 
 using namespace ultratrack;
 using namespace ultratrack::receiver;
@@ -23,8 +24,8 @@ constexpr double kFs = 2.5e6;  // 2.44 samples per chip: non-integer, as real fr
 struct EpochRecord {
   CorrelationEpoch epoch;
   TrackingReport report;
-  double t_s;               // time of the epoch's first sample
-  double code_error_chips;  // truth - replica at the first sample
+  double t_s;                 // time of the epoch's first sample
+  double code_error_chips;    // truth - replica at the first sample
   double phase_error_cycles;  // truth - replica at mid-epoch, modulo 1/2 (Costas ambiguity)
   std::int64_t true_period;   // signal code period starting nearest to the first sample
 };
@@ -44,8 +45,9 @@ test::TestSatellite satellite(int prn, double cn0) {
 }
 
 // Runs the channel + scalar closure over duration_s of signal starting from an acquisition-like result.
-std::vector<EpochRecord> track(const test::TestSatellite& sat, const ScalarTrackingOptions& opt, double doppler_error_hz,
-                               double code_error_chips, double duration_s, std::uint64_t seed = 42) {
+std::vector<EpochRecord> track(const test::TestSatellite& sat, const ScalarTrackingOptions& opt,
+                               double doppler_error_hz, double code_error_chips, double duration_s,
+                               std::uint64_t seed = 42) {
   ChannelStart start;
   start.sample_index = 0;
   start.code_phase_chips = std::fmod(sat.code_phase_chips - code_error_chips + 1023.0, 1023.0);
@@ -155,8 +157,10 @@ TEST(ScalarTracking, PullsInAndTracksAt45DbHzWithinThermalNoiseBounds) {
   // Factors: 1.5 on the carrier (~30 independent samples in 2.5 s at 6 Hz: the RMS itself scatters ~13 %);
   // 2.5 on the code (a 1 Hz loop gives only ~10 independent samples, chi-square 99 % ~ 1.7, plus the sampled,
   // non-ideal triangle at 2.44 samples per chip).
-  std::printf("45 dB-Hz: carrier RMS %.5f cycles (bound %.5f), code RMS %.5f chips (bound %.5f), lock %.3f s, "
-              "bit sync %.3f s\n", phase_rms, sigma_phase, code_rms, sigma_code, t_locked, t_synced);
+  std::printf(
+      "45 dB-Hz: carrier RMS %.5f cycles (bound %.5f), code RMS %.5f chips (bound %.5f), lock %.3f s, "
+      "bit sync %.3f s\n",
+      phase_rms, sigma_phase, code_rms, sigma_code, t_locked, t_synced);
   EXPECT_LT(phase_rms, 1.5 * sigma_phase);
   EXPECT_LT(code_rms, 2.5 * sigma_code);
   double mean_cn0 = 0.0;
@@ -284,49 +288,51 @@ TEST(ScalarTracking, CoastsThroughAFadeAndReLocksFromTheAidedFrequency) {
   std::vector<double> phase_err, phase_err_before;
   const std::int64_t block = 125000;
   bool lost = false;
-  test::feed_generated(channel, {before, after}, sig, static_cast<std::int64_t>(8.5 * kFs), block,
-                       [&](const CorrelationEpoch& e) {
-    const TrackingReport rep = loop.update(e);
-    const double t = e.first_sample / kFs;
-    if (rep.state == TrackingState::kLost) {
-      ADD_FAILURE() << "lost at t " << t;
-      lost = true;
-      return false;
-    }
-    NcoCommand cmd = rep.command;
-    const double next_t = static_cast<double>(e.first_sample + e.num_samples) / kFs;
-    if (rep.state == TrackingState::kBitSynced || rep.state == TrackingState::kCoasting) {
-      ScalarTrackingControl control;
-      control.coasting_allowed = true;
-      if (!aiding) {
-        control.aid = CarrierAid::kStart;
-        aiding = true;
-      } else {
-        control.aid = CarrierAid::kShift;
-        control.aid_delta_hz = true_doppler(next_t) - true_doppler(aided_at);
-        cmd.carrier_frequency_hz += control.aid_delta_hz;
-      }
-      loop.apply(control);
-      aided_at = next_t;
-    }
-    channel.command(cmd);
-    if (rep.set_coherent) channel.set_coherent_periods(rep.coherent_periods, rep.aligned_period);
-    if (rep.state == TrackingState::kCoasting && coast_from < 0.0) coast_from = t;
-    if (coast_from > 0.0 && relocked_at < 0.0 && rep.state == TrackingState::kBitSynced) relocked_at = next_t;
-    if (e.num_code_periods == 20) {  // on true bit edges, gap included
-      const double true_code = test::true_code_phase_chips(before, t);
-      const auto period = static_cast<std::int64_t>(std::round(true_code / 1023.0));
-      EXPECT_EQ(((period + before.bit_offset_periods) % 20 + 20) % 20, 0) << "t " << t;
-    }
-    if (t > 7.0 || (t > 2.3 && t < 2.95)) {
-      (t > 7.0 ? phase_err : phase_err_before).push_back(test::costas_phase_error_cycles(before, e, kFs));
-      EXPECT_EQ(rep.state, TrackingState::kBitSynced) << "t " << t;
-    }
-    return true;
-  });
+  test::feed_generated(
+      channel, {before, after}, sig, static_cast<std::int64_t>(8.5 * kFs), block, [&](const CorrelationEpoch& e) {
+        const TrackingReport rep = loop.update(e);
+        const double t = e.first_sample / kFs;
+        if (rep.state == TrackingState::kLost) {
+          ADD_FAILURE() << "lost at t " << t;
+          lost = true;
+          return false;
+        }
+        NcoCommand cmd = rep.command;
+        const double next_t = static_cast<double>(e.first_sample + e.num_samples) / kFs;
+        if (rep.state == TrackingState::kBitSynced || rep.state == TrackingState::kCoasting) {
+          ScalarTrackingControl control;
+          control.coasting_allowed = true;
+          if (!aiding) {
+            control.aid = CarrierAid::kStart;
+            aiding = true;
+          } else {
+            control.aid = CarrierAid::kShift;
+            control.aid_delta_hz = true_doppler(next_t) - true_doppler(aided_at);
+            cmd.carrier_frequency_hz += control.aid_delta_hz;
+          }
+          loop.apply(control);
+          aided_at = next_t;
+        }
+        channel.command(cmd);
+        if (rep.set_coherent) channel.set_coherent_periods(rep.coherent_periods, rep.aligned_period);
+        if (rep.state == TrackingState::kCoasting && coast_from < 0.0) coast_from = t;
+        if (coast_from > 0.0 && relocked_at < 0.0 && rep.state == TrackingState::kBitSynced) relocked_at = next_t;
+        if (e.num_code_periods == 20) {  // on true bit edges, gap included
+          const double true_code = test::true_code_phase_chips(before, t);
+          const auto period = static_cast<std::int64_t>(std::round(true_code / 1023.0));
+          EXPECT_EQ(((period + before.bit_offset_periods) % 20 + 20) % 20, 0) << "t " << t;
+        }
+        if (t > 7.0 || (t > 2.3 && t < 2.95)) {
+          (t > 7.0 ? phase_err : phase_err_before).push_back(test::costas_phase_error_cycles(before, e, kFs));
+          EXPECT_EQ(rep.state, TrackingState::kBitSynced) << "t " << t;
+        }
+        return true;
+      });
   if (lost) return;  // the figures below would only repeat it
-  std::printf("fade 3.0-4.5 s: coasting from %.3f s, re-locked %.3f s after the return, carrier RMS %.4f cycles "
-              "afterwards, %.4f before (bound %.4f)\n", coast_from, relocked_at - 4.5, rms(phase_err), rms(phase_err_before), pll_jitter_cycles(6.0, 45.0, 0.02));
+  std::printf(
+      "fade 3.0-4.5 s: coasting from %.3f s, re-locked %.3f s after the return, carrier RMS %.4f cycles "
+      "afterwards, %.4f before (bound %.4f)\n",
+      coast_from, relocked_at - 4.5, rms(phase_err), rms(phase_err_before), pll_jitter_cycles(6.0, 45.0, 0.02));
   EXPECT_GT(coast_from, 3.0);
   EXPECT_LT(coast_from, 4.0);
   ASSERT_GT(relocked_at, 4.5);

@@ -1,16 +1,17 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Coarse-time navigation against the IF synthesiser's exact truth: the code phase and Doppler of every
 // satellite at sample 0 (signals::IfSynthesiser::visible_satellites, which solves the light time, SV clock,
 // ionosphere and the receiver clock its own way), then solve_snapshot with a wrong approximate time.
+#include "receiver/snapshot_navigation.hpp"
+
 #include <gtest/gtest.h>
 
 #include <GeographicLib/Geocentric.hpp>
-
 #include <cmath>
 #include <memory>
 #include <random>
 
 #include "receiver/ionosphere_model.hpp"
-#include "receiver/snapshot_navigation.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/nominal_constellation.hpp"
 #include "signals/receiver_motion.hpp"
@@ -90,8 +91,8 @@ TEST(SnapshotNavigation, ExactMeasurementsGiveTheTruePositionAndTimeFromAWrongTi
 TEST(SnapshotNavigation, WithoutAnApproximatePositionTheDopplerFixAndGridFindTheTruth) {
   for (const auto& [lat, lon] : {std::pair{35.27, 137.01}, std::pair{-33.9, 18.4}, std::pair{64.1, -21.9}}) {
     const Truth t = simulate_truth(ecef(lat, lon, 300.0), {2190, 540000.0});
-    const SnapshotSolution s = solve_snapshot(t.measurements, signals::add_seconds(t.start, 4.0), std::nullopt,
-                                              options_for(t));
+    const SnapshotSolution s =
+        solve_snapshot(t.measurements, signals::add_seconds(t.start, 4.0), std::nullopt, options_for(t));
     ASSERT_TRUE(s.valid) << s.failure;
     EXPECT_LT((s.r_e_m - t.r_e_m).norm(), 0.5) << lat << " " << lon;
     EXPECT_EQ(s.quality, "pass");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Snapshot measurements on a real recording (../shared/data, skipped when absent): the 100 ms PocketSDR
 // capture, 12 MHz real 8-bit at a 3 MHz IF (searched on 4 MHz boxcar sums, then fine code at 12 MHz). Every
 // satellite the data README lists (an independent acquisition) must be kept, at its Doppler (one 250 Hz bin)
@@ -35,8 +36,8 @@ TEST(SnapshotRealData, PocketSdr12MHzKeepsTheListedSatellitesAndDropsTheSpurs) {
     int prn;
     double doppler_hz, readme_delay_chips;
   };
-  const Listed listed[] = {{2, -2750, 454.2},  {5, 250, 478.3},   {11, -3250, 938.1}, {13, -250, 511.8},
-                           {15, 1750, 794.3},  {18, 3250, 561.0}, {20, -1250, 696.7}, {30, -2000, 402.3}};
+  const Listed listed[] = {{2, -2750, 454.2}, {5, 250, 478.3},   {11, -3250, 938.1}, {13, -250, 511.8},
+                           {15, 1750, 794.3}, {18, 3250, 561.0}, {20, -1250, 696.7}, {30, -2000, 402.3}};
   for (const Listed& l : listed) {
     const auto it = std::find_if(found.begin(), found.end(), [&](const auto& d) { return d.prn == l.prn; });
     ASSERT_NE(it, found.end()) << "PRN " << l.prn;
@@ -46,8 +47,8 @@ TEST(SnapshotRealData, PocketSdr12MHzKeepsTheListedSatellitesAndDropsTheSpurs) {
   }
   for (const auto& d : found) {
     std::printf("  PRN %2d  C/N0 %.1f dB-Hz  Doppler %8.1f Hz  code %9.4f chips (1-sigma %.1f m)  metric %.1f / %.2f\n",
-                d.prn, d.cn0_dbhz, d.doppler_hz, d.code_phase_chips, d.code_sigma_chips * 293.05,
-                d.acquisition_metric, d.acquisition_threshold);
+                d.prn, d.cn0_dbhz, d.doppler_hz, d.code_phase_chips, d.code_sigma_chips * 293.05, d.acquisition_metric,
+                d.acquisition_threshold);
     EXPECT_GE(d.cn0_dbhz, 30.0) << "PRN " << d.prn << ": a spur or cross-correlation kept";
   }
   EXPECT_LE(found.size(), 12u);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Output writers: NMEA checksums against published sentences, complete-or-nothing files, RINEX layout.
 #include "receiver/solution_writer.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test signal, written apart from the acquisition code: one or more GPS C/A signals at known code phase,
 // Doppler (with the coherent code Doppler), C/N0 and data bits, in complex white Gaussian noise of unit
 // power per sample (so N0 = 1 / fs and the carrier amplitude is sqrt(C/N0 / fs)).

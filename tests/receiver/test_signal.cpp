@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "test_signal.hpp"
 
 #include <cmath>
@@ -49,7 +50,8 @@ std::vector<std::complex<float>> generate(const std::vector<TestSatellite>& sats
         const auto nb = static_cast<std::int64_t>(sat.bits.size());
         value *= sat.bits[static_cast<std::size_t>(((k % nb) + nb) % nb)];
       }
-      const double phase = 2.0 * M_PI * (true_carrier_phase_cycles(sat, t) - std::floor(true_carrier_phase_cycles(sat, t)));
+      const double phase =
+          2.0 * M_PI * (true_carrier_phase_cycles(sat, t) - std::floor(true_carrier_phase_cycles(sat, t)));
       out[static_cast<std::size_t>(i)] += std::complex<float>(static_cast<float>(a * value * std::cos(phase)),
                                                               static_cast<float>(a * value * std::sin(phase)));
     }

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test signal generator for the receiver tests, written independently of the correlator and NCO code: each
 // sample is computed from closed forms in double precision (C/A chips at a code rate that follows the Doppler,
 // carrier phase with Doppler and Doppler rate, LNAV-rate data bits aligned to code periods, complex white
@@ -12,15 +13,15 @@ namespace ultratrack::test {
 
 struct TestSatellite {
   int prn = 1;
-  double cn0_dbhz = 45.0;            // carrier-to-noise density, dB-Hz (ignored when noise is off: amplitude 1)
-  double doppler_hz = 0.0;           // carrier Doppler at sample 0
-  double doppler_rate_hzps = 0.0;    // constant Doppler rate
-  double code_phase_chips = 0.0;     // code phase at sample 0, chips (any value; period 0 starts at phase 0)
-  double carrier_phase_cycles = 0.0; // carrier phase at sample 0
+  double cn0_dbhz = 45.0;             // carrier-to-noise density, dB-Hz (ignored when noise is off: amplitude 1)
+  double doppler_hz = 0.0;            // carrier Doppler at sample 0
+  double doppler_rate_hzps = 0.0;     // constant Doppler rate
+  double code_phase_chips = 0.0;      // code phase at sample 0, chips (any value; period 0 starts at phase 0)
+  double carrier_phase_cycles = 0.0;  // carrier phase at sample 0
   // Bit k spans code periods [20k - bit_offset_periods, 20k + 20 - bit_offset_periods); +1/-1 values,
   // repeated cyclically. Empty = no data modulation.
   std::vector<int> bits;
-  int bit_offset_periods = 0;        // 0..19
+  int bit_offset_periods = 0;           // 0..19
   double start_s = 0.0, stop_s = 1e30;  // signal present only in [start_s, stop_s)
 };
 

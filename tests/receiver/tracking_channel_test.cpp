@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tracking channel: epoch boundaries at code-period starts, block-size independence, 20 ms epochs aligned to
 // a given period, phase jumps, the phase-accurate NCO over 300 s against the closed form, and antennas.
 #include "receiver/tracking_channel.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The vector FLL's pieces on the channel side (issue 7): the frequency discriminator a vector loop reads from two
 // contiguous 20 ms epochs (receiver/vector_frequency_discriminator.hpp) against a Monte Carlo of the receiver's own
 // discriminator on Gaussian-noise correlator sums, and the differential bit detection (BitAssembler) that keeps the
@@ -146,8 +147,8 @@ TEST(BitAssembler, DifferentialDetectionKeepsTheBitsOfARotatingCarrier) {
     e.first_code_period = 20 * k;
     e.num_code_periods = 20;
     e.first_sample = 40000LL * k;
-    e.antenna[0].prompt = std::complex<float>(value * a * std::polar(1.0, 0.2 + kTwoPi * 0.1 * k) +
-                                              std::complex<double>(g(rng), g(rng)));
+    e.antenna[0].prompt =
+        std::complex<float>(value * a * std::polar(1.0, 0.2 + kTwoPi * 0.1 * k) + std::complex<double>(g(rng), g(rng)));
     const auto d = differential.add(e);
     const auto c = coherent.add(e);
     ASSERT_TRUE(d && c);

@@ -1,6 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The worker pool: every job of a parallel_for runs exactly once whatever the thread count, a background task
 // runs beside the jobs and wait() returns only after it, exceptions come back to the caller, and one thread
 // means everything inline on the caller.
+#include "receiver/worker_pool.hpp"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -8,8 +11,6 @@
 #include <stdexcept>
 #include <thread>
 #include <vector>
-
-#include "receiver/worker_pool.hpp"
 
 using namespace ultratrack::receiver;
 
@@ -21,7 +22,8 @@ TEST(WorkerPool, EveryJobRunsExactlyOnceForAnyThreadCount) {
       std::vector<std::atomic<int>> hits(static_cast<std::size_t>(n));
       auto job = [&](int i) { hits[static_cast<std::size_t>(i)].fetch_add(1); };
       for (int round = 0; round < 20; ++round) pool.parallel_for(n, job);
-      for (int i = 0; i < n; ++i) EXPECT_EQ(hits[static_cast<std::size_t>(i)].load(), 20) << threads << " " << n << " " << i;
+      for (int i = 0; i < n; ++i)
+        EXPECT_EQ(hits[static_cast<std::size_t>(i)].load(), 20) << threads << " " << n << " " << i;
     }
   }
 }

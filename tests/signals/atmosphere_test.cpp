@@ -1,13 +1,14 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Klobuchar and troposphere against closed forms of IS-GPS-200 20.3.3.5.2.5 (night-time floor, the
 // 14:00 peak, the period and amplitude floors) and the Saastamoinen/standard-atmosphere magnitudes.
 // (The daytime model is also checked against gps-sdr-sim's printed delays in sky_brdc_test.cpp.)
-#include "io/units.hpp"
 #include "signals/atmosphere.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 
 using namespace ultratrack::signals;
@@ -28,7 +29,6 @@ KlobucharParameters brdc0010_params() {
 
 double obliquity(double elevation_rad) { return 1.0 + 16.0 * std::pow(0.53 - elevation_rad / kPi, 3); }
 
-
 }  // namespace
 
 TEST(Klobuchar, NightTimeIsFiveNanosecondsTimesObliquity) {
@@ -37,7 +37,8 @@ TEST(Klobuchar, NightTimeIsFiveNanosecondsTimesObliquity) {
   // At 02:00 the phase |x| is far beyond 1.57 for any period >= 72000 s.
   for (double el_deg : {5.0, 15.0, 30.0, 60.0, 90.0}) {
     for (double az_deg : {0.0, 90.0, 200.0}) {
-      const double d = klobuchar_delay_s(k, 45.0 * ultratrack::io::kRadPerDeg, 0.0, az_deg * ultratrack::io::kRadPerDeg, el_deg * ultratrack::io::kRadPerDeg, 2.0 * 3600.0);
+      const double d = klobuchar_delay_s(k, 45.0 * ultratrack::io::kRadPerDeg, 0.0, az_deg * ultratrack::io::kRadPerDeg,
+                                         el_deg * ultratrack::io::kRadPerDeg, 2.0 * 3600.0);
       EXPECT_NEAR(d, 5e-9 * obliquity(el_deg * ultratrack::io::kRadPerDeg), 1e-15) << el_deg << " " << az_deg;
     }
   }
@@ -87,21 +88,26 @@ TEST(Troposphere, ZenithDelayAtSeaLevelIsAboutTwoPointThreeToTwoPointFourMetres)
   EXPECT_GT(z, 2.30);
   EXPECT_LT(z, 2.45);
   // Higher receivers see less: the scale height of the dry delay is ~8 km.
-  const double z1000 = troposphere_delay_m(45.0 * ultratrack::io::kRadPerDeg, 1000.0, 90.0 * ultratrack::io::kRadPerDeg);
+  const double z1000 =
+      troposphere_delay_m(45.0 * ultratrack::io::kRadPerDeg, 1000.0, 90.0 * ultratrack::io::kRadPerDeg);
   EXPECT_NEAR(z1000 / z, std::exp(-1000.0 / 8400.0), 0.02);
-  EXPECT_LT(troposphere_delay_m(45.0 * ultratrack::io::kRadPerDeg, 10000.0, 90.0 * ultratrack::io::kRadPerDeg), 0.35 * z);
+  EXPECT_LT(troposphere_delay_m(45.0 * ultratrack::io::kRadPerDeg, 10000.0, 90.0 * ultratrack::io::kRadPerDeg),
+            0.35 * z);
   EXPECT_GE(troposphere_delay_m(45.0 * ultratrack::io::kRadPerDeg, 50000.0, 90.0 * ultratrack::io::kRadPerDeg), 0.0);
 }
 
 TEST(Troposphere, MappingFollowsOneOverSinElevationAboveFifteenDegrees) {
-  const double zenith = troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, 90.0 * ultratrack::io::kRadPerDeg);
+  const double zenith =
+      troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, 90.0 * ultratrack::io::kRadPerDeg);
   for (double el_deg = 15.0; el_deg <= 90.0; el_deg += 5.0) {
-    const double ratio = troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, el_deg * ultratrack::io::kRadPerDeg) / zenith;
+    const double ratio =
+        troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, el_deg * ultratrack::io::kRadPerDeg) / zenith;
     // The curvature term changes the flat-earth 1/sin(el) by less than 2 % above 15 deg.
     EXPECT_NEAR(ratio * std::sin(el_deg * ultratrack::io::kRadPerDeg), 1.0, 0.02) << el_deg;
   }
   // Near the horizon the spherical atmosphere keeps the mapping below 1/sin(el) and finite.
-  const double m5 = troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, 5.0 * ultratrack::io::kRadPerDeg) / zenith;
+  const double m5 =
+      troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, 5.0 * ultratrack::io::kRadPerDeg) / zenith;
   EXPECT_LT(m5, 1.0 / std::sin(5.0 * ultratrack::io::kRadPerDeg));
   EXPECT_GT(m5, 9.5);
   EXPECT_TRUE(std::isfinite(troposphere_delay_m(35.0 * ultratrack::io::kRadPerDeg, 100.0, 0.0)));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // C/A codes against IS-GPS-200 Table 3-Ia (first 10 chips, octal) and the Gold-code correlation property.
 #include "signals/ca_code.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ephemeris selection: health, IODE/IODC consistency, fit interval and nearest toe, on the shipped
 // brdc3540_0000-0200.14n (PRN 8 unhealthy, 01:59:44 sets), on brdc0010.22n's known cases (PRN 14/18 IODC, PRN 28
 // unhealthy; shared data) and on hand-made sets for the rules.

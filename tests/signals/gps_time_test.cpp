@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // GPS time: checked against published calendar anchors (GPS epoch, week rollovers, leap seconds).
 #include "signals/gps_time.hpp"
 

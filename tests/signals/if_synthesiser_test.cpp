@@ -1,8 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The IF synthesiser against independent truth: a brute-force acquisition written in the test finds every
 // visible satellite at the Doppler, code phase and C/N0 the synthesiser states; noise and gain levels
 // follow the documented convention; the pseudorange implied by the synthesised code equals the
 // receiver-side model range + c (b - dt_sv) + I + T; synthesised samples follow the exact timing.
-#include "io/units.hpp"
 #include "signals/if_synthesiser.hpp"
 
 #include <gtest/gtest.h>
@@ -10,13 +10,14 @@
 #include <numbers>
 #include <numeric>
 
+#include "io/units.hpp"
+#include "io/why_invalid.hpp"
 #include "signals/atmosphere.hpp"
 #include "signals/sample_reader.hpp"
 #include "signals/sample_writer.hpp"
 #include "signals/satellite_state.hpp"
 #include "support/brute_force_acquisition.hpp"
 #include "support/test_data.hpp"
-#include "io/why_invalid.hpp"
 
 namespace ultratrack::signals {
 namespace {
@@ -98,8 +99,8 @@ TEST(IfSynthesiser, BruteForceAcquisitionFindsEverySatelliteAtStatedDopplerCodeP
     // checks the level tightly).
     EXPECT_NEAR(r.cn0_dbhz, v.cn0_dbhz, 1.5);
     std::printf("PRN %2d el %5.1f deg: doppler %9.2f / %9.2f Hz  code %8.3f / %8.3f chips  C/N0 %5.2f / %5.2f dB-Hz\n",
-                v.prn, v.elevation_rad / io::kRadPerDeg, r.doppler_hz, v.doppler_hz, r.code_phase_chips, v.code_phase_chips,
-                r.cn0_dbhz, v.cn0_dbhz);
+                v.prn, v.elevation_rad / io::kRadPerDeg, r.doppler_hz, v.doppler_hz, r.code_phase_chips,
+                v.code_phase_chips, r.cn0_dbhz, v.cn0_dbhz);
   }
   // A satellite that is not transmitted is not found (its best cell is noise or another satellite's
   // cross-correlation, which the confirmation stage measures far below 30 dB-Hz).
@@ -276,15 +277,17 @@ TEST(IfSynthesiser, PseudorangeEqualsRangePlusClockTermsPlusDelays) {
       const Eigen::Vector3d r_sat = rotate_to_receive_frame(st.r_e_m, flight);
       const double range = (r_sat - r_rx).norm();
       const Eigen::Vector3d u = (r_sat - r_rx).normalized();
-      const Eigen::Vector3d up(std::cos(lat * io::kRadPerDeg) * std::cos(lon * io::kRadPerDeg), std::cos(lat * io::kRadPerDeg) * std::sin(lon * io::kRadPerDeg),
+      const Eigen::Vector3d up(std::cos(lat * io::kRadPerDeg) * std::cos(lon * io::kRadPerDeg),
+                               std::cos(lat * io::kRadPerDeg) * std::sin(lon * io::kRadPerDeg),
                                std::sin(lat * io::kRadPerDeg));
       const Eigen::Vector3d east(-std::sin(lon * io::kRadPerDeg), std::cos(lon * io::kRadPerDeg), 0.0);
       const Eigen::Vector3d north = up.cross(east);
       const double el = std::asin(u.dot(up));
       double az = std::atan2(u.dot(east), u.dot(north));
       if (az < 0) az += 2 * std::numbers::pi;
-      const double iono_m = kSpeedOfLight_mps * klobuchar_delay_s(o.klobuchar, lat * io::kRadPerDeg, lon * io::kRadPerDeg, az, el,
-                                                                  add_seconds(t_rx_clock, -b).tow_s);
+      const double iono_m =
+          kSpeedOfLight_mps * klobuchar_delay_s(o.klobuchar, lat * io::kRadPerDeg, lon * io::kRadPerDeg, az, el,
+                                                add_seconds(t_rx_clock, -b).tow_s);
       const double tropo_m = troposphere_delay_m(lat * io::kRadPerDeg, h, el);
       const double model = range + kSpeedOfLight_mps * (b - dt_sv) + iono_m + tropo_m;
       EXPECT_NEAR(rho - model, 0.0, 1e-4) << "PRN " << v.prn << " sample " << sample;
@@ -463,7 +466,7 @@ TEST(IfSynthesiser, HeldParametersKeepTheOscillatorNoiseOnEveryBlock) {
   IfSynthesiser quiet(o, {eph[static_cast<std::size_t>(prn - 1)]}, static_receiver());
   const auto quiet_carrier = [&](double t) { return quiet.timing(prn, 0, std::llround(t * fs)).carrier_phase_cycles; };
   const double fdot = (quiet_carrier(0.6) - 2.0 * quiet_carrier(0.5) + quiet_carrier(0.4)) / 0.01;
-  o.clock.bias_noise_s_per_sqrt_s = std::sqrt(2e-19 / 2.0);                          // TCXO h0
+  o.clock.bias_noise_s_per_sqrt_s = std::sqrt(2e-19 / 2.0);                                           // TCXO h0
   o.clock.drift_noise_sps_per_sqrt_s = std::sqrt(2.0 * std::numbers::pi * std::numbers::pi * 2e-20);  // h-2
   IfSynthesiser synth(o, {eph[static_cast<std::size_t>(prn - 1)]}, static_receiver());
   const std::vector<std::complex<float>> x = synthesise(synth, static_cast<std::size_t>(1.05 * fs));
@@ -593,7 +596,8 @@ TEST(IfSynthesiser, LineBiasSlipAndBlockageOnOneAntenna) {
   const double fs = p.fs;
   auto at = [&](double t) { return static_cast<std::size_t>(t * fs); };
   for (double t = 0.001; t < 0.02; t += 0.0007) EXPECT_NEAR(wrap_cycles(p.phase(at(t)) - 0.3), 0.0, 3e-4) << t;
-  // 4096-entry carrier table: +-1.2e-4 cycles per antenna. Blockage [0.0205, 0.0295) resolved to 1 ms blocks: silent from 0.021 to 0.029, present again from 0.030.
+  // 4096-entry carrier table: +-1.2e-4 cycles per antenna. Blockage [0.0205, 0.0295) resolved to 1 ms blocks: silent
+  // from 0.021 to 0.029, present again from 0.030.
   for (double t = 0.0212; t < 0.0289; t += 0.0003) EXPECT_TRUE(std::isnan(p.phase(at(t)))) << t;
   for (double t = 0.0302; t < 0.05; t += 0.0007) EXPECT_NEAR(wrap_cycles(p.phase(at(t)) - 0.3), 0.0, 3e-4) << t;
   // The slip: faded for 10 ms, then stepped by 2.25 cycles (only the quarter cycle is visible).
@@ -670,10 +674,13 @@ TEST(IfSynthesiser, Cn0StepsChangeTheMeasuredCn0WithinNoise) {
   }
   // The noise floor is the same before and after the step (the gain is one for the run): the variance of the
   // samples, signal included, differs only by the signal's share, (C/N0) / fs = 3e-2 at 48 dB-Hz.
-  const std::vector<std::complex<float>> before(x.begin(), x.begin() + 512000), after(x.begin() + 512000, x.begin() + 1024000);
+  const std::vector<std::complex<float>> before(x.begin(), x.begin() + 512000),
+      after(x.begin() + 512000, x.begin() + 1024000);
   const double c48 = std::pow(10.0, 4.8) / o.sample_rate_hz, c41 = std::pow(10.0, 4.1) / o.sample_rate_hz;
-  const double ratio = (variance(before, false) + variance(before, true)) / (variance(after, false) + variance(after, true));
-  // Sample variance of 512000 complex samples: relative sigma 1 / sqrt(512000) = 0.0014 per window; 4 sigma on the ratio.
+  const double ratio =
+      (variance(before, false) + variance(before, true)) / (variance(after, false) + variance(after, true));
+  // Sample variance of 512000 complex samples: relative sigma 1 / sqrt(512000) = 0.0014 per window; 4 sigma on the
+  // ratio.
   EXPECT_NEAR(ratio, (1.0 + c48) / (1.0 + c41), 4 * std::sqrt(2.0 / 512000));
 }
 
@@ -693,7 +700,8 @@ TEST(IfSynthesiser, Cn0StepIsSampleExactOnItsAntennaAndSatellitesOnly) {
   const std::int64_t first = cn0_step_first_sample(o.cn0_steps[0], o.sample_rate_hz);
   ASSERT_EQ(first, 12346);  // 12345.6 samples: the next whole sample
   const Eigen::Vector3d r0 = ecef_from_llh(35.274016, 137.013759, 100.0);
-  IfSynthesiser synth(o, {eph[stepped - 1], eph[other - 1]}, std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r0, r0}));
+  IfSynthesiser synth(o, {eph[stepped - 1], eph[other - 1]},
+                      std::make_shared<StaticMotion>(std::vector<Eigen::Vector3d>{r0, r0}));
   const std::size_t n = 30000;
   std::vector<std::complex<float>> a0(n), a1(n);
   for (std::size_t done = 0; done < n;) {  // calls of 777 samples: the step falls inside one

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Frame sync of a bit-at-a-time LNAV stream: lock on the first full subframe wherever the stream starts,
 // either polarity; parity failures reported while locked; relock after a bit slip.
 #include "signals/lnav_frame_sync.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LNAV word parity against independent truth: words received from real satellites, and the IS-GPS-200
 // Table 20-XIV equations written out again here as bit strings.
 #include "signals/lnav_parity.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // LNAV message: transmitter -> bits -> decoder round trips on real broadcast ephemerides, field positions
 // read straight from the transmitted bits with IS-GPS-200's bit numbers, parity error detection, polarity,
 // HOW timing, frames entered mid-way, and the bit stream on the air across subframe and week boundaries.
@@ -453,7 +454,8 @@ TEST(LnavDecoder, AlmanacRoundTripOfAWholeMasterFrame) {
     expect_within_half_lsb(a->sqrt_a_sqrtm, sqrt_a, std::ldexp(1.0, -11), "sqrt A", e.prn);
     const double lsb_angle = std::ldexp(1.0, -23) * kPi;
     EXPECT_LE(std::abs(std::remainder(a->omega0_rad - (e.omega0_rad + e.omega_dot_radps * dt), 2 * kPi)),
-              0.5 * lsb_angle + 1e-12) << e.prn;
+              0.5 * lsb_angle + 1e-12)
+        << e.prn;
     EXPECT_LE(std::abs(std::remainder(a->omega_rad - e.omega_rad, 2 * kPi)), 0.5 * lsb_angle + 1e-12) << e.prn;
     EXPECT_LE(std::abs(std::remainder(a->m0_rad - (e.m0_rad + n * dt), 2 * kPi)), 0.5 * lsb_angle + 1e-12) << e.prn;
     expect_within_half_lsb(a->af0_s, e.af0_s + e.af1_sps * seconds_between(toa, e.toc()), std::ldexp(1.0, -20), "af0",

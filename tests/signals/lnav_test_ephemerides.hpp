@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Broadcast ephemerides of 2022-01-01 00:00 GPST (week 2190, toe 518400 s) typed from the IGS file
 // brdc0010.22n (RINEX 2.11 order), used as realistic inputs for the LNAV tests.
 #pragma once

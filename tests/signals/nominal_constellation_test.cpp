@@ -1,12 +1,13 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The built-in constellation: its broadcast ephemerides, put through the IS-GPS-200 orbit algorithm,
 // give the SPS Performance Standard slot geometry (planes 60 deg apart at 55 deg, slot RAAN and argument
 // of latitude at the 1993-07-01 defined epoch), and are valid, healthy and deterministic.
 #include "signals/nominal_constellation.hpp"
 
-#include <Eigen/Geometry>
-#include <GeographicLib/Geocentric.hpp>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <GeographicLib/Geocentric.hpp>
 #include <cmath>
 #include <set>
 
@@ -102,10 +103,11 @@ TEST(NominalConstellation, SlotsMatchTheSpsPerformanceStandardTableAtItsEpoch) {
   const struct {
     int index;
     double raan_deg, arg_lat_deg;
-  } slots[] = {{0, 272.847, 268.126}, {5, 332.847, 173.336}, {10, 32.847, 339.666},
+  } slots[] = {{0, 272.847, 268.126}, {5, 332.847, 173.336},  {10, 32.847, 339.666},
                {12, 92.847, 135.226}, {19, 152.847, 333.686}, {23, 212.847, 135.346}};
   for (const auto& s : slots) {
-    const Elements el = elements(satellite_state(c.ephemerides[s.index], epoch), c.ephemerides[s.index].omega_dot_radps);
+    const Elements el =
+        elements(satellite_state(c.ephemerides[s.index], epoch), c.ephemerides[s.index].omega_dot_radps);
     // The slot's argument of latitude is the mean one (M + omega); the true one from geometry differs
     // by the equation of the centre, at most 2e rad.
     const double e = c.ephemerides[s.index].e;

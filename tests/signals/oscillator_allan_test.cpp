@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The simulated receiver clock of a named oscillator has the Allan deviation its power-law coefficients give in
 // closed form (sigma_y^2(tau) = h0 / (2 tau) + (2 pi^2 / 3) h-2 tau): the synthesiser's clock noise is what
 // the scenario's oscillator says, measured from the clock itself with the overlapping Allan estimator.
@@ -39,7 +40,8 @@ TEST(OscillatorAllan, PresetsAreBrownAndHwangsTable) {
 // 3 % and 6 % bounds are >= 3 sigma of the estimator (a wrong factor of 2 in either h is 40 % or more); the
 // seed is fixed, so the test is deterministic.
 TEST(OscillatorAllan, SimulatedClockHasTheClosedFormAllanDeviation) {
-  for (const auto& allan : {*oscillator_preset("tcxo"), *oscillator_preset("ocxo"), *oscillator_signal_preset("tcxo")}) {
+  for (const auto& allan :
+       {*oscillator_preset("tcxo"), *oscillator_preset("ocxo"), *oscillator_signal_preset("tcxo")}) {
     const std::string name = "h0 " + std::to_string(allan.h0);
     ReceiverClock clock(receiver_clock_from_allan(allan), 7);
     const double tau0 = ReceiverClock::kGridStep_s;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Receiver motion and clock models of the synthesiser: Hermite trajectory exact for quadratic motion,
 // trajectory CSV errors, the clock's deterministic part exact, and its random walks with the stated
 // variance growth (closed forms: var = q^2 T).

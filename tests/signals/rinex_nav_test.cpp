@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // RINEX navigation reading (2.11 and 3.x, mixed files, malformed input) and the 3.04 writer (round trip).
 #include "signals/rinex_nav.hpp"
 
@@ -103,8 +104,8 @@ TEST(RinexNav, ReadsMixed304KeepingGpsAndSkippingOtherSystems) {
   EXPECT_DOUBLE_EQ(e.sqrt_a_sqrtm, 5.153644044876e+03);
   EXPECT_DOUBLE_EQ(e.omega_dot_radps, -8.056050174046e-09);
   EXPECT_DOUBLE_EQ(e.tgd_s, -1.024454832077e-08);
-  EXPECT_EQ(e.ura_index, 0);                 // 2.0 m
-  EXPECT_EQ(e.fit_interval_flag, 0);         // missing fit interval reads as 0 (= 4 h)
+  EXPECT_EQ(e.ura_index, 0);          // 2.0 m
+  EXPECT_EQ(e.fit_interval_flag, 0);  // missing fit interval reads as 0 (= 4 h)
   EXPECT_DOUBLE_EQ(nav.transmit_tow_s[0], 518418.0);
   EXPECT_TRUE(nav.klobuchar.valid);
   EXPECT_DOUBLE_EQ(nav.klobuchar.alpha[1], -7.4506e-09);
@@ -121,8 +122,8 @@ TEST(RinexNav, ReadsMixed304KeepingGpsAndSkippingOtherSystems) {
 }
 
 TEST(RinexNav, Reads305WithFourLineGlonassRecords) {
-  std::string text = replace_line(kMixed304, 1,
-                                  "     3.05           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE");
+  std::string text =
+      replace_line(kMixed304, 1, "     3.05           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE");
   // Insert the fourth GLONASS line (3.05) after line 22.
   std::istringstream in(text);
   std::string out, line;
@@ -156,7 +157,7 @@ TEST(RinexNav, Reads211WithDExponentsTwoDigitYearsAndShortLines) {
   ASSERT_EQ(nav.ephemerides.size(), 1u);
   const Ephemeris& e = nav.ephemerides[0];
   EXPECT_EQ(e.prn, 14);
-  EXPECT_EQ(e.week, 1042);               // 1999-12-31 is the Friday of GPS week 1042 (1024 + 18)
+  EXPECT_EQ(e.week, 1042);              // 1999-12-31 is the Friday of GPS week 1042 (1024 + 18)
   EXPECT_DOUBLE_EQ(e.toc_s, 511200.0);  // 5 days + 22 h
   EXPECT_DOUBLE_EQ(e.m0_rad, -0.193589100453e+01);
   EXPECT_EQ(e.iode, 23);
@@ -322,13 +323,26 @@ TEST(RinexNav, WriteThenReadGivesTheSameValues) {
     EXPECT_EQ(a.l2p_data_flag, b.l2p_data_flag);
     EXPECT_EQ(a.fit_interval_flag, b.fit_interval_flag);
     EXPECT_DOUBLE_EQ(a.toc_s, b.toc_s);
-    for (auto [x, y] : {std::pair{a.af0_s, b.af0_s}, {a.af1_sps, b.af1_sps}, {a.af2_sps2, b.af2_sps2},
-                        {a.tgd_s, b.tgd_s}, {a.toe_s, b.toe_s}, {a.sqrt_a_sqrtm, b.sqrt_a_sqrtm},
-                        {a.e, b.e}, {a.m0_rad, b.m0_rad}, {a.delta_n_radps, b.delta_n_radps},
-                        {a.omega0_rad, b.omega0_rad}, {a.i0_rad, b.i0_rad}, {a.omega_rad, b.omega_rad},
-                        {a.omega_dot_radps, b.omega_dot_radps}, {a.idot_radps, b.idot_radps},
-                        {a.cuc_rad, b.cuc_rad}, {a.cus_rad, b.cus_rad}, {a.crc_m, b.crc_m},
-                        {a.crs_m, b.crs_m}, {a.cic_rad, b.cic_rad}, {a.cis_rad, b.cis_rad},
+    for (auto [x, y] : {std::pair{a.af0_s, b.af0_s},
+                        {a.af1_sps, b.af1_sps},
+                        {a.af2_sps2, b.af2_sps2},
+                        {a.tgd_s, b.tgd_s},
+                        {a.toe_s, b.toe_s},
+                        {a.sqrt_a_sqrtm, b.sqrt_a_sqrtm},
+                        {a.e, b.e},
+                        {a.m0_rad, b.m0_rad},
+                        {a.delta_n_radps, b.delta_n_radps},
+                        {a.omega0_rad, b.omega0_rad},
+                        {a.i0_rad, b.i0_rad},
+                        {a.omega_rad, b.omega_rad},
+                        {a.omega_dot_radps, b.omega_dot_radps},
+                        {a.idot_radps, b.idot_radps},
+                        {a.cuc_rad, b.cuc_rad},
+                        {a.cus_rad, b.cus_rad},
+                        {a.crc_m, b.crc_m},
+                        {a.crs_m, b.crs_m},
+                        {a.cic_rad, b.cic_rad},
+                        {a.cis_rad, b.cis_rad},
                         {in.transmit_tow_s[i], back.transmit_tow_s[i]}})
       EXPECT_TRUE(near(x, y)) << "record " << i << ": " << x << " vs " << y;
   }
@@ -375,20 +389,20 @@ TEST(RinexNav, RoundTripsExtendedFitIntervalAndUraIndices) {
 TEST(RinexNav, MalformedInputNamesFileLineAndProblem) {
   expect_error_at("", 0, "empty file");
   expect_error_at("garbage\n", 1, "RINEX VERSION / TYPE");
-  expect_error_at(replace_line(kMixed304, 1,
-                               "     4.00           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE"),
-                  1, "unsupported RINEX version");
-  expect_error_at(replace_line(kMixed304, 1,
-                               "     3.04           O: OBSERVATION DATA M: MIXED            RINEX VERSION / TYPE"),
-                  1, "wrong file type");
-  expect_error_at(replace_line(kMixed304, 1,
-                               "     3.04           N: GNSS NAV DATA    E: GALILEO          RINEX VERSION / TYPE"),
-                  1, "only GPS");
+  expect_error_at(
+      replace_line(kMixed304, 1, "     4.00           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE"), 1,
+      "unsupported RINEX version");
+  expect_error_at(
+      replace_line(kMixed304, 1, "     3.04           O: OBSERVATION DATA M: MIXED            RINEX VERSION / TYPE"), 1,
+      "wrong file type");
+  expect_error_at(
+      replace_line(kMixed304, 1, "     3.04           N: GNSS NAV DATA    E: GALILEO          RINEX VERSION / TYPE"), 1,
+      "only GPS");
   expect_error_at(first_lines(kMixed304, 5), 5, "END OF HEADER");
   // An unparseable number in the GPS record (line 24 = first orbit line of G05).
-  expect_error_at(replace_line(kMixed304, 24,
-                               "     5.400000000000E+01 3.12500x000000E+01 4.517690474355E-09-3.120281450818E+00"),
-                  24, "cannot parse");
+  expect_error_at(
+      replace_line(kMixed304, 24, "     5.400000000000E+01 3.12500x000000E+01 4.517690474355E-09-3.120281450818E+00"),
+      24, "cannot parse");
   // A GPS record cut after three orbit lines, followed by the next record.
   {
     std::istringstream in(kMixed304);
@@ -402,9 +416,9 @@ TEST(RinexNav, MalformedInputNamesFileLineAndProblem) {
   // The file ends inside the Galileo record.
   expect_error_at(first_lines(kMixed304, 13), 13, "truncated record for system 'E'");
   // Nonsense orbit (sqrt(A) = 0) is rejected with the record's line.
-  expect_error_at(replace_line(kMixed304, 25,
-                               "     1.587718725204E-06 5.822420492768E-03 9.916350245476E-06 0.000000000000E+00"),
-                  23, "sqrt(A)");
+  expect_error_at(
+      replace_line(kMixed304, 25, "     1.587718725204E-06 5.822420492768E-03 9.916350245476E-06 0.000000000000E+00"),
+      23, "sqrt(A)");
 }
 
 TEST(RinexNav, MissingFileThrowsInputErrorNamingIt) {
@@ -425,7 +439,8 @@ TEST(RinexNav, RtklibConvbinReadsOurFile) {
   const RinexNavData in = read_rinex_nav(ultratrack::test::shipped_nav_file());
   const auto dir = ultratrack::test::scratch_dir();
   write_rinex_nav_304(dir / "ours.rnx", in);
-  const std::string cmd = "cd '" + dir.string() + "' && convbin -r rinex -v 3.04 -n rtklib.rnx ours.rnx >/dev/null 2>&1";
+  const std::string cmd =
+      "cd '" + dir.string() + "' && convbin -r rinex -v 3.04 -n rtklib.rnx ours.rnx >/dev/null 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   const RinexNavData back = read_rinex_nav(dir / "rtklib.rnx");
   ASSERT_EQ(back.ephemerides.size(), in.ephemerides.size());

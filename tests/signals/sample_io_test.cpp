@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sample file formats: write -> read round trips for every format (exact for representable values,
 // rounding and saturation at the integer limits), and the clear errors for broken files.
 #include <gtest/gtest.h>

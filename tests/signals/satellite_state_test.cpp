@@ -1,10 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Satellite position/velocity/clock (IS-GPS-200 Table 20-IV) against a published worked example, finite
 // differences of the position and clock, the Kepler-orbit closed forms and the Sagnac closed form.
 #include "signals/satellite_state.hpp"
 
-#include <GeographicLib/Geocentric.hpp>
 #include <gtest/gtest.h>
 
+#include <GeographicLib/Geocentric.hpp>
 #include <cmath>
 
 #include "signals/gps_constants.hpp"
@@ -98,8 +99,7 @@ TEST(SatelliteState, RadiusAndRelativisticTermFollowKeplerOrbit) {
     const SatelliteState s = satellite_state(eph, t);
     const double E = eccentric_anomaly_by_bisection(mean_anomaly(eph, t), eph.e);
     // |r| = A(1 - e cos E) + dr, with |dr| <= sqrt(Crs^2 + Crc^2).
-    EXPECT_LE(std::abs(s.r_e_m.norm() - A * (1.0 - eph.e * std::cos(E))),
-              std::hypot(eph.crs_m, eph.crc_m) + 1e-3);
+    EXPECT_LE(std::abs(s.r_e_m.norm() - A * (1.0 - eph.e * std::cos(E))), std::hypot(eph.crs_m, eph.crc_m) + 1e-3);
     EXPECT_NEAR(s.relativistic_s, kRelativisticF_spsqrtm * eph.e * eph.sqrt_a_sqrtm * std::sin(E), 1e-17);
     EXPECT_LE(std::abs(s.relativistic_s), std::abs(kRelativisticF_spsqrtm) * eph.e * eph.sqrt_a_sqrtm);
     EXPECT_DOUBLE_EQ(s.tgd_s, eph.tgd_s);

@@ -1,9 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sky geometry from broadcast ephemerides cross-checked with what gps-sdr-sim (an independent simulator) printed
 // for the same file: the shipped brdc3540_0000-0200.14n (tests/data) and the shared brdc0010.22n; and the sky over
 // the seed scenario's receiver listed for the record.
-#include <GeographicLib/Geocentric.hpp>
 #include <gtest/gtest.h>
 
+#include <GeographicLib/Geocentric.hpp>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -53,7 +54,7 @@ std::vector<Seen> sky(const RinexNavData& nav, double lat_deg, double lon_deg, d
     const LookAngles la = look_angles(rx, sat_rx_frame);
     if (la.elevation_rad * kRad2Deg <= mask_deg) continue;
     const double iono_m = kSpeedOfLight_mps * klobuchar_delay_s(nav.klobuchar, lat_deg / kRad2Deg, lon_deg / kRad2Deg,
-                                                                 la.azimuth_rad, la.elevation_rad, t.tow_s);
+                                                                la.azimuth_rad, la.elevation_rad, t.tow_s);
     out.push_back({prn, la.azimuth_rad * kRad2Deg, la.elevation_rad * kRad2Deg, tau * kSpeedOfLight_mps, iono_m});
   }
   return out;
@@ -105,7 +106,8 @@ TEST(SkyBrdc, ShippedFileSatellitesAboveTenDegreesAtNagoya) {
   const RinexNavData nav = read_rinex_nav(ultratrack::test::shipped_nav_file());
   const GpsTime t{ultratrack::test::shipped_nav_week, ultratrack::test::shipped_nav_tow_s};
   const auto healthy = sky(nav, 35.274016, 137.013759, 100.0, t, 10.0, false);
-  std::printf("brdc3540_0000-0200.14n, 2014-12-20 00:00:00 GPST, receiver 35.274016 N 137.013759 E 100 m, el > 10 deg:\n");
+  std::printf(
+      "brdc3540_0000-0200.14n, 2014-12-20 00:00:00 GPST, receiver 35.274016 N 137.013759 E 100 m, el > 10 deg:\n");
   std::vector<int> prns;
   for (const Seen& s : healthy) {
     std::printf("  PRN %02d  az %6.1f deg  el %5.1f deg  range %11.1f m  iono %4.1f m\n", s.prn, s.az_deg, s.el_deg,
@@ -122,13 +124,12 @@ TEST(SkyBrdc, ShippedFileSatellitesAboveTenDegreesAtNagoya) {
 TEST(SkyBrdc, MatchesGpsSdrSimAtTokyoMidnight) {
   ULTRATRACK_REQUIRE_SHARED_FILE(path, "brdc0010.22n");
   const RinexNavData nav = read_rinex_nav(path);
-  const std::map<int, Seen> printed = {
-      {5, {5, 132.8, 38.4, 22193165.8, 0}},   {10, {10, 314.3, 7.5, 25151827.0, 0}},
-      {12, {12, 169.9, 6.2, 25170039.8, 0}},  {13, {13, 56.4, 38.0, 22086492.4, 0}},
-      {14, {14, 49.4, 13.8, 24336055.8, 0}},  {15, {15, 27.5, 64.8, 20373400.1, 0}},
-      {18, {18, 260.3, 41.8, 21828922.3, 0}}, {20, {20, 138.5, 10.2, 24538408.1, 0}},
-      {23, {23, 316.0, 39.6, 22035131.1, 0}}, {24, {24, 222.6, 66.4, 20285310.6, 0}},
-      {28, {28, 67.7, 22.4, 23705677.8, 0}}};
+  const std::map<int, Seen> printed = {{5, {5, 132.8, 38.4, 22193165.8, 0}},   {10, {10, 314.3, 7.5, 25151827.0, 0}},
+                                       {12, {12, 169.9, 6.2, 25170039.8, 0}},  {13, {13, 56.4, 38.0, 22086492.4, 0}},
+                                       {14, {14, 49.4, 13.8, 24336055.8, 0}},  {15, {15, 27.5, 64.8, 20373400.1, 0}},
+                                       {18, {18, 260.3, 41.8, 21828922.3, 0}}, {20, {20, 138.5, 10.2, 24538408.1, 0}},
+                                       {23, {23, 316.0, 39.6, 22035131.1, 0}}, {24, {24, 222.6, 66.4, 20285310.6, 0}},
+                                       {28, {28, 67.7, 22.4, 23705677.8, 0}}};
   // gps-sdr-sim ignores health, so PRN 28 (unhealthy) is in its list: include it here.
   expect_matches_printout(sky(nav, 35.681298, 139.766247, 10.0, {2190, 518400.0}, 0.0, true), printed, false);
 }

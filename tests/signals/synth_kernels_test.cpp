@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The synthesiser's Gaussian noise against the normal distribution's closed forms: moments and tail
 // fractions P(|x| > k) = erfc(k / sqrt 2), from 4 million values; tolerances are 5 sigma of each estimate.
 #include "signals/synth_kernels.hpp"

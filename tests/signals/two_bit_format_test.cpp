@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Packed 2-bit formats (r2, i2): decoding of hand-written bytes against the conventions as the peers write
 // them (GNSS-SDR's unpack_2bit_samples: a signed 2-bit field v gives 2v + 1; PocketSDR's MAX2771 table
 // {+1, +3, -1, -3} indexed by the field; GNSS-SDR's NTLab unpacker: high bit magnitude, low bit sign = +),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // sim::simulate_imu stops between two IMU intervals when its stop token is requested (`imusim`'s Ctrl-C): the rows
 // handed over are exactly those before the request, the truth has one sample more (t = 0), and the result says it
 // was interrupted; without a request the run covers the whole trajectory.

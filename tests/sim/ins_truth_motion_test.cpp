@@ -1,8 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The INS trajectory simulator driving the synthesiser through InsTruthMotion: on a vehicle circling at
 // 500 km/h with two antennas 1.2 m apart, the carrier phase difference between the antennas equals the
 // baseline projected on the line of sight over the wavelength (the attitude receiver's observable), and the
 // code timing of each antenna follows its own position.
-#include "io/units.hpp"
 #include "sim/ins_truth_motion.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +12,7 @@
 
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/nominal_constellation.hpp"

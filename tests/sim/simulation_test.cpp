@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // sim::simulate into memory: what a sink receives is what the files of `ultratrack simulate` hold (f32 samples bit
 // for bit), static truth is the scenario's position, an inertial run hands one IMU row per interval, a stop
 // request ends the run, and Scenario::IsValid names the key of what is wrong.

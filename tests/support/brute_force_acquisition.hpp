@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test support for synthesiser tests (signals/ and tools/): a hand-made 24-satellite constellation (not the project's
 // nominal one, so the tests do not depend on it), receiver coordinates, and an independent brute-force
 // acquisition (radix-2 FFT code search, then direct correlations) written here from textbook formulas.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test helper: a call that must throw io::InputError naming a file, a line and a phrase of the problem.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Readers of the receive outputs that several tools tests check against the truth: the coasting windows of
 // tracking.csv, the vector filter's position error (vector_state.csv) against a static truth.csv, and the loss of
 // lock indicators of observations.rnx's last epoch.
@@ -16,7 +17,8 @@
 namespace ultratrack::test {
 
 // Per PRN, its coasting windows: the times (s) of the first and last rows of each run of "coasting" rows.
-inline std::map<int, std::vector<std::pair<double, double>>> coasting_windows(const std::filesystem::path& tracking_csv) {
+inline std::map<int, std::vector<std::pair<double, double>>> coasting_windows(
+    const std::filesystem::path& tracking_csv) {
   std::map<int, std::vector<std::pair<double, double>>> windows;
   std::ifstream in(tracking_csv);
   std::string line;
@@ -41,7 +43,7 @@ struct PositionErrorRms {
 
 // The vector filter's ECEF position (vector_state.csv) from from_s on against the first row of a static truth.csv.
 inline PositionErrorRms static_filter_position_rms(const std::filesystem::path& vector_state_csv,
-                                                    const std::filesystem::path& truth_csv, double from_s) {
+                                                   const std::filesystem::path& truth_csv, double from_s) {
   std::ifstream truth_in(truth_csv);
   std::string line;
   std::getline(truth_in, line);

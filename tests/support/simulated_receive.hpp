@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // End-to-end tests through the library: a scenario file simulated in process (config/ reads it, sim/ writes the
 // files) and its IF samples received by pipelines::receive_file into an output folder, with the few settings the
 // tests vary. Header-only; for test executables that link pipelines and config.

@@ -1,6 +1,8 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "support/test_data.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -11,8 +13,6 @@
 #include <string>
 #include <system_error>
 #include <vector>
-
-#include <unistd.h>
 
 namespace ultratrack::test {
 
@@ -65,8 +65,8 @@ std::filesystem::path scratch_dir() {
   // One root per checkout: two checkouts' suites running at once on one machine (CI beside a developer, two
   // worktrees) must not share a test's folder; runs of one checkout still reuse (and first clear) theirs.
   const std::string checkout = ULTRATRACK_SCENARIOS_DIR;
-  const auto root = std::filesystem::temp_directory_path() / "ultratrack_tests" /
-                    to_hex(std::hash<std::string>{}(checkout));
+  const auto root =
+      std::filesystem::temp_directory_path() / "ultratrack_tests" / to_hex(std::hash<std::string>{}(checkout));
   std::filesystem::path dir;
   if (info) {
     dir = root / (std::string(info->test_suite_name()) + "." + info->name());

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test helpers: where the optional shared recordings and the shipped test data are, a scratch folder per test,
 // and reading outputs back.
 #pragma once
@@ -35,12 +36,12 @@ std::size_t csv_column(const std::vector<std::string>& header, const std::string
 }  // namespace ultratrack::test
 
 // Skips the current test with a clear message when the shared data folder (or one file in it) is absent.
-#define ULTRATRACK_REQUIRE_SHARED_FILE(var, name)                                           \
-  std::filesystem::path var;                                                                \
-  {                                                                                         \
-    auto dir_ = ::ultratrack::test::shared_data_dir();                                      \
-    if (!dir_ || !std::filesystem::exists(*dir_ / (name)))                                  \
-      GTEST_SKIP() << "shared data file " << (name)                                         \
-                   << " not found (../shared/data or $ULTRATRACK_SHARED_DATA): skipped";     \
-    var = *dir_ / (name);                                                                   \
+#define ULTRATRACK_REQUIRE_SHARED_FILE(var, name)                                        \
+  std::filesystem::path var;                                                             \
+  {                                                                                      \
+    auto dir_ = ::ultratrack::test::shared_data_dir();                                   \
+    if (!dir_ || !std::filesystem::exists(*dir_ / (name)))                               \
+      GTEST_SKIP() << "shared data file " << (name)                                      \
+                   << " not found (../shared/data or $ULTRATRACK_SHARED_DATA): skipped"; \
+    var = *dir_ / (name);                                                                \
   }

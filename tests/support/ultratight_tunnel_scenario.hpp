@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The ultra-tight tunnel scenario of the end-to-end tests (tests/pipelines/receive_ultratight_test.cpp and the command
 // line's, tests/tools/receive_ultratight_cli_test.cpp): 21 s of a car on a 100 m circle at 30 km/h, 45 dB-Hz, 2 MHz
 // i8, the shipped ephemeris from TOW 518476 (week 1823), HG1700AE IMU at 100 Hz, every signal absent from 14 to 18 s.
@@ -14,10 +15,10 @@ inline constexpr double kStartTow_s = 518476.0;  // the scenario's [time] tow_s 
 // Writes dir/circle.csv and dir/circle.toml (the scenario; brdc: the ephemeris file it names).
 inline void write_tunnel_scenario(const std::filesystem::path& dir, const std::filesystem::path& brdc) {
   std::ofstream(dir / "circle.csv") << "duration_s,accel_mps2,turn_rate_dps,climb_rate_mps,grade_deg\n"
-                                        << kDuration_s << ",0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
+                                    << kDuration_s << ",0.0,4.774648,0.0,0.0\n";  // v / R = 8.3333 / 100 rad/s
   std::ofstream(dir / "circle.toml")
-      << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = "
-      << kDuration_s << "\ncn0_dbhz = 45.0\nseed = 4\n"
+      << "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " << kDuration_s
+      << "\ncn0_dbhz = 45.0\nseed = 4\n"
          "[time]\ngps_week = 1823\ntow_s = 518476.0\n[navigation]\nrinex = \""
       << brdc.generic_string()
       << "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Set-up shared by the vector FLL and PLL end-to-end tests (receive_vector_fll_test.cpp,
 // receive_vector_pll_test.cpp): their scenarios (tests/support/vector_carrier_scenarios.hpp), one vector-coupled
 // receive per carrier mode through the library, and the lock losses summary.json reports.
@@ -22,8 +23,12 @@ inline void receive_vector_carrier(const std::filesystem::path& sim, const std::
   const fusion::VectorCarrier mode = carrier == "fll"   ? fusion::VectorCarrier::kFll
                                      : carrier == "pll" ? fusion::VectorCarrier::kPll
                                                         : fusion::VectorCarrier::kAidedPll;
-  receive_simulated({.input = sim / "antenna0.i8.bin", .nav = brdc, .out = out,
-                     .coupling = pipelines::Coupling::kVector, .troposphere = false, .vector_carrier = mode});
+  receive_simulated({.input = sim / "antenna0.i8.bin",
+                     .nav = brdc,
+                     .out = out,
+                     .coupling = pipelines::Coupling::kVector,
+                     .troposphere = false,
+                     .vector_carrier = mode});
 }
 
 // The sum of summary.json's per-satellite "losses"; satellites (if given): how many satellites it lists.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The scenarios of the vector FLL/PLL end-to-end tests and of the pipeline's vector test: 2 MHz i8, 45 dB-Hz, a
 // broadcast ephemeris at tow 518772 (the shipped brdc3540 file, week 1823, or the shared brdc0010.22n, week 2190),
 // Nagoya, ionosphere on, troposphere off; a static receiver or the 2 g turn step trajectory.
@@ -17,8 +18,8 @@ inline std::string vector_carrier_scenario(const std::filesystem::path& brdc, do
                                            const std::string& trajectory, int gps_week = shipped_nav_week) {
   return "[signal]\nsample_rate_hz = 2.0e6\nformat = \"i8\"\nduration_s = " + std::to_string(duration_s) +
          "\ncn0_dbhz = 45.0\nseed = 4\n[time]\ngps_week = " + std::to_string(gps_week) +
-         "\ntow_s = 518772.0\n[navigation]\nrinex = \"" +
-         brdc.generic_string() + "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, " + std::to_string(height_m) +
+         "\ntow_s = 518772.0\n[navigation]\nrinex = \"" + brdc.generic_string() +
+         "\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, " + std::to_string(height_m) +
          "]\n[atmosphere]\nionosphere = true\ntroposphere = false\n" + trajectory;
 }
 

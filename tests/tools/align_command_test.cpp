@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack align` end to end, in process, on simulated inputs with known truth (pipelines/alignment_monte_carlo's
 // IMU at rest with HG1700AE errors, GPS attitude = the array's truth + white Euler noise, written as attitude.csv in
 // GPS time): the attitude inside its 1-sigma, the files, the array's mounting (seed 000 Table 3) estimated within
@@ -71,12 +72,14 @@ pl::StationaryScenario scenario(const Eigen::Vector3d& mounting_deg) {
 
 // attitude.csv of the inputs (every row fixed unless all_unfixed), GPS time = kOrigin + t.
 void write_attitude(const fs::path& file, const pl::StationaryInputs& in, bool all_unfixed = false) {
-  std::string t = "gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,"
-                  "fixed,ratio\n";
+  std::string t =
+      "gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,"
+      "fixed,ratio\n";
   for (const auto& a : in.gps) {
     char line[400];
     if (all_unfixed)
-      std::snprintf(line, sizeof line, "%d,%.3f,nan,nan,nan,nan,nan,nan,9,0,1.2\n", kOrigin.week, kOrigin.tow_s + a.t_s);
+      std::snprintf(line, sizeof line, "%d,%.3f,nan,nan,nan,nan,nan,nan,9,0,1.2\n", kOrigin.week,
+                    kOrigin.tow_s + a.t_s);
     else
       std::snprintf(line, sizeof line, "%d,%.3f,%.6f,%.6f,%.6f,%.4f,%.4f,%.4f,9,1,8.5\n", kOrigin.week,
                     kOrigin.tow_s + a.t_s, a.euler_a.roll_rad / kDeg, a.euler_a.pitch_rad / kDeg,
@@ -109,8 +112,19 @@ Case make_case(const std::string& name, const Eigen::Vector3d& mounting_deg, std
 }
 
 std::vector<std::string> base_args(const Case& c, const std::string& out) {
-  return {"--imu", c.imu.string(), "--attitude", c.attitude.string(), "--attitude-origin", "2190", "518400",
-          "--position", "36.37", "127.36", "80", "--out", (c.dir / out).string()};
+  return {"--imu",
+          c.imu.string(),
+          "--attitude",
+          c.attitude.string(),
+          "--attitude-origin",
+          "2190",
+          "518400",
+          "--position",
+          "36.37",
+          "127.36",
+          "80",
+          "--out",
+          (c.dir / out).string()};
 }
 
 TEST(AlignCommand, AlignsInsideSigmaAndWritesItsFiles) {
@@ -348,7 +362,8 @@ TEST(AlignCommand, ImuOnALocalClockThroughPps) {
   EXPECT_NE(b.find("103 edges used, 0 rejected"), std::string::npos) << b;
   // A gap in the PPS record is refused, naming the file.
   std::string gappy = "local_s,gps_week,gps_tow_s\n";
-  for (int k : {0, 1, 2, 30, 31, 32}) gappy += std::to_string(local_of(k)) + ",2190," + std::to_string(518400 + k) + "\n";
+  for (int k : {0, 1, 2, 30, 31, 32})
+    gappy += std::to_string(local_of(k)) + ",2190," + std::to_string(518400 + k) + "\n";
   std::ofstream(pps) << gappy;
   args.back() = pps.string();
   args[args.size() - 3] = (c.dir / "pps2").string();
@@ -408,7 +423,8 @@ TEST(AlignCommand, AlignmentBiasesStartFuseWithinThreeSigma) {
   const std::string j = read_text(with_file);
   const double end_s = json_number(j, "t_s");
   const Eigen::Matrix3d C_bn = ins::quaternion_from_euler(sc.attitude).toRotationMatrix().transpose();
-  const Eigen::Vector3d f_b = C_bn * -ins::gravity_n(sc.lat_rad, sc.height_m), w_b = C_bn * ins::earth_rate_n(sc.lat_rad);
+  const Eigen::Vector3d f_b = C_bn * -ins::gravity_n(sc.lat_rad, sc.height_m),
+                        w_b = C_bn * ins::earth_rate_n(sc.lat_rad);
   const auto& e = c.inputs.errors;  // output = (I + M) input + bias + noise; at rest M acts as a bias too
   const Eigen::Vector3d accel = e.accel.bias + e.accel.scale_misalignment * f_b;
   const Eigen::Vector3d gyro = e.gyro.bias + e.gyro.scale_misalignment * w_b;
@@ -449,15 +465,17 @@ TEST(AlignCommand, AlignmentBiasesStartFuseWithinThreeSigma) {
   };
   const auto [rms_with, max_with] = drift(with_file, "fuse_with");
   const auto [rms_without, max_without] = drift(without_file, "fuse_without");
-  std::printf("first minute of pure inertial navigation, horizontal error RMS / max: with the alignment's biases "
-              "%.3f / %.3f m, without %.3f / %.3f m\n",
-              rms_with, max_with, rms_without, max_without);
+  std::printf(
+      "first minute of pure inertial navigation, horizontal error RMS / max: with the alignment's biases "
+      "%.3f / %.3f m, without %.3f / %.3f m\n",
+      rms_with, max_with, rms_without, max_without);
   EXPECT_LT(rms_with, 0.5 * rms_without);
   // fuse started from the file's biases: no update touched them in pure inertial navigation.
   const std::string fj = read_text(c.dir / "fuse_with" / "summary.json");
   std::smatch m;
   ASSERT_TRUE(std::regex_search(fj, m, std::regex("\"gyro_dph\": \\[([-+0-9.eE]+)")));
-  EXPECT_NEAR(std::stod(m[1]), f.biases->gyro_rps.x() / (kDeg / 3600.0), 1e-3 * f.biases->sigma_gyro_rps.x() / (kDeg / 3600.0) + 1e-5);
+  EXPECT_NEAR(std::stod(m[1]), f.biases->gyro_rps.x() / (kDeg / 3600.0),
+              1e-3 * f.biases->sigma_gyro_rps.x() / (kDeg / 3600.0) + 1e-5);
 }
 
 }  // namespace

@@ -1,12 +1,12 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The antenna file of `ultratrack attitude`: the [solver] switches reach the solver's options, a wrong type is an
 // InputError naming the key.
-#include "config/antenna_config_toml.hpp"
-
 #include <gtest/gtest.h>
 
 #include <fstream>
 #include <string>
 
+#include "config/antenna_config_toml.hpp"
 #include "signals/input_error.hpp"
 #include "support/test_data.hpp"
 
@@ -17,9 +17,10 @@ namespace {
 
 std::filesystem::path write_antennas(const std::string& name, const std::string& solver) {
   const auto path = test::scratch_dir() / name;
-  std::ofstream(path) << "[[antenna]]\nlever_arm_body_m = [0.0, 0.0, 0.0]\n[[antenna]]\nlever_arm_body_m = [1.0, 0.0, 0.0]\n"
-                         "[[antenna]]\nlever_arm_body_m = [0.0, 1.025, 0.0]\n[solver]\n"
-                      << solver;
+  std::ofstream(path)
+      << "[[antenna]]\nlever_arm_body_m = [0.0, 0.0, 0.0]\n[[antenna]]\nlever_arm_body_m = [1.0, 0.0, 0.0]\n"
+         "[[antenna]]\nlever_arm_body_m = [0.0, 1.025, 0.0]\n[solver]\n"
+      << solver;
   return path;
 }
 

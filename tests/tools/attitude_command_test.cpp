@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate` then `ultratrack attitude` on a short static 3-antenna scenario (seed 000/003 geometry,
 // 3 mm phase noise per antenna, 45 dB-Hz, line biases, the shipped 2014-12-20 broadcast ephemeris as hot start),
 // checked against the scenario's set attitude: the attitude must be fixed, its errors within the solver's own
@@ -140,9 +141,9 @@ TEST(AttitudeCommand, InputCountMustMatchTheAntennaFile) {
                ultratrack::signals::InputError);
   std::ofstream(dir / "bad.toml") << "[[antenna]]\nlever_arm_body_m = [0.0, 0.0, 0.0]\ncable = 3\n";
   try {
-    run("attitude", {"--input", (dir / "a.bin").string(), (dir / "a.bin").string(), "--format", "i8", "--fs", "2.6e6",
-                     "--antennas", (dir / "bad.toml").string(), "--reference-week", "2190", "--out",
-                     (dir / "rx").string()});
+    run("attitude",
+        {"--input", (dir / "a.bin").string(), (dir / "a.bin").string(), "--format", "i8", "--fs", "2.6e6", "--antennas",
+         (dir / "bad.toml").string(), "--reference-week", "2190", "--out", (dir / "rx").string()});
     FAIL() << "no error";
   } catch (const ultratrack::signals::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("antenna.cable"), std::string::npos) << e.what();

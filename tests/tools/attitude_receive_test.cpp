@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The multi-antenna receive path end to end on the synthesiser's signal, without the attitude solver: a static
 // 3-antenna receiver (ENU offsets, so the geometry is exact and independent of any attitude code), 45 dB-Hz, 3 mm
 // of extra phase noise per antenna, line biases, one injected cycle slip and a short blockage. Checked against
@@ -8,17 +9,17 @@
 #include <Eigen/Geometry>
 #include <GeographicLib/Geocentric.hpp>
 #include <cmath>
-#include <cstdio>
 #include <complex>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <vector>
 
+#include "config/scenario_toml.hpp"
 #include "io/units.hpp"
 #include "receiver/multi_sample_source.hpp"
 #include "receiver/receiver_engine.hpp"
-#include "config/scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/if_synthesiser.hpp"
 #include "signals/input_error.hpp"
@@ -36,7 +37,6 @@ struct Collector final : receiver::ReceiverObserver {
   std::vector<receiver::AntennaPhaseEpoch> epochs;
   void on_antenna_phases(const receiver::AntennaPhaseEpoch& e) override { epochs.push_back(e); }
 };
-
 
 sim::Scenario attitude_scenario() {
   sim::Scenario s;
@@ -95,8 +95,9 @@ bool same_epoch(const receiver::AntennaPhaseEpoch& a, const receiver::AntennaPha
     return false;
   for (std::size_t i = 0; i < a.satellites.size(); ++i) {
     const auto &x = a.satellites[i], &y = b.satellites[i];
-    if (x.prn != y.prn || x.los_e != y.los_e || x.elevation_rad != y.elevation_rad || x.num_antennas != y.num_antennas ||
-        x.carrier_phase_cycles != y.carrier_phase_cycles || x.slip != y.slip || x.usable != y.usable)
+    if (x.prn != y.prn || x.los_e != y.los_e || x.elevation_rad != y.elevation_rad ||
+        x.num_antennas != y.num_antennas || x.carrier_phase_cycles != y.carrier_phase_cycles || x.slip != y.slip ||
+        x.usable != y.usable)
       return false;
     for (int k = 0; k < x.num_antennas; ++k)  // NaN C/N0 (no estimate yet) equals NaN here
       if (!(x.cn0_dbhz[k] == y.cn0_dbhz[k] || (std::isnan(x.cn0_dbhz[k]) && std::isnan(y.cn0_dbhz[k])))) return false;
@@ -126,8 +127,9 @@ TEST(AttitudeReceive, BetweenAntennaPhasesMatchTheGeometryAndFlagTheEvents) {
   ASSERT_TRUE(fs::exists(dir / "antenna_events.csv"));
 
   const Collector collector = receive(s, sim.sample_files, nav, 1);
-  ASSERT_GT(collector.epochs.size(), 35u) << "antenna phases from at least 2 s of the run; first at "
-                                          << (collector.epochs.empty() ? -1.0 : collector.epochs.front().receive_time.tow_s);
+  ASSERT_GT(collector.epochs.size(), 35u)
+      << "antenna phases from at least 2 s of the run; first at "
+      << (collector.epochs.empty() ? -1.0 : collector.epochs.front().receive_time.tow_s);
 
   // Baselines in ECEF from the scenario's ENU offsets (exact: a static receiver).
   const auto motion = sim::make_motion(s);
@@ -166,9 +168,12 @@ TEST(AttitudeReceive, BetweenAntennaPhasesMatchTheGeometryAndFlagTheEvents) {
         if (o.slip[k]) {
           // Flags inside an arc (not its first epoch) at the events.
           const bool inside_arc = integer.count(key) > 0;
-          if (inside_arc && k == 1 && o.prn == slip_prn && t >= 12.0 && t < 12.6) slip_seen = true;
-          else if (inside_arc && k == 2 && t >= 13.5 && t < 13.8) block_recovered = true;
-          else if (integer.count(key)) ++false_flags;  // a flag that no event explains (the first of an arc is fine)
+          if (inside_arc && k == 1 && o.prn == slip_prn && t >= 12.0 && t < 12.6)
+            slip_seen = true;
+          else if (inside_arc && k == 2 && t >= 13.5 && t < 13.8)
+            block_recovered = true;
+          else if (integer.count(key))
+            ++false_flags;  // a flag that no event explains (the first of an arc is fine)
           integer[key] = n;
         } else if (integer.count(key) && integer[key] != n) {
           ++arcs_broken_without_flag;
@@ -214,7 +219,8 @@ TEST(AttitudeReceive, AntennaPhasesAreIdenticalForAnyNumberOfThreads) {
     const Collector other = receive(s, sim.sample_files, nav, threads);
     ASSERT_EQ(other.epochs.size(), one.epochs.size()) << threads << " threads";
     for (std::size_t i = 0; i < one.epochs.size(); ++i)
-      ASSERT_TRUE(same_epoch(one.epochs[i], other.epochs[i])) << "epoch " << i << " differs with " << threads << " threads";
+      ASSERT_TRUE(same_epoch(one.epochs[i], other.epochs[i]))
+          << "epoch " << i << " differs with " << threads << " threads";
   }
 }
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Test-only brute-force fine search of one satellite in complex baseband samples: time-domain correlation
 // with a fractional-delay C/A replica (no FFT, no receiver code), code phase by an early-late amplitude
 // balance on the correlation triangle, Doppler from the carrier-phase progression of code-aligned 1 ms

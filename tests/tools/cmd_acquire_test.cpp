@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack acquire` through CLI11 as main() runs it: bad input is an InputError (exit 2 in main); a real
 // recording gives a JSON row for each satellite the data README lists; synthetic files written with
 // signals::SampleWriter (2.6 MHz complex i16, 6.5 MHz real r16 at an IF) give their satellites' truth.

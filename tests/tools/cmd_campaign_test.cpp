@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack campaign run|run-one|report` as the program runs them: the local engine, resume, a failing run
 // reported (exit 1), a malformed campaign file (InputError naming the file and the key), and the Slurm engine
 // against fake `sbatch` and `squeue` on PATH that run the array tasks here (the script's content, the wait, the

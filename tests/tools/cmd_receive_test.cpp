@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive` through CLI11 as main() runs it: bad input gives an InputError (exit 2) and leaves no
 // output files; a --config with an unknown key names the file and the key; real recordings (skipped when
 // ../shared/data is absent) are acquired and tracked to their end with C/N0 reported.
@@ -91,9 +92,9 @@ TEST(ReceiveCommand, BadInputIsAnInputErrorAndLeavesNoOutputs) {
   EXPECT_THROW(run({"--input", truncated, "--format", "i8", "--fs", "2.6e6", "--out", out.string()}), InputError);
   EXPECT_THROW(run({"--input", noise, "--format", "i9", "--fs", "2.6e6", "--out", out.string()}), InputError);
   EXPECT_THROW(run({"--input", noise, "--format", "i8", "--fs", "2.6MHz", "--out", out.string()}), InputError);
-  EXPECT_THROW(run({"--input", noise, "--format", "i8", "--fs", "2.6e6", "--troposphere", "maybe", "--out",
-                    out.string()}),
-               InputError);
+  EXPECT_THROW(
+      run({"--input", noise, "--format", "i8", "--fs", "2.6e6", "--troposphere", "maybe", "--out", out.string()}),
+      InputError);
   EXPECT_EQ(files_in(out), 0);
   // White noise (or a wrong rate): no satellite in the searched PRNs -> InputError, and no outputs.
   try {
@@ -157,7 +158,8 @@ namespace {
 // acquired, keep its channel to the end of the file (a tracking.csv row in the last 40 ms, never "lost") and
 // report a C/N0 between 30 and 55 dB-Hz (front-end recordings of open sky: 35-50 dB-Hz).
 // The C/N0 window (default 0.2 s) is set to 40 ms so that 0.1 s files report one.
-void expect_tracked(const fs::path& file, std::vector<std::string> args, const std::vector<int>& prns, double length_s) {
+void expect_tracked(const fs::path& file, std::vector<std::string> args, const std::vector<int>& prns,
+                    double length_s) {
   const auto dir = ultratrack::test::scratch_dir();
   const auto out = dir / "out";
   std::ofstream(dir / "short.toml") << "[tracking]\ncn0_window_s = 0.04\n";
@@ -204,8 +206,8 @@ TEST(ReceiveCommand, TracksUgsdr38MHzRealIf) {
 TEST(ReceiveCommand, WrongRateFindsNoSatellite) {
   ULTRATRACK_REQUIRE_SHARED_FILE(path, "pocketsdr_L1_4MHz_iq_2bit.bin");
   const auto out = ultratrack::test::scratch_dir() / "out";
-  EXPECT_THROW(run({"--input", path.string(), "--format", "i8", "--fs", "2.6e6", "--q-negate", "--prn", "16,26,29,31,32",
-                    "--out", out.string()}),
+  EXPECT_THROW(run({"--input", path.string(), "--format", "i8", "--fs", "2.6e6", "--q-negate", "--prn",
+                    "16,26,29,31,32", "--out", out.string()}),
                InputError);
   EXPECT_EQ(files_in(out), 0);
 }

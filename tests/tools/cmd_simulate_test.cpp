@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate` through CLI11 as main() runs it: a missing or broken scenario is an InputError
 // (exit 2 in main) naming the scenario file; a good one writes the outputs into --out.
 #include <gtest/gtest.h>

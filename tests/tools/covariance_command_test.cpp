@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack covariance --coupling ultra-tight`: the options reach the analysis (the CSV history equals the
 // library's run with the same settings) and bad choices are typed input errors.
 #include <gtest/gtest.h>

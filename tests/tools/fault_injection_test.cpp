@@ -1,9 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Faults around `ultratrack receive` (issue 21's fault injection): an input that is a directory, an output folder
 // that cannot be made (its parent is a file), and a disk that fills mid-run (a file-size limit, RLIMIT_FSIZE, with
 // SIGXFSZ ignored so that the write fails as on a full disk). Each gives one error naming the path and the
 // problem; the file being written is removed, never left half-written under its final name or as a .partial.
 #include <gtest/gtest.h>
-
 #include <sys/resource.h>
 
 #include <csignal>
@@ -43,7 +43,8 @@ std::string error_of(const std::vector<std::string>& args) {
 
 TEST(FaultInjection, InputThatIsADirectoryIsNamed) {
   const auto dir = ultratrack::test::scratch_dir();
-  const std::string e = error_of({"--input", dir.string(), "--format", "i8", "--fs", "2.6e6", "--out", (dir / "rx").string()});
+  const std::string e =
+      error_of({"--input", dir.string(), "--format", "i8", "--fs", "2.6e6", "--out", (dir / "rx").string()});
   EXPECT_NE(e.find(dir.string()), std::string::npos) << e;
   EXPECT_NE(e.find("not a regular file"), std::string::npos) << e;
   EXPECT_FALSE(fs::exists(dir / "rx"));

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Other generators' and front ends' rates and formats work with flags only (issue 3): `ultratrack simulate`
 // writes short files at 2.6 / 4 MHz i8, i16 and i2, 16 MHz i16, 12 MHz r8 at IF 3 MHz, 38.192 MHz r8 at
 // IF 9.548 MHz and 16.368 MHz r2 at IF 4.092 MHz (the MAX2769's classic setting); `ultratrack receive` must
@@ -20,10 +21,10 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "config/scenario_toml.hpp"
+#include "run_command.hpp"
 #include "signals/input_error.hpp"
 #include "signals/nominal_constellation.hpp"
 #include "signals/rinex_nav.hpp"
-#include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack fuse --attitude` end to end, in process: a parked vehicle with a MEMS IMU (imusim truth), 1 Hz GNSS
 // fixes (gnsssim) and a GPS attitude file written here from the simulator's truth + Gaussian noise, in GPS time,
 // with the antenna array mounted 3 deg off the IMU axes, 20 % of the rows unfixed and a 10 s gap. With
@@ -16,16 +17,16 @@
 #include <string>
 #include <vector>
 
-#include "io/units.hpp"
-#include "pipelines/gps_attitude_csv.hpp"
 #include "commands.hpp"
-#include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/attitude.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
+#include "pipelines/gps_attitude_csv.hpp"
 #include "signals/gps_time.hpp"
-#include "support/test_data.hpp"
 #include "sim/truth_csv.hpp"
+#include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
 using ultratrack::io::InputError;
@@ -77,8 +78,9 @@ AttitudeFile write_attitude(const fs::path& truth_csv, const fs::path& out, cons
   std::normal_distribution<double> n01;
   std::uniform_real_distribution<double> u01;
   const Eigen::Vector3d sigma_deg(0.1, 0.1, 0.2);
-  std::string text = "gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,"
-                     "fixed,ratio\n";
+  std::string text =
+      "gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,"
+      "fixed,ratio\n";
   AttitudeFile f;
   for (double t = 0.61; t < truth.end_s(); t += 1.0) {
     const auto g = ultratrack::signals::add_seconds(kOrigin, t);
@@ -90,8 +92,10 @@ AttitudeFile write_attitude(const fs::path& truth_csv, const fs::path& out, cons
     } else {
       const auto e = ultratrack::ins::euler_from_quaternion(truth.attitude(t) * q_ba);
       std::snprintf(line, sizeof line, "%d,%.4f,%.5f,%.5f,%.5f,%.5f,%.5f,%.5f,7,1,8.500\n", g.week, g.tow_s,
-                    e.roll_rad / ultratrack::io::kRadPerDeg + sigma_deg.x() * n01(rng), e.pitch_rad / ultratrack::io::kRadPerDeg + sigma_deg.y() * n01(rng),
-                    e.yaw_rad / ultratrack::io::kRadPerDeg + sigma_deg.z() * n01(rng), sigma_deg.x(), sigma_deg.y(), sigma_deg.z());
+                    e.roll_rad / ultratrack::io::kRadPerDeg + sigma_deg.x() * n01(rng),
+                    e.pitch_rad / ultratrack::io::kRadPerDeg + sigma_deg.y() * n01(rng),
+                    e.yaw_rad / ultratrack::io::kRadPerDeg + sigma_deg.z() * n01(rng), sigma_deg.x(), sigma_deg.y(),
+                    sigma_deg.z());
     }
     text += line;
     ++f.rows;
@@ -108,16 +112,26 @@ class FuseAttitude : public ::testing::Test {
          "--out", (*dir_ / "sim").string()});
     run({"gnsssim", "--truth", (*dir_ / "sim/truth.csv").string(), "--rate", "1", "--first", "0.37", "--seed", "5",
          "--out", (*dir_ / "gnss.csv").string()});
-    mounting_ = ultratrack::ins::quaternion_from_euler({0.5 * ultratrack::io::kRadPerDeg, -0.3 * ultratrack::io::kRadPerDeg, 3.0 * ultratrack::io::kRadPerDeg});
+    mounting_ = ultratrack::ins::quaternion_from_euler(
+        {0.5 * ultratrack::io::kRadPerDeg, -0.3 * ultratrack::io::kRadPerDeg, 3.0 * ultratrack::io::kRadPerDeg});
     file_ = write_attitude(*dir_ / "sim/truth.csv", *dir_ / "attitude.csv", mounting_);
-    write_text(*dir_ / "mounted.toml", "[imu]\npreset = \"mems\"\n[attitude]\ngps_time_at_imu_zero = [2190, 604790.0]\n"
-                                       "misalignment_deg = [0.5, -0.3, 3.0]\n");
+    write_text(*dir_ / "mounted.toml",
+               "[imu]\npreset = \"mems\"\n[attitude]\ngps_time_at_imu_zero = [2190, 604790.0]\n"
+               "misalignment_deg = [0.5, -0.3, 3.0]\n");
   }
   static void TearDownTestSuite() { delete dir_; }
 
   static std::vector<std::string> fuse_args(const std::string& out) {
-    return {"fuse", "--imu", (*dir_ / "sim/imu.csv").string(), "--gnss", (*dir_ / "gnss.csv").string(), "--truth",
-            (*dir_ / "sim/truth.csv").string(), "--quiet", "--out", (*dir_ / out).string()};
+    return {"fuse",
+            "--imu",
+            (*dir_ / "sim/imu.csv").string(),
+            "--gnss",
+            (*dir_ / "gnss.csv").string(),
+            "--truth",
+            (*dir_ / "sim/truth.csv").string(),
+            "--quiet",
+            "--out",
+            (*dir_ / out).string()};
   }
   static std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& more) {
     a.insert(a.end(), more.begin(), more.end());
@@ -137,8 +151,9 @@ TEST_F(FuseAttitude, HeadingConvergesWithGpsAttitudeOnlyAndCountsAddUp) {
   run(with(fuse_args("with"), {"--attitude", (d / "attitude.csv").string(), "--align", "attitude", "--config",
                                (d / "mounted.toml").string()}));
   // Without GPS attitude: the configured attitude with the truth's tilt and a 5 deg heading error (1-sigma 5 deg).
-  write_text(d / "config.toml", "[imu]\npreset = \"mems\"\n[initial]\nattitude_deg = [0.0, 0.0, 5.0]\n"
-                                "sigma_attitude_deg = [1.0, 1.0, 5.0]\n");
+  write_text(d / "config.toml",
+             "[imu]\npreset = \"mems\"\n[initial]\nattitude_deg = [0.0, 0.0, 5.0]\n"
+             "sigma_attitude_deg = [1.0, 1.0, 5.0]\n");
   run(with(fuse_args("without"), {"--align", "config", "--config", (d / "config.toml").string()}));
   // The mounting left out: GPS attitude of the array taken for the IMU's.
   run(with(fuse_args("unmounted"), {"--attitude", (d / "attitude.csv").string(), "--align", "attitude",
@@ -149,9 +164,10 @@ TEST_F(FuseAttitude, HeadingConvergesWithGpsAttitudeOnlyAndCountsAddUp) {
   const double h_unmounted = json_number(su, "heading_deg", "rms_all");
   const double sigma_with = json_number(sw, "heading_deg", "final_sigma");
   const double sigma_without = json_number(so, "heading_deg", "final_sigma");
-  std::printf("fuse, parked MEMS 150 s: heading RMS with GPS attitude %.4f deg (final 1-sigma %.4f), without %.2f deg "
-              "(1-sigma %.2f), mounting not configured %.3f deg\n",
-              h_with, sigma_with, h_without, sigma_without, h_unmounted);
+  std::printf(
+      "fuse, parked MEMS 150 s: heading RMS with GPS attitude %.4f deg (final 1-sigma %.4f), without %.2f deg "
+      "(1-sigma %.2f), mounting not configured %.3f deg\n",
+      h_with, sigma_with, h_without, sigma_without, h_unmounted);
   // GPS yaw sigma 0.2 deg, one attitude a second averaged by the filter: the heading RMS below it.
   EXPECT_LT(h_with, 0.2);
   EXPECT_LE(sigma_with, 0.2);

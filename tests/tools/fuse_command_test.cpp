@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack fuse` end to end, in process, on simulated data: a "foreign" data set (200 Hz IMU, 5 Hz GNSS
 // fixes at non-integer times t = 0.137 + 0.2 k) aligned in motion converges, beats the fixes it was given and
 // stays consistent with its own 1-sigma; static and configured alignments; outages; an IMU on a free-running local
@@ -19,9 +20,9 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "ins/imu_csv.hpp"
+#include "io/input_error.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
-#include "io/input_error.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -260,9 +261,19 @@ TEST(FuseCommand, ImuOnALocalClockThroughPpsGivesTheGpsStampedSolution) {
   for (int k = 0; k <= 121; ++k)
     if (k != 60) pps += fmt::format("{:.7f},2190,{}\n", local_of(k) + jitter(rng), 518400 + k);
   std::ofstream(dir / "pps.csv") << pps;
-  const std::vector<std::string> pps_args = {"fuse", "--imu", (dir / "imu_local.csv").string(), "--imu-pps",
-                                             (dir / "pps.csv").string(), "--attitude-origin", "2190", "518400",
-                                             "--gnss", gnss, "--truth", truth, "--quiet"};
+  const std::vector<std::string> pps_args = {"fuse",
+                                             "--imu",
+                                             (dir / "imu_local.csv").string(),
+                                             "--imu-pps",
+                                             (dir / "pps.csv").string(),
+                                             "--attitude-origin",
+                                             "2190",
+                                             "518400",
+                                             "--gnss",
+                                             gnss,
+                                             "--truth",
+                                             truth,
+                                             "--quiet"};
   std::vector<std::string> args = pps_args;
   args.insert(args.end(), {"--out", (dir / "pps").string()});
   run(args);

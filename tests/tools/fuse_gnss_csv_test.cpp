@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // gnss.csv (fuse's external fixes) and fuse's nav.csv: exact round trips, position-only rows, and every kind
 // of malformed row rejected with the file and the line.
 #include <gtest/gtest.h>
@@ -9,15 +10,15 @@
 #include <string>
 #include <vector>
 
-#include "io/units.hpp"
-#include "pipelines/fused_nav_csv.hpp"
-#include "pipelines/gnss_fix_csv.hpp"
-#include "pipelines/gnss_fix_simulation.hpp"
 #include "ins/earth_model.hpp"
 #include "ins/trajectory.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
+#include "pipelines/fused_nav_csv.hpp"
+#include "pipelines/gnss_fix_csv.hpp"
+#include "pipelines/gnss_fix_simulation.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -137,7 +138,8 @@ TEST(FuseNavCsv, RoundTripKeepsStateAndSigmas) {
 // Simulated fixes: exact non-integer times, and errors with the requested white statistics (2000 fixes: the
 // sample standard deviation is within 5 sampling sigmas, sqrt(1 / (2 n)) ~ 1.6 %, of the setting).
 TEST(FuseGnssFixSimulation, TimesAndErrorStatistics) {
-  const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * ultratrack::io::kRadPerDeg, 127.0 * ultratrack::io::kRadPerDeg, 100.0);
+  const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * ultratrack::io::kRadPerDeg,
+                                                  127.0 * ultratrack::io::kRadPerDeg, 100.0);
   const ultratrack::ins::TruthInterpolator truth(ultratrack::ins::simulate(spec, 20.0).truth);
   ultratrack::pipelines::GnssFixSimulationOptions o;
   o.rate_hz = 5.0;
@@ -152,12 +154,12 @@ TEST(FuseGnssFixSimulation, TimesAndErrorStatistics) {
   for (std::size_t k = 0; k < fixes.size(); ++k) {
     EXPECT_NEAR(fixes[k].t_s, 0.137 + 0.2 * static_cast<double>(k), 1e-12);
     const auto m = truth.antenna(fixes[k].t_s, Eigen::Vector3d::Zero());
-    const Eigen::Vector3d d = ultratrack::ins::C_en(fixes[k].lat_rad, fixes[k].lon_rad).transpose() *
-                              (ultratrack::ins::ecef_from_geodetic(fixes[k].lat_rad, fixes[k].lon_rad,
-                                                                   fixes[k].height_m) - m.r_e);
+    const Eigen::Vector3d d =
+        ultratrack::ins::C_en(fixes[k].lat_rad, fixes[k].lon_rad).transpose() *
+        (ultratrack::ins::ecef_from_geodetic(fixes[k].lat_rad, fixes[k].lon_rad, fixes[k].height_m) - m.r_e);
     sum2 += d.cwiseAbs2();
-    vel2 += (fixes[k].v_n - ultratrack::ins::C_en(fixes[k].lat_rad, fixes[k].lon_rad).transpose() * m.v_e)
-                .squaredNorm();
+    vel2 +=
+        (fixes[k].v_n - ultratrack::ins::C_en(fixes[k].lat_rad, fixes[k].lon_rad).transpose() * m.v_e).squaredNorm();
   }
   const double n = static_cast<double>(fixes.size());
   const Eigen::Vector3d sd = (sum2 / n).cwiseSqrt();

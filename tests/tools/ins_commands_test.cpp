@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack imusim` and `ultratrack ins` end to end, in process: simulated files navigate back onto their
 // own truth; coarse alignment mode runs from the stationary start; bad input is a typed error.
 #include <gtest/gtest.h>

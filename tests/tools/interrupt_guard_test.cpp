@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // tools::InterruptGuard: SIGINT and SIGTERM become a stop request on every live guard's token (nested guards too),
 // and the handlers that were there before come back when the last guard goes.
 #include "interrupt_guard.hpp"

@@ -1,9 +1,10 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // io/json_text: escaping as RFC 8259 section 7 requires (quote, backslash, U+0000-U+001F), the rest untouched.
+#include "io/json_text.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string>
-
-#include "io/json_text.hpp"
 
 TEST(JsonText, EscapesQuoteBackslashAndControlCharactersOnly) {
   using ultratrack::io::json_escape;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive` on a synthetic file read with wrong flags (issue 3's bad input, without ../shared/data):
 // a wrong format, a wrong rate and a 2-bit file read as 8-bit find no satellite (InputError naming the file,
 // no outputs), a wrong 2-bit order fails with a message naming the file; the right flags on a file too short for a fix
@@ -15,8 +16,8 @@
 
 #include "command_exit.hpp"
 #include "commands.hpp"
-#include "signals/input_error.hpp"
 #include "run_command.hpp"
+#include "signals/input_error.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;

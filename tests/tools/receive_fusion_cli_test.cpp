@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --imu --coupling tight` with bad IMU input: one InputError naming the IMU file and no outputs
 // under their final names (a missing file, a NaN field, an IMU time line that does not cover the signal). The
 // coupling's physics: tests/pipelines/receive_fusion_test.cpp (the same scenario).
@@ -44,8 +45,9 @@ Sim& simulated() {
 
 std::vector<std::string> receive_args(const fs::path& rx) {
   const auto& s = simulated();
-  return {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string(),
-          "--imu", (s.sim / "imu.csv").string(), "--out", rx.string()};
+  return {
+      "--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8",       "--fs", "2.0e6", "--nav", s.nav.string(),
+      "--imu",   (s.sim / "imu.csv").string(),         "--out",    rx.string()};
 }
 
 }  // namespace
@@ -83,10 +85,10 @@ TEST(ReceiveFusionCli, BadImuInputIsOneInputErrorNamingTheFileAndLeavesNoOutputs
   expect_error("nan", s.dir / "nan_imu.csv", {}, "");
   // The IMU's times taken as seconds since tow 518000: the signal lies ~776 s after the IMU's 16 s.
   expect_error("not_covering", s.sim / "imu.csv", {"--imu-time-origin", "518000"}, "does not cover the signal");
-  EXPECT_THROW(test_support::run_command("receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8",
-                                                     "--fs", "2.0e6", "--coupling", "loose", "--out",
-                                                     (s.dir / "bad_no_imu").string()}),
-               io::InputError);
+  EXPECT_THROW(
+      test_support::run_command("receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs",
+                                            "2.0e6", "--coupling", "loose", "--out", (s.dir / "bad_no_imu").string()}),
+      io::InputError);
 }
 
 // --odometer: loose only (tight and ultra-tight carry no odometer states), a bad odometer file is one InputError
@@ -115,8 +117,8 @@ TEST(ReceiveFusionCli, OdometerIsLooseOnlyAndABadFileIsOneInputErrorNamingIt) {
   }
   const io::InputError e = run("backwards", "loose", bad);
   EXPECT_EQ(e.file(), bad.string()) << e.what();
-  EXPECT_THROW(test_support::run_command("receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8",
-                                                     "--fs", "2.0e6", "--odometer", good.string(), "--out",
-                                                     (s.dir / "odo_scalar").string()}),
+  EXPECT_THROW(test_support::run_command(
+                   "receive", {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6",
+                               "--odometer", good.string(), "--out", (s.dir / "odo_scalar").string()}),
                io::InputError);
 }

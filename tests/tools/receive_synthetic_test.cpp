@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // End to end on the synthesiser's signal: `ultratrack simulate` (signals/if_synthesiser, nominal constellation,
 // static receiver, 45 dB-Hz, 2.6 MHz i8) then `ultratrack receive`, checked against the scenario's truth.csv.
 // The scenario starts 2 s before a frame start (tow 518398, week 2190), so subframes 1-3 leave the satellites at
@@ -11,10 +12,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <stdexcept>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -121,8 +122,8 @@ troposphere = false
   const auto truth = columns(sim / "truth.csv", {"ecef_x_m", "ecef_y_m", "ecef_z_m"});
   ASSERT_FALSE(truth.empty());
   const Eigen::Vector3d r_true(truth[0][0], truth[0][1], truth[0][2]);
-  const auto fixes = columns(out / "solution.csv", {"ecef_x_m", "ecef_y_m", "ecef_z_m", "vel_e_mps", "vel_n_mps",
-                                                    "vel_u_mps", "num_sats"});
+  const auto fixes = columns(out / "solution.csv",
+                             {"ecef_x_m", "ecef_y_m", "ecef_z_m", "vel_e_mps", "vel_n_mps", "vel_u_mps", "num_sats"});
   ASSERT_GT(fixes.size(), 40u);  // ~6 s of fixes at 10 Hz
   double sum_r2 = 0.0, sum_v2 = 0.0;
   for (const auto& f : fixes) {

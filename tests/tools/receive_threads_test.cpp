@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --threads N` writes the same outputs byte for byte for every N: solution, RINEX, NMEA,
 // KML, tracking.csv and summary.json, apart from the wall-clock fields (summary.json's wall_time_s and
 // realtime_factor, the RINEX files' creation date). The scenario (10 satellites, 2.6 MHz i8, 21 s from 2 s
@@ -60,14 +61,14 @@ llh_deg_m = [35.274016, 137.013759, 100.0]
   std::ofstream(config) << "[receiver]\nreacquisition_interval_s = 2.0\nblind_prns_per_snapshot = 5\n";
   const auto sim = dir / "sim";
   run("simulate", {"--scenario", scenario.string(), "--out", sim.string()});
-  const std::vector<std::string> files = {"solution.csv",   "tracking.csv", "observations.rnx", "navigation.rnx",
+  const std::vector<std::string> files = {"solution.csv",  "tracking.csv", "observations.rnx", "navigation.rnx",
                                           "solution.nmea", "solution.kml", "summary.json"};
   std::vector<std::string> reference;
   for (int threads = 1; threads <= 3; ++threads) {
     const auto out = dir / ("rx" + std::to_string(threads));
-    run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.6e6", "--out",
-                    out.string(), "--reference-week", "2190", "--config", config.string(), "--threads",
-                    std::to_string(threads)});
+    run("receive",
+        {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.6e6", "--out", out.string(),
+         "--reference-week", "2190", "--config", config.string(), "--threads", std::to_string(threads)});
     ASSERT_GT(fs::file_size(out / "solution.csv"), 1000u) << "no fixes";
     for (std::size_t i = 0; i < files.size(); ++i) {
       const std::string text = without_wall_clock(out / files[i]);

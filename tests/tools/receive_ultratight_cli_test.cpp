@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --coupling ultra-tight` on the command line: the flags that choose the loop say what the
 // library's options say (--ut-pipelined is the default, --ut-pipelined=false is --ut-serial: the same bytes), and
 // bad option combinations are one InputError naming the flag, before anything is written. The loop's physics is
@@ -41,9 +42,15 @@ Sim& tunnel() {
 std::string ultratight_log(const std::string& name, const std::vector<std::string>& extra) {
   const auto& s = tunnel();
   const auto rx = s.dir / name;
-  std::vector<std::string> args = {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6",
-                                   "--nav", s.nav.string(), "--imu", (s.sim / "imu.csv").string(), "--align", "motion",
-                                   "--coupling", "ultra-tight", "--threads", "2", "--out", rx.string()};
+  std::vector<std::string> args = {"--input",    (s.sim / "antenna0.i8.bin").string(),
+                                   "--format",   "i8",
+                                   "--fs",       "2.0e6",
+                                   "--nav",      s.nav.string(),
+                                   "--imu",      (s.sim / "imu.csv").string(),
+                                   "--align",    "motion",
+                                   "--coupling", "ultra-tight",
+                                   "--threads",  "2",
+                                   "--out",      rx.string()};
   args.insert(args.end(), extra.begin(), extra.end());
   test_support::run_command("receive", args);
   return test::read_text_file(rx / "ultratight.csv");
@@ -63,8 +70,8 @@ TEST(ReceiveUltraTightCli, LoopFlagsSelectTheLoops) {
 
 TEST(ReceiveUltraTightCli, BadOptionsAreOneInputError) {
   const auto& s = tunnel();
-  const std::vector<std::string> base = {"--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs",
-                                         "2.0e6", "--nav", s.nav.string()};
+  const std::vector<std::string> base = {
+      "--input", (s.sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.0e6", "--nav", s.nav.string()};
   auto expect_error = [&](const std::string& name, std::vector<std::string> extra, const std::string& words) {
     auto args = base;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -78,20 +85,21 @@ TEST(ReceiveUltraTightCli, BadOptionsAreOneInputError) {
     EXPECT_FALSE(fs::exists(s.dir / ("bad_" + name) / "summary.json")) << name;
   };
   expect_error("no_imu", {"--coupling", "ultra-tight"}, "--coupling ultra-tight needs --imu");
-  expect_error("form_without_ut", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-measurement", "iq"},
+  expect_error("form_without_ut",
+               {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-measurement", "iq"},
                "--ut-measurement needs --coupling ultra-tight");
   expect_error("form_scalar", {"--ut-measurement", "iq"}, "--ut-measurement needs --coupling ultra-tight");
   expect_error("pipelined_scalar", {"--ut-pipelined"}, "--ut-pipelined needs --coupling ultra-tight");
   expect_error("serial_scalar", {"--ut-serial"}, "--ut-serial needs --coupling ultra-tight");
   expect_error("serial_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-serial"},
                "--ut-serial needs --coupling ultra-tight");
-  expect_error("serial_and_pipelined", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight",
-                                        "--ut-serial", "--ut-pipelined"},
+  expect_error("serial_and_pipelined",
+               {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-serial", "--ut-pipelined"},
                "--ut-serial and --ut-pipelined exclude each other");
   expect_error("pipelined_tight", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-pipelined"},
                "--ut-pipelined needs --coupling ultra-tight");
-  expect_error("bad_form", {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement",
-                            "phase"},
+  expect_error("bad_form",
+               {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement", "phase"},
                "--ut-measurement must be iq or discriminator");
   expect_error("bad_coupling", {"--coupling", "ultratight"}, "ultra-tight");
   expect_error("missing_imu_file", {"--imu", (s.dir / "none.csv").string(), "--coupling", "ultra-tight"}, "not found");

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --vector-carrier`: an unknown carrier mode, and a carrier mode without --coupling vector, are
 // bad input on the command line. The vector loops themselves: tests/pipelines/receive_vector*_test.cpp.
 #include <gtest/gtest.h>
@@ -15,7 +16,7 @@ TEST(ReceiveVectorCli, RejectsUnknownCarrierModesAndOneWithoutVectorCoupling) {
   std::ofstream(dir / "x.bin", std::ios::binary) << std::string(400000, '\0');
   const auto receive = [&](const std::vector<std::string>& extra, const std::string& out) {
     std::vector<std::string> args = {"--input", (dir / "x.bin").string(), "--format", "i8", "--fs", "2.0e6",
-                                     "--out", (dir / out).string()};
+                                     "--out",   (dir / out).string()};
     args.insert(args.end(), extra.begin(), extra.end());
     ultratrack::test_support::run_command("receive", args);
   };

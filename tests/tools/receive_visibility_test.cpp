@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Acquisition skips satellites below the horizon: a receiver with a rough position (here the simulator's
 // truth) and the broadcast ephemerides of the whole constellation searches, once its clock is set, only the
 // PRNs the orbits put above the horizon, plus at most one hidden PRN per hidden_prn_check_interval_s. Truth:

@@ -1,9 +1,9 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Runs one `ultratrack` subcommand in the test process, as the program would parse its command line
 // (the same app as main.cpp: every subcommand registered). Exceptions (InputError, CommandExit) propagate.
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <string>
 #include <vector>
 

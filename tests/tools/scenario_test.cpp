@@ -1,11 +1,11 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scenario files: the keys parse to the stated values; unknown keys, wrong types and conflicting
 // keys are InputErrors naming the file, the key and the line; the echo (to_toml) reads back the same.
-#include "config/scenario_toml.hpp"
-
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "config/scenario_toml.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::tools {
@@ -221,12 +221,14 @@ TEST(Scenario, AntennaImpairmentsSlipsAndBlockagesParseAndEcho) {
 
 TEST(Scenario, EventsOnMissingAntennasOrWithUnknownKeysAreErrors) {
   std::string text = kAttitudeScenario;
-  EXPECT_NE(error_of(text + "[[blockage]]\nantenna = 2\nstart_s = 1.0\nduration_s = 1.0\n").find("antenna 2 does not exist"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(text + "[[blockage]]\nantenna = 2\nstart_s = 1.0\nduration_s = 1.0\n").find("antenna 2 does not exist"),
+      std::string::npos);
   EXPECT_NE(error_of(text + "[[cycle_slip]]\nantenna = 0\nprn = 3\ntime_s = 1.0\n").find("cycle_slip.cycles"),
             std::string::npos);
-  EXPECT_NE(error_of(text + "[[blockage]]\nantenna = 0\nstart_s = 1.0\nduration_s = 1.0\nprn = 4\n").find("blockage.prn"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(text + "[[blockage]]\nantenna = 0\nstart_s = 1.0\nduration_s = 1.0\nprn = 4\n").find("blockage.prn"),
+      std::string::npos);
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate` with [trajectory] and [imu]: one trajectory drives the IMU data, the truth and the
 // IF synthesiser's antennas. Checked against an independent run of the trajectory generator with the
 // antenna positions built by hand (GeographicLib position, NED->ECEF rotation, C_nb from the truth
@@ -11,11 +12,11 @@
 #include <numbers>
 #include <sstream>
 
+#include "config/scenario_toml.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/strapdown.hpp"
 #include "ins/trajectory_simulator.hpp"
 #include "ins/truth_interpolator.hpp"
-#include "config/scenario_toml.hpp"
 #include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/input_error.hpp"
@@ -57,7 +58,8 @@ std::vector<std::vector<double>> read_rows(const std::filesystem::path& p) {
 
 Eigen::Vector3d ecef(double lat_rad, double lon_rad, double h) {
   Eigen::Vector3d r;
-  GeographicLib::Geocentric::WGS84().Forward(lat_rad / io::kRadPerDeg, lon_rad / io::kRadPerDeg, h, r.x(), r.y(), r.z());
+  GeographicLib::Geocentric::WGS84().Forward(lat_rad / io::kRadPerDeg, lon_rad / io::kRadPerDeg, h, r.x(), r.y(),
+                                             r.z());
   return r;
 }
 
@@ -135,7 +137,8 @@ lever_arm_body_m = [-2.0, 1.0, -0.8]
   EXPECT_EQ(to_toml(read_scenario(out / "scenario.toml")), to_toml(s));
 
   // The same trajectory, run independently.
-  const auto ref = ins::simulate(ins::profile_spec("circle", 1.5, kLat * io::kRadPerDeg, kLon * io::kRadPerDeg, kH), 100.0).truth;
+  const auto ref =
+      ins::simulate(ins::profile_spec("circle", 1.5, kLat * io::kRadPerDeg, kLon * io::kRadPerDeg, kH), 100.0).truth;
   ASSERT_EQ(ref.size(), 151u);
   const std::vector<Eigen::Vector3d> levers = {{0.5, 0.2, -1.0}, {-2.0, 1.0, -0.8}};
 
@@ -158,8 +161,8 @@ lever_arm_body_m = [-2.0, 1.0, -0.8]
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(row[9 + i], r.v_n[i], 2e-5);
     const Eigen::Matrix3d C = r.q_nb.toRotationMatrix();
     const double roll = std::atan2(C(2, 1), C(2, 2)), pitch = -std::asin(C(2, 0)), yaw = std::atan2(C(1, 0), C(0, 0));
-    worst_att = std::max(
-        {worst_att, std::abs(row[14] - roll / io::kRadPerDeg), std::abs(row[15] - pitch / io::kRadPerDeg), std::abs(row[16] - yaw / io::kRadPerDeg)});
+    worst_att = std::max({worst_att, std::abs(row[14] - roll / io::kRadPerDeg),
+                          std::abs(row[15] - pitch / io::kRadPerDeg), std::abs(row[16] - yaw / io::kRadPerDeg)});
   }
   std::printf("truth.csv vs independent trajectory: position %.2e m, attitude %.2e deg\n", worst_pos, worst_att);
   EXPECT_LT(worst_pos, 1e-3);
@@ -240,7 +243,8 @@ lever_arm_body_m = [1.5, 0.4, -0.3]
 
   const Eigen::Matrix3d C_nb = C_nb_from_euler(12.0 * io::kRadPerDeg, -7.0 * io::kRadPerDeg, 63.0 * io::kRadPerDeg);
   const Eigen::Vector3d r0 = ecef(kLat * io::kRadPerDeg, kLon * io::kRadPerDeg, kH);
-  const Eigen::Vector3d baseline_e = C_en(kLat * io::kRadPerDeg, kLon * io::kRadPerDeg) * C_nb * Eigen::Vector3d(1.5, 0.4, -0.3);
+  const Eigen::Vector3d baseline_e =
+      C_en(kLat * io::kRadPerDeg, kLon * io::kRadPerDeg) * C_nb * Eigen::Vector3d(1.5, 0.4, -0.3);
 
   // truth.csv carries the parked attitude; imu.csv's specific force levels to it.
   const auto truth = read_rows(out / "truth.csv");
@@ -310,7 +314,8 @@ preset = "ideal"
     n.lon_rad = row[7] * io::kRadPerDeg;
     n.height_m = row[8];
     n.v_n = {row[9], row[10], row[11]};
-    n.q_nb = Eigen::Quaterniond(C_nb_from_euler(row[14] * io::kRadPerDeg, row[15] * io::kRadPerDeg, row[16] * io::kRadPerDeg));
+    n.q_nb = Eigen::Quaterniond(
+        C_nb_from_euler(row[14] * io::kRadPerDeg, row[15] * io::kRadPerDeg, row[16] * io::kRadPerDeg));
     return n;
   };
   ins::Strapdown ins(state_of(truth[0]));
@@ -323,7 +328,8 @@ preset = "ideal"
     const auto& st = ins.state();
     worst =
         std::max(worst, (ecef(st.lat_rad, st.lon_rad, st.height_m) - Eigen::Vector3d(row[3], row[4], row[5])).norm());
-    worst_att = std::max(worst_att, Eigen::AngleAxisd(st.q_nb.conjugate() * state_of(row).q_nb).angle() / io::kRadPerDeg);
+    worst_att =
+        std::max(worst_att, Eigen::AngleAxisd(st.q_nb.conjugate() * state_of(row).q_nb).angle() / io::kRadPerDeg);
   }
   std::printf("imu.csv (ideal) mechanised over 60 s of circle: position error %.3e m, attitude %.2e deg\n", worst,
               worst_att);

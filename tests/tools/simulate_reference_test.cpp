@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate` against another GPS simulator, the acceptance check of issue 2: on brdc0010.22n at
 // 35.274016 N, 137.013759 E, 100 m and 2022-01-01 00:00 GPST (week 2190, tow 518400 s) it must put the same
 // satellites at the same Doppler and code phase as gps-sdr-sim does (docs/validation.md). The reference
@@ -163,8 +164,8 @@ TEST(SimulateReference, ShippedFileSameSatellitesInViewAsGpsSdrSim) {
     int prn;
     double azimuth_deg, elevation_deg;
   };
-  constexpr Printed kPrinted[] = {{1, 75.5, 19.0},   {2, 278.2, 8.6},  {3, 44.8, 38.2},  {6, 298.1, 43.4},
-                                  {9, 144.3, 29.1},  {10, 222.8, 34.6}, {11, 98.7, 7.0},  {12, 326.9, 5.0},
+  constexpr Printed kPrinted[] = {{1, 75.5, 19.0},   {2, 278.2, 8.6},   {3, 44.8, 38.2},   {6, 298.1, 43.4},
+                                  {9, 144.3, 29.1},  {10, 222.8, 34.6}, {11, 98.7, 7.0},   {12, 326.9, 5.0},
                                   {17, 350.8, 83.8}, {20, 47.2, 49.4},  {23, 106.0, 35.7}, {28, 201.9, 27.9},
                                   {32, 43.1, 2.2}};
   double lat_deg = 0, lon_deg = 0, h_m = 0;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack simulate` end to end: the files it writes, and an independent brute-force acquisition
 // (tests/support) of the written samples that must find every satellite of satellites.csv at the stated
 // Doppler, code phase and C/N0, with the nominal constellation and with a broadcast ephemeris (the shipped
@@ -248,11 +249,14 @@ prns = [3, 40]
   };
   EXPECT_NE(error_of(base + steps).find("cn0_step.prns"), std::string::npos);  // PRN 40
   EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\n").find("cn0_step.cn0_dbhz"), std::string::npos);
-  EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\ncn0_dbhz = 90.0\n").find("cn0_step.cn0_dbhz"), std::string::npos);
-  EXPECT_NE(error_of(base + "[[cn0_step]]\nantenna = 1\nstart_s = 1.0\ncn0_dbhz = 30.0\n").find("antenna 1 does not exist"),
+  EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\ncn0_dbhz = 90.0\n").find("cn0_step.cn0_dbhz"),
             std::string::npos);
-  EXPECT_NE(error_of(base + "[[cn0_step]]\nstart_s = 1.0\ncn0_dbhz = 30.0\nduration_s = 2\n").find("cn0_step.duration_s"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(base + "[[cn0_step]]\nantenna = 1\nstart_s = 1.0\ncn0_dbhz = 30.0\n").find("antenna 1 does not exist"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of(base + "[[cn0_step]]\nstart_s = 1.0\ncn0_dbhz = 30.0\nduration_s = 2\n").find("cn0_step.duration_s"),
+      std::string::npos);
 
   const std::string good_steps = R"(
 [[cn0_step]]

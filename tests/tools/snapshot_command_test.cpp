@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack snapshot` end to end: a simulated 2-bit real snapshot (the format of the low-power front ends that
 // snapshot receivers use) solved without an approximate position from a time 6 s off, against simulate's truth;
 // and the bad inputs: no satellite (exit 2), fewer than 5 usable satellites and a time off by more than the
@@ -32,43 +33,45 @@ struct SnapshotFiles {
 
 // 80 ms of r2 at 8.184 MHz (IF 2.046 MHz), 42 dB-Hz, nominal constellation, ionosphere on, clock 0.2 ms / 0.3 ppm.
 const SnapshotFiles& files() {
-  static const SnapshotFiles f = [] {
-    SnapshotFiles s;
-    s.dir = ultratrack::test::scratch_dir();
-    std::ofstream(s.dir / "snap.toml") << "[signal]\nsample_rate_hz = 8.184e6\nif_hz = 2.046e6\nformat = \"r2\"\n"
-                                          "duration_s = 0.082\ncn0_dbhz = 42.0\nseed = 11\n"
-                                          "[time]\ngps_week = 2190\ntow_s = "
-                                       << kTow
-                                       << "\n[navigation]\nconstellation = \"nominal\"\nelevation_mask_deg = 5.0\n"
-                                          "[receiver]\nllh_deg_m = [47.3, 8.55, 420.0]\nclock_bias_m = 60000.0\n"
-                                          "clock_drift_mps = 90.0\n[atmosphere]\nionosphere = true\ntroposphere = true\n";
-    ultratrack::test_support::run_command("simulate",
-                                          {"--scenario", (s.dir / "snap.toml").string(), "--out", (s.dir / "sim").string()});
-    const auto c = ultratrack::signals::nominal_constellation({2190, kTow});
-    ultratrack::signals::RinexNavData nav;
-    nav.ephemerides = c.ephemerides;
-    nav.klobuchar = c.klobuchar;
-    nav.utc = c.utc;
-    s.nav = s.dir / "nominal.rnx";
-    ultratrack::signals::write_rinex_nav_304(s.nav, nav);
-    s.input = s.dir / "sim" / "antenna0.r2.bin";
-    std::ifstream truth(s.dir / "sim" / "truth.csv");
-    std::string header, row;
-    std::getline(truth, header);
-    std::getline(truth, row);
-    const auto names = ultratrack::test::split_csv_line(header);
-    const auto values = ultratrack::test::split_csv_line(row);
-    s.truth_e_m = {std::stod(values.at(ultratrack::test::csv_column(names, "ecef_x_m"))),
-                   std::stod(values.at(ultratrack::test::csv_column(names, "ecef_y_m"))),
-                   std::stod(values.at(ultratrack::test::csv_column(names, "ecef_z_m")))};
-    return s;
-  }();
+  static const SnapshotFiles f =
+      [] {
+        SnapshotFiles s;
+        s.dir = ultratrack::test::scratch_dir();
+        std::ofstream(s.dir / "snap.toml")
+            << "[signal]\nsample_rate_hz = 8.184e6\nif_hz = 2.046e6\nformat = \"r2\"\n"
+               "duration_s = 0.082\ncn0_dbhz = 42.0\nseed = 11\n"
+               "[time]\ngps_week = 2190\ntow_s = "
+            << kTow
+            << "\n[navigation]\nconstellation = \"nominal\"\nelevation_mask_deg = 5.0\n"
+               "[receiver]\nllh_deg_m = [47.3, 8.55, 420.0]\nclock_bias_m = 60000.0\n"
+               "clock_drift_mps = 90.0\n[atmosphere]\nionosphere = true\ntroposphere = true\n";
+        ultratrack::test_support::run_command(
+            "simulate", {"--scenario", (s.dir / "snap.toml").string(), "--out", (s.dir / "sim").string()});
+        const auto c = ultratrack::signals::nominal_constellation({2190, kTow});
+        ultratrack::signals::RinexNavData nav;
+        nav.ephemerides = c.ephemerides;
+        nav.klobuchar = c.klobuchar;
+        nav.utc = c.utc;
+        s.nav = s.dir / "nominal.rnx";
+        ultratrack::signals::write_rinex_nav_304(s.nav, nav);
+        s.input = s.dir / "sim" / "antenna0.r2.bin";
+        std::ifstream truth(s.dir / "sim" / "truth.csv");
+        std::string header, row;
+        std::getline(truth, header);
+        std::getline(truth, row);
+        const auto names = ultratrack::test::split_csv_line(header);
+        const auto values = ultratrack::test::split_csv_line(row);
+        s.truth_e_m = {std::stod(values.at(ultratrack::test::csv_column(names, "ecef_x_m"))),
+                       std::stod(values.at(ultratrack::test::csv_column(names, "ecef_y_m"))),
+                       std::stod(values.at(ultratrack::test::csv_column(names, "ecef_z_m")))};
+        return s;
+      }();
   return f;
 }
 
 std::vector<std::string> snapshot_args(const SnapshotFiles& f, const fs::path& out, const std::string& time) {
-  return {"--input", f.input.string(), "--format", "r2", "--fs", "8.184e6", "--if", "2.046e6", "--nav", f.nav.string(),
-          "--time", time, "--doppler-max", "6000", "--out", out.string()};
+  return {"--input", f.input.string(), "--format", "r2", "--fs",          "8.184e6", "--if",  "2.046e6",
+          "--nav",   f.nav.string(),   "--time",   time, "--doppler-max", "6000",    "--out", out.string()};
 }
 
 // A number after "key": in a JSON text (the first occurrence).
@@ -144,14 +147,14 @@ TEST(SnapshotCommand, NoiseOnlyFileIsAnInputError) {
   std::ofstream out(noise, std::ios::binary);
   for (int i = 0; i < 2 * 2600 * 40; ++i) out.put(static_cast<char>(static_cast<signed char>(g(rng))));
   out.close();
-  EXPECT_THROW(ultratrack::test_support::run_command("snapshot", {"--input", noise.string(), "--format", "i8", "--fs",
-                                                                  "2.6e6", "--nav", f.nav.string(), "--time",
-                                                                  "2190:540123", "--out", (f.dir / "noise").string()}),
+  EXPECT_THROW(ultratrack::test_support::run_command(
+                   "snapshot", {"--input", noise.string(), "--format", "i8", "--fs", "2.6e6", "--nav", f.nav.string(),
+                                "--time", "2190:540123", "--out", (f.dir / "noise").string()}),
                ultratrack::signals::InputError);
   // Bad --time text.
-  EXPECT_THROW(ultratrack::test_support::run_command("snapshot", {"--input", noise.string(), "--format", "i8", "--fs",
-                                                                  "2.6e6", "--nav", f.nav.string(), "--time", "540123",
-                                                                  "--out", (f.dir / "noise").string()}),
+  EXPECT_THROW(ultratrack::test_support::run_command(
+                   "snapshot", {"--input", noise.string(), "--format", "i8", "--fs", "2.6e6", "--nav", f.nav.string(),
+                                "--time", "540123", "--out", (f.dir / "noise").string()}),
                ultratrack::signals::InputError);
 }
 

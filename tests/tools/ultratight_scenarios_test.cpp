@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The ultra-tight test bed (issue 7): scenarios/ultratight_*.toml parse and their trajectories have the stated
 // dynamics, checked on truth.csv / imu.csv of an IMU-only `simulate` run (no [signal]; IMU errors off) against
 // closed forms: seed 001's straight (1 m/s^2), circle (500 km/h, pi/100 rad/s), S (turn reverses at 100 s) and
@@ -88,9 +89,9 @@ std::size_t row_at(const Csv& t, double t_s) {
 }
 
 TEST(UltratightScenarios, AllParseWithSignalImuAndTruthRate) {
-  for (const char* n : {"ultratight_straight.toml", "ultratight_circle.toml", "ultratight_s.toml",
-                        "ultratight_spiral.toml", "ultratight_10g_turn.toml", "ultratight_tunnel.toml",
-                        "ultratight_circle_100m_30kmh.toml"}) {
+  for (const char* n :
+       {"ultratight_straight.toml", "ultratight_circle.toml", "ultratight_s.toml", "ultratight_spiral.toml",
+        "ultratight_10g_turn.toml", "ultratight_tunnel.toml", "ultratight_circle_100m_30kmh.toml"}) {
     SCOPED_TRACE(n);
     const Scenario s = read_scenario(scenarios_dir() / n);
     EXPECT_TRUE(s.signal);
@@ -173,7 +174,8 @@ TEST(UltratightScenarios, TenGTurnHasTenGSpecificForceAndHundredMetresPerSecondC
   for (std::size_t k = 1; k < r.imu.rows.size(); ++k) {
     const double dt = r.imu.at(k, "t_s") - r.imu.at(k - 1, "t_s");
     const double f = std::sqrt(std::pow(r.imu.at(k, "dv_x_mps"), 2) + std::pow(r.imu.at(k, "dv_y_mps"), 2) +
-                               std::pow(r.imu.at(k, "dv_z_mps"), 2)) / dt;
+                               std::pow(r.imu.at(k, "dv_z_mps"), 2)) /
+                     dt;
     f_max = std::max(f_max, f);
   }
   EXPECT_NEAR(f_max, 10.0 * kG0, 0.01 * 10.0 * kG0);
@@ -186,7 +188,8 @@ TEST(UltratightScenarios, TenGTurnHasTenGSpecificForceAndHundredMetresPerSecondC
   for (std::size_t k = h; k + h < n; ++k) {
     const double dt = t.at(k + h, "t_s") - t.at(k - h, "t_s");
     a[k] = std::hypot(t.at(k + h, "vel_n_mps") - t.at(k - h, "vel_n_mps"),
-                      t.at(k + h, "vel_e_mps") - t.at(k - h, "vel_e_mps")) / dt;
+                      t.at(k + h, "vel_e_mps") - t.at(k - h, "vel_e_mps")) /
+           dt;
   }
   double a_max = 0.0, jerk_max = 0.0;
   for (std::size_t k = 2 * h; k + 2 * h < n; ++k) {
@@ -254,7 +257,8 @@ TEST(UltratightScenarios, CoordinatedTurnsAndRampAreSegmentFileKeys) {
   EXPECT_THROW(parse_scenario("[trajectory]\nprofile = \"circle\"\nduration_s = 10.0\nramp_s = 2.0\n", "x.toml"),
                signals::InputError);
   EXPECT_THROW(parse_scenario("[trajectory]\nfile = \"a.csv\"\nramp_s = -1.0\n", "x.toml"), signals::InputError);
-  EXPECT_THROW(parse_scenario("[trajectory]\nfile = \"a.csv\"\ncoordinated_turns = 1.0\n", "x.toml"), signals::InputError);
+  EXPECT_THROW(parse_scenario("[trajectory]\nfile = \"a.csv\"\ncoordinated_turns = 1.0\n", "x.toml"),
+               signals::InputError);
 }
 
 }  // namespace
