@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Loose GNSS/INS integration figures (docs/validation.md), not timing: `ultratrack fuse`'s engine in process
-// on simulated data. (1) Position RMS against the simulator's truth versus the GNSS-only RMS on the seed 001
+// on simulated data. (1) Position RMS against the simulator's truth versus the GNSS-only RMS on the [ChoUKF]
 // trajectories and the land profile, HG1700AE at 100 Hz, 1 Hz fixes (white 1.5/1.5/3 m, 0.05 m/s).
 // The 60 s outage Monte Carlo lives with the filter's tests (tests/fusion/integration_test.cpp,
 // ULTRATRACK_FUSION_MC_RUNS=100). Run by hand: `nice -n 5 build/benchmarks/bench_fuse_loose`.

@@ -17,7 +17,7 @@
 //                first-order Gauss-Markov with this time: their variance is inflated by 1 + 2 tau / dt; 0: white)
 //   [vehicle]    nhc = false (land vehicles: zero lateral and vertical body velocity, fusion/nhc_measurement.hpp),
 //                nhc_sigma_mps = 0.3, nhc_interval_s = 0.5, nhc_lever_arm_body_m = [x, y, z] (IMU -> rear axle)
-//   [odometer]   (fuse --odometer; seed 004, fusion/vms_measurement.hpp) mode = "gated"|"always" (gated: update only
+//   [odometer]   (fuse --odometer; [KimVMS], fusion/vms_measurement.hpp) mode = "gated"|"always" (gated: update only
 //                while |heading change| per second < yaw_rate_threshold_dps = 1.5 and the VMS speed > min_speed_mps
 //                = 5; always: every window), update_rate_hz = 1, rate_hz (the odometer file's declared rate; else
 //                its first interval), lever_arm_body_m = [x, y, z] (IMU -> wheels' non-holonomic point),

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Observability of the stationary alignment (seed 000 eqs. 18-20): the rank of O = [H; H A; ...; H A^11] of the
+// Observability of the stationary alignment ([KimAlign] eqs. 18-20): the rank of O = [H; H A; ...; H A^11] of the
 // 12-state model at rest (fusion/stationary_alignment_model.hpp) for a given attitude, and its weakest direction.
 // H_G's rows are scaled by cos(pitch) (roll and yaw rows), which changes no rank away from pitch +-90 deg and has
 // a limit there: at +-90 deg the roll and yaw rows coincide, the GPS attitude gives only two angles, and the rank

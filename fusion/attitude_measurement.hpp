@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// GPS attitude (multi-antenna receiver, seed 003; seed 000 eqs. 10-17) as a measurement of the INS
+// GPS attitude (multi-antenna receiver, [OhAttINS]; [KimAlign] eqs. 10-17) as a measurement of the INS
 // psi-angle attitude error. The receiver gives roll/pitch/yaw of its antenna-array frame a; the known
 // misalignment q_ba (array -> IMU body) turns it into a measured C_nb = C_na C_ab.
 //

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Covariance analysis of tightly coupled GPS/INS (seed 001 section IV.1): the 17-state INS error model
-// linearised along a simulated trajectory (seed 001 profiles: straight, circle, s, spiral), propagated by an
+// Covariance analysis of tightly coupled GPS/INS ([ChoUKF] section IV.1): the 17-state INS error model
+// linearised along a simulated trajectory ([ChoUKF] profiles: straight, circle, s, spiral), propagated by an
 // EKF or a UKF and updated once per second with the pseudoranges (optionally rates) of every satellite above
 // the mask, with the seed's noise settings (eq. 38). The nominal is the truth, so the innovations are zero and
 // only the covariance moves. Reports position 1-sigma (north, east, down) after each update.
-// Ultra-tight (seed 001 section IV.2, issue 7): the same filter updated every coherent integration T with the
+// Ultra-tight ([ChoUKF] section IV.2, issue 7): the same filter updated every coherent integration T with the
 // I&Q of every satellite (fusion/iq_measurements.hpp: 6 taps per satellite, normalised, amplitude from C/N0)
 // or with their discriminators as range and range-rate errors. The EKF is linearised at the truth; the UKF
 // draws its sigma points around the truth with its own covariance and pushes them through the nonlinear I&Q
@@ -28,7 +28,7 @@
 namespace ultratrack::fusion {
 
 enum class IqForm {
-  Iq,             // the correlator taps themselves (seed 001 eqs. 11-17)
+  Iq,             // the correlator taps themselves ([ChoUKF] eqs. 11-17)
   Discriminator,  // pre-filtered: code / frequency discriminators as range / range-rate errors
 };
 

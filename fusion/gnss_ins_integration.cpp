@@ -56,44 +56,49 @@ bool finite(const Pending& p) {
   return true;  // observation epochs: prepare_satellites skips non-finite pseudoranges
 }
 
-void check_options(const IntegrationOptions& o) {
+}  // namespace
+
+bool IntegrationOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& w) {
+    if (why) *why = w;
+    return false;
+  };
+  const IntegrationOptions& o = *this;
   if (o.coupling != Coupling::kLoose && o.coupling != Coupling::kTight)
-    throw std::invalid_argument("integration: the coupling must be loose or tight");
+    return fail("integration: the coupling must be loose or tight");
   auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
   if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
-    throw std::invalid_argument("integration: initial sigmas must be positive");
+    return fail("integration: initial sigmas must be positive");
   if ((o.sigma_initial_accel_bias_b && !positive(*o.sigma_initial_accel_bias_b)) ||
       (o.sigma_initial_gyro_bias_b && !positive(*o.sigma_initial_gyro_bias_b)) || !o.initial_accel_bias_b.allFinite() ||
       !o.initial_gyro_bias_b.allFinite())
-    throw std::invalid_argument("integration: initial biases must be finite, their sigmas positive");
-  if (!(o.propagation_interval_s >= 0.0)) throw std::invalid_argument("integration: negative propagation interval");
+    return fail("integration: initial biases must be finite, their sigmas positive");
+  if (!(o.propagation_interval_s >= 0.0)) return fail("integration: negative propagation interval");
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
-    throw std::invalid_argument("integration: gate probability must lie in (0, 1)");
+    return fail("integration: gate probability must lie in (0, 1)");
   if (!(o.fix_min_interval_s >= 0.0) || !std::isfinite(o.fix_min_interval_s) || !(o.fix_error_correlation_s >= 0.0) ||
       !std::isfinite(o.fix_error_correlation_s))
-    throw std::invalid_argument("integration: the fix interval and error correlation time must be >= 0");
-  if (std::string why; !o.recovery.IsValid(&why)) throw std::invalid_argument("integration: " + why);
-  if (std::string why; o.odometer.enabled && !o.odometer.IsValid(&why))
-    throw std::invalid_argument("integration: " + why);
+    return fail("integration: the fix interval and error correlation time must be >= 0");
+  if (std::string inner; !o.recovery.IsValid(&inner)) return fail("integration: " + inner);
+  if (std::string inner; o.odometer.enabled && !o.odometer.IsValid(&inner)) return fail("integration: " + inner);
   if (o.odometer.enabled && o.coupling != Coupling::kLoose)
-    throw std::invalid_argument("integration: odometer aiding is implemented for the loose coupling only");
+    return fail("integration: odometer aiding is implemented for the loose coupling only");
   if (o.land.nhc &&
       (!(o.land.nhc_sigma_mps > 0.0) || !(o.land.nhc_interval_s >= 0.0) || !o.land.lever_arm_b.allFinite()))
-    throw std::invalid_argument("integration: non-holonomic constraints need a positive sigma and interval >= 0");
+    return fail("integration: non-holonomic constraints need a positive sigma and interval >= 0");
   if (!o.attitude.q_ba.coeffs().allFinite() || std::abs(o.attitude.q_ba.norm() - 1.0) > 1e-6)
-    throw std::invalid_argument("integration: attitude mounting q_ba must be a unit quaternion");
+    return fail("integration: attitude mounting q_ba must be a unit quaternion");
   if (!(o.attitude.max_abs_pitch_rad > 0.0 && o.attitude.max_abs_pitch_rad <= 0.5 * std::numbers::pi))
-    throw std::invalid_argument("integration: attitude pitch limit must lie in (0, 90] deg");
+    return fail("integration: attitude pitch limit must lie in (0, 90] deg");
   const HeightAidingOptions& h = o.height_aiding;
   if (!(h.sigma0_m > 0.0) || !std::isfinite(h.sigma0_m) || !(h.terrain_sigma_m > 0.0) ||
       !std::isfinite(h.terrain_sigma_m) || !(h.terrain_correlation_s > 0.0) ||
       !std::isfinite(h.terrain_correlation_s) || !(h.min_interval_s >= 0.0) ||
       (h.fixed_height_m && !std::isfinite(*h.fixed_height_m)))
-    throw std::invalid_argument(
+    return fail(
         "integration: height aiding needs positive sigmas and correlation time, interval >= 0, a finite height");
+  return true;
 }
-
-}  // namespace
 
 struct CoreBase {
   virtual ~CoreBase() = default;
@@ -445,7 +450,7 @@ class Core final : public CoreBase {
     while (history_.size() > 2 && history_[1].t_s < nominal_.nav.t_s - keep_s) history_.pop_front();
   }
 
-  // One odometer window (seed 004 eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
+  // One odometer window ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
   void apply_odometer(const OdometerSpeed& speed) {
     if constexpr (N == 19) {
       const double t0 = nominal_.nav.t_s - speed.window_s;
@@ -523,7 +528,7 @@ struct GnssInsIntegration::Impl {
 
 GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const IntegrationOptions& options)
     : impl_(std::make_unique<Impl>()) {
-  check_options(options);
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument(why);
   impl_->options = options;
   if (options.coupling == Coupling::kLoose && options.odometer.enabled)
     impl_->core = make_core<19>(initial, options);

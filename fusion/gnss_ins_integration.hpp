@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Closed-loop GNSS/INS integration driver (seed 003 feedback filter; seed 001 17-state tight model).
+// Closed-loop GNSS/INS integration driver ([OhAttINS] feedback filter; [ChoUKF] 17-state tight model).
 // Feed IMU increments and GNSS data in time order at any rates and times: the INS (ins::Strapdown, raw IMU
 // samples compensated by the estimated biases) runs through every IMU interval; a GNSS measurement at time t
 // inside an interval splits that interval at t (increments shared in proportion to time), so it is applied at
@@ -7,20 +7,21 @@
 // (position, velocity, attitude via ins/nav_correction; biases into the IMU compensation; clock) and the error
 // state reset to zero. Fallback: whatever part of an epoch is present is used (position without velocity,
 // pseudoranges without Doppler, fewer than four satellites in tight mode); nothing present = pure INS.
-// GPS attitude (multi-antenna receiver, seed 003) is a third measurement type in either coupling, applied at
+// GPS attitude (multi-antenna receiver, [OhAttINS]) is a third measurement type in either coupling, applied at
 // its own time: epochs with attitude, position/velocity, or both; without attitude the update falls back to
 // position/velocity only (counted: fixes_without_attitude). At equal times attitude goes first.
 // A filter locked out by its own gate re-opens (fusion/lockout_recovery.hpp): a rejected fix can never make every
 // later fix rejected.
 // Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides; with height aiding 18 (+ the
-// terrain height). Loose with odometer aiding: 19 (+ VMS delay, misalignment, scale factor; seed 004), odometer
+// terrain height). Loose with odometer aiding: 19 (+ VMS delay, misalignment, scale factor; [KimVMS]), odometer
 // speeds through add_odometer, gated by fusion/vms_measurement.hpp's rule. EKF or UKF.
 #pragma once
 
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "fusion/attitude_measurement.hpp"
@@ -74,7 +75,7 @@ struct IntegrationOptions {
   double fix_error_correlation_s = 0.0;
   // Land vehicles: non-holonomic constraints (fusion/nhc_measurement.hpp), off by default.
   LandVehicleOptions land;
-  // Land vehicles: odometer (VMS) aiding, seed 004 (loose coupling only; off by default).
+  // Land vehicles: odometer (VMS) aiding, [KimVMS] (loose coupling only; off by default).
   OdometerAidingOptions odometer;
   UkfParameters ukf;
   Discretisation discretisation = Discretisation::SecondOrderSeries;
@@ -93,6 +94,9 @@ struct IntegrationOptions {
   // Tight mode: initial receiver clock (c * offset, c * drift) for the nominal.
   double initial_clock_bias_m = 0.0;
   double initial_clock_drift_mps = 0.0;
+
+  // Every field in range (sigmas positive, probabilities in (0, 1), ...); why says the first that is not.
+  bool IsValid(std::string* why) const;
 };
 
 // The solution after each IMU interval (and after each measurement update).
@@ -126,7 +130,7 @@ struct IntegrationCounters {
   long long attitude_rejected = 0;  // refused by the innovation gate
   long long attitude_unusable = 0;  // refused before the gate: near vertical (Euler sigmas degenerate)
   long long attitude_late = 0;      // older than the INS time when it came (dropped)
-  // Fallback (seed 003): fixes / observation epochs with no accepted attitude since the previous one.
+  // Fallback ([OhAttINS]): fixes / observation epochs with no accepted attitude since the previous one.
   long long fixes_without_attitude = 0;
   // Tight mode: epochs with fewer than height_aiding.min_satellites usable satellites, and the height
   // pseudo-measurements applied there (accepted / refused by the gate; none before a height is known).

@@ -2,7 +2,7 @@
 // Continuous-time INS error dynamics in NED for the error state of ins_error_state.hpp (15 or 17 states),
 // linearised about the current nominal: position, velocity and psi-angle attitude errors driven by the
 // residual IMU biases and white sensor noise, including the position/velocity dependence of earth rate,
-// transport rate and gravity (exact first order for the error definitions; at rest it reduces to seed 000
+// transport rate and gravity (exact first order for the error definitions; at rest it reduces to [KimAlign]
 // eqs. 5-9: T = [C_nb 0; 0 -C_nb]). Biases: random constant or first-order Gauss-Markov. Clock (17 states):
 // bias' = drift + w_b, drift' = w_d. Units: m, m/s, rad, m/s^2, rad/s; PSDs in units^2/Hz.
 // Satisfies the ProcessModel concept (filter_types.hpp): f(x, dt) = Phi(dt) x with the model's own

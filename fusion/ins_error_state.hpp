@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The INS error state in NED (psi-angle form, seed 000 eqs. 2-9 extended with position as in seed 001 eq. 10):
+// The INS error state in NED (psi-angle form, [KimAlign] eqs. 2-9 extended with position as in [ChoUKF] eq. 10):
 //   [0,3)  dr_n  position error, NED metres          [3,6)  dv_n  velocity error, NED m/s
 //   [6,9)  psi   attitude error, rad (ins/nav_state.hpp convention: C_nb_est = (I - [psi x]) C_nb_true)
 //   [9,12) ba    residual accelerometer bias, body, m/s^2   [12,15) bg residual gyro bias, body, rad/s

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Ultra-tight measurements (seed 001 eqs. 5-8, 11-17): the early/prompt/late in-phase and quadrature correlator
+// Ultra-tight measurements ([ChoUKF] eqs. 5-8, 11-17): the early/prompt/late in-phase and quadrature correlator
 // outputs of one channel as functions of the 17-state error, and the "pre-filtered" alternative (code and
 // frequency discriminators turned into range and range-rate errors), both with closed-form noise from C/N0.
-// Units: correlator outputs normalised so that the noise of each I or Q is N(0, 1) (seed 001 eq. 16); the
+// Units: correlator outputs normalised so that the noise of each I or Q is N(0, 1) ([ChoUKF] eq. 16); the
 // signal amplitude is then A = sqrt(2 C/N0 T) (C/N0 in Hz, T the coherent integration in s). Code errors in
 // chips, frequency errors in Hz, range errors in m, range-rate errors in m/s. Navigation data bits known or
 // wiped off (no sign ambiguity); the carrier NCO phase is realigned at the start of every integration, so the
@@ -79,7 +79,7 @@ Eigen::Vector2d period_replica_errors(double replica_range_start_m, double repli
 // E[I], E[Q] of the early/prompt/late taps: with x = pi df T and phi the start phase,
 // I_k = A R(tau - o_k) sinc(x) cos(phi + x), Q_k = A R(tau - o_k) sinc(x) sin(phi + x), o = (+d, 0, -d) for E, P, L
 // (the early replica runs d chips ahead, so a leading signal, tau > 0, raises the early tap)
-// (seed 001 eq. 7 with the phase error zero at the interval's start; its I and Q are swapped by its sin/cos
+// ([ChoUKF] eq. 7 with the phase error zero at the interval's start; its I and Q are swapped by its sin/cos
 // replica convention).
 IqTaps expected_iq(const TrackingErrors& e, const IqSettings& s);
 // Jacobian of (I_E, I_P, I_L, Q_E, Q_P, Q_L) with respect to (code chips, frequency Hz), and to the start phase.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The antenna array's mounting on the IMU (seed 000 Table 3): the rotation q_ba (array -> IMU body) from the mean
+// The antenna array's mounting on the IMU ([KimAlign] Table 3): the rotation q_ba (array -> IMU body) from the mean
 // of the GPS array attitudes over a span and an attitude of the body from elsewhere (a reference INS, or the IMU's
 // own levelling and gyrocompassing), q_ba = q_nb_ref^-1 * mean(q_na). Its 1-sigma: the reference's NED psi-angle
 // covariance plus that of the mean GPS attitude (each attitude's Euler sigmas through euler_rate_to_rotation_n,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Non-holonomic constraints of a land vehicle (seed 004 eqs. 11-15 without the odometer row): a wheeled vehicle
+// Non-holonomic constraints of a land vehicle ([KimVMS] eqs. 11-15 without the odometer row): a wheeled vehicle
 // neither slides sideways nor leaves the road, so at its non-holonomic point (the rear axle's centre, at
 // lever_arm_b from the IMU in body axes) the body-frame velocity has zero lateral (y) and vertical (z)
 // components. As a pseudo-measurement it makes heading observable at any speed without horizontal acceleration

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The 19-state land-navigation error model of seed 004 (sec. 2-1): the 15 INS error states of
+// The 19-state land-navigation error model of [KimVMS] (sec. 2-1): the 15 INS error states of
 // fusion/ins_error_state.hpp plus four odometer (VMS) states, each estimate minus truth:
 //   [15] VMS time delay error, s         [16] mounting misalignment pitch error, rad (about the vehicle's y)
 //   [17] mounting misalignment yaw error, rad (about z)          [18] VMS scale-factor error, ratio
@@ -26,7 +26,7 @@ inline constexpr int kOdoScale = 18;
 }  // namespace ix
 
 enum class OdometerMode {
-  kGated,   // seed 004: update only while the heading change rate and the VMS speed pass their thresholds
+  kGated,   // [KimVMS]: update only while the heading change rate and the VMS speed pass their thresholds
   kAlways,  // every update interval, turns and stops included (the always-on non-holonomic constraint)
 };
 

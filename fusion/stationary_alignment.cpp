@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
+#include <string>
 
 #include "fusion/ekf.hpp"
 #include "ins/attitude.hpp"
@@ -95,11 +97,33 @@ StationaryAlignmentResult run(Filter& filter, std::span<const ins::ImuIncrement>
 
 }  // namespace
 
+bool StationaryAlignmentOptions::IsValid(std::string* why) const {
+  auto fail = [&](const char* w) {
+    if (why) *why = w;
+    return false;
+  };
+  if (!(filter_interval_s > 0.0) || !std::isfinite(filter_interval_s))
+    return fail("alignment: the filter interval must be positive");
+  if (!(duration_s >= 0.0) || !std::isfinite(duration_s)) return fail("alignment: the duration must be >= 0");
+  if (!std::isfinite(lat_rad) || !std::isfinite(lon_rad) || !std::isfinite(height_m))
+    return fail("alignment: the position must be finite");
+  if (!(zero_velocity_sigma_mps >= 0.0) || !(initial_velocity_sigma_mps > 0.0) ||
+      !std::isfinite(zero_velocity_sigma_mps) || !std::isfinite(initial_velocity_sigma_mps))
+    return fail("alignment: the velocity sigmas must be finite, the initial one positive");
+  if (!q_ba.coeffs().allFinite() || std::abs(q_ba.norm() - 1.0) > 1e-6)
+    return fail("alignment: the mounting q_ba must be a unit quaternion");
+  if (!(max_abs_pitch_rad > 0.0 && max_abs_pitch_rad <= 0.5 * std::numbers::pi))
+    return fail("alignment: the pitch limit must lie in (0, 90] deg");
+  if (!(gate.probability > 0.0 && gate.probability < 1.0))
+    return fail("alignment: the gate probability must lie in (0, 1)");
+  return true;
+}
+
 StationaryAlignmentResult align_stationary(std::span<const ins::ImuIncrement> imu,
                                            std::span<const GnssAttitude> attitudes,
                                            const StationaryAlignmentOptions& o) {
   if (imu.size() < 2) throw std::invalid_argument("fewer than 2 IMU rows");
-  if (!(o.filter_interval_s > 0.0)) throw std::invalid_argument("filter interval must be positive");
+  if (std::string why; !o.IsValid(&why)) throw std::invalid_argument(why);
   AttitudeAidingOptions usable;
   usable.max_abs_pitch_rad = o.max_abs_pitch_rad;
   const double imu_start = imu[0].t_s - (imu[1].t_s - imu[0].t_s);

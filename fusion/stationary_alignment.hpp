@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Fine alignment of a strapdown INS at rest from zero velocity and a multi-antenna receiver's GPS attitude
-// (seed 000, Fig. 1): the INS runs at the IMU rate from the first usable GPS attitude; every filter interval the
+// ([KimAlign], Fig. 1): the INS runs at the IMU rate from the first usable GPS attitude; every filter interval the
 // 12-state filter (fusion/stationary_alignment_model.hpp, EKF or UKF) predicts, takes the zero-velocity
 // measurement and the latest GPS attitude of the interval, and its estimate is fed back into the INS (attitude,
 // velocity, bias estimates) and reset: a closed loop, as the seed's strapdown computation corrected by the filter.
@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <numbers>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "fusion/attitude_measurement.hpp"
@@ -27,7 +28,7 @@ struct StationaryAlignmentOptions {
   FilterKind filter = FilterKind::Ekf;
   UkfParameters ukf;
   GateOptions gate;
-  double filter_interval_s = 1.0;  // seed 000: 1 s
+  double filter_interval_s = 1.0;  // [KimAlign]: 1 s
   double duration_s = 0.0;         // from the first GPS attitude; 0: to the end of the IMU data
   double lat_rad = 0.0, lon_rad = 0.0, height_m = 0.0;
   ins::ImuErrorSpec imu;                 // noise PSDs and initial bias 1-sigmas (floors 1e-5 m/s^2, 1e-8 rad/s)
@@ -35,6 +36,9 @@ struct StationaryAlignmentOptions {
   double initial_velocity_sigma_mps = 0.01;
   Eigen::Quaterniond q_ba = Eigen::Quaterniond::Identity();    // antenna array -> IMU body (known mounting)
   double max_abs_pitch_rad = 80.0 * std::numbers::pi / 180.0;  // GPS attitudes beyond are not used
+
+  // Interval positive, sigmas and position finite, q_ba a unit quaternion, pitch limit in (0, 90] deg.
+  bool IsValid(std::string* why) const;
 };
 
 // The state after one filter epoch (after feedback).

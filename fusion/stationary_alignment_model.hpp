@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The 12-state stationary alignment filter of seed 000 (eqs. 2-17): the error model of a strapdown INS at rest
+// The 12-state stationary alignment filter of [KimAlign] (eqs. 2-17): the error model of a strapdown INS at rest
 // and its two measurements, zero velocity and the GPS Euler attitude through H_G.
 //   [0,3)  dv_n  velocity error, NED m/s             [3,6)  psi  attitude error, NED rad (psi-angle, the
 //          convention of ins/nav_state.hpp: C_nb_est = (I - [psi x]) C_nb_true)
 //   [6,9)  ba    residual accelerometer bias, body m/s^2      [9,12) bg  residual gyro bias, body rad/s
-// Position is not a state (the alignment runs on a surveyed point, seed 000 section III.1). Errors are estimate
+// Position is not a state (the alignment runs on a surveyed point, [KimAlign] section III.1). Errors are estimate
 // minus truth; a residual bias is what remains in the compensated IMU output (fusion/ins_error_state.hpp).
 // The model is linear and time invariant while the vehicle is at rest: A = [F T; 0 0] with F = [F11 F12; 0 F22]
 // (eqs. 5-8, Omega = earth rate in NED, g = gravity) and T = diag(C_nb, -C_nb) (eq. 9). Noise: accelerometer and

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Unscented Kalman filter on a fixed-size state with scaled sigma points (seed 001 eqs. 18-37):
+// Unscented Kalman filter on a fixed-size state with scaled sigma points ([ChoUKF] eqs. 18-37):
 // lambda = alpha^2 (n + kappa) - n, sigma points x +- columns of the Cholesky factor of (n + lambda) P,
-// weights Wm0 = lambda / (n + lambda), Wc0 = Wm0 + 1 - alpha^2 + beta, Wi = 1 / (2 (n + lambda)) (seed 001
+// weights Wm0 = lambda / (n + lambda), Wc0 = Wm0 + 1 - alpha^2 + beta, Wi = 1 / (2 (n + lambda)) ([ChoUKF]
 // eq. 23 prints lambda in the numerator of Wi: a typo, the weights would not sum to one). Process noise is
 // additive: Qd from the model's F, G, Qc at the prior mean (discretisation.hpp), the same as the EKF's.
 // Covariances are symmetrised after every step and repaired to the nearest PSD matrix if the Cholesky
@@ -25,7 +25,7 @@
 namespace ultratrack::fusion {
 
 struct UkfParameters {
-  double alpha = 1.0;  // spread of the sigma points (seed 001: 1e-4 <= alpha <= 1)
+  double alpha = 1.0;  // spread of the sigma points ([ChoUKF]: 1e-4 <= alpha <= 1)
   double beta = 2.0;   // prior knowledge of the distribution (2 optimal for Gaussian)
   double kappa = 0.0;  // secondary scaling
 };

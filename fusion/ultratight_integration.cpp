@@ -18,19 +18,25 @@ namespace {
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kLambda_m = signals::kL1Wavelength_m;
 
-void check_options(const UltraTightOptions& o) {
+}  // namespace
+
+bool UltraTightOptions::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& w) {
+    if (why) *why = w;
+    return false;
+  };
+  const UltraTightOptions& o = *this;
   auto positive = [](const Eigen::Vector3d& v) { return (v.array() > 0.0).all() && v.allFinite(); };
   if (!positive(o.sigma_pos_ned_m) || !positive(o.sigma_vel_n_mps) || !positive(o.sigma_att_rad))
-    throw std::invalid_argument("ultra-tight: initial sigmas must be positive");
+    return fail("ultra-tight: initial sigmas must be positive");
   if (!(o.tap_offset_chips > 0.0 && o.tap_offset_chips <= 0.5))
-    throw std::invalid_argument("ultra-tight: tap offset must lie in (0, 0.5] chip");
+    return fail("ultra-tight: tap offset must lie in (0, 0.5] chip");
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
-    throw std::invalid_argument("ultra-tight: gate probability must lie in (0, 1)");
-  if (!std::isfinite(o.coast_cn0_dbhz)) throw std::invalid_argument("ultra-tight: coasting threshold not finite");
-  if (std::isnan(o.measurement_mask_rad)) throw std::invalid_argument("ultra-tight: measurement mask is NaN");
+    return fail("ultra-tight: gate probability must lie in (0, 1)");
+  if (!std::isfinite(o.coast_cn0_dbhz)) return fail("ultra-tight: coasting threshold not finite");
+  if (std::isnan(o.measurement_mask_rad)) return fail("ultra-tight: measurement mask is NaN");
+  return true;
 }
-
-}  // namespace
 
 struct UltraTightCoreBase {
   virtual ~UltraTightCoreBase() = default;
@@ -437,7 +443,7 @@ struct UltraTightIntegration::Impl {
 UltraTightIntegration::UltraTightIntegration(const ins::NavState& initial, std::vector<signals::Ephemeris> eph,
                                              const UltraTightOptions& options)
     : impl_(std::make_unique<Impl>()) {
-  check_options(options);
+  if (std::string why; !options.IsValid(&why)) throw std::invalid_argument(why);
   impl_->options = options;
   InsErrorModelOptions mo = options.model;
   mo.discretisation = options.discretisation;

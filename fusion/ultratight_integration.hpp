@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Closed-loop ultra-tight GPS/INS driver (seed 001): the INS (ins::Strapdown on bias-compensated IMU samples) and
+// Closed-loop ultra-tight GPS/INS driver ([ChoUKF]): the INS (ins::Strapdown on bias-compensated IMU samples) and
 // the 17-state error filter (EKF or UKF) predict every satellite's replica for each integration period T
 // (code phase/rate, carrier frequency, running carrier phase: the "INS-predicted replica", as NcoCommands), then
 // update from the E/P/L correlations measured over that period, either the seed's I&Q model directly (eqs.
@@ -20,6 +20,7 @@
 #include <Eigen/Core>
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "fusion/gnss_ins_integration.hpp"
@@ -62,6 +63,9 @@ struct UltraTightOptions {
   // states are errors of these.
   Eigen::Vector3d initial_accel_bias_b = Eigen::Vector3d::Zero();
   Eigen::Vector3d initial_gyro_bias_b = Eigen::Vector3d::Zero();
+
+  // Sigmas positive, tap offset in (0, 0.5] chip, gate probability in (0, 1), thresholds not NaN; why says which.
+  bool IsValid(std::string* why) const;
 };
 
 // The replica of one satellite for the period starting at t_start_s, held constant-rate over the period.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The odometer (VMS) measurement with non-holonomic constraints of seed 004 (eqs. 11-15) on the 19-state model
+// The odometer (VMS) measurement with non-holonomic constraints of [KimVMS] (eqs. 11-15) on the 19-state model
 // (fusion/odometer_error_model.hpp), and its gating rule (eqs. 16-17).
 // Measurement, in the vehicle frame v (x forward, y right, z down; C_bv = ins::C_bv_from_misalignment):
 //   z = [s, 0, 0]   s: VMS speed = distance counted over the last window / window length

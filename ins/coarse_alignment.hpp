@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Coarse (analytic) self-alignment from stationary IMU data (seed 002 eq. 17, in its levelling +
+// Coarse (analytic) self-alignment from stationary IMU data ([ParkSDINS] eq. 17, in its levelling +
 // gyrocompassing form): roll and pitch from the mean specific force, heading from the mean body rate
 // resolved in the levelled frame. Also the closed-form alignment errors caused by sensor biases.
 // Angles in rad; biases in body axes (rad/s, m/s^2); errors as NED psi-angles (see attitude_error_n).

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer (vehicle motion sensor, VMS) simulation from truth: wheel pulses counted over each output interval
-// with every error seed 004's filter models: a scale-factor error (eq. 1: measured distance = (1 + sf) true
+// with every error [KimVMS]'s filter models: a scale-factor error (eq. 1: measured distance = (1 + sf) true
 // distance), a time delay (the pulses of time t are those the wheel made at t - delay), pulse quantisation, and
 // wheel slip / skid events (pulses scaled by 1 + ratio inside an event: -1 a locked wheel, > 0 a spinning one).
 // The mounting misalignment (eqs. 2-10) is a rotation between the IMU body and the vehicle frame (x forward

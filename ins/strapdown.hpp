@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Strapdown mechanisation in the local-level NED frame on WGS-84 (seed 002 eqs. 3-8, quaternion attitude
+// Strapdown mechanisation in the local-level NED frame on WGS-84 ([ParkSDINS] eqs. 3-8, quaternion attitude
 // eq. 15 in its incremental form): attitude from delta-theta with two-sample coning correction, velocity
 // from delta-v with rotation and sculling corrections, Coriolis/transport and gravity at mid-interval,
 // position (lat, lon, h) by trapezoidal integration; optional height aiding of the vertical channel.

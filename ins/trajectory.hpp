@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Trajectory description: a start state and a list of segments (duration, along-track acceleration,
 // turn rate, climb rate, road grade). Commands change smoothly (quintic blend over ramp_s) at segment
-// starts, so body rates and specific force are continuous. Named profiles of seed 001 plus a land vehicle.
+// starts, so body rates and specific force are continuous. Named profiles of [ChoUKF] plus a land vehicle.
 // Units: SI (rad, m, s); headings from north towards east.
 #pragma once
 

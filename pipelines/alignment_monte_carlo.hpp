@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Filter-level Monte Carlo of the stationary alignment (seed 000 section IV.1, Table 2): per run, an IMU at rest
+// Filter-level Monte Carlo of the stationary alignment ([KimAlign] section IV.1, Table 2): per run, an IMU at rest
 // (closed-form earth rate and gravity increments at the IMU rate, corrupted by errors drawn from the IMU spec) and
 // GPS attitudes (the array's truth attitude plus white Euler noise at the attitude rate), aligned by
 // fusion::align_stationary; statistics of the final errors over the runs beside the filter's own 1-sigma.

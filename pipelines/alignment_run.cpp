@@ -92,7 +92,7 @@ AlignRunResult run_alignment(const std::vector<ins::ImuIncrement>& imu, const st
     r.warnings.push_back(fmt::format("the data covered {:.1f} s of alignment, less than the {:.1f} s asked for",
                                      a.end_s - a.start_s, s.duration_s));
 
-  // Observability at the final attitude (seed 000 theorem 1: full rank unless pitch = 90 deg).
+  // Observability at the final attitude ([KimAlign] theorem 1: full rank unless pitch = 90 deg).
   const ins::EulerAngles e = ins::euler_from_quaternion(a.nav.q_nb);
   const double g = ins::gravity_n(o.lat_rad, o.height_m).z();
   r.observability = fusion::alignment_observability(e, fusion::alignment_model_options(o.imu, o.lat_rad, g));

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The work of `ultratrack align`, callable in process: an IMU at rest and a multi-antenna receiver's attitude.csv
-// through seed 000's stationary alignment (fusion/stationary_alignment.hpp), with the observability of the final
+// through [KimAlign]'s stationary alignment (fusion/stationary_alignment.hpp), with the observability of the final
 // attitude (fusion/alignment_observability.hpp, a warning near pitch 90 deg), the array's mounting on the IMU
 // (fusion/mounting_misalignment.hpp: mean GPS attitude against the IMU's own levelling and gyrocompassing over the
 // same span, or against a given reference attitude), and the files: alignment.json (the result) and alignment.csv (one
@@ -31,7 +31,7 @@ struct AlignSettings {
   double filter_interval_s = 1.0;
   std::string imu_file = "IMU file", attitude_file = "attitude file";  // for messages
   std::string time_note;  // how the IMU was put on GPS time (PPS), for the json
-  // The body's attitude from a reference (an INS aligned to the vehicle, as seed 000's MAPS) and its 1-sigma (roll,
+  // The body's attitude from a reference (an INS aligned to the vehicle, as [KimAlign]'s MAPS) and its 1-sigma (roll,
   // pitch, yaw): the mounting is then measured against it instead of the IMU's own levelling and gyrocompassing.
   std::optional<ins::EulerAngles> reference_attitude;
   Eigen::Vector3d reference_sigma_rad = Eigen::Vector3d::Zero();

@@ -4,11 +4,11 @@
 // gyrocompassing over the first seconds; motion: heading from the GNSS track, tilt from the accelerometers;
 // config: the configuration's attitude), with optional GNSS outages, and the statistics the summary reports
 // (update counts, convergence, RMS against a truth trajectory and of the GNSS fixes themselves).
-// Optional GPS attitude (seed 003, a multi-antenna receiver's attitude.csv): fixed rows are attitude updates at
+// Optional GPS attitude ([OhAttINS], a multi-antenna receiver's attitude.csv): fixed rows are attitude updates at
 // their own times (GPS time -> IMU time by [attitude] gps_time_at_imu_zero), unfixed rows are skipped and the
 // filter falls back to position/velocity; `attitude` alignment takes the first fixed attitude (a MEMS IMU cannot
-// gyrocompass, seed 000). Attitudes inside --outage spans are dropped with the fixes.
-// Optional odometer (seed 004, fusion/vms_measurement.hpp): the odometer rows summed into windows of
+// gyrocompass, [KimAlign]). Attitudes inside --outage spans are dropped with the fixes.
+// Optional odometer ([KimVMS], fusion/vms_measurement.hpp): the odometer rows summed into windows of
 // 1 / [odometer] update_rate_hz, each a VMS/NHC update at its end, gated by heading rate and speed; with
 // gnss_until_s the fixes after that time are dropped (GNSS for the alignment and until then, odometer only after);
 // without fixes the start is the configuration's (--align config with [initial] position_deg_m).
@@ -56,7 +56,7 @@ struct FuseSettings {
   std::optional<double> gnss_until_s;  // fixes after this time are dropped
 };
 
-// Odometer aiding's account (seed 004's metric: error / distance travelled since GNSS was last used, in %).
+// Odometer aiding's account ([KimVMS]'s metric: error / distance travelled since GNSS was last used, in %).
 struct OdometerUse {
   long long windows = 0;              // odometer windows handed to the filter
   fusion::OdometerEstimate estimate;  // at the end

@@ -13,7 +13,7 @@ namespace ultratrack::pipelines {
 std::string recovery_events_json(const std::vector<fusion::RecoveryEvent>& events);
 
 // The "odometer" object: settings, update counts by rule, the odometer estimates with their 1-sigma and, against
-// truth, seed 004's errors as % of the distance travelled since GNSS was last used (DT; null without truth).
+// truth, [KimVMS]'s errors as % of the distance travelled since GNSS was last used (DT; null without truth).
 // file names the odometer data. `fuse` and `receive` (pipelines/gnss_ins_coupler.hpp) write it.
 std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounters& counters,
                           const fusion::OdometerAidingOptions& options, const std::string& file);

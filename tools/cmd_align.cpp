@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `ultratrack align`: the stationary fine alignment of seed 000 from an IMU CSV and a multi-antenna receiver's
+// `ultratrack align`: the stationary fine alignment of [KimAlign] from an IMU CSV and a multi-antenna receiver's
 // attitude.csv (pipelines/alignment_run.hpp): writes DIR/alignment.json (attitude, 1-sigma, biases, the array's
 // mounting estimate, observability rank, warnings) and DIR/alignment.csv (one row per filter epoch). --imu-pps maps
-// IMU stamps of a free-running local clock to GPS time through a PPS record (seed 003, pipelines/pps_time_sync.hpp).
+// IMU stamps of a free-running local clock to GPS time through a PPS record ([OhAttINS], pipelines/pps_time_sync.hpp).
 // The result starts `fuse` (and `receive --imu`) with --align file:DIR/alignment.json.
 #include <fmt/core.h>
 
@@ -108,7 +108,7 @@ void run_align_command(const AlignCommandOptions& o) {
 
 void add_align_command(CLI::App& app) {
   auto o = std::make_shared<AlignCommandOptions>();
-  auto* cmd = app.add_subcommand("align", "Stationary fine alignment from an IMU and GPS attitude (seed 000)");
+  auto* cmd = app.add_subcommand("align", "Stationary fine alignment from an IMU and GPS attitude ([KimAlign])");
   cmd->add_option("--imu", o->imu_file, "IMU CSV of the vehicle at rest")->required()->check(CLI::ExistingFile);
   cmd->add_option("--attitude", o->attitude_file, "attitude.csv of `ultratrack attitude` (fixed rows used)")
       ->required()

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `ultratrack covariance`: the seed 001 covariance analysis of tightly or ultra-tightly coupled GPS/INS (17
+// `ultratrack covariance`: the [ChoUKF] covariance analysis of tightly or ultra-tightly coupled GPS/INS (17
 // states, eq. 38 noise; ultra-tight: I&Q taps or their discriminators every coherent integration, noise from
 // C/N0) on a named trajectory with an EKF or a UKF; prints position 1-sigma (north, east, down) at 30 s and
 // 150 s (or the given times) and optionally writes the whole history as CSV.

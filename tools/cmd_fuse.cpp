@@ -2,9 +2,9 @@
 // `ultratrack fuse`: loosely coupled GNSS/INS from an IMU CSV and a GNSS fix CSV (EKF or UKF, closed loop),
 // after a static, in-motion or configured alignment. Writes DIR/nav.csv (nav columns + 1-sigma) and
 // DIR/summary.json (update counts, convergence, RMS against --truth); progress and a summary on stdout.
-// --attitude adds a multi-antenna receiver's GPS attitude (attitude.csv) as a measurement (seed 003);
-// --odometer an odometer's pulses (odometer.csv) as VMS/non-holonomic updates (seed 004), with or without --gnss.
-// --imu-pps puts IMU stamps of a free-running local clock on GPS time through a PPS record (seed 003,
+// --attitude adds a multi-antenna receiver's GPS attitude (attitude.csv) as a measurement ([OhAttINS]);
+// --odometer an odometer's pulses (odometer.csv) as VMS/non-holonomic updates ([KimVMS]), with or without --gnss.
+// --imu-pps puts IMU stamps of a free-running local clock on GPS time through a PPS record ([OhAttINS],
 // pipelines/pps_time_sync.hpp) before anything uses them: t_s = GPS time - the --attitude-origin (or the first edge).
 #include <fmt/core.h>
 

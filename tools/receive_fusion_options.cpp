@@ -42,7 +42,7 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
                   "PPS CSV (local_s,gps_week,gps_tow_s): IMU stamps are a free-running local clock, mapped to GPS "
                   "time through the PPS record (instead of --imu-time-origin)");
   cmd->add_option("--ut-measurement", a.ut_measurement,
-                  "with --coupling ultra-tight: iq (default: the E/P/L I&Q, seed 001 eqs. 11-17) or discriminator");
+                  "with --coupling ultra-tight: iq (default: the E/P/L I&Q, [ChoUKF] eqs. 11-17) or discriminator");
   cmd->add_flag("--ut-serial", a.ut_serial,
                 "with --coupling ultra-tight: run the loop between blocks, its commands at once (by default it runs "
                 "beside the correlation of the next block, its commands reaching the channels one 20 ms loop "

@@ -4,6 +4,7 @@
 #   tools/run.sh demo   install missing Debian packages, build (Release, 2 jobs), run `ultratrack demo`
 #   tools/run.sh test   the same build, then the whole test suite through ctest
 #   tools/run.sh build  only the build
+#   tools/run.sh lint   the same build, then tools/lint.sh on the whole tree (clang-format, SPDX lines, clang-tidy)
 # Idempotent: a second run installs nothing and rebuilds only what changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -13,6 +14,8 @@ packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-
 # The test suite also runs RTKLIB (convbin, rnx2rtkp) on our RINEX output as an independent reader.
 # python3: ctest docs.file_map checks docs/architecture.md's module tables against the code; pybind11-dev,
 # python3-dev, python3-numpy and python3-matplotlib: the Python package (python/) and its tests (python.module).
+# clang-format and clang-tidy: the conventions (tools/lint.sh; ctest lint.*).
+[[ "${1:-build}" == test || "${1:-build}" == lint ]] && packages+=(clang-format clang-tidy)
 [[ "${1:-build}" == test ]] && packages+=(rtklib python3 pybind11-dev python3-dev python3-numpy python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do
@@ -34,6 +37,7 @@ cmake --build "$build_dir" -j"$jobs"
 case "${1:-build}" in
   demo) shift; exec "$build_dir/tools/ultratrack" demo "$@" ;;
   test) exec ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" ;;
+  lint) exec tools/lint.sh --build "$build_dir" --jobs "$jobs" ;;
   build) ;;
-  *) echo "usage: tools/run.sh demo|test|build" >&2; exit 2 ;;
+  *) echo "usage: tools/run.sh demo|test|build|lint" >&2; exit 2 ;;
 esac

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// GPS attitude aiding (seed 003; seed 000 eqs. 10-17): the measurement model against numerical
-// differentiation and seed 000's published H_G, the innovation across yaw +-180 deg, and closed-loop runs on the
+// GPS attitude aiding ([OhAttINS]; [KimAlign] eqs. 10-17): the measurement model against numerical
+// differentiation and [KimAlign]'s published H_G, the innovation across yaw +-180 deg, and closed-loop runs on the
 // trajectory simulator's truth with GPS attitudes simulated from it (truth + Gaussian Euler-angle noise):
 // a parked MEMS IMU whose heading position/velocity cannot observe, with and without GPS attitude; a moving
 // run with dropouts (20 % of epochs unfixed, a 10 s gap) that stays consistent and counts its fallbacks.

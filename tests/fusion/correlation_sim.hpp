@@ -18,7 +18,7 @@
 namespace ultratrack::fusion::test {
 
 struct CorrelationSimConfig {
-  std::string profile = "circle";  // seed 001 circle: 500 km/h
+  std::string profile = "circle";  // [ChoUKF] circle: 500 km/h
   double duration_s = 10.0;
   double imu_rate_hz = 100.0;
   std::string imu_preset = "hg1700ae";

@@ -196,7 +196,7 @@ TEST(LooseIntegration, AppliesFixesAtTheirExactTime) {
   EXPECT_EQ(integ.counters().rejected, 0);
 }
 
-// Fallback (seed 003): epochs with position only, velocity only, or nothing still run the filter.
+// Fallback ([OhAttINS]): epochs with position only, velocity only, or nothing still run the filter.
 TEST(LooseIntegration, FallsBackToWhatIsPresent) {
   SimConfig cfg;
   cfg.seed = 9;

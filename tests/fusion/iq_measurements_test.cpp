@@ -46,7 +46,7 @@ TEST(IqModel, AmplitudeAndPeakValues) {
   for (double q : t.q) EXPECT_EQ(q, 0.0);
 }
 
-// The prompt is the mean of A exp(j 2 pi df s) over [0, T) (seed 001 eqs. 6-7 with zero start phase):
+// The prompt is the mean of A exp(j 2 pi df s) over [0, T) ([ChoUKF] eqs. 6-7 with zero start phase):
 // integrated here by Simpson's rule, independently of the sinc form.
 TEST(IqModel, PromptEqualsTheIntegralOfTheRotatingPhasor) {
   const IqSettings s = settings(40.0, 0.02, 0.5);

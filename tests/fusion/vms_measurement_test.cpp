@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer aiding (fusion/vms_measurement.hpp, fusion/odometer_error_model.hpp): the VMS/NHC Jacobian against
-// central differences of h, h against the closed form for known errors, the gating rule of seed 004 eqs.
+// central differences of h, h against the closed form for known errors, the gating rule of [KimVMS] eqs.
 // 16-17, and a short drive where the 19-state filter recovers a simulated scale factor.
 #include "fusion/vms_measurement.hpp"
 

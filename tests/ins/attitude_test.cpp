@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Attitude helpers: Euler angles against the explicit DCM of seed 002 eq. (12) (transposed: C_bn),
+// Attitude helpers: Euler angles against the explicit DCM of [ParkSDINS] eq. (12) (transposed: C_bn),
 // rotation vectors against Eigen's AngleAxis, and the psi-angle error convention.
 #include "ins/attitude.hpp"
 
@@ -14,7 +14,7 @@ TEST(Attitude, EulerDcmMatchesSeed002Eq12) {
   const double phi = 0.3, theta = -0.2, psi = 2.5;
   const double sf = std::sin(phi), cf = std::cos(phi), st = std::sin(theta), ct = std::cos(theta);
   const double sp = std::sin(psi), cp = std::cos(psi);
-  Eigen::Matrix3d C_bn;  // seed 002 eq. (12): the n -> b transformation
+  Eigen::Matrix3d C_bn;  // [ParkSDINS] eq. (12): the n -> b transformation
   // clang-format off
   C_bn << ct * cp,                ct * sp,                -st,
           sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct,

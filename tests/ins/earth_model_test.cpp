@@ -69,7 +69,7 @@ TEST(EarthModel, EarthAndTransportRatesMatchTheirDefinitions) {
   const double lat = 36.37 * ultratrack::io::kRadPerDeg, h = 1000.0;
   const Eigen::Vector3d w_ie = earth_rate_n(lat);
   EXPECT_NEAR(w_ie.norm(), 7.292115e-5, 1e-17);
-  // omega_en^n = (dlon/dt cos L, -dlat/dt, -dlon/dt sin L)  (seed 002 eq. 5 with the longitude rate)
+  // omega_en^n = (dlon/dt cos L, -dlat/dt, -dlon/dt sin L)  ([ParkSDINS] eq. 5 with the longitude rate)
   const Eigen::Vector3d v(120.0, -75.0, 3.0);
   const Eigen::Vector3d rates = geodetic_rates(lat, h, v);
   const Eigen::Vector3d w_en = transport_rate_n(lat, h, v);

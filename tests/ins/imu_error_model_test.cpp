@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // IMU error model: statistics of each error term against its definition, presets against their sources
-// (seed 000 Table 1, seed 003 Table 1, the navigation grade), determinism of the seed, and
+// ([KimAlign] Table 1, [OhAttINS] Table 1, the navigation grade), determinism of the seed, and
 // IMU data at rest (simulator + preset) whose |f| and |w| equal normal gravity and earth rate within the
 // preset's errors.
 #include "ins/imu_error_model.hpp"

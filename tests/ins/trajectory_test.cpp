@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Trajectory profiles reproduce seed 001's motions (checked on the truth, not on the code's inputs),
+// Trajectory profiles reproduce [ChoUKF]'s motions (checked on the truth, not on the code's inputs),
 // the land profile stays within 0-30 m/s and stops, the antenna motion interpolates the truth with its
 // own velocity (checked against finite differences of the exact antenna positions), and the odometer
 // counts the distance travelled with its scale-factor error.

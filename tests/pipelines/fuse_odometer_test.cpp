@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Odometer (VMS) aiding through the library (seed 004): a 6-minute simulated drive (turns, a slope, a lane
+// Odometer (VMS) aiding through the library ([KimVMS]): a 6-minute simulated drive (turns, a slope, a lane
 // change, a stop, a locked-wheel skid) whose odometer has every error the 19-state filter models; GNSS only for the
 // first 90 s. Checked against the simulator's truth: the estimated scale factor, misalignment and delay within
-// 3 sigma of the simulated ones, the horizontal error below seed 004's best Table 1 figure (0.16 % of the distance
+// 3 sigma of the simulated ones, the horizontal error below [KimVMS]'s best Table 1 figure (0.16 % of the distance
 // travelled), both gating rules active, the skid refused; and the same drive without the odometer drifts further.
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer (VMS) aiding in `receive --coupling loose --odometer` from IF samples end to end through the library
-// (issue 19, seed 004): one simulation of a car at 20 m/s (HG1700AE IMU at 100 Hz, a 10 Hz odometer with a +0.3 %
+// (issue 19, [KimVMS]): one simulation of a car at 20 m/s (HG1700AE IMU at 100 Hz, a 10 Hz odometer with a +0.3 %
 // scale factor, 20 ms delay and a 0.2 / -0.3 deg mounting misalignment, nominal constellation, 2.0 MHz i8 at
 // 45 dB-Hz, 80 s) with a 40 deg turn before a 45 s tunnel (every satellite blocked from 30 s to 75 s) that holds
 // a 15 deg curve at 1 deg/s (below the odometer gate's 1.5 deg/s). The same receive

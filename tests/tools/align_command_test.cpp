@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack align` end to end, in process, on simulated inputs with known truth (pipelines/alignment_monte_carlo's
 // IMU at rest with HG1700AE errors, GPS attitude = the array's truth + white Euler noise, written as attitude.csv in
-// GPS time): the attitude inside its 1-sigma, the files, the array's mounting (seed 000 Table 3) estimated within
-// 3 sigma, the IMU on a free-running local clock mapped through a PPS record (seed 003), `fuse --align file:` (the
+// GPS time): the attitude inside its 1-sigma, the files, the array's mounting ([KimAlign] Table 3) estimated within
+// 3 sigma, the IMU on a free-running local clock mapped through a PPS record ([OhAttINS]), `fuse --align file:` (the
 // attitude and the bias estimates), and
 // bad input (no fixed rows, no overlap, NaN, PPS gaps and bad rows) as one InputError naming the file.
 #include <fmt/format.h>
@@ -206,7 +206,7 @@ TEST(AlignCommand, EstimatesTheArrayMountingWithinThreeSigma) {
     EXPECT_GT(json_number(j, "sigma_yaw_deg", m), 3.0);
     EXPECT_NE(j.find("misalignment_deg"), std::string::npos) << "the unknown mounting is flagged" << j;
   }
-  // Against a reference attitude of the body (seed 000's MAPS INS, here the truth to 0.005 deg), every axis of the
+  // Against a reference attitude of the body ([KimAlign]'s MAPS INS, here the truth to 0.005 deg), every axis of the
   // mounting to a few hundredths of a degree: the mean of 100 GPS attitudes.
   {
     const Case c = make_case("mounting_reference", mounting, 14);
@@ -237,7 +237,7 @@ TEST(AlignCommand, EstimatesTheArrayMountingWithinThreeSigma) {
 
 TEST(AlignCommand, WarnsNearPitch90) {
   // At 70 deg of pitch the GPS attitude still serves (the filter's limit is 80 deg) but roll and yaw are turning
-  // about one axis: the result says so (seed 000 theorem 1: the rank drops at 90 deg).
+  // about one axis: the result says so ([KimAlign] theorem 1: the rank drops at 90 deg).
   pl::StationaryScenario sc = scenario(Eigen::Vector3d::Zero());
   sc.attitude = {10.0 * kDeg, 70.0 * kDeg, -60.0 * kDeg};
   sc.duration_s = 20.0;

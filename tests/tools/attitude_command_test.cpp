@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// `ultratrack simulate` then `ultratrack attitude` on a short static 3-antenna scenario (seed 000/003 geometry,
+// `ultratrack simulate` then `ultratrack attitude` on a short static 3-antenna scenario ([KimAlign]/003 geometry,
 // 3 mm phase noise per antenna, 45 dB-Hz, line biases, the shipped 2014-12-20 broadcast ephemeris as hot start),
 // checked against the scenario's set attitude: the attitude must be fixed, its errors within the solver's own
 // sigma, and the files as documented. The long runs (100 s static, moving, faults) are in docs/validation.md.

@@ -192,7 +192,7 @@ TEST(FuseCommand, BadInputIsOneInputError) {
 }
 
 // Position-only fixes (empty velocity columns): the in-motion alignment takes the track from position
-// differences and the filter updates with positions alone (the seed 003 fallback).
+// differences and the filter updates with positions alone (the [OhAttINS] fallback).
 TEST(FuseCommand, PositionOnlyFixesAlignFromPositionDifferences) {
   const fs::path dir = ultratrack::test::scratch_dir();
   run({"imusim", "--profile", "land", "--duration", "240", "--rate", "200", "--preset", "hg1700ae", "--seed", "11",
@@ -209,7 +209,7 @@ TEST(FuseCommand, PositionOnlyFixesAlignFromPositionDifferences) {
   EXPECT_LT(json_number(summary, "heading_deg", "rms_converged"), 1.0);
 }
 
-// --odometer (seed 004): with GNSS until a time, the summary's "odometer" object; without GNSS the configured
+// --odometer ([KimVMS]): with GNSS until a time, the summary's "odometer" object; without GNSS the configured
 // start; a bad odometer file or no measurement at all is one InputError.
 TEST(FuseCommand, OdometerWithAndWithoutGnss) {
   const fs::path dir = ultratrack::test::scratch_dir();
@@ -241,7 +241,7 @@ TEST(FuseCommand, OdometerWithAndWithoutGnss) {
   }
 }
 
-// --imu-pps (seed 003's time sync): the same IMU re-stamped by a free-running local clock 50 ppm fast (offset 1000.25
+// --imu-pps ([OhAttINS]'s time sync): the same IMU re-stamped by a free-running local clock 50 ppm fast (offset 1000.25
 // s), with its PPS record (1 us jitter, one pulse missing), gives the GPS-stamped run's solution. A mapping error dt
 // shifts the IMU against the fixes by dt, moving the solution by about speed x dt: the PPS fit is good to well under
 // 10 us (PpsTimeSync tests), the land profile below 30 m/s, so rows agree within 30 m/s x 10 us = 0.3 mm (1 mm

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The ultra-tight test bed (issue 7): scenarios/ultratight_*.toml parse and their trajectories have the stated
 // dynamics, checked on truth.csv / imu.csv of an IMU-only `simulate` run (no [signal]; IMU errors off) against
-// closed forms: seed 001's straight (1 m/s^2), circle (500 km/h, pi/100 rad/s), S (turn reverses at 100 s) and
+// closed forms: [ChoUKF]'s straight (1 m/s^2), circle (500 km/h, pi/100 rad/s), S (turn reverses at 100 s) and
 // spiral (climb 0.2 m/s); the 10 g turn (peak specific force 10 g0, jerk 100 m/s^3); the tunnel's blockage
 // silences every satellite at the only antenna (signal level).
 #include <gtest/gtest.h>
