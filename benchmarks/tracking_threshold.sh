@@ -35,7 +35,11 @@
 # appended to, not restarted. A file and coupling received again (e.g. the same --out with a larger --files)
 # replaces its earlier rows in runs.csv, positions.csv and nav_positions.csv instead of counting twice.
 #
-# Issue 7's protocol (--strong-s T0 > 0): every file is T0 + DURATION s long, all satellites at --strong-cn0
+# The common loss-of-lock rule (pipelines/truth_lock_rule.hpp, `ultratrack compare --tracking`): beside each
+# receiver's own detectors, every coupling's channels are judged the same way against the simulator's
+# satellite_truth.csv (runs_truth.csv and the last table of the report), so that the thresholds compare.
+#
+# The step protocol (--strong-s T0 > 0): every file is T0 + DURATION s long, all satellites at --strong-cn0
 # (45 dB-Hz) for the first T0 s, so that acquisition, bit and frame sync and a vector hand-over complete, then a
 # [[cn0_step]] (sample-exact) to the level under test for DURATION s. A satellite-run is then
 #   kept          locked (phase-locked or bit-synced) at the step (a locked record within 0.2 s before T0), and
@@ -115,6 +119,8 @@ if [ "$report_only" = 1 ]; then levels=""; elif [ "$reuse" = 0 ] || [ ! -f "$run
   echo "cn0_dbhz,file,prn,outcome,first_lock_s,lock_end_s,coupling" > "$runs"
   echo "cn0_dbhz,file,coupling,fixes,rms_3d_m" > "$positions"
   echo "cn0_dbhz,file,coupling,rows,nav_rms_3d_m,nav_max_3d_m" > "$out/nav_positions.csv"
+  echo "cn0_dbhz,file,prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records,coupling" \
+    > "$out/runs_truth.csv"
 fi
 skipped=" "
 for level in $levels; do
@@ -201,10 +207,11 @@ TOML
       rx=$out/$name${label:+.$label}.rx
       if [ "$reuse" = 1 ]; then
         # --reuse: drop this file's and coupling's earlier rows (a second receive would count it twice).
-        python3 - "$name" "$label" "$runs" "$positions" "$out/nav_positions.csv" <<'PY'
+        python3 - "$name" "$label" "$runs" "$positions" "$out/nav_positions.csv" "$out/runs_truth.csv" <<'PY'
 import os, sys
 name, label = sys.argv[1:3]
-for path, coupling_col in zip(sys.argv[3:], (6, 2, 2)):  # runs.csv: coupling last; the others: third
+# runs.csv: coupling last (6); positions, nav_positions: third (2); runs_truth.csv: last (9)
+for path, coupling_col in zip(sys.argv[3:], (6, 2, 2, 9)):
     if not os.path.exists(path):
         continue
     lines = open(path).read().splitlines()
@@ -271,6 +278,16 @@ for prn in prns:
             end = f"{end_t:.3f}"
     print(f"{level},{name},{prn},{outcome},{first},{end},{coupling}")
 PY
+      # The common rule (pipelines/truth_lock_rule.hpp): every coupling's channels against the simulator's
+      # satellite_truth.csv, from the step (or the lock deadline) to the end: code within 0.5 chip, each 1 s mean
+      # carrier frequency error within 2.5 Hz, no gap. Lines of runs_truth.csv; files simulated before the
+      # simulator wrote satellite_truth.csv are left out.
+      if [ -f "$sim/satellite_truth.csv" ] && [ -f "$rx/tracking.csv" ]; then
+        [ -f "$out/runs_truth.csv" ] || echo "cn0_dbhz,file,prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records,coupling" > "$out/runs_truth.csv"
+        from_s=$strong_s; [ "$strong_s" != 0 ] || from_s=$lock_deadline_s
+        "$ultratrack" compare --tracking "$rx/tracking.csv" --satellite-truth "$sim/satellite_truth.csv" \
+          --from "$from_s" --end "$file_s" | tail -n +2 | sed "s/^/$level,$name,/; s/\$/,$label/" >> "$out/runs_truth.csv"
+      fi
       # 3-D position RMS over the weak part: fixes at and after T0 (receiver time since the first sample).
       fixes=0; rms=""
       if [ -f "$rx/solution.csv" ]; then
@@ -389,4 +406,27 @@ for coupling in sorted({r.get("coupling") or "" for r in all_runs}):
             continue  # in the step protocol both fractions are kept / (kept + lost)
         print(f"90 % threshold, {label}: {crossing([(L, f) for L, f, _, _ in t])} dB-Hz; from the 68 % intervals: "
               f"{crossing([(L, hi) for L, _, _, hi in t])} .. {crossing([(L, lo) for L, _, lo, _ in t])}")
+# The common rule: the same truth-based judgement for every coupling (runs_truth.csv).
+truth_file = os.path.join(os.path.dirname(sys.argv[2]), "runs_truth.csv")
+truth_runs = list(csv.DictReader(open(truth_file))) if os.path.exists(truth_file) else []
+if truth_runs:
+    print("== common loss-of-lock rule (simulator truth: code <= 0.5 chip, 1 s mean frequency error <= 2.5 Hz, no gap)")
+    print("coupling        cn0_dbhz  runs  kept  lost(code/frequency/gap/end)  not_tracked  fraction_kept  wilson68")
+for coupling in sorted({r["coupling"] for r in truth_runs}):
+    runs = [r for r in truth_runs if r["coupling"] == coupling]
+    table = []
+    for L in sorted({float(r["cn0_dbhz"]) for r in runs}):
+        rs = [r for r in runs if float(r["cn0_dbhz"]) == L]
+        kept = sum(r["outcome"] == "kept" for r in rs)
+        lost = [r["reason"] for r in rs if r["outcome"] == "lost"]
+        not_tracked = sum(r["outcome"] == "not_tracked" for r in rs)
+        f = kept / len(rs) if rs else float("nan")
+        lo, hi = wilson(kept, len(rs))
+        table.append((L, f, lo, hi))
+        why = "/".join(str(lost.count(k)) for k in ("code", "frequency", "gap", "end"))
+        print(f"{coupling or '-':14s}  {L:8.1f}  {len(rs):4d}  {kept:4d}  {len(lost):4d} ({why:>17s})  {not_tracked:11d}  "
+              f"{f:13.3f}  [{lo:.3f}, {hi:.3f}]")
+    print(f"{coupling or '-'}: 90 % threshold by the common rule: {crossing([(L, f) for L, f, _, _ in table])} dB-Hz; "
+          f"from the 68 % intervals: {crossing([(L, hi) for L, _, _, hi in table])} .. "
+          f"{crossing([(L, lo) for L, _, lo, _ in table])}")
 PY

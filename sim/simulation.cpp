@@ -211,6 +211,7 @@ class SignalRun {
     row.clock_bias_m = clk.bias_s * signals::kSpeedOfLight_mps;
     row.clock_drift_mps = clk.drift_sps * signals::kSpeedOfLight_mps;
     sink_.truth(row);
+    sink_.satellite_truth(n, t_s, synth_.visible_satellites(n));
     if (!inertial_) return;
     for (int a = 0; a < synth_.antenna_count(); ++a) {
       const auto st = motion_.antenna_state(a, t_r);

@@ -108,6 +108,11 @@ class SimulationSink {
   virtual void events(std::span<const AntennaEventRow>, std::span<const Cn0StepRow>) {}
   virtual void truth(const TruthRow&) {}
   virtual void antenna_truth(const AntennaTruthRow&) {}
+  // The satellites transmitted at a truth row's sample (antenna 0): Doppler and code phase there, the truth a
+  // tracking channel is judged against (pipelines/truth_lock_rule.hpp).
+  virtual void satellite_truth(std::int64_t sample, double t_s, std::span<const signals::SatelliteView> in_view) {
+    (void)sample, (void)t_s, (void)in_view;
+  }
   virtual void samples(int antenna, std::span<const std::complex<float>> block) { (void)antenna, (void)block; }
   virtual void progress(const SimulationProgress&) {}
   virtual void finish(const SimulationResult&) {}

@@ -99,6 +99,13 @@ void SimulationFiles::antenna_truth(const AntennaTruthRow& r) {
                                 r.r_e_m.y(), r.r_e_m.z(), r.v_e_mps.x(), r.v_e_mps.y(), r.v_e_mps.z());
 }
 
+void SimulationFiles::satellite_truth(std::int64_t sample, double t_s,
+                                      std::span<const signals::SatelliteView> in_view) {
+  for (const auto& v : in_view)
+    satellite_truth_ += fmt::format("{},{:.9f},{},{:.2f},{:.4f},{:.6f}\n", sample, t_s, v.prn, v.cn0_dbhz, v.doppler_hz,
+                                    v.code_phase_chips);
+}
+
 void SimulationFiles::samples(int antenna, std::span<const std::complex<float>> block) {
   writers_[static_cast<std::size_t>(antenna)]->write(block);
 }
@@ -114,6 +121,8 @@ void SimulationFiles::finish(const SimulationResult& result) {
   if (scenario_.signal) {
     if (shape_.inertial) io::write_file_atomically(out_dir_ / "antenna_truth.csv", antenna_truth_);
     io::write_file_atomically(out_dir_ / "satellites.csv", satellites_);
+    io::write_file_atomically(out_dir_ / "satellite_truth.csv",
+                              "sample,t_s,prn,cn0_dbhz,doppler_hz,code_phase_chips\n" + satellite_truth_);
   }
   io::write_file_atomically(out_dir_ / "scenario.toml", scenario_echo_);
   if (!scenario_.cycle_slips.empty() || !scenario_.blockages.empty())

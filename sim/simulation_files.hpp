@@ -6,6 +6,8 @@
 //                   vel_d_mps,clock_bias_m,clock_drift_mps[,roll_deg,pitch_deg,yaw_deg]: antenna 0, or with
 //                   [trajectory] the IMU (body origin) and its attitude (body to NED, z-y-x)
 //   satellites.csv  prn,elevation_deg,azimuth_deg,cn0_dbhz,doppler_hz,code_phase_chips at the first sample
+//   satellite_truth.csv  sample,t_s,prn,cn0_dbhz,doppler_hz,code_phase_chips of every satellite transmitted, at the
+//                   truth rows (antenna 0; code phase at that sample, [0, 1023); Doppler includes the clock drift)
 //   imu.csv         ins/imu_csv.hpp columns, increments ending at t_s (trajectory time = GPS time since the start)
 //   antenna_truth.csv  t_s,antenna,ecef_x_m,...,vel_z_mps of every antenna at the truth rows ([trajectory])
 //   odometer.csv    t_s,pulses,distance_m ([trajectory] odometer = true)
@@ -50,6 +52,7 @@ class SimulationFiles : public SimulationSink {
   void events(std::span<const AntennaEventRow> events, std::span<const Cn0StepRow> steps) override;
   void truth(const TruthRow& row) override;
   void antenna_truth(const AntennaTruthRow& row) override;
+  void satellite_truth(std::int64_t sample, double t_s, std::span<const signals::SatelliteView> in_view) override;
   void samples(int antenna, std::span<const std::complex<float>> block) override;
   void progress(const SimulationProgress& progress) override;
   void finish(const SimulationResult& result) override;
@@ -68,7 +71,7 @@ class SimulationFiles : public SimulationSink {
   std::vector<std::filesystem::path> sample_files_;
   std::vector<std::unique_ptr<signals::SampleWriter>> writers_;
   std::unique_ptr<ins::ImuCsvWriter> imu_;
-  std::string truth_, antenna_truth_, satellites_, events_, cn0_steps_;
+  std::string truth_, antenna_truth_, satellites_, satellite_truth_, events_, cn0_steps_;
 };
 
 // simulate() into out_dir through SimulationFiles; the result lists the sample files.

@@ -2,9 +2,13 @@
 // `ultratrack compare --solution S --truth T [--skip S] [--json]`: a receiver's solution.csv against a
 // simulation's truth.csv (pipelines/solution_compare.hpp): position errors (3-D, horizontal, vertical RMS, max,
 // mean ENU bias) and velocity errors, over the fixes the truth covers. Exit 3 when no fix could be compared.
+// `ultratrack compare --tracking tracking.csv --satellite-truth satellite_truth.csv [--from S] [--end S]`: each
+// channel against the signal by the common loss-of-lock rule (pipelines/truth_lock_rule.hpp), one line per
+// satellite (prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records) as CSV on stdout.
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -13,6 +17,7 @@
 #include "commands.hpp"
 #include "io/input_error.hpp"
 #include "pipelines/solution_compare.hpp"
+#include "pipelines/truth_lock_rule.hpp"
 
 namespace ultratrack::tools {
 
@@ -20,10 +25,36 @@ namespace {
 
 struct CompareArgs {
   std::string solution, truth, skip = "0";
+  std::string tracking, satellite_truth, from = "0", end = "0", code_error = "0.5", frequency_error = "2.5";
   bool json = false;
 };
 
+void run_lock_rule(const CompareArgs& args) {
+  pipelines::TruthLockOptions options;
+  options.from_s = parse_double_option("--from", args.from);
+  options.end_s = parse_double_option("--end", args.end);
+  options.code_error_chips = parse_double_option("--code-error-chips", args.code_error);
+  options.frequency_error_hz = parse_double_option("--frequency-error-hz", args.frequency_error);
+  if (std::string why; !options.IsValid(&why)) throw io::InputError("command line", why);
+  const auto outcomes = pipelines::truth_lock_outcomes(args.satellite_truth, args.tracking, options);
+  fmt::print("prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records\n");
+  for (const auto& o : outcomes)
+    fmt::print("{},{},{},{},{:.4f},{:.3f},{}\n", o.prn, o.outcome, o.reason,
+               std::isnan(o.lost_s) ? std::string{} : fmt::format("{:.3f}", o.lost_s), o.max_code_error_chips,
+               o.max_frequency_error_hz, o.records);
+}
+
 void run_compare(const CompareArgs& args) {
+  if (!args.tracking.empty() || !args.satellite_truth.empty()) {
+    if (args.tracking.empty() || args.satellite_truth.empty())
+      throw io::InputError("command line", "--tracking and --satellite-truth go together");
+    if (!args.solution.empty() || !args.truth.empty())
+      throw io::InputError("command line", "--tracking compares channels, --solution fixes: one at a time");
+    run_lock_rule(args);
+    return;
+  }
+  if (args.solution.empty() || args.truth.empty())
+    throw io::InputError("command line", "give --solution and --truth (or --tracking and --satellite-truth)");
   pipelines::ComparisonOptions options;
   options.skip_s = parse_double_option("--skip", args.skip);
   if (!(options.skip_s >= 0.0)) throw io::InputError("command line", "--skip: must be >= 0 s");
@@ -51,10 +82,22 @@ void run_compare(const CompareArgs& args) {
 void add_compare_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("compare", "Compare a receiver's solution.csv with a simulation's truth.csv");
   auto args = std::make_shared<CompareArgs>();
-  cmd->add_option("--solution", args->solution, "solution.csv written by `ultratrack receive`")->required();
-  cmd->add_option("--truth", args->truth, "truth.csv written by `ultratrack simulate`")->required();
+  cmd->add_option("--solution", args->solution, "solution.csv written by `ultratrack receive`");
+  cmd->add_option("--truth", args->truth, "truth.csv written by `ultratrack simulate`");
   cmd->add_option("--skip", args->skip, "seconds after the first fix left out (settling)")->capture_default_str();
   cmd->add_flag("--json", args->json, "machine-readable output");
+  cmd->add_option("--tracking", args->tracking,
+                  "tracking.csv of `ultratrack receive`: each channel judged by the common loss-of-lock rule");
+  cmd->add_option("--satellite-truth", args->satellite_truth, "satellite_truth.csv written by `ultratrack simulate`");
+  cmd->add_option("--from", args->from, "with --tracking: judged from this time (s since the first sample)")
+      ->capture_default_str();
+  cmd->add_option("--end", args->end, "with --tracking: the signal's end in s (0: the truth's last row)")
+      ->capture_default_str();
+  cmd->add_option("--code-error-chips", args->code_error, "with --tracking: the code error bound")
+      ->capture_default_str();
+  cmd->add_option("--frequency-error-hz", args->frequency_error,
+                  "with --tracking: the bound of each 1 s mean carrier frequency error")
+      ->capture_default_str();
   cmd->callback([args] { run_compare(*args); });
 }
 

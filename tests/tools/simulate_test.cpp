@@ -107,7 +107,8 @@ troposphere = true
   const Scenario s = read_scenario(dir / "s.toml");
   const auto result = run_simulation(s, dir / "out");
   const auto out = dir / "out";
-  for (const char* f : {"antenna0.i8.bin", "truth.csv", "satellites.csv", "scenario.toml", "summary.json"})
+  for (const char* f :
+       {"antenna0.i8.bin", "truth.csv", "satellites.csv", "satellite_truth.csv", "scenario.toml", "summary.json"})
     EXPECT_TRUE(std::filesystem::exists(out / f)) << f;
   for (const auto& e : std::filesystem::directory_iterator(out))
     EXPECT_NE(e.path().extension(), ".part") << "temporary file left: " << e.path();
@@ -134,6 +135,41 @@ troposphere = true
   ASSERT_EQ(rows.size(), result.satellites.size());
   for (const auto& row : rows) EXPECT_GE(row.elevation_deg, 5.0);
   expect_acquired_as_stated(read_samples(out / "antenna0.i8.bin", signals::SampleFormat::i8), 2.048e6, rows);
+}
+
+// satellite_truth.csv states the signal at every truth row, not only at the first sample: the rows of 0.1 s later
+// against an independent acquisition of the samples from there on (the truth the common loss-of-lock rule,
+// pipelines/truth_lock_rule.hpp, judges channels against).
+TEST(Simulate, SatelliteTruthStatesTheSignalAtLaterRows) {
+  const auto dir = test::scratch_dir();
+  Scenario s = parse_scenario(
+      "[signal]\nsample_rate_hz = 2.048e6\nduration_s = 0.25\nseed = 3\n[time]\ngps_week = 2190\ntow_s = 518400.0\n"
+      "[navigation]\nconstellation = \"nominal\"\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+      "clock_drift_mps = 90.0\n",
+      dir / "s.toml");
+  const auto result = run_simulation(s, dir / "out");
+  const auto lines = read_lines(dir / "out" / "satellite_truth.csv");
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0], "sample,t_s,prn,cn0_dbhz,doppler_hz,code_phase_chips");
+  std::vector<SatelliteRow> at_start, later;
+  for (std::size_t i = 1; i < lines.size(); ++i) {
+    const auto f = test::split_csv_line(lines[i]);
+    ASSERT_EQ(f.size(), 6u) << lines[i];
+    const SatelliteRow row{std::stoi(f[2]), 0.0, 0.0, std::stod(f[3]), std::stod(f[4]), std::stod(f[5])};
+    if (f[0] == "0") at_start.push_back(row);
+    if (f[0] == "204800") later.push_back(row);
+  }
+  // Rows at 0, 0.1 and 0.2 s; the first are satellites.csv's.
+  EXPECT_EQ(lines.size(), 1 + 3 * result.satellites.size());
+  ASSERT_EQ(at_start.size(), result.satellites.size());
+  for (std::size_t i = 0; i < at_start.size(); ++i) {
+    EXPECT_EQ(at_start[i].prn, result.satellites[i].prn);
+    EXPECT_NEAR(at_start[i].doppler_hz, result.satellites[i].doppler_hz, 1e-4);
+    EXPECT_NEAR(at_start[i].code_phase_chips, result.satellites[i].code_phase_chips, 1e-6);
+  }
+  ASSERT_EQ(later.size(), result.satellites.size());
+  const auto x = read_samples(result.sample_files.at(0), signals::SampleFormat::i8);
+  expect_acquired_as_stated(std::vector<std::complex<float>>(x.begin() + 204800, x.end()), 2.048e6, later);
 }
 
 TEST(Simulate, BroadcastEphemerisScenarioOfTheIssue) {
