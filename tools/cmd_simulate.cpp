@@ -49,8 +49,8 @@ void add_simulate_command(CLI::App& app) {
       fmt::print("  {:3d} {:6.1f} {:7.1f} {:5.1f} {:10.1f} {:9.3f}\n", v.prn, v.elevation_rad * 180.0 / M_PI,
                  v.azimuth_rad * 180.0 / M_PI, v.cn0_dbhz, v.doppler_hz, v.code_phase_chips);
     }
-    fmt::print("outputs in {}: {}, {}truth.csv, {}satellites.csv, satellite_truth.csv, scenario.toml, summary.json\n", *out_dir,
-               r.sample_files.front().filename().string(), inertial,
+    fmt::print("outputs in {}: {}, {}truth.csv, {}satellites.csv, satellite_truth.csv, scenario.toml, summary.json\n",
+               *out_dir, r.sample_files.front().filename().string(), inertial,
                scenario.trajectory_enabled() ? "antenna_truth.csv, " : "");
   });
 }

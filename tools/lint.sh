@@ -39,10 +39,10 @@ failed=0
 
 if wants format; then
   mapfile -t cxx < <(git ls-files '*.cpp' '*.hpp')
-  unformatted=()
-  for f in "${cxx[@]}"; do
-    clang-format --dry-run --Werror "$f" >/dev/null 2>&1 || unformatted+=("$f")
-  done
+  # --dry-run --Werror names each file that differs ("FILE:LINE:COL: error: code should be clang-formatted").
+  mapfile -t unformatted < <(printf '%s\n' "${cxx[@]}" |
+    xargs -r -P "$jobs" -n 16 clang-format --dry-run --Werror 2>&1 |
+    sed -n 's/^\(.*\):[0-9]*:[0-9]*: error: code should be clang-formatted.*/\1/p' | sort -u)
   if ((${#unformatted[@]})); then
     printf 'lint format: %s differs from clang-format (run clang-format -i on it)\n' "${unformatted[@]}"
     failed=1
