@@ -2,6 +2,7 @@
 #include "campaign_engines.hpp"
 
 #include <fmt/core.h>
+#include <sys/wait.h>
 
 #include <atomic>
 #include <chrono>
@@ -30,7 +31,7 @@ std::string read_text(const fs::path& file) {
   return s.str();
 }
 
-// A command's standard output (popen), and its exit status.
+// A command's standard output (popen), and its exit status (-1 when it did not exit normally).
 std::pair<std::string, int> capture(const std::string& command) {
   std::FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) throw std::runtime_error("cannot run: " + command);
@@ -38,7 +39,7 @@ std::pair<std::string, int> capture(const std::string& command) {
   char buffer[4096];
   while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
   const int status = pclose(pipe);
-  return {out, status};
+  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
 // Single-quoted for the shell.
