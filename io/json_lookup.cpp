@@ -27,6 +27,13 @@ struct Walker {
     if (at >= text.size() || text[at] != c) fail((std::string("expected '") + c + "'").c_str());
     ++at;
   }
+  // Consumes `c` when it comes next (after white space).
+  bool next_is(char c) {
+    skip_space();
+    if (at >= text.size() || text[at] != c) return false;
+    ++at;
+    return true;
+  }
   std::string string_value() {
     expect('"');
     std::string out;
@@ -68,41 +75,20 @@ struct Walker {
     skip_space();
     if (at >= text.size()) fail("unexpected end");
     const char c = text[at];
-    if (c == '{') {
+    if (c == '{' || c == '[') {
+      // Members (key: value) or elements, each matched against the path's next key or index.
+      const char close = c == '{' ? '}' : ']';
       ++at;
-      skip_space();
-      if (at < text.size() && text[at] == '}') {
-        ++at;
-        return;
-      }
-      for (;;) {
-        const std::string key = string_value();
-        expect(':');
-        value(depth + 1, on_path && depth < path.size() && key == path[depth]);
-        skip_space();
-        if (at < text.size() && text[at] == ',') {
-          ++at;
-          continue;
-        }
-        expect('}');
-        return;
-      }
-    }
-    if (c == '[') {
-      ++at;
-      skip_space();
-      if (at < text.size() && text[at] == ']') {
-        ++at;
-        return;
-      }
+      if (next_is(close)) return;
       for (std::size_t index = 0;; ++index) {
-        value(depth + 1, on_path && depth < path.size() && path[depth] == std::to_string(index));
-        skip_space();
-        if (at < text.size() && text[at] == ',') {
-          ++at;
-          continue;
+        std::string key = std::to_string(index);
+        if (c == '{') {
+          key = string_value();
+          expect(':');
         }
-        expect(']');
+        value(depth + 1, on_path && depth < path.size() && key == path[depth]);
+        if (next_is(',')) continue;
+        expect(close);
         return;
       }
     }
