@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 #include <toml++/toml.h>
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -12,7 +13,9 @@
 #include "config/fuse_config_toml.hpp"
 #include "config/receive_config_toml.hpp"
 #include "config/scenario_toml.hpp"
+#include "ins/imu_error_model.hpp"
 #include "io/input_error.hpp"
+#include "io/units.hpp"
 #include "signals/rinex_nav.hpp"
 
 namespace ultratrack::config {
@@ -204,8 +207,18 @@ CampaignReduction read_reduction(const std::string& file, const toml::table& t, 
     r.kind = CampaignReduction::Kind::kStats;
     r.value = table.text("value", "");
     if (r.value.empty()) throw io::InputError(file, "key '" + table.key_name("value") + "' is required", line_of(t));
+  } else if (kind == "rms" || kind == "table" || kind == "error_stats") {
+    const char* key = kind == "rms" ? "values" : kind == "table" ? "columns" : "axes";
+    r.kind = kind == "rms"     ? CampaignReduction::Kind::kRms
+             : kind == "table" ? CampaignReduction::Kind::kTable
+                               : CampaignReduction::Kind::kErrorStats;
+    r.values = table.texts(key);
+    if (r.values.empty())
+      throw io::InputError(file, "key '" + table.key_name(key) + "' must be a non-empty array of strings", line_of(t));
   } else {
-    throw io::InputError(file, "key '" + table.key_name("kind") + "' must be lock_threshold, nav_consistency or stats",
+    throw io::InputError(file,
+                         "key '" + table.key_name("kind") +
+                             "' must be lock_threshold, nav_consistency, stats, rms, table or error_stats",
                          line_of(t));
   }
   table.check_done();
@@ -281,7 +294,8 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
   c.source = path;
   c.base_dir = base_dir.empty() ? fs::absolute(path).parent_path() : fs::absolute(base_dir);
   Table top{file, "", root, {}};
-  for (const char* s : {"campaign", "axis", "simulate", "recording", "receive", "compute", "report", "slurm"})
+  for (const char* s : {"campaign", "axis", "simulate", "recording", "step", "file", "alignment_mc", "receive",
+                        "compute", "report", "slurm"})
     top.get(s);
   top.check_done();
 
@@ -293,8 +307,10 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
   }
   const std::vector<const toml::table*> recordings = tables_of(file, root, "recording");
   const toml::table* simulate = section(file, root, "simulate");
-  if (recordings.empty() == (simulate == nullptr))
-    throw io::InputError(file, "a campaign has either [simulate] or [[recording]] tables");
+  const std::vector<const toml::table*> steps = tables_of(file, root, "step");
+  const toml::table* alignment = section(file, root, "alignment_mc");
+  if (!recordings.empty() + (simulate != nullptr) + !steps.empty() + (alignment != nullptr) != 1)
+    throw io::InputError(file, "a campaign has one of [simulate], [[recording]], [[step]] or [alignment_mc]");
   if (!recordings.empty()) {
     c.recordings = true;
     c.axes.push_back(read_recordings(file, recordings, c.base_dir));
@@ -314,6 +330,42 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
     c.keep_samples = table.boolean("keep_samples", false);
     table.check_done();
     c.scenario_text = read_text(c.scenario_template, file);
+  }
+  for (const toml::table* s : steps) {
+    Table table{file, fmt::format("step[{}]", c.steps.size()), *s, {}};
+    c.steps.push_back(table.texts("args"));
+    if (c.steps.back().empty()) table.fail(*s, "args", "must be a non-empty array of strings");
+    table.check_done();
+  }
+  for (const toml::table* f : tables_of(file, root, "file")) {
+    Table table{file, fmt::format("file[{}]", c.files.size()), *f, {}};
+    CampaignTemplateFile written;
+    written.source = resolve(c, table.text("template", ""));
+    written.name = table.text("name", "");
+    if (written.source.empty() || written.name.empty() || written.name.find('/') != std::string::npos)
+      table.fail(*f, "", "needs template (a file) and name (a file name in the run folder)");
+    table.check_done();
+    written.text = read_text(written.source, file);
+    c.files.push_back(std::move(written));
+  }
+
+  if (alignment) {
+    Table table{file, "alignment_mc", *alignment, {}};
+    CampaignAlignment a;
+    const auto text_of = [&](const char* key, std::string& into) {
+      if (const toml::node* n = table.get(key)) into = value_text(*n, table, key);
+    };
+    text_of("seed", a.seed);
+    text_of("filter", a.filter);
+    text_of("imu", a.imu);
+    text_of("lat_deg", a.lat_deg);
+    text_of("duration_s", a.duration_s);
+    if (const toml::node* n = table.get("gps_sigma_deg")) {
+      a.gps_sigma_deg = values_of(*n, table, "gps_sigma_deg");
+      if (a.gps_sigma_deg.size() != 3) table.fail(*n, "gps_sigma_deg", "must hold 3 values (roll, pitch, yaw)");
+    }
+    table.check_done();
+    c.alignment = a;
   }
   if (const toml::table* t = section(file, root, "receive")) {
     Table table{file, "receive", *t, {}};
@@ -352,8 +404,26 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
       }
       c.metrics.nav_z_times_s = times;
     }
+    c.remove_after = table.texts("remove");
+    for (const std::string& r : c.remove_after)
+      if (r.empty() || r.front() == '/' || r.find("..") != std::string::npos)
+        throw io::InputError(file, "key 'compute.remove': '" + r + "' must be a path inside the run folder");
+    if (const toml::node* n = table.get("json")) {
+      if (!n->as_table()) table.fail(*n, "json", "must be a table { name = \"FILE:dotted.path\" }");
+      for (const auto& [key, value] : *n->as_table()) {
+        const auto spec = value.value<std::string>();
+        try {
+          if (!spec) throw std::invalid_argument("must be a string FILE:dotted.path");
+          c.metrics.json_scalars.push_back(pipelines::parse_campaign_json_scalar(std::string(key.str()), *spec));
+        } catch (const std::invalid_argument& e) {
+          table.fail(value, "json." + std::string(key.str()), e.what());
+        }
+      }
+    }
     table.check_done();
   }
+  if ((!c.files.empty() || !c.remove_after.empty()) && steps.empty())
+    throw io::InputError(file, "[[file]] and [compute] remove go with [[step]] tables");
   int report_number = 0;
   for (const toml::table* t : tables_of(file, root, "report"))
     c.reductions.push_back(read_reduction(file, *t, report_number++, c));
@@ -373,12 +443,69 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
   // Every run's templates must fill in: a misspelt {name} fails here, before any run.
   const std::vector<pipelines::CampaignRun> runs = pipelines::expand_campaign(c.axes);
   if (!runs.empty()) {
-    if (!c.recordings) (void)substitute(c, c.scenario_text, runs.front(), c.scenario_template.string());
+    if (simulate) (void)substitute(c, c.scenario_text, runs.front(), c.scenario_template.string());
+    for (const auto& args : c.steps)
+      for (const std::string& arg : args) (void)fill_in(c, arg, runs.front(), file + ": [[step]]");
+    for (const CampaignTemplateFile& f : c.files) (void)fill_in(c, f.text, runs.front(), f.source.string());
+    if (c.alignment) (void)campaign_job(c, runs.front());
     for (const std::string* text : {&c.receive.nav, &c.receive.coupling, &c.receive.filter, &c.receive.align})
       (void)substitute(c, *text, runs.front(), file + ": [receive]");
   }
   return c;
 }
+
+std::string fill_in(const CampaignFile& c, const std::string& text, const pipelines::CampaignRun& run,
+                    const std::string& where) {
+  pipelines::CampaignRun with_folder = run;
+  with_folder.parameters.emplace_back("campaign_dir", c.base_dir.string());
+  return substitute(c, text, with_folder, where);
+}
+
+namespace {
+
+double number_in(const std::string& text, const std::string& where, const std::string& key) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(text, &used);
+    if (used == text.size() && std::isfinite(v)) return v;
+  } catch (const std::exception&) {
+  }
+  throw io::InputError(where, "key '" + key + "' must be a number, got '" + text + "'");
+}
+
+pipelines::CampaignAlignmentJob alignment_job(const CampaignFile& c, const pipelines::CampaignRun& run) {
+  const std::string where = c.source.string() + ": [alignment_mc]";
+  const CampaignAlignment& a = *c.alignment;
+  const auto value = [&](const std::string& text, const std::string& key) {
+    return number_in(fill_in(c, text, run, where), where, key);
+  };
+  pipelines::CampaignAlignmentJob job;
+  const double seed = value(a.seed, "seed");
+  if (seed < 0 || seed != std::floor(seed) || seed > 9e15)
+    throw io::InputError(where, "key 'seed' must be a non-negative integer");
+  job.seed = static_cast<std::uint64_t>(seed);
+  const std::string imu = fill_in(c, a.imu, run, where);
+  try {
+    job.scenario.imu = ins::imu_preset(imu);
+  } catch (const std::exception& e) {
+    throw io::InputError(where, "key 'imu': " + std::string(e.what()));
+  }
+  job.scenario.lat_rad = value(a.lat_deg, "lat_deg") * io::kRadPerDeg;
+  job.scenario.duration_s = value(a.duration_s, "duration_s");
+  for (int i = 0; i < 3; ++i)
+    job.scenario.gps_sigma_euler_rad(i) =
+        value(a.gps_sigma_deg[static_cast<std::size_t>(i)], "gps_sigma_deg") * io::kRadPerDeg;
+  if (job.scenario.duration_s <= 2.0 || job.scenario.gps_sigma_euler_rad.minCoeff() <= 0.0)
+    throw io::InputError(where, "duration_s must exceed 2 s and gps_sigma_deg be positive");
+  job.options.imu = job.scenario.imu;
+  const std::string filter = fill_in(c, a.filter, run, where);
+  if (filter != "ekf" && filter != "ukf")
+    throw io::InputError(where, "filter must be ekf or ukf, got '" + filter + "'");
+  job.options.filter = filter == "ukf" ? fusion::FilterKind::Ukf : fusion::FilterKind::Ekf;
+  return job;
+}
+
+}  // namespace
 
 pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::CampaignRun& run) {
   const std::string file = c.source.string();
@@ -387,6 +514,11 @@ pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::Camp
   job.keep_samples = c.keep_samples;
   job.metrics = c.metrics;
   job.prns_from_simulation = c.receive.prns_from_simulation;
+  if (c.alignment) {
+    job.alignment = alignment_job(c, run);
+    return job;
+  }
+  if (!c.steps.empty()) throw std::logic_error("a [[step]] campaign's runs are tools::run_campaign_steps's");
   if (!c.recordings) {
     const std::string text = substitute(c, c.scenario_text, run, c.scenario_template.string());
     job.scenario = parse_scenario(text, c.scenario_template);

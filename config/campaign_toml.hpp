@@ -14,18 +14,30 @@
 //                keep_samples = false                   (the IF sample file is deleted after the receive)
 //   [[recording]] instead of [simulate]: name = "a"  input = "a.bin"  format = "i8"  sample_rate_hz = 4e6
 //                if_hz = 0.0  imu = "imu.csv"  truth = "truth.csv"; the recordings are the first axis, "recording"
+//   [[step]]     instead of [simulate]: args = ["fuse", "--imu", "sim/imu.csv", ...]   ultratrack subcommands run in
+//                order in the run's folder (tools/campaign_steps.hpp), parameters as {name}, {campaign_dir} the
+//                campaign's folder; [[file]] template = "c.toml"  name = "c.toml": a file written into the run's
+//                folder first, its {name} parameters filled in
+//   [alignment_mc] instead of [simulate]: one run of the filter-level stationary alignment Monte Carlo
+//                (pipelines/campaign_alignment_run.hpp): seed = "{seed}"  filter = "ekf"  imu = "hg1700ae"
+//                gps_sigma_deg = [0.255, 0.263, 0.087]  lat_deg = 36.37  duration_s = 100.0 (all may name parameters)
 //   [receive]    nav = "brdc0010.22n" (hot start)  config = "receive.toml" (`receive --config`)
 //                fusion_config = "motion.toml"  coupling = "scalar"  filter = "ekf"  align = "motion"
 //                threads = 1  prns = "simulated" (search the simulated satellites) or "all"
 //                (nav, coupling, filter and align may name parameters, e.g. coupling = "{coupling}")
 //   [compute]    lock_outcomes = { lock_deadline_s = 5.0, strong_s = 0.0 }   nav_z_times_s = [10.5, 11.0]
+//                json = { drift_m = "f/summary.json:outages.0.horizontal_error_m" }   run scalars from a JSON file
+//                remove = ["s", "f/nav.csv"]   [[step]] runs: files or folders deleted once the scalars are read
 //   [[report]]   kind = "lock_threshold" (level = "cn0_dbhz")  or "nav_consistency"  or "stats" (value = "fixes")
+//                or "rms" (values = ["drift_m"])  or "table" (columns = ["preset", "drift_m:.3f"])
+//                or "error_stats" (axes = ["roll"]: scalars roll_error_deg and roll_sigma_deg)
 //                group = ["coupling"]   (one table per combination of these parameters)
 //   [slurm]      time = "01:00:00"  cpus_per_task = 1  mem = "4G"  partition = ""  account = ""
 //                runs_per_task = 1  max_parallel = 0 (array throttle; 0: none)  extra = ["--qos=normal"]
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +62,18 @@ struct SlurmResources {
   std::vector<std::string> extra;
 };
 
+// A file written into each run's folder with the run's parameters filled in ([[file]]).
+struct CampaignTemplateFile {
+  std::filesystem::path source;
+  std::string text, name;
+};
+
+// [alignment_mc]: each value as written, parameters still named ({seed}); campaign_job fills them in.
+struct CampaignAlignment {
+  std::string seed = "1", filter = "ekf", imu = "hg1700ae", lat_deg = "36.37", duration_s = "100.0";
+  std::vector<std::string> gps_sigma_deg = {"0.255", "0.263", "0.087"};
+};
+
 struct CampaignFile {
   std::filesystem::path source;    // the file read (errors name it)
   std::filesystem::path base_dir;  // relative paths resolve here
@@ -59,6 +83,10 @@ struct CampaignFile {
   std::string scenario_text;
   bool keep_samples = false;
   bool recordings = false;
+  std::vector<std::vector<std::string>> steps;  // [[step]] args, templated
+  std::vector<CampaignTemplateFile> files;
+  std::vector<std::string> remove_after;  // [compute] remove: relative to the run folder
+  std::optional<CampaignAlignment> alignment;
   CampaignReceive receive;
   pipelines::CampaignMetrics metrics;
   std::vector<pipelines::CampaignReduction> reductions;
@@ -68,6 +96,10 @@ struct CampaignFile {
 // Reads and checks a campaign file (and its scenario template: every {name} must be a parameter). base_dir: where
 // relative paths resolve (empty: the file's folder). Throws io::InputError naming the file, the line and the key.
 CampaignFile read_campaign(const std::filesystem::path& file, const std::filesystem::path& base_dir = {});
+
+// `text` with the run's parameters and {campaign_dir} filled in; `where` names the template in the InputError.
+std::string fill_in(const CampaignFile& campaign, const std::string& text, const pipelines::CampaignRun& run,
+                    const std::string& where);
 
 // What run `run` of the campaign does: the scenario template filled in and parsed, the receive's options.
 // Throws io::InputError naming the campaign file or the template.

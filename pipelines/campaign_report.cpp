@@ -11,6 +11,7 @@
 #include "io/input_error.hpp"
 #include "pipelines/campaign_metrics.hpp"
 #include "pipelines/campaign_run.hpp"
+#include "pipelines/campaign_tables.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
@@ -229,6 +230,28 @@ std::string stats(const std::vector<CompleteRun>& runs, const CampaignReduction&
   return out;
 }
 
+// The rms, table and error_stats reductions: each group's runs as their parameters and scalars.
+std::string tables(const std::vector<CompleteRun>& runs, const CampaignReduction& r) {
+  std::string out;
+  for (const auto& [key, members] : split(runs, r.group)) {
+    std::vector<CampaignRunValues> values;
+    for (const CompleteRun* run : members) {
+      CampaignRunValues v = run->status.scalars;
+      for (const auto& [name, value] : run->run->parameters) v.emplace(name, value);
+      values.push_back(std::move(v));
+    }
+    const std::string label = key.empty() ? "runs" : key;
+    if (r.kind == CampaignReduction::Kind::kRms) {
+      out += rms_table(label, values, r.values);
+    } else if (r.kind == CampaignReduction::Kind::kTable) {
+      out += group_title(r.group, key) + run_table(values, r.values);
+    } else {
+      out += error_stats_table(label, values, r.values);
+    }
+  }
+  return out;
+}
+
 std::string describe(const CampaignRun& run) {
   std::string text;
   for (const auto& [name, value] : run.parameters) text += (text.empty() ? "" : " ") + name + "=" + value;
@@ -293,6 +316,11 @@ std::string campaign_report(const fs::path& campaign_dir, const std::vector<Camp
         break;
       case CampaignReduction::Kind::kStats:
         out += stats(complete, r);
+        break;
+      case CampaignReduction::Kind::kRms:
+      case CampaignReduction::Kind::kTable:
+      case CampaignReduction::Kind::kErrorStats:
+        out += tables(complete, r);
         break;
     }
   }

@@ -9,7 +9,8 @@
 //   nav consistency  per evaluation time: mean z and mean z^2 per NED axis of position and velocity over the runs
 //                    (95 % bands +-1.96/sqrt(N) and chi2(N)/N, Wilson-Hilferty), RMS error and RMS sigma;
 //   stats            a run scalar (complete.csv) or parameter: count, mean with its 95 % Student-t interval,
-//                    median, standard deviation, minimum and maximum.
+//                    median, standard deviation, minimum and maximum;
+//   rms, table, error_stats   the fuse and alignment Monte Carlos' tables (pipelines/campaign_tables.hpp).
 // The step protocol (LockOutcomeOptions::strong_s) adds the not_locked_at_step column when a satellite was not
 // locked at its step; the threshold script's position RMS columns are not computed. Each reduction may split the
 // runs by parameters (`group`): one table per combination, in the sorted order of their values (as the scripts
@@ -25,12 +26,13 @@
 namespace ultratrack::pipelines {
 
 struct CampaignReduction {
-  enum class Kind { kLockThreshold, kNavConsistency, kStats };
+  enum class Kind { kLockThreshold, kNavConsistency, kStats, kRms, kTable, kErrorStats };
   Kind kind = Kind::kStats;
-  std::vector<std::string> group;  // parameters that split the runs
-  std::string level = "cn0_dbhz";  // kLockThreshold: the parameter whose values are the levels (numbers)
-  std::vector<double> times_s;     // kNavConsistency: the evaluation times (those the runs computed)
-  std::string value;               // kStats: a complete.csv scalar or a parameter (numbers)
+  std::vector<std::string> group;   // parameters that split the runs
+  std::string level = "cn0_dbhz";   // kLockThreshold: the parameter whose values are the levels (numbers)
+  std::vector<double> times_s;      // kNavConsistency: the evaluation times (those the runs computed)
+  std::string value;                // kStats: a complete.csv scalar or a parameter (numbers)
+  std::vector<std::string> values;  // kRms: values; kTable: columns; kErrorStats: axes (pipelines/campaign_tables.hpp)
 };
 
 // The report's text. Reads complete.csv, lock_outcomes.csv and nav_z.csv of the complete runs; throws

@@ -35,15 +35,10 @@ std::string json_number(const std::string& json, const std::string& key) {
   return json.substr(begin, end - begin);
 }
 
-void write_scalars(const fs::path& file, const std::map<std::string, std::string>& scalars) {
-  std::string text = "name,value\n";
-  for (const auto& [name, value] : scalars) text += name + "," + value + "\n";
-  io::write_file_atomically(file, text);
-}
-
 // Receives, computes the metrics and returns the run's scalars; nothing when a stop request ended it early.
 std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, const fs::path& run_dir,
                                                       std::stop_token stop) {
+  if (job.alignment) return campaign_alignment_scalars(*job.alignment);
   std::map<std::string, std::string> scalars;
   ReceiveFileJob rx = job.receive;
   rx.out = run_dir / "rx";
@@ -140,10 +135,7 @@ CampaignRunStatus campaign_run_status(const fs::path& run_dir) {
   return status;
 }
 
-namespace {
-
-// A fresh run folder with the run's parameters.
-void start_run_dir(const CampaignRun& run, const fs::path& run_dir) {
+void start_campaign_run_dir(const CampaignRun& run, const fs::path& run_dir) {
   fs::remove_all(run_dir);
   fs::create_directories(run_dir);
   std::string parameters = "name,value\n";
@@ -151,22 +143,27 @@ void start_run_dir(const CampaignRun& run, const fs::path& run_dir) {
   io::write_file_atomically(run_dir / "parameters.csv", parameters);
 }
 
-}  // namespace
+void complete_campaign_run(const fs::path& run_dir, const std::map<std::string, std::string>& scalars) {
+  std::string text = "name,value\n";
+  for (const auto& [name, value] : scalars) text += name + "," + value + "\n";
+  io::write_file_atomically(run_dir / "complete.csv", text);
+}
 
 CampaignRunStatus record_campaign_run_failure(const CampaignRun& run, const fs::path& run_dir,
                                               const std::string& message) {
-  start_run_dir(run, run_dir);
+  start_campaign_run_dir(run, run_dir);
   io::write_file_atomically(run_dir / "failed.txt", message + "\n");
   return campaign_run_status(run_dir);
 }
 
 CampaignRunStatus run_campaign_job(const CampaignJob& job, const fs::path& run_dir, std::stop_token stop) {
   if (CampaignRunStatus done = campaign_run_status(run_dir); done.state == CampaignRunState::kComplete) return done;
-  start_run_dir(job.run, run_dir);
+  start_campaign_run_dir(job.run, run_dir);
   try {
-    const auto scalars = run(job, run_dir, stop);
+    auto scalars = run(job, run_dir, stop);
     if (!scalars) return {};
-    write_scalars(run_dir / "complete.csv", *scalars);
+    scalars->merge(read_campaign_json_scalars(run_dir, job.metrics.json_scalars));
+    complete_campaign_run(run_dir, *scalars);
   } catch (const std::exception& e) {
     io::write_file_atomically(run_dir / "failed.txt", std::string(e.what()) + "\n");
   }

@@ -5,7 +5,7 @@
 //   parameters.csv    the run's parameters (name,value), written first
 //   sim/              the simulation's files (the IF sample file deleted after the receive unless kept)
 //   rx/               the receive's outputs
-//   lock_outcomes.csv, nav_z.csv   the metrics asked for
+//   lock_outcomes.csv, nav_z.csv   the metrics asked for ([compute] json scalars go into complete.csv)
 //   complete.csv      the marker, written last (atomically, by rename): the run's scalars (name,value)
 //   failed.txt        instead of complete.csv when the run threw: the message (a failed run is redone on resume)
 // A run found complete is not redone; any other folder is cleared and run again.
@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "pipelines/campaign_alignment_run.hpp"
+#include "pipelines/campaign_json_scalars.hpp"
 #include "pipelines/campaign_metrics.hpp"
 #include "pipelines/campaign_plan.hpp"
 #include "pipelines/receive_file.hpp"
@@ -28,6 +30,7 @@ namespace ultratrack::pipelines {
 struct CampaignMetrics {
   std::optional<LockOutcomeOptions> lock_outcomes;
   std::optional<std::vector<double>> nav_z_times_s;  // nav z-scores at these times (needs a truth.csv and nav.csv)
+  std::vector<CampaignJsonScalar> json_scalars;      // run scalars read from the run's JSON files
 };
 
 // Everything one run does, resolved (config/campaign_toml.hpp builds it from the campaign file and the run).
@@ -44,6 +47,8 @@ struct CampaignJob {
   std::filesystem::path truth_csv;   // recordings: the truth for nav z-scores (simulated runs: sim/truth.csv)
   std::filesystem::path imu_csv;     // recordings: the IMU file of the GNSS/INS couplings
   CampaignMetrics metrics;
+  // A run of the alignment Monte Carlo instead of a simulate-and-receive (no scenario, no receive).
+  std::optional<CampaignAlignmentJob> alignment;
 };
 
 enum class CampaignRunState { kMissing, kComplete, kFailed };
@@ -63,6 +68,11 @@ CampaignRunStatus campaign_run_status(const std::filesystem::path& run_dir);
 // without a marker (missing, redone on resume).
 CampaignRunStatus run_campaign_job(const CampaignJob& job, const std::filesystem::path& run_dir,
                                    std::stop_token stop = {});
+
+// A fresh run folder (cleared) holding parameters.csv: how every kind of run starts.
+void start_campaign_run_dir(const CampaignRun& run, const std::filesystem::path& run_dir);
+// The completion marker, complete.csv (name,value), written atomically: how every kind of run ends.
+void complete_campaign_run(const std::filesystem::path& run_dir, const std::map<std::string, std::string>& scalars);
 
 // Records a run that failed before run_campaign_job could start (e.g. its job could not be built): parameters.csv
 // and failed.txt with the message. Returns the kFailed status.

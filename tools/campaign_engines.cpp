@@ -2,6 +2,7 @@
 #include "campaign_engines.hpp"
 
 #include <fmt/core.h>
+#include <sys/wait.h>
 
 #include <atomic>
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "campaign_steps.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "pipelines/campaign_run.hpp"
@@ -29,7 +31,7 @@ std::string read_text(const fs::path& file) {
   return s.str();
 }
 
-// A command's standard output (popen), and its exit status.
+// A command's standard output (popen), and its exit status (-1 when it did not exit normally).
 std::pair<std::string, int> capture(const std::string& command) {
   std::FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) throw std::runtime_error("cannot run: " + command);
@@ -37,7 +39,7 @@ std::pair<std::string, int> capture(const std::string& command) {
   char buffer[4096];
   while (const std::size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
   const int status = pclose(pipe);
-  return {out, status};
+  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
 // Single-quoted for the shell.
@@ -82,13 +84,16 @@ std::vector<int> pending_runs(const config::CampaignFile& campaign, const fs::pa
   return pending;
 }
 
-bool run_campaign_index(const config::CampaignFile& campaign, const fs::path& out, int index, std::stop_token stop) {
+bool run_campaign_index(const config::CampaignFile& campaign, const fs::path& out, int index, const fs::path& program,
+                        std::stop_token stop) {
   const std::vector<pipelines::CampaignRun> runs = pipelines::expand_campaign(campaign.axes);
   if (index < 0 || index >= static_cast<int>(runs.size()))
     throw io::InputError("command line", fmt::format("run index {} is outside 0..{}", index, runs.size() - 1));
   const pipelines::CampaignRun& run = runs[static_cast<std::size_t>(index)];
   const fs::path dir = pipelines::campaign_run_dir(out, index);
   if (pipelines::campaign_run_status(dir).state == pipelines::CampaignRunState::kComplete) return true;
+  if (!campaign.steps.empty())
+    return run_campaign_steps(campaign, run, dir, program, stop).state == pipelines::CampaignRunState::kComplete;
   pipelines::CampaignJob job;
   try {
     job = config::campaign_job(campaign, run);
@@ -99,8 +104,8 @@ bool run_campaign_index(const config::CampaignFile& campaign, const fs::path& ou
   return pipelines::run_campaign_job(job, dir, stop).state == pipelines::CampaignRunState::kComplete;
 }
 
-int run_campaign_local(const config::CampaignFile& campaign, const fs::path& out, int jobs, std::FILE* log,
-                       std::stop_token stop) {
+int run_campaign_local(const config::CampaignFile& campaign, const fs::path& out, int jobs, const fs::path& program,
+                       std::FILE* log, std::stop_token stop) {
   const std::vector<int> pending = pending_runs(campaign, out);
   std::atomic<std::size_t> next{0};
   std::atomic<int> failed{0};
@@ -108,7 +113,7 @@ int run_campaign_local(const config::CampaignFile& campaign, const fs::path& out
   const auto worker = [&] {
     for (std::size_t i = next++; i < pending.size() && !stop.stop_requested(); i = next++) {
       const auto start = std::chrono::steady_clock::now();
-      const bool ok = run_campaign_index(campaign, out, pending[i], stop);
+      const bool ok = run_campaign_index(campaign, out, pending[i], program, stop);
       if (!ok && !stop.stop_requested()) ++failed;
       if (!log) continue;
       const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

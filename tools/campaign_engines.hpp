@@ -29,12 +29,13 @@ config::CampaignFile load_campaign_dir(const std::filesystem::path& out);
 std::vector<int> pending_runs(const config::CampaignFile& campaign, const std::filesystem::path& out);
 
 // Runs one run (building its job; a job that cannot be built is recorded as failed). True when complete.
+// program: the ultratrack that the steps of a [[step]] campaign run (tools/campaign_steps.hpp).
 bool run_campaign_index(const config::CampaignFile& campaign, const std::filesystem::path& out, int index,
-                        std::stop_token stop = {});
+                        const std::filesystem::path& program, std::stop_token stop = {});
 
 // The local engine: returns the number of runs that failed. log: one line per finished run (nullptr: silent).
-int run_campaign_local(const config::CampaignFile& campaign, const std::filesystem::path& out, int jobs, std::FILE* log,
-                       std::stop_token stop = {});
+int run_campaign_local(const config::CampaignFile& campaign, const std::filesystem::path& out, int jobs,
+                       const std::filesystem::path& program, std::FILE* log, std::stop_token stop = {});
 
 // The sbatch script for `pending` runs; program: the ultratrack the tasks run (an absolute path).
 std::string slurm_script(const config::CampaignFile& campaign, const std::filesystem::path& out, std::size_t pending,

@@ -50,6 +50,11 @@ int failed_runs(const fs::path& out) {
   return failed;
 }
 
+// The ultratrack that Slurm tasks and [[step]] runs execute: --program, or this program.
+fs::path program_of(const CampaignArgs& args) {
+  return args.program.empty() ? fs::read_symlink("/proc/self/exe") : fs::absolute(args.program);
+}
+
 void run_campaign(const CampaignArgs& args) {
   const fs::path out = args.out;
   const config::CampaignFile campaign = prepare_campaign_dir(args.campaign, out);
@@ -60,9 +65,9 @@ void run_campaign(const CampaignArgs& args) {
                                        : parse_int_option("--jobs", args.jobs);
     if (jobs < 1) throw io::InputError("command line", "--jobs: at least 1");
     InterruptGuard interrupt;
-    run_campaign_local(campaign, out, jobs, log, interrupt.token());
+    run_campaign_local(campaign, out, jobs, program_of(args), log, interrupt.token());
   } else if (args.engine == "slurm") {
-    const fs::path program = args.program.empty() ? fs::read_symlink("/proc/self/exe") : fs::absolute(args.program);
+    const fs::path program = program_of(args);
     const double poll_s = parse_double_option("--poll-s", args.poll_s);
     const SlurmSubmission s = run_campaign_slurm(campaign, out, program, args.no_wait, poll_s, log);
     if (s.job_id.empty() && log) fmt::print(log, "campaign: every run is complete; nothing submitted\n");
@@ -84,7 +89,7 @@ void run_one(const CampaignArgs& args) {
   const config::CampaignFile campaign = load_campaign_dir(out);
   const int index = parse_int_option("INDEX", args.index);
   InterruptGuard interrupt;
-  if (!run_campaign_index(campaign, out, index, interrupt.token())) {
+  if (!run_campaign_index(campaign, out, index, program_of(args), interrupt.token())) {
     const auto status = pipelines::campaign_run_status(pipelines::campaign_run_dir(out, index));
     throw CommandExit(1, fmt::format("run {} failed: {}", pipelines::campaign_run_folder(index),
                                      status.message.empty() ? "stopped" : status.message));
@@ -94,8 +99,9 @@ void run_one(const CampaignArgs& args) {
 }  // namespace
 
 void add_campaign_command(CLI::App& app) {
-  auto* cmd =
-      app.add_subcommand("campaign", "Campaigns: many simulate-and-receive runs from one file, locally or on Slurm");
+  auto* cmd = app.add_subcommand(
+      "campaign",
+      "Campaigns: many runs (simulate and receive, command steps, Monte Carlos) from one file, locally or on Slurm");
   cmd->require_subcommand(1);
   auto args = std::make_shared<CampaignArgs>();
 
@@ -106,7 +112,8 @@ void add_campaign_command(CLI::App& app) {
       ->capture_default_str();
   run->add_option("--jobs", args->jobs, "local: runs at once (default: cores / [receive] threads)");
   run->add_flag("--no-wait", args->no_wait, "slurm: return once submitted");
-  run->add_option("--program", args->program, "slurm: the ultratrack the array tasks run (default: this program)");
+  run->add_option("--program", args->program,
+                  "the ultratrack that Slurm tasks and [[step]] runs execute (default: this program)");
   run->add_option("--poll-s", args->poll_s, "slurm: seconds between squeue polls")->capture_default_str();
   run->add_flag("--quiet", args->quiet, "no line per finished run");
   run->callback([args] { run_campaign(*args); });
@@ -114,6 +121,7 @@ void add_campaign_command(CLI::App& app) {
   auto* one = cmd->add_subcommand("run-one", "Run one run of a campaign folder (what a Slurm array task calls)");
   one->add_option("DIR", args->out, "campaign output folder")->required();
   one->add_option("INDEX", args->index, "run index (0-based)")->required();
+  one->add_option("--program", args->program, "the ultratrack that [[step]] runs execute (default: this program)");
   one->callback([args] { run_one(*args); });
 
   auto* rep =

@@ -147,9 +147,27 @@ TEST(CampaignToml, MalformedFilesNameTheFileAndTheKey) {
   EXPECT_NE(error_of(axis + "[[report]]\nkind = \"stats\"\nvalue = \"fixes\"\ngroup = [\"coupling\"]\n")
                 .find("names no parameter 'coupling'"),
             std::string::npos);
-  EXPECT_NE(error_of("[[axis]]\nname = \"seed\"\nvalues = [1]\n").find("either [simulate] or [[recording]]"),
+  EXPECT_NE(error_of("[[axis]]\nname = \"seed\"\nvalues = [1]\n")
+                .find("one of [simulate], [[recording]], [[step]] or [alignment_mc]"),
             std::string::npos);
   EXPECT_NE(error_of("[simulate\n").find("c.toml"), std::string::npos);
+  // [[step]] and [alignment_mc] campaigns
+  const std::string seed = "[[axis]]\nname = \"seed\"\nvalues = [1]\n";
+  EXPECT_NE(error_of(seed + "[[step]]\nargs = []\n").find("key 'step[0].args' must be a non-empty array"),
+            std::string::npos);
+  EXPECT_NE(error_of(seed + "[[step]]\nargs = [\"x\"]\n[compute]\njson = { a = \"summary.json\" }\n")
+                .find("key 'compute.json.a' must be FILE:dotted.path, got 'summary.json'"),
+            std::string::npos);
+  EXPECT_NE(error_of(seed + "[[step]]\nargs = [\"x\"]\n[compute]\nremove = [\"../x\"]\n").find("inside the run folder"),
+            std::string::npos);
+  EXPECT_NE(error_of(seed + "[[step]]\nargs = [\"x\"]\n[[file]]\nname = \"a\"\n").find("needs template"),
+            std::string::npos);
+  EXPECT_NE(error_of(seed + "[alignment_mc]\nfilter = \"kf\"\n").find("filter must be ekf or ukf, got 'kf'"),
+            std::string::npos);
+  EXPECT_NE(error_of(seed + "[alignment_mc]\nseed = \"{sed}\"\n").find("{sed} names no campaign parameter"),
+            std::string::npos);
+  EXPECT_NE(error_of(seed + "[alignment_mc]\n[[report]]\nkind = \"rms\"\n").find("key 'report[0].values'"),
+            std::string::npos);
   // A template naming a parameter no axis defines: the template's file and the name.
   const std::string e = error_of(axis, "[signal]\nseed = {sede}\n");
   EXPECT_NE(e.find("{sede}"), std::string::npos) << e;
