@@ -11,65 +11,14 @@
 
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
+#include "io/named_csv.hpp"
 #include "io/numeric_csv.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
 
-// A CSV file read by column names (the outputs' later columns do not matter): the header, then rows of as many
-// fields.
-struct NamedCsv {
-  std::string file;
-  std::vector<std::string> header;
-  std::vector<std::vector<std::string>> rows;
-  std::vector<int> lines;
-
-  std::size_t column(const std::string& name) const {
-    const auto it = std::find(header.begin(), header.end(), name);
-    if (it == header.end()) throw io::InputError(file, "no column '" + name + "'");
-    return static_cast<std::size_t>(it - header.begin());
-  }
-  double number(std::size_t row, std::size_t column) const {
-    const auto v = io::parse_csv_number(file, lines[row], header[column], rows[row][column]);
-    if (!v) throw io::InputError(file, header[column] + " is empty", lines[row]);
-    return *v;
-  }
-};
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> fields;
-  std::stringstream in(line);
-  std::string field;
-  while (std::getline(in, field, ',')) fields.emplace_back(io::trim(field));
-  if (!line.empty() && line.back() == ',') fields.emplace_back();
-  return fields;
-}
-
-NamedCsv read_named_csv(const std::filesystem::path& path) {
-  NamedCsv csv;
-  csv.file = path.string();
-  std::ifstream in(path);
-  if (!in) throw io::InputError(csv.file, "cannot open the file");
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (io::trim(line).empty()) continue;
-    std::vector<std::string> fields = split(line);
-    if (csv.header.empty()) {
-      csv.header = std::move(fields);
-      continue;
-    }
-    if (fields.size() != csv.header.size())
-      throw io::InputError(csv.file, fmt::format("{} fields, the header has {}", fields.size(), csv.header.size()),
-                           number);
-    csv.rows.push_back(std::move(fields));
-    csv.lines.push_back(number);
-  }
-  if (csv.header.empty()) throw io::InputError(csv.file, "empty file");
-  return csv;
-}
+using io::NamedCsv;
+using io::read_named_csv;
 
 bool is_locked(const std::string& state) { return state == "phase-locked" || state == "bit-synced"; }
 
