@@ -22,6 +22,8 @@ void register_receive(py::module_& m);   // bind_receive.cpp: receive
 void register_acquire(py::module_& m);   // bind_acquire.cpp: acquire (file or numpy samples)
 void register_fuse(py::module_& m);      // bind_fuse.cpp: fuse
 void register_attitude(py::module_& m);  // bind_attitude.cpp: attitude
+void register_snapshot(py::module_& m);  // bind_snapshot.cpp: snapshot
+void register_align(py::module_& m);     // bind_align.cpp: align
 
 // Takes `key` out of `options` (so that what is left over are unknown names), converted to T; false when absent.
 template <typename T>

@@ -42,4 +42,6 @@ PYBIND11_MODULE(_ultratrack, m) {
   up::register_acquire(m);
   up::register_fuse(m);
   up::register_attitude(m);
+  up::register_snapshot(m);
+  up::register_align(m);
 }
