@@ -407,8 +407,9 @@ def _ultratight_figures(page, rows):
 
 
 def _vector_nis_figure(page, rows):
-    """Each channel's NIS of the vector filter from its normalised pseudorange and pseudorange-rate innovations
-    (those used that epoch), with the chi-square 95 % band of dimension 2 (epochs with both)."""
+    """Each channel's NIS of the vector filter, as the sum of its squared normalised pseudorange and pseudorange-rate
+    innovations (epochs where both were used), with the chi-square 95 % band of dimension 2: a proxy, since
+    vector.csv does not hold the two innovations' correlation."""
     needed = ("pr_used", "pr_innovation_m", "pr_sigma_m", "rate_used", "rate_innovation_mps", "rate_sigma_mps")
     if any(c not in rows.dtype.names for c in needed):
         return
@@ -432,8 +433,9 @@ def _vector_nis_figure(page, rows):
     page.add("vector_nis", "Vector filter NIS with its 95 % band", fig)
 
 
-def _alignment_figure(page, epochs, alignment):
-    """The alignment filter's attitude per epoch with its 1-sigma, and the final estimate (alignment.json)."""
+def _alignment_figure(page, epochs, alignment, truth):
+    """The alignment filter's attitude per epoch with its 1-sigma, the final estimate (alignment.json) and the truth's
+    attitude on the IMU time line (t_s) when given."""
     t = epochs["t_s"]
     fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
     for k, angle in enumerate(("roll_deg", "pitch_deg", "yaw_deg")):
@@ -442,6 +444,9 @@ def _alignment_figure(page, epochs, alignment):
         axes[k].fill_between(t, value - sigma, value + sigma, alpha=0.3, label="1-sigma")
         if alignment is not None and angle in alignment:
             axes[k].axhline(alignment[angle], color="k", lw=0.6, ls="--", label="alignment.json")
+        if truth is not None and angle in truth.dtype.names and "t_s" in truth.dtype.names:
+            at = (truth["t_s"] >= t[0]) & (truth["t_s"] <= t[-1])
+            axes[k].plot(truth["t_s"][at], truth[angle][at], "k", lw=0.8, label="truth")
         axes[k].set_ylabel(angle)
         axes[k].grid(True, alpha=0.3)
     axes[0].legend(fontsize=8)
@@ -527,7 +532,7 @@ def make_report(run_dir, truth=None, out_dir=None, prn=None):
         _attitude_figure(page, attitude, truth_rows)
     epochs = _optional(readers.read_alignment_epochs, run_dir)
     if epochs is not None:
-        _alignment_figure(page, epochs, alignment)
+        _alignment_figure(page, epochs, alignment, truth_rows)
     tables = [(name, data) for name, data in (("summary.json", summary), ("snapshot.json", snapshot),
                                               ("alignment.json", alignment)) if data is not None]
 

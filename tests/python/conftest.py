@@ -70,6 +70,22 @@ phase_noise_m = 0.003
 lever_arm_body_m = [0.0, 1.025, 0.0]
 phase_noise_m = 0.003
 """ % ((WEEK, TOW0, NAV) + LLH + ATTITUDE_DEG)
+# IMU and truth only (no [signal]) for fuse: a 30 s circle with a navigation-grade IMU, simulated in a fraction of a
+# second.
+INERTIAL = """
+[time]
+gps_week = 1823
+tow_s = 518400.0
+[receiver]
+llh_deg_m = [35.274016, 137.013759, 100.0]
+[trajectory]
+profile = "circle"
+duration_s = 30.0
+imu_rate_hz = 100.0
+[imu]
+preset = "hg1700ae"
+seed = 3
+"""
 COUPLINGS = ("scalar", "vector", "loose", "tight", "ultra-tight")
 INERTIAL_COUPLINGS = ("loose", "tight", "ultra-tight")
 # The vehicle is at rest: the GNSS/INS couplings start with a static alignment, over 5 s (the default 60 s would
@@ -161,8 +177,8 @@ def sim(workdir):
 class Runs:
     """Runs made once per session, on demand: receive per coupling, attitude, align, snapshot."""
 
-    def __init__(self, workdir, sim):
-        self.workdir, self.sim, self.made = workdir, sim, {}
+    def __init__(self, workdir, sim, artefacts):
+        self.workdir, self.sim, self.artefacts, self.made = workdir, sim, artefacts, {}
 
     def _once(self, name, make):
         if name not in self.made:
@@ -193,6 +209,40 @@ class Runs:
             os.path.join(self.sim["dir"], "imu.csv"), attitude, out, position=LLH, attitude_origin=(WEEK, TOW0),
             duration=0))
 
+    def run(self, name):
+        """The run of a command or coupling by name: a coupling of receive, or attitude, align, snapshot, fuse."""
+        return self.receive(name) if name in COUPLINGS else getattr(self, name)()
+
+    def inertial(self):
+        """The INERTIAL simulation and GNSS fixes at 1 Hz from its truth itself (sigma 1 m): files imu, gnss, truth."""
+        def make(folder):
+            ut.simulate(INERTIAL, folder)
+            truth = ut.read_truth(folder)
+            step = int(round(1.0 / (truth["t_s"][1] - truth["t_s"][0])))
+            gnss = os.path.join(folder, "gnss.csv")
+            with open(gnss, "w") as f:
+                f.write("t_s,lat_deg,lon_deg,height_m,vel_n_mps,vel_e_mps,vel_d_mps,sigma_n_m,sigma_e_m,sigma_d_m\n")
+                for row in truth[::step]:
+                    f.write("%.6f,%.10f,%.10f,%.4f,%.5f,%.5f,%.5f,1,1,1\n" % (
+                        row["t_s"], row["lat_deg"], row["lon_deg"], row["height_m"], row["vel_n_mps"],
+                        row["vel_e_mps"], row["vel_d_mps"]))
+            return {"imu": os.path.join(folder, "imu.csv"), "gnss": gnss, "truth": os.path.join(folder, "truth.csv")}
+        return self._once("inertial", make)
+
+    def fuse(self):
+        files = self.inertial()
+        return self._once("fuse", lambda out: ut.fuse(files["imu"], files["gnss"], out, truth=files["truth"]))
+
+    def report(self, name):
+        """The report of run(name) against the simulation's truth, made once by `python3 -m ultratrack.report`'s
+        main into the artefacts folder (report_NAME); returns the folder."""
+        def make(_):
+            out = os.path.join(self.artefacts, "report_" + name)
+            truth = self.inertial()["truth"] if name == "fuse" else os.path.join(self.sim["dir"], "truth.csv")
+            assert ultratrack.report.main([self.run(name)["out"], "--truth", truth, "--out", out]) == 0
+            return out
+        return self._once("report_" + name, make)
+
     def snapshot(self):
         return self._once("snapshot", lambda out: ut.snapshot(
             self.sim["input"], NAV, (WEEK, TOW0 + 1.0), out, format="i8", fs=FS, skip=1.0, ms=60,
@@ -200,5 +250,5 @@ class Runs:
 
 
 @pytest.fixture(scope="session")
-def runs(workdir, sim):
-    return Runs(workdir, sim)
+def runs(workdir, sim, artefacts):
+    return Runs(workdir, sim, artefacts)

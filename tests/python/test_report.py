@@ -10,7 +10,6 @@ import pytest
 
 import ultratrack as ut
 import ultratrack.report
-from conftest import COUPLINGS
 
 TRACKING = {"sky", "cn0", "tracking_state", "prompt_iq", "position_map", "position_error", "velocity",
             "satellites_dop"}
@@ -24,14 +23,9 @@ FIGURES = {
     "attitude": TRACKING | {"attitude"},
     "align": {"alignment_attitude", "alignment_biases"},
     "snapshot": {"sky", "position_map", "position_error", "snapshot_residuals"},
+    "fuse": INERTIAL,
 }
 TABLES = {"align": "alignment.json", "snapshot": "snapshot.json"}
-
-
-def run_of(runs, name):
-    if name in COUPLINGS:
-        return runs.receive(name)
-    return getattr(runs, name)()
 
 
 def check_report(folder, expected, table):
@@ -47,11 +41,8 @@ def check_report(folder, expected, table):
 
 
 @pytest.mark.parametrize("name", sorted(FIGURES))
-def test_report_of_every_command(runs, sim, artefacts, name):
-    out = os.path.join(artefacts, "report_" + name)
-    truth = os.path.join(sim["dir"], "truth.csv")
-    assert ultratrack.report.main([run_of(runs, name)["out"], "--truth", truth, "--out", out]) == 0
-    page = check_report(out, FIGURES[name], TABLES.get(name, "summary.json"))
+def test_report_of_every_command(runs, name):
+    page = check_report(runs.report(name), FIGURES[name], TABLES.get(name, "summary.json"))
     if name == "scalar":
         assert "<td>fixes</td>" in page
 
@@ -74,13 +65,3 @@ def test_report_as_a_command(runs, workdir):
     done = subprocess.run([sys.executable, "-m", "ultratrack.report", os.path.join(workdir, "no_such_run")],
                           capture_output=True, text=True)
     assert done.returncode == 2 and "no_such_run: not a folder" in done.stderr
-
-
-def test_report_of_a_fuse_run(workdir, artefacts):
-    fuse_out = os.path.join(workdir, "fuse")
-    if not os.path.isdir(fuse_out):
-        pytest.skip("the fuse run of test_fuse.py did not run in this session")
-    out = os.path.join(artefacts, "report_fuse")
-    truth = os.path.join(workdir, "inertial", "truth.csv")
-    assert ultratrack.report.main([fuse_out, "--truth", truth, "--out", out]) == 0
-    check_report(out, INERTIAL, "summary.json")
