@@ -10,7 +10,7 @@ through the module and, for the comparisons, once through the program.
 Environment: PYTHONPATH holding build/python, ULTRATRACK_PROGRAM (the `ultratrack` program: needed by the
 comparisons), ULTRATRACK_SOURCE_DIR (the checkout), ULTRATRACK_ARTEFACTS (a folder kept after the run: reports and
 browser screenshots; default: the session's temporary folder), ULTRATRACK_CHROMIUM (the browser of the report test).
-When the module was not built, every test is skipped with the reason and pytest exits 77 (ctest: skipped).
+When the module was not built, no test is collected, the reason is printed and pytest exits 77 (ctest: skipped).
 """
 import os
 import subprocess
@@ -93,10 +93,8 @@ INERTIAL_COUPLINGS = ("loose", "tight", "ultra-tight")
 FUSION_CONFIG = "[alignment]\nstatic_duration_s = 5.0\n"
 
 
-def pytest_collection_modifyitems(config, items):
-    if NOT_BUILT:
-        for item in items:
-            item.add_marker(pytest.mark.skip(reason=NOT_BUILT))
+# Without the module the test files (which import it) are not collected; the session says why and exits 77.
+collect_ignore_glob = ["test_*.py"] if NOT_BUILT else []
 
 
 def pytest_sessionfinish(session, exitstatus):
