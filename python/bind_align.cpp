@@ -25,11 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void require_file(const std::string& file, const char* what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) throw io::InputError(file, std::string(what) + " file not found");
-}
-
 std::string align(const std::string& imu_file, const std::string& attitude_file, const std::string& out,
                   const std::string& config_file, const std::optional<std::vector<double>>& position,
                   const std::optional<std::pair<int, double>>& attitude_origin, const std::string& pps_file,

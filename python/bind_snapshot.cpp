@@ -29,11 +29,8 @@ bool snapshot(const std::string& input, const std::string& format, double fs_hz,
   const auto started = std::chrono::steady_clock::now();
   pipelines::SnapshotFileJob job;
   job.input = input;
-  const auto sample_format = signals::parse_sample_format(format);
-  if (!sample_format)
-    throw io::InputError("python", "format: unknown sample format '" + format + "' (" +
-                                       std::string(signals::sample_format_names()) + ")");
-  job.format = *sample_format;
+  const signals::SampleFormat sample_format = sample_format_from_name(format);
+  job.format = sample_format;
   job.source.fs_hz = fs_hz;
   job.source.if_hz = if_hz;
   job.source.iq_swap = iq_swap;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "io/input_error.hpp"
+#include "signals/sample_format.hpp"
 
 namespace ultratrack::python {
 
@@ -46,6 +47,12 @@ Enum enum_from_name(const std::string& option, const std::string& name, std::ini
   }
   throw io::InputError("python", option + " must be one of " + names + ", got '" + name + "'");
 }
+
+// The sample format named `format` (i8, i16, ...); otherwise an InputError ("python") that lists the names.
+signals::SampleFormat sample_format_from_name(const std::string& format);
+
+// An InputError naming `file` ("<what> file not found") unless it is a regular file.
+void require_file(const std::string& file, const char* what);
 
 // Raises TypeError naming the options left in `options` (none of `command`'s names).
 void reject_unknown_options(const py::dict& options, const std::string& command);

@@ -31,6 +31,7 @@ from ._ultratrack import InputError  # noqa: E402
 
 _A = 6378137.0                  # WGS-84 semi-major axis, m
 _E2 = 6.69437999014e-3          # WGS-84 first eccentricity squared
+ANGLES = ("roll_deg", "pitch_deg", "yaw_deg")
 
 
 def _ecef(lat_deg, lon_deg, h_m):
@@ -235,19 +236,11 @@ def _nav_figures(page, nav, truth):
         axes[-1].set_xlabel("t_s (s)")
         page.add("nav_position_error", "GNSS/INS position error with 1-sigma", fig)
 
-    fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
-    for k, (angle, sigma) in enumerate((("roll_deg", "sigma_att_n_deg"), ("pitch_deg", "sigma_att_e_deg"),
-                                        ("yaw_deg", "sigma_att_d_deg"))):
-        axes[k].plot(t, nav[angle], lw=0.8, label=angle)
-        axes[k].fill_between(t, nav[angle] - nav[sigma], nav[angle] + nav[sigma], alpha=0.3, label="1-sigma")
-        if truth is not None and angle in truth.dtype.names:
-            axes[k].plot(truth["t_s"], truth[angle], "k", lw=0.6, label="truth")
-        axes[k].set_ylabel(angle)
-        axes[k].grid(True, alpha=0.3)
-    axes[0].legend(fontsize=8)
-    axes[0].set_title("GNSS/INS attitude (nav.csv) with 1-sigma")
-    axes[-1].set_xlabel("t_s (s)")
-    page.add("nav_attitude", "GNSS/INS attitude with 1-sigma", fig)
+    sigmas = {"roll_deg": "sigma_att_n_deg", "pitch_deg": "sigma_att_e_deg", "yaw_deg": "sigma_att_d_deg"}
+    _attitude_panels(page, "nav_attitude", "GNSS/INS attitude with 1-sigma",
+                     "GNSS/INS attitude (nav.csv) with 1-sigma", t,
+                     {angle: (nav[angle], nav[sigma]) for angle, sigma in sigmas.items()},
+                     None if truth is None else (truth["t_s"], truth), "t_s (s)")
 
     _time_series(page, "nav_velocity", "GNSS/INS velocity (nav.csv, NED)", t,
                  [(nav[c], c) for c in ("vel_n_mps", "vel_e_mps", "vel_d_mps")], "t_s (s)", "velocity (m/s)")
@@ -276,23 +269,33 @@ def _vector_innovation_figure(page, rows):
     page.add("vector_innovations", "Vector filter normalised pseudorange innovations", fig)
 
 
-def _attitude_figure(page, attitude, truth):
-    t = attitude["tow_s"] - attitude["tow_s"][0]
+def _attitude_panels(page, name, title, figure_title, t, angles, truth, xlabel, final=None):
+    """Roll, pitch and yaw against time, each with its 1-sigma band. angles: {angle: (values, sigmas)}; truth:
+    (its times on the same axis, its rows) or None, drawn over the span of t; final: {angle: a final estimate}."""
     fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
-    for k, angle in enumerate(("roll_deg", "pitch_deg", "yaw_deg")):
-        value, sigma = attitude[angle], attitude["sigma_" + angle]
+    for k, (angle, (value, sigma)) in enumerate(angles.items()):
         axes[k].plot(t, value, lw=0.8, label=angle)
         axes[k].fill_between(t, value - sigma, value + sigma, alpha=0.3, label="1-sigma")
-        if truth is not None and angle in truth.dtype.names:
-            axes[k].plot(truth["tow_s"] - attitude["tow_s"][0], truth[angle], "k", lw=0.6, label="truth")
-            axes[k].set_xlim(t[0], t[-1])
+        if final is not None and angle in final:
+            axes[k].axhline(final[angle], color="k", lw=0.6, ls="--", label="final estimate")
+        if truth is not None and angle in truth[1].dtype.names:
+            at = (truth[0] >= t[0]) & (truth[0] <= t[-1])
+            axes[k].plot(truth[0][at], truth[1][angle][at], "k", lw=0.8, label="truth")
         axes[k].set_ylabel(angle)
         axes[k].grid(True, alpha=0.3)
     axes[0].legend(fontsize=8)
-    axes[0].set_title("Multi-antenna attitude (attitude.csv) with 1-sigma; %d of %d epochs fixed"
-                      % (int(np.sum(attitude["fixed"])), attitude.size))
-    axes[-1].set_xlabel("time since the first epoch (s)")
-    page.add("attitude", "Attitude with 1-sigma", fig)
+    axes[0].set_title(figure_title)
+    axes[-1].set_xlabel(xlabel)
+    page.add(name, title, fig)
+
+
+def _attitude_figure(page, attitude, truth):
+    t0 = attitude["tow_s"][0]
+    _attitude_panels(page, "attitude", "Attitude with 1-sigma",
+                     "Multi-antenna attitude (attitude.csv) with 1-sigma; %d of %d epochs fixed"
+                     % (int(np.sum(attitude["fixed"])), attitude.size), attitude["tow_s"] - t0,
+                     {angle: (attitude[angle], attitude["sigma_" + angle]) for angle in ANGLES},
+                     None if truth is None else (truth["tow_s"] - t0, truth), "time since the first epoch (s)")
 
 
 def _chi2_quantile(m, p):
@@ -437,22 +440,11 @@ def _alignment_figure(page, epochs, alignment, truth):
     """The alignment filter's attitude per epoch with its 1-sigma, the final estimate (alignment.json) and the truth's
     attitude on the IMU time line (t_s) when given."""
     t = epochs["t_s"]
-    fig, axes = plt.subplots(3, 1, figsize=(10, 7), sharex=True)
-    for k, angle in enumerate(("roll_deg", "pitch_deg", "yaw_deg")):
-        value, sigma = epochs[angle], epochs["sigma_" + angle]
-        axes[k].plot(t, value, lw=0.8, label=angle)
-        axes[k].fill_between(t, value - sigma, value + sigma, alpha=0.3, label="1-sigma")
-        if alignment is not None and angle in alignment:
-            axes[k].axhline(alignment[angle], color="k", lw=0.6, ls="--", label="alignment.json")
-        if truth is not None and angle in truth.dtype.names and "t_s" in truth.dtype.names:
-            at = (truth["t_s"] >= t[0]) & (truth["t_s"] <= t[-1])
-            axes[k].plot(truth["t_s"][at], truth[angle][at], "k", lw=0.8, label="truth")
-        axes[k].set_ylabel(angle)
-        axes[k].grid(True, alpha=0.3)
-    axes[0].legend(fontsize=8)
-    axes[0].set_title("Stationary alignment (alignment.csv) with 1-sigma")
-    axes[-1].set_xlabel("IMU time t_s (s)")
-    page.add("alignment_attitude", "Alignment attitude with 1-sigma", fig)
+    _attitude_panels(page, "alignment_attitude", "Alignment attitude with 1-sigma",
+                     "Stationary alignment (alignment.csv) with 1-sigma; dashed: alignment.json", t,
+                     {angle: (epochs[angle], epochs["sigma_" + angle]) for angle in ANGLES},
+                     None if truth is None or "t_s" not in truth.dtype.names else (truth["t_s"], truth),
+                     "IMU time t_s (s)", alignment)
     biases = [c for c in epochs.dtype.names if c.startswith(("accel_bias_", "gyro_bias_"))]
     if biases:
         fig, axes = plt.subplots(2, 1, figsize=(10, 5), sharex=True)
