@@ -164,12 +164,15 @@ def artefacts(workdir):
 
 @pytest.fixture(scope="session")
 def sim(workdir):
-    """The session's simulation (SCENARIO): its summary dict, with "dir" and "input" (antenna 0's file)."""
+    """The session's simulation (SCENARIO): its summary dict, with "dir" and "input" (antenna 0's file). The sample
+    files are removed at the end of the session."""
     folder = os.path.join(workdir, "sim")
     result = ut.simulate(SCENARIO, folder)
     result["dir"] = folder
     result["input"] = result["sample_files"][0]
-    return result
+    yield result
+    for f in result["sample_files"]:  # 52 MB each; pytest keeps its last three session folders
+        os.remove(f)
 
 
 class Runs:
