@@ -65,16 +65,13 @@ py::list acquire(const py::object& input, const std::string& format, double fs_h
     samples.assign(array.data(), array.data() + array.size());
   } else {
     name = py::str(input).cast<std::string>();
-    const auto sample_format = signals::parse_sample_format(format);
-    if (!sample_format)
-      throw io::InputError("python", "format: unknown sample format '" + format + "' (" +
-                                         std::string(signals::sample_format_names()) + ")");
+    const signals::SampleFormat sample_format = sample_format_from_name(format);
     receiver::SampleSourceOptions source_options;
     source_options.fs_hz = fs_hz;
     source_options.if_hz = if_hz;
     source_options.iq_swap = iq_swap;
     source_options.q_negate = q_negate;
-    receiver::SampleSource source(name, *sample_format, source_options);
+    receiver::SampleSource source(name, sample_format, source_options);
     samples.resize(static_cast<std::size_t>(std::min<std::int64_t>(source.total_samples(), block * noncoherent)));
     if (source.read(samples).count != samples.size())
       throw io::InputError(name, "ended before the samples it reported");

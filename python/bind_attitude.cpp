@@ -19,10 +19,7 @@ namespace {
 
 py::dict attitude(const std::vector<std::string>& inputs, const std::string& format, double fs_hz, double if_hz,
                   const std::string& antennas_file, const std::string& nav, const std::string& out, py::dict options) {
-  const auto sample_format = signals::parse_sample_format(format);
-  if (!sample_format)
-    throw io::InputError("python", "format: unknown sample format '" + format + "' (" +
-                                       std::string(signals::sample_format_names()) + ")");
+  const signals::SampleFormat sample_format = sample_format_from_name(format);
   const config::AntennaConfig antennas = config::read_antenna_config(antennas_file);
   const auto n_ant = antennas.solver.array.lever_arm_body_m.size();
   if (inputs.size() != n_ant)
@@ -30,7 +27,7 @@ py::dict attitude(const std::vector<std::string>& inputs, const std::string& for
                                        std::to_string(n_ant) + " antennas of " + antennas_file);
   pipelines::AttitudeFileJob job;
   job.inputs.assign(inputs.begin(), inputs.end());
-  job.format = *sample_format;
+  job.format = sample_format;
   job.solver = antennas.solver;
   job.line_bias_cycles = antennas.line_bias_cycles;
   job.out = out;

@@ -28,11 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void require_file(const std::string& file, const char* what) {
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) throw io::InputError(file, std::string(what) + " file not found");
-}
-
 std::string fuse(const std::string& imu_file, const std::string& gnss_file, const std::string& out,
                  const std::string& truth_file, const std::string& filter, const std::string& align,
                  const std::string& config_file, const std::vector<std::pair<double, double>>& outages,

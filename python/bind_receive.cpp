@@ -130,11 +130,8 @@ py::dict receive(const std::string& input, const std::string& format, double fs_
   pipelines::ReceiveFileJob job;
   job.input = input;
   job.out = out;
-  const auto sample_format = signals::parse_sample_format(format);
-  if (!sample_format)
-    throw io::InputError("python", "format: unknown sample format '" + format + "' (" +
-                                       std::string(signals::sample_format_names()) + ")");
-  job.format = *sample_format;
+  const signals::SampleFormat sample_format = sample_format_from_name(format);
+  job.format = sample_format;
   receiver::SampleSourceOptions& source = job.source;
   std::string coding, order;
   if (take_option(options, "two_bit_coding", coding)) {

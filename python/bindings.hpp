@@ -12,6 +12,7 @@
 #include <string>
 
 #include "io/input_error.hpp"
+#include "signals/sample_format.hpp"
 
 namespace ultratrack::python {
 
@@ -22,6 +23,8 @@ void register_receive(py::module_& m);   // bind_receive.cpp: receive
 void register_acquire(py::module_& m);   // bind_acquire.cpp: acquire (file or numpy samples)
 void register_fuse(py::module_& m);      // bind_fuse.cpp: fuse
 void register_attitude(py::module_& m);  // bind_attitude.cpp: attitude
+void register_snapshot(py::module_& m);  // bind_snapshot.cpp: snapshot
+void register_align(py::module_& m);     // bind_align.cpp: align
 
 // Takes `key` out of `options` (so that what is left over are unknown names), converted to T; false when absent.
 template <typename T>
@@ -44,6 +47,12 @@ Enum enum_from_name(const std::string& option, const std::string& name, std::ini
   }
   throw io::InputError("python", option + " must be one of " + names + ", got '" + name + "'");
 }
+
+// The sample format named `format` (i8, i16, ...); otherwise an InputError ("python") that lists the names.
+signals::SampleFormat sample_format_from_name(const std::string& format);
+
+// An InputError naming `file` ("<what> file not found") unless it is a regular file.
+void require_file(const std::string& file, const char* what);
 
 // Raises TypeError naming the options left in `options` (none of `command`'s names).
 void reject_unknown_options(const py::dict& options, const std::string& command);

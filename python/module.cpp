@@ -3,10 +3,25 @@
 // io::InputError translated to ultratrack.InputError (a ValueError) with the same message.
 #include <pybind11/pybind11.h>
 
+#include <filesystem>
+
 #include "bindings.hpp"
 #include "io/input_error.hpp"
 
 namespace ultratrack::python {
+
+signals::SampleFormat sample_format_from_name(const std::string& format) {
+  const auto sample_format = signals::parse_sample_format(format);
+  if (!sample_format)
+    throw io::InputError("python", "format: unknown sample format '" + format + "' (" +
+                                       std::string(signals::sample_format_names()) + ")");
+  return *sample_format;
+}
+
+void require_file(const std::string& file, const char* what) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw io::InputError(file, std::string(what) + " file not found");
+}
 
 void reject_unknown_options(const py::dict& options, const std::string& command) {
   if (options.empty()) return;
@@ -42,4 +57,6 @@ PYBIND11_MODULE(_ultratrack, m) {
   up::register_acquire(m);
   up::register_fuse(m);
   up::register_attitude(m);
+  up::register_snapshot(m);
+  up::register_align(m);
 }

@@ -13,13 +13,15 @@ packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-
           libtomlplusplus-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev)
 # The test suite also runs RTKLIB (convbin, rnx2rtkp) on our RINEX output as an independent reader.
 # python3: ctest docs.file_map checks docs/architecture.md's module tables against the code; pybind11-dev,
-# python3-dev, python3-numpy and python3-matplotlib: the Python package (python/) and its tests (python.module).
+# python3-dev, python3-numpy and python3-matplotlib: the Python package (python/) and its report; python3-pytest and
+# chromium (headless: the report pages must render without a console error): its tests (python.module).
 # clang-format and clang-tidy: the conventions (tools/lint.sh; ctest lint.*).
 [[ "${1:-build}" == test || "${1:-build}" == lint ]] && packages+=(clang-format clang-tidy)
 # munge slurmctld slurmd slurm-client: ctest campaign.slurm_local runs campaigns on a real single-node Slurm
 # (tools/slurm-local.sh; about 11 s to install, 4 MB; not the slurm-wlm metapackage, whose recommends pull 31 plugins).
-[[ "${1:-build}" == test ]] && packages+=(rtklib python3 pybind11-dev python3-dev python3-numpy python3-matplotlib
-                                          munge slurmctld slurmd slurm-client)
+[[ "${1:-build}" == test ]] &&
+  packages+=(rtklib python3 pybind11-dev python3-dev python3-numpy python3-matplotlib python3-pytest chromium
+             munge slurmctld slurmd slurm-client)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Ultratrack from Python: the library's runs (simulate, receive, acquire, fuse, attitude) and readers that return
+"""Ultratrack from Python: the library's runs (simulate, receive, acquire, fuse, attitude, snapshot, align) and readers that return
 numpy structured arrays for the files a run writes (readers.py). Every run writes the same files as the
 `ultratrack` command of the same name with the same settings; option names are the command line's with
 underscores (--elevation-mask-deg -> elevation_mask_deg). Bad input raises ultratrack.InputError (a ValueError)
@@ -21,7 +21,7 @@ from ._ultratrack import InputError
 from .readers import *  # noqa: F401,F403  (read_solution, read_tracking, read_nav, ...)
 from .readers import __all__ as _reader_names
 
-__all__ = ["InputError", "simulate", "receive", "acquire", "fuse", "attitude"] + list(_reader_names)
+__all__ = ["InputError", "simulate", "receive", "acquire", "fuse", "attitude", "snapshot", "align"] + list(_reader_names)
 
 
 def _path(p):
@@ -128,3 +128,55 @@ def attitude(inputs, format, fs, antennas, out, if_hz=0.0, nav=None, **options):
     options: prn, threads, interval, duration, reference_week."""
     return _ultratrack._attitude([_path(p) for p in inputs], format, float(fs), float(if_hz), _path(antennas),
                                  _path(nav), _path(out), dict(options))
+
+
+def snapshot(input, nav, time, out, format=None, fs=None, if_hz=0.0, time_sigma_s=10.0, approx_llh=None, ms=100.0,
+             skip=0.0, prn=range(1, 33), doppler_max=5000.0, pfa=1e-3, spacing_chips=0.5, iq_swap=False,
+             q_negate=False):
+    """A position from a short recording (`ultratrack snapshot`): coarse-time navigation with the broadcast
+    ephemerides of `nav` and the approximate GPS time `time` = (week, tow_s) of the snapshot's first sample, into
+    out/snapshot.json and out/solution.csv. input: a file name with format, or a numpy array of samples (as for
+    receive). approx_llh: (lat_deg, lon_deg, height_m), else a Doppler fix and a grid search. Returns snapshot.json
+    as a dict (valid, failure, llh, satellites, ...); no fix is no exception (valid False, failure says why)."""
+    if fs is None:
+        raise TypeError("snapshot: fs (the sample rate, Hz) is required")
+    week, tow = time
+    llh = None if approx_llh is None else [float(v) for v in approx_llh]
+
+    def run(path, name, if_hz):
+        return _ultratrack._snapshot(path, name, float(fs), float(if_hz), _path(nav), int(week), float(tow), _path(out),
+                                     float(time_sigma_s), llh, float(ms), float(skip), [int(p) for p in prn],
+                                     float(doppler_max), float(pfa), float(spacing_chips), bool(iq_swap),
+                                     bool(q_negate))
+
+    if isinstance(input, _np.ndarray):
+        if if_hz:
+            raise InputError("python: samples given as an array are complex baseband: if_hz must be 0")
+        with _tempfile.TemporaryDirectory(prefix="ultratrack_samples_") as folder:
+            run(*_samples_file(input, folder), 0.0)
+    else:
+        if format is None:
+            raise TypeError("snapshot: format is required with a file input")
+        run(_path(input), format, if_hz)
+    result = read_snapshot(out)
+    result["out"] = _path(out)
+    return result
+
+
+def align(imu, attitude, out, position=None, attitude_origin=None, imu_pps=None, reference_attitude=None,
+          duration=100.0, filter_interval=1.0, config=None, filter="ekf"):
+    """Stationary fine alignment (`ultratrack align`) from an IMU CSV at rest and an attitude run's attitude.csv
+    into out/alignment.json and out/alignment.csv; returns alignment.json as a dict (roll_deg, sigma_roll_deg,
+    biases, mounting, warnings, ...). position: (lat_deg, lon_deg, height_m), else [initial] position_deg_m of
+    config; attitude_origin: (week, tow_s) of IMU t = 0; imu_pps: a PPS CSV that puts a local IMU clock on GPS time;
+    reference_attitude: (roll, pitch, yaw, sigma_roll, sigma_pitch, sigma_yaw) in deg, for the mounting estimate."""
+    summary = _ultratrack._align(_path(imu), _path(attitude), _path(out), _path(config),
+                                 None if position is None else [float(v) for v in position],
+                                 None if attitude_origin is None else (int(attitude_origin[0]),
+                                                                       float(attitude_origin[1])),
+                                 _path(imu_pps),
+                                 None if reference_attitude is None else [float(v) for v in reference_attitude],
+                                 float(duration), float(filter_interval), filter)
+    result = _json.loads(summary)
+    result["out"] = _path(out)
+    return result

@@ -16,7 +16,7 @@ from ._ultratrack import InputError
 
 __all__ = ["read_csv", "read_solution", "read_tracking", "read_nav", "read_vector", "read_vector_state",
            "read_ultratight", "read_attitude", "read_antenna_phases", "read_truth", "read_satellites", "read_imu",
-           "read_summary", "find_output"]
+           "read_summary", "read_snapshot", "read_alignment", "read_alignment_epochs", "read_sky", "find_output"]
 
 _INT = re.compile(r"^[+-]?\d+$")
 _SNIFF_ROWS = 500
@@ -139,9 +139,7 @@ def read_imu(path):
     return read_csv(find_output(path, "imu.csv"))
 
 
-def read_summary(path):
-    """summary.json of any run, as a dict."""
-    path = find_output(path, "summary.json", subfolders=())
+def _read_json(path):
     if not os.path.isfile(path):
         raise InputError(path + ": file not found")
     with open(path) as f:
@@ -149,3 +147,51 @@ def read_summary(path):
             return json.load(f)
         except ValueError as e:
             raise InputError("%s: %s" % (path, e))
+
+
+def read_summary(path):
+    """summary.json of any run, as a dict."""
+    return _read_json(find_output(path, "summary.json", subfolders=()))
+
+
+def read_snapshot(path):
+    """snapshot.json of a snapshot run, as a dict: input, approximate_time, valid, failure, llh, sigma, satellites
+    (each with prn, cn0_dbhz, doppler_hz, used, elevation_deg, azimuth_deg, residual_m when paired), ..."""
+    return _read_json(find_output(path, "snapshot.json", subfolders=()))
+
+
+def read_alignment(path):
+    """alignment.json of an align run, as a dict: roll/pitch/yaw_deg and their sigmas, biases, mounting, warnings."""
+    return _read_json(find_output(path, "alignment.json", subfolders=()))
+
+
+def read_alignment_epochs(path):
+    """alignment.csv of an align run, one row per filter epoch: t_s, attitude and its 1-sigma, NED velocity, bias
+    estimates, attitude_used."""
+    return read_csv(find_output(path, "alignment.csv", subfolders=()))
+
+
+_GSV_DTYPE = [("epoch", "i8"), ("prn", "i8"), ("elevation_deg", "f8"), ("azimuth_deg", "f8"), ("cn0_dbhz", "f8")]
+
+
+def read_sky(path):
+    """The satellites in view per fix from solution.nmea's GSV sentences (whole degrees, as NMEA writes them):
+    epoch (the fix's index, counted by GGA sentences), prn, elevation_deg, azimuth_deg, cn0_dbhz (nan when empty)."""
+    path = find_output(path, "solution.nmea")
+    if not os.path.isfile(path):
+        raise InputError(path + ": file not found")
+    rows, epoch = [], -1
+    with open(path, newline="") as f:
+        for number, line in enumerate(f, 1):
+            body = line.strip().split("*")[0]
+            if body.startswith("$GPGGA"):
+                epoch += 1
+            elif body.startswith("$GPGSV"):
+                fields = body.split(",")
+                try:
+                    for k in range(4, len(fields) - 3, 4):
+                        prn, el, az, cn0 = fields[k:k + 4]
+                        rows.append((epoch, int(prn), float(el), float(az), float(cn0) if cn0 else float("nan")))
+                except ValueError:
+                    raise InputError("%s:%d: malformed GSV sentence" % (path, number))
+    return np.array(rows, dtype=_GSV_DTYPE) if rows else np.zeros(0, dtype=_GSV_DTYPE)
