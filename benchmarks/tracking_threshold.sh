@@ -411,7 +411,7 @@ truth_file = os.path.join(os.path.dirname(sys.argv[2]), "runs_truth.csv")
 truth_runs = list(csv.DictReader(open(truth_file))) if os.path.exists(truth_file) else []
 if truth_runs:
     print("== common loss-of-lock rule (simulator truth: code <= 0.5 chip, 1 s mean frequency error <= 2.5 Hz, no gap)")
-    print("coupling        cn0_dbhz  runs  kept  lost(code/frequency/gap/end)  not_tracked  fraction_kept  wilson68")
+    print("coupling        cn0_dbhz  runs  kept  lost(code/frequency/gap/end)  not_tracked  kept_of_tracked  wilson68")
 for coupling in sorted({r["coupling"] for r in truth_runs}):
     runs = [r for r in truth_runs if r["coupling"] == coupling]
     table = []
@@ -420,12 +420,13 @@ for coupling in sorted({r["coupling"] for r in truth_runs}):
         kept = sum(r["outcome"] == "kept" for r in rs)
         lost = [r["reason"] for r in rs if r["outcome"] == "lost"]
         not_tracked = sum(r["outcome"] == "not_tracked" for r in rs)
-        f = kept / len(rs) if rs else float("nan")
-        lo, hi = wilson(kept, len(rs))
+        tracked = kept + len(lost)  # not_tracked left out, as not_acquired above
+        f = kept / tracked if tracked else float("nan")
+        lo, hi = wilson(kept, tracked)
         table.append((L, f, lo, hi))
         why = "/".join(str(lost.count(k)) for k in ("code", "frequency", "gap", "end"))
         print(f"{coupling or '-':14s}  {L:8.1f}  {len(rs):4d}  {kept:4d}  {len(lost):4d} ({why:>17s})  {not_tracked:11d}  "
-              f"{f:13.3f}  [{lo:.3f}, {hi:.3f}]")
+              f"{f:15.3f}  [{lo:.3f}, {hi:.3f}]")
     above = f"above {table[-1][0]:.1f}"  # the curve never stays >= 0.9 up to the highest level run
     print(f"{coupling or '-'}: 90 % threshold by the common rule: {crossing([(L, f) for L, f, _, _ in table]) or above} "
           f"dB-Hz; from the 68 % intervals: {crossing([(L, hi) for L, _, _, hi in table]) or above} .. "

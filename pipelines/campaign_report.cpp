@@ -12,6 +12,7 @@
 #include "pipelines/campaign_metrics.hpp"
 #include "pipelines/campaign_run.hpp"
 #include "pipelines/campaign_tables.hpp"
+#include "pipelines/truth_lock_rule.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
@@ -71,6 +72,39 @@ std::string crossing(const std::vector<std::pair<double, double>>& pts) {
   return "None";
 }
 
+// The same satellite-runs judged by the common rule (truth_lock_outcomes.csv), when the runs wrote it.
+std::string common_rule_table(const std::vector<const CompleteRun*>& members, const CampaignReduction& r) {
+  std::map<double, std::map<std::string, int>> count;  // level -> outcome or loss reason -> satellite-runs
+  for (const CompleteRun* run : members) {
+    const fs::path file = run->dir / "truth_lock_outcomes.csv";
+    const std::string* level = run->run->find(r.level);
+    if (!level || !fs::exists(file)) continue;
+    auto& c = count[number(*level, r.level)];
+    for (const TruthLockOutcome& o : read_truth_lock_outcomes_csv(file)) {
+      ++c[o.outcome];
+      ++c["runs"];
+      if (o.outcome == "lost") ++c[o.reason];
+    }
+  }
+  if (count.empty()) return "";
+  std::string out =
+      "common loss-of-lock rule (simulator truth: code <= 0.5 chip, 1 s mean frequency error <= 2.5 Hz, no gap)\n"
+      "cn0_dbhz  runs  kept  lost (code/frequency/gap/end)  not_tracked  kept_of_tracked  wilson68\n";
+  std::vector<std::pair<double, double>> curve, hi_curve, lo_curve;
+  for (auto& [L, c] : count) {
+    const int tracked = c["kept"] + c["lost"];  // not_tracked left out, as not_acquired above
+    const double f = tracked ? static_cast<double>(c["kept"]) / tracked : std::nan("");
+    const auto [lo, hi] = wilson_interval(c["kept"], tracked, 1.0);
+    curve.emplace_back(L, f), hi_curve.emplace_back(L, hi), lo_curve.emplace_back(L, lo);
+    out += fmt::format("{:8.1f}  {:4d}  {:4d}  {:4d} ({:>20})  {:11d}  {:15.3f}  [{:.3f}, {:.3f}]\n", L, c["runs"],
+                       c["kept"], c["lost"], fmt::format("{}/{}/{}/{}", c["code"], c["frequency"], c["gap"], c["end"]),
+                       c["not_tracked"], f, lo, hi);
+  }
+  out += fmt::format("90 % threshold by the common rule: {} dB-Hz; from the 68 % intervals: {} .. {}\n",
+                     crossing(curve), crossing(hi_curve), crossing(lo_curve));
+  return out;
+}
+
 std::string lock_threshold(const std::vector<CompleteRun>& runs, const CampaignReduction& r) {
   std::string out;
   for (const auto& [key, members] : split(runs, r.group)) {
@@ -117,6 +151,7 @@ std::string lock_threshold(const std::vector<CompleteRun>& runs, const CampaignR
     out +=
         fmt::format("90 % threshold, of locked satellites (lock kept): {} dB-Hz; from the 68 % intervals: {} .. {}\n",
                     crossing(g_curve), crossing(g_hi), crossing(g_lo));
+    out += common_rule_table(members, r);
   }
   return out;
 }

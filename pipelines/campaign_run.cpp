@@ -9,6 +9,7 @@
 #include "ins/imu_csv.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
+#include "pipelines/truth_lock_rule.hpp"
 #include "sim/simulation_files.hpp"
 
 namespace ultratrack::pipelines {
@@ -89,6 +90,17 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
   if (job.metrics.lock_outcomes)
     write_lock_outcomes_csv(run_dir / "lock_outcomes.csv", lock_outcomes(prns, run_dir / "rx" / "tracking.csv",
                                                                          duration_s, *job.metrics.lock_outcomes));
+  // The common rule beside the receiver's own (pipelines/truth_lock_rule.hpp), where the simulation wrote its truth.
+  const fs::path satellite_truth = run_dir / "sim" / "satellite_truth.csv";
+  if (job.metrics.lock_outcomes && job.scenario && fs::exists(satellite_truth) &&
+      fs::exists(run_dir / "rx" / "tracking.csv")) {
+    TruthLockOptions common;
+    const LockOutcomeOptions& own = *job.metrics.lock_outcomes;
+    common.from_s = own.strong_s > 0.0 ? own.strong_s : own.lock_deadline_s;
+    common.end_s = duration_s;
+    write_truth_lock_outcomes_csv(run_dir / "truth_lock_outcomes.csv",
+                                  truth_lock_outcomes(satellite_truth, run_dir / "rx" / "tracking.csv", common));
+  }
   if (job.metrics.nav_z_times_s && s.navigation_started) {
     if (truth.empty()) throw io::InputError("campaign", "nav z-scores need a truth file ([[recording]] truth)");
     write_nav_z_csv(run_dir / "nav_z.csv", nav_z_scores(run_dir / "rx" / "nav.csv", truth, *job.metrics.nav_z_times_s));

@@ -5,7 +5,8 @@
 //   parameters.csv    the run's parameters (name,value), written first
 //   sim/              the simulation's files (the IF sample file deleted after the receive unless kept)
 //   rx/               the receive's outputs
-//   lock_outcomes.csv, nav_z.csv   the metrics asked for ([compute] json scalars go into complete.csv)
+//   lock_outcomes.csv, nav_z.csv   the metrics asked for ([compute] json scalars go into complete.csv); with
+//                     lock_outcomes of a simulated run also truth_lock_outcomes.csv (pipelines/truth_lock_rule.hpp)
 //   complete.csv      the marker, written last (atomically, by rename): the run's scalars (name,value)
 //   failed.txt        instead of complete.csv when the run threw: the message (a failed run is redone on resume)
 // A run found complete is not redone; any other folder is cleared and run again.

@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "pipelines/truth_lock_rule.hpp"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <map>
 #include <stdexcept>
 
+#include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "io/named_csv.hpp"
 #include "signals/gps_constants.hpp"
@@ -168,6 +171,41 @@ std::vector<TruthLockOutcome> truth_lock_outcomes(const std::filesystem::path& s
     outcomes.push_back(o);
   }
   return outcomes;
+}
+
+std::string truth_lock_outcomes_text(const std::vector<TruthLockOutcome>& outcomes) {
+  std::string text = "prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records\n";
+  for (const TruthLockOutcome& o : outcomes)
+    text += fmt::format("{},{},{},{},{:.4f},{:.3f},{}\n", o.prn, o.outcome, o.reason,
+                        std::isnan(o.lost_s) ? std::string{} : fmt::format("{:.3f}", o.lost_s), o.max_code_error_chips,
+                        o.max_frequency_error_hz, o.records);
+  return text;
+}
+
+void write_truth_lock_outcomes_csv(const std::filesystem::path& file, const std::vector<TruthLockOutcome>& outcomes) {
+  io::write_file_atomically(file, truth_lock_outcomes_text(outcomes));
+}
+
+std::vector<TruthLockOutcome> read_truth_lock_outcomes_csv(const std::filesystem::path& file) {
+  const io::NamedCsv csv = io::read_named_csv(file);
+  const auto prn = csv.column("prn"), outcome = csv.column("outcome"), reason = csv.column("reason"),
+             lost = csv.column("lost_s"), code = csv.column("max_code_error_chips"),
+             frequency = csv.column("max_frequency_error_hz"), records = csv.column("records");
+  std::vector<TruthLockOutcome> out;
+  for (std::size_t i = 0; i < csv.rows.size(); ++i) {
+    TruthLockOutcome o;
+    o.prn = static_cast<int>(csv.number(i, prn));
+    o.outcome = csv.rows[i][outcome];
+    if (o.outcome != "kept" && o.outcome != "lost" && o.outcome != "not_tracked")
+      throw io::InputError(csv.file, "outcome '" + o.outcome + "' is not kept, lost or not_tracked", csv.lines[i]);
+    o.reason = csv.rows[i][reason];
+    if (!csv.rows[i][lost].empty()) o.lost_s = csv.number(i, lost);
+    o.max_code_error_chips = csv.number(i, code);
+    o.max_frequency_error_hz = csv.number(i, frequency);
+    o.records = static_cast<int>(csv.number(i, records));
+    out.push_back(o);
+  }
+  return out;
 }
 
 }  // namespace ultratrack::pipelines

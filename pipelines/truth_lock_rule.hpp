@@ -52,4 +52,10 @@ std::vector<TruthLockOutcome> truth_lock_outcomes(const std::filesystem::path& s
                                                   const std::filesystem::path& tracking_csv,
                                                   const TruthLockOptions& options);
 
+// truth_lock_outcomes.csv of a campaign run: prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,
+// records (lost_s empty unless lost), written atomically; the reader throws io::InputError naming the file.
+std::string truth_lock_outcomes_text(const std::vector<TruthLockOutcome>& outcomes);  // the CSV's text
+void write_truth_lock_outcomes_csv(const std::filesystem::path& file, const std::vector<TruthLockOutcome>& outcomes);
+std::vector<TruthLockOutcome> read_truth_lock_outcomes_csv(const std::filesystem::path& file);
+
 }  // namespace ultratrack::pipelines

@@ -8,7 +8,6 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <memory>
 #include <string>
 
@@ -37,11 +36,7 @@ void run_lock_rule(const CompareArgs& args) {
   options.frequency_error_hz = parse_double_option("--frequency-error-hz", args.frequency_error);
   if (std::string why; !options.IsValid(&why)) throw io::InputError("command line", why);
   const auto outcomes = pipelines::truth_lock_outcomes(args.satellite_truth, args.tracking, options);
-  fmt::print("prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records\n");
-  for (const auto& o : outcomes)
-    fmt::print("{},{},{},{},{:.4f},{:.3f},{}\n", o.prn, o.outcome, o.reason,
-               std::isnan(o.lost_s) ? std::string{} : fmt::format("{:.3f}", o.lost_s), o.max_code_error_chips,
-               o.max_frequency_error_hz, o.records);
+  fmt::print("{}", pipelines::truth_lock_outcomes_text(outcomes));
 }
 
 void run_compare(const CompareArgs& args) {

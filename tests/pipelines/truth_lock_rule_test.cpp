@@ -133,6 +133,29 @@ TEST(TruthLockRule, TighterBoundsLoseTheOffsetChannel) {
   EXPECT_EQ(truth_lock_outcomes(dir / "satellite_truth.csv", dir / "tracking.csv", options)[0].reason, "frequency");
 }
 
+TEST(TruthLockRule, OutcomesFileReadsBackAsWritten) {
+  const auto dir = test::scratch_dir();
+  write_files(dir, plan);
+  TruthLockOptions options;
+  options.from_s = 3.0;
+  const auto outcomes = truth_lock_outcomes(dir / "satellite_truth.csv", dir / "tracking.csv", options);
+  write_truth_lock_outcomes_csv(dir / "truth_lock_outcomes.csv", outcomes);
+  const auto back = read_truth_lock_outcomes_csv(dir / "truth_lock_outcomes.csv");
+  ASSERT_EQ(back.size(), outcomes.size());
+  for (std::size_t i = 0; i < back.size(); ++i) {
+    EXPECT_EQ(back[i].prn, outcomes[i].prn);
+    EXPECT_EQ(back[i].outcome, outcomes[i].outcome);
+    EXPECT_EQ(back[i].reason, outcomes[i].reason);
+    EXPECT_EQ(std::isnan(back[i].lost_s), std::isnan(outcomes[i].lost_s));
+    if (!std::isnan(back[i].lost_s)) EXPECT_NEAR(back[i].lost_s, outcomes[i].lost_s, 5e-4);
+    EXPECT_NEAR(back[i].max_code_error_chips, outcomes[i].max_code_error_chips, 5e-5);
+    EXPECT_EQ(back[i].records, outcomes[i].records);
+  }
+  std::ofstream(dir / "bad_outcome.csv")
+      << "prn,outcome,reason,lost_s,max_code_error_chips,max_frequency_error_hz,records\n3,maybe,,,0,0,1\n";
+  EXPECT_THROW(read_truth_lock_outcomes_csv(dir / "bad_outcome.csv"), io::InputError);
+}
+
 TEST(TruthLockRule, BadInputIsNamed) {
   const auto dir = test::scratch_dir();
   write_files(dir, plan);
