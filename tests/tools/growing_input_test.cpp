@@ -21,6 +21,7 @@
 #include <thread>
 #include <vector>
 
+#include "child_program.hpp"
 #include "ins/imu_csv.hpp"
 #include "io/input_error.hpp"
 #include "support/test_data.hpp"
@@ -30,12 +31,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-std::string read_text(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string read_text(const fs::path& f) { return ultratrack::test::read_text_file(f); }
 
 // IMU row k: t = k / 100 s, dtheta_x = k * 1e-7 rad (so that every value read can be checked against its row).
 std::string imu_row(long k) {
@@ -97,28 +93,8 @@ TEST(GrowingInput, ImuCsvAppendedWhileReadGivesTheWholeRowsOnly) {
   EXPECT_GT(last_n, 200u);  // rows appended before a read are read
 }
 
-struct Child {
-  pid_t pid = -1;
-  fs::path log;
-};
-
-Child start(const std::vector<std::string>& args, const fs::path& log) {
-  Child c{-1, log};
-  std::vector<std::string> argv_s{ULTRATRACK_PROGRAM};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  c.pid = fork();
-  if (c.pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return c;
-}
+using Child = ultratrack::test::ChildProgram;
+using ultratrack::test::start_program;
 
 // Waits for the first progress line of `receive` (the file is open and sized by then); false if it ended first.
 bool wait_for_progress(const Child& c) {
@@ -178,9 +154,9 @@ double summary_duration(const fs::path& summary) {
 TEST_F(GrowingRecording, AppendedWhileReceivedIsTakenAtItsSizeWhenOpened) {
   const fs::path dir = ultratrack::test::scratch_dir() / "growing_rx";
   const fs::path input = recording(dir, "grow.i8.bin");
-  const Child c = start({"receive", "--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--threads", "1",
-                         "--out", (dir / "rx").string()},
-                        dir / "log");
+  const Child c = start_program({"receive", "--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--threads",
+                                 "1", "--out", (dir / "rx").string()},
+                                dir / "log");
   if (!wait_for_progress(c)) return;
   {
     std::ofstream out(input, std::ios::app | std::ios::binary);
@@ -196,9 +172,9 @@ TEST_F(GrowingRecording, AppendedWhileReceivedIsTakenAtItsSizeWhenOpened) {
 TEST_F(GrowingRecording, ThatShrinksWhileReceivedIsOneErrorNamingIt) {
   const fs::path dir = ultratrack::test::scratch_dir() / "shrinking_rx";
   const fs::path input = recording(dir, "shrink.i8.bin");
-  const Child c = start({"receive", "--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--threads", "1",
-                         "--out", (dir / "rx").string()},
-                        dir / "log");
+  const Child c = start_program({"receive", "--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--threads",
+                                 "1", "--out", (dir / "rx").string()},
+                                dir / "log");
   if (!wait_for_progress(c)) return;
   fs::resize_file(input, 4096);
   const int status = wait_end(c);

@@ -24,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "child_program.hpp"
 #include "ins/imu_csv.hpp"
 #include "ins/imu_error_model.hpp"
 #include "io/units.hpp"
@@ -37,38 +38,10 @@ using namespace std::chrono_literals;
 
 namespace {
 
-std::string read_text(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+std::string read_text(const fs::path& f) { return ultratrack::test::read_text_file(f); }
 
-// A running `ultratrack ARGS...`, its stdout and stderr in `log`.
-struct Child {
-  pid_t pid = -1;
-  fs::path log;
-};
-
-Child start(const std::vector<std::string>& args, const fs::path& log) {
-  Child c{-1, log};
-  std::vector<std::string> argv_s{ULTRATRACK_PROGRAM};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  c.pid = fork();
-  if (c.pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    execv(argv[0], argv.data());
-    _exit(127);
-  }
-  return c;
-}
+using Child = ultratrack::test::ChildProgram;
+using ultratrack::test::start_program;
 
 // Waits (up to `timeout`) until `ready` holds; false if the child ended first or the time ran out.
 bool wait_until(const Child& c, const std::function<bool()>& ready, std::chrono::milliseconds timeout = 30s) {
@@ -294,7 +267,8 @@ TEST_P(Interrupt, Simulate) {
   const fs::path d = out("simulate");
   std::ofstream(d / "s.toml") << "[signal]\nsample_rate_hz = 2.6e6\nduration_s = 30.0\n[time]\ngps_week = 2190\n"
                                  "tow_s = 518400.0\n[navigation]\nconstellation = \"nominal\"\n";
-  const Child c = start({"simulate", "--scenario", (d / "s.toml").string(), "--out", (d / "o").string()}, d / "log");
+  const Child c =
+      start_program({"simulate", "--scenario", (d / "s.toml").string(), "--out", (d / "o").string()}, d / "log");
   if (!wait_until(c, [&] { return log_has(c, "s of signal"); })) return;
   expect_stopped_exit(stop(c, sig()), sig(), c);
   expect_complete_outputs(d / "o");
@@ -304,9 +278,9 @@ TEST_P(Interrupt, Simulate) {
 
 TEST_P(Interrupt, ReceiveScalar) {
   const fs::path d = out("receive");
-  const Child c = start({"receive", "--input", inputs().recording.string(), "--format", "i8", "--fs", "2.6e6",
-                         "--threads", "1", "--out", (d / "o").string()},
-                        d / "log");
+  const Child c = start_program({"receive", "--input", inputs().recording.string(), "--format", "i8", "--fs", "2.6e6",
+                                 "--threads", "1", "--out", (d / "o").string()},
+                                d / "log");
   if (!wait_until(c, [&] { return log_has(c, "tracking"); })) return;
   expect_stopped_exit(stop(c, sig()), sig(), c);
   expect_complete_outputs(d / "o");
@@ -315,10 +289,10 @@ TEST_P(Interrupt, ReceiveScalar) {
 
 TEST_P(Interrupt, ReceiveLooseCoupling) {
   const fs::path d = out("receive_loose");
-  const Child c =
-      start({"receive", "--input", inputs().recording.string(), "--format", "i8", "--fs", "2.6e6", "--threads", "1",
-             "--imu", (inputs().dir / "sim" / "imu.csv").string(), "--coupling", "loose", "--out", (d / "o").string()},
-            d / "log");
+  const Child c = start_program(
+      {"receive", "--input", inputs().recording.string(), "--format", "i8", "--fs", "2.6e6", "--threads", "1", "--imu",
+       (inputs().dir / "sim" / "imu.csv").string(), "--coupling", "loose", "--out", (d / "o").string()},
+      d / "log");
   if (!wait_until(c, [&] { return log_has(c, "tracking"); })) return;
   expect_stopped_exit(stop(c, sig()), sig(), c);
   expect_complete_outputs(d / "o");
@@ -327,9 +301,9 @@ TEST_P(Interrupt, ReceiveLooseCoupling) {
 
 TEST_P(Interrupt, Imusim) {
   const fs::path d = out("imusim");
-  const Child c = start({"imusim", "--profile", "land", "--duration", "100000", "--rate", "200", "--odometer", "--out",
-                         (d / "o").string()},
-                        d / "log");
+  const Child c = start_program({"imusim", "--profile", "land", "--duration", "100000", "--rate", "200", "--odometer",
+                                 "--out", (d / "o").string()},
+                                d / "log");
   if (!wait_until(c, [&] { return fs::exists(d / "o" / "imu.csv.partial"); })) return;
   std::this_thread::sleep_for(100ms);
   expect_stopped_exit(stop(c, sig()), sig(), c);
@@ -339,7 +313,7 @@ TEST_P(Interrupt, Imusim) {
 
 TEST_P(Interrupt, Ins) {
   const fs::path d = out("ins");
-  const Child c = start(
+  const Child c = start_program(
       {"ins", "--imu", inputs().imu_long.string(), "--init", inputs().truth_long.string(), "--out", (d / "o").string()},
       d / "log");
   if (!wait_until(c, [&] { return fs::exists(d / "o"); })) return;
@@ -350,9 +324,10 @@ TEST_P(Interrupt, Ins) {
 
 TEST_P(Interrupt, Fuse) {
   const fs::path d = out("fuse");
-  const Child c = start({"fuse", "--imu", inputs().imu_long.string(), "--gnss", inputs().gnss_long.string(), "--align",
-                         "motion", "--truth", inputs().truth_long.string(), "--out", (d / "o").string()},
-                        d / "log");
+  const Child c =
+      start_program({"fuse", "--imu", inputs().imu_long.string(), "--gnss", inputs().gnss_long.string(), "--align",
+                     "motion", "--truth", inputs().truth_long.string(), "--out", (d / "o").string()},
+                    d / "log");
   if (!wait_until(c, [&] { return fs::exists(d / "o" / "nav.csv.partial"); })) return;
   std::this_thread::sleep_for(100ms);
   expect_stopped_exit(stop(c, sig()), sig(), c);
@@ -368,10 +343,10 @@ TEST_P(Interrupt, Attitude) {
                                  "[[antenna]]\nlever_arm_body_m = [1.0, 0.0, 0.0]\n"
                                  "[[antenna]]\nlever_arm_body_m = [0.0, 1.0, 0.0]\n";
   const std::string a0 = (sim / "antenna0.i8.bin").string();
-  const Child c =
-      start({"attitude", "--input", a0, a0, a0, "--format", "i8", "--fs", "2.6e6", "--antennas",
-             (d / "a.toml").string(), "--reference-week", "2190", "--threads", "1", "--out", (d / "o").string()},
-            d / "log");
+  const Child c = start_program(
+      {"attitude", "--input", a0, a0, a0, "--format", "i8", "--fs", "2.6e6", "--antennas", (d / "a.toml").string(),
+       "--reference-week", "2190", "--threads", "1", "--out", (d / "o").string()},
+      d / "log");
   if (!wait_until(c, [&] { return fs::exists(d / "o"); })) return;
   std::this_thread::sleep_for(200ms);
   expect_stopped_exit(stop(c, sig()), sig(), c);
@@ -386,7 +361,7 @@ TEST_P(Interrupt, CampaignRunLocal) {
                                  "[navigation]\nconstellation = \"nominal\"\n";
   std::ofstream(d / "c.toml") << "[campaign]\nname = \"stop\"\n[[axis]]\nname = \"seed\"\nvalues = [7]\n"
                                  "[simulate]\nscenario = \"s.toml\"\n[receive]\ncoupling = \"scalar\"\n";
-  const Child c = start(
+  const Child c = start_program(
       {"campaign", "run", (d / "c.toml").string(), "--out", (d / "o").string(), "--engine", "local", "--jobs", "1"},
       d / "log");
   if (!wait_until(c, [&] { return fs::exists(d / "o" / "runs" / "0000"); })) return;
@@ -399,9 +374,9 @@ TEST_P(Interrupt, CampaignRunLocal) {
 // gnsssim writes its one file at the end: stopped mid-run it leaves nothing, or the whole file.
 TEST_P(Interrupt, Gnsssim) {
   const fs::path d = out("gnsssim");
-  const Child c =
-      start({"gnsssim", "--truth", inputs().truth_long.string(), "--rate", "100", "--out", (d / "gnss.csv").string()},
-            d / "log");
+  const Child c = start_program(
+      {"gnsssim", "--truth", inputs().truth_long.string(), "--rate", "100", "--out", (d / "gnss.csv").string()},
+      d / "log");
   std::this_thread::sleep_for(20ms);
   const int status = stop(c, sig());
   EXPECT_TRUE((WIFSIGNALED(status) && WTERMSIG(status) == sig()) ||
@@ -436,11 +411,11 @@ TEST_P(Interrupt, Align) {
                        g.euler_a.roll_rad / kDeg, g.euler_a.pitch_rad / kDeg, g.euler_a.yaw_rad / kDeg);
     return dir;
   }();
-  const Child c =
-      start({"align", "--imu", (inputs_dir / "imu.csv").string(), "--attitude", (inputs_dir / "attitude.csv").string(),
-             "--attitude-origin", "2190", "518400", "--position", "36.37", "127.36", "80", "--duration", "0",
-             "--filter-interval", "0.01", "--out", (d / "o").string()},
-            d / "log");
+  const Child c = start_program(
+      {"align", "--imu", (inputs_dir / "imu.csv").string(), "--attitude", (inputs_dir / "attitude.csv").string(),
+       "--attitude-origin", "2190", "518400", "--position", "36.37", "127.36", "80", "--duration", "0",
+       "--filter-interval", "0.01", "--out", (d / "o").string()},
+      d / "log");
   std::this_thread::sleep_for(300ms);  // its progress lines are buffered (stdout to a file): a fixed wait
   int status = 0;
   ASSERT_EQ(waitpid(c.pid, &status, WNOHANG), 0) << "align ended before the signal:\n" << read_text(c.log);
@@ -461,9 +436,9 @@ TEST_P(Interrupt, Snapshot) {
   nav.utc = constellation.utc;
   ultratrack::signals::write_rinex_nav_304(d / "nominal.rnx", nav);
   const Child c =
-      start({"snapshot", "--input", inputs().recording.string(), "--format", "i8", "--fs", "2.6e6", "--nav",
-             (d / "nominal.rnx").string(), "--time", "2190:518400", "--ms", "100", "--out", (d / "o").string()},
-            d / "log");
+      start_program({"snapshot", "--input", inputs().recording.string(), "--format", "i8", "--fs", "2.6e6", "--nav",
+                     (d / "nominal.rnx").string(), "--time", "2190:518400", "--ms", "100", "--out", (d / "o").string()},
+                    d / "log");
   std::this_thread::sleep_for(300ms);
   int status = 0;
   ASSERT_EQ(waitpid(c.pid, &status, WNOHANG), 0) << "snapshot ended before the signal:\n" << read_text(c.log);
