@@ -8,8 +8,12 @@
 
 #include <csignal>
 #include <filesystem>
+#include <functional>
 #include <string>
+#include <system_error>
 #include <vector>
+
+#include "support/test_data.hpp"
 
 namespace ultratrack::test {
 
@@ -37,6 +41,28 @@ inline ChildProgram start_program(const std::vector<std::string>& args, const st
     _exit(127);
   }
   return c;
+}
+
+// A folder of inputs that `make` fills once per build of the program and that every test process then shares (ctest
+// runs each test in its own process): made under a temporary name and renamed, so that two processes making it at
+// once both end with one whole folder. Older builds' folders of that name are removed. Call from SetUpTestSuite.
+inline std::filesystem::path shared_inputs(const std::string& name,
+                                           const std::function<void(const std::filesystem::path&)>& make) {
+  namespace fs = std::filesystem;
+  const fs::path root = scratch_dir().parent_path();
+  const auto build = fs::last_write_time(ULTRATRACK_PROGRAM).time_since_epoch().count();
+  const fs::path dir = root / (name + ".inputs." + std::to_string(build));
+  if (fs::exists(dir)) return dir;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(root, ec))
+    if (e.path().filename().string().rfind(name + ".inputs.", 0) == 0) fs::remove_all(e.path(), ec);
+  const fs::path making = root / (name + ".making." + std::to_string(getpid()));
+  fs::remove_all(making);
+  fs::create_directories(making);
+  make(making);
+  fs::rename(making, dir, ec);
+  if (ec) fs::remove_all(making);  // another process made it first
+  return dir;
 }
 
 }  // namespace ultratrack::test

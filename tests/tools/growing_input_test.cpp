@@ -124,18 +124,20 @@ int wait_end(const Child& c) {
 }
 
 // 8 s of the nominal constellation at 2.6 MHz, i8 (41.6 MB).
-// Copied as dir/name. Made once in the suite's folder (scratch_dir() outside a test; removed at exit).
+// Copied as dir/name. Made once per build of the program, shared by the test processes.
 fs::path recording(const fs::path& dir, const std::string& name) {
-  static const fs::path made = [] {
-    const fs::path d = ultratrack::test::scratch_dir() / "growing_sim";
-    fs::create_directories(d);
-    std::ofstream(d / "s.toml") << "[signal]\nsample_rate_hz = 2.6e6\nduration_s = 8.0\n[time]\ngps_week = 2190\n"
-                                   "tow_s = 518400.0\n[navigation]\nconstellation = \"nominal\"\n";
-    const std::string cmd = std::string(ULTRATRACK_PROGRAM) + " simulate --quiet --scenario " +
-                            (d / "s.toml").string() + " --out " + (d / "o").string() + " > /dev/null 2>&1";
-    EXPECT_EQ(std::system(cmd.c_str()), 0);
-    return d / "o" / "antenna0.i8.bin";
-  }();
+  static const fs::path made =
+      ultratrack::test::shared_inputs(
+          "growing_input",
+          [](const fs::path& d) {
+            std::ofstream(d / "s.toml")
+                << "[signal]\nsample_rate_hz = 2.6e6\nduration_s = 8.0\n[time]\ngps_week = 2190\n"
+                   "tow_s = 518400.0\n[navigation]\nconstellation = \"nominal\"\n";
+            const std::string cmd = std::string(ULTRATRACK_PROGRAM) + " simulate --quiet --scenario " +
+                                    (d / "s.toml").string() + " --out " + (d / "o").string() + " > /dev/null 2>&1";
+            EXPECT_EQ(std::system(cmd.c_str()), 0);
+          }) /
+      "o" / "antenna0.i8.bin";
   if (name.empty()) return made;
   fs::create_directories(dir);
   fs::copy_file(made, dir / name, fs::copy_options::overwrite_existing);

@@ -227,24 +227,46 @@ struct Inputs {
   fs::path gnss_long;             // gnsssim at 1 Hz on it
 };
 
+// Made once per build of the program, shared by every test process (ctest runs each test alone).
+void make_inputs(const fs::path& dir) {
+  std::ofstream(dir / "s.toml") << "[signal]\nsample_rate_hz = 2.6e6\nduration_s = 8.0\n[time]\ngps_week = 2190\n"
+                                   "tow_s = 518400.0\n[navigation]\nconstellation = \"nominal\"\n"
+                                   "[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
+                                   "[trajectory]\nprofile = \"static\"\nduration_s = 8.0\nimu_rate_hz = 100.0\n"
+                                   "[imu]\npreset = \"hg1700ae\"\n";
+  run_program({"simulate", "--quiet", "--scenario", (dir / "s.toml").string(), "--out", (dir / "sim").string()});
+  run_program({"imusim", "--profile", "circle", "--duration", "1200", "--rate", "100", "--preset", "hg1700ae", "--out",
+               (dir / "imu").string()});
+  run_program({"gnsssim", "--truth", (dir / "imu" / "truth.csv").string(), "--rate", "1", "--out",
+               (dir / "gnss.csv").string()});
+  // align: 600 s at rest with GPS attitude at 10 Hz
+  namespace pl = ultratrack::pipelines;
+  constexpr double kDeg = ultratrack::io::kRadPerDeg;
+  pl::StationaryScenario sc;
+  sc.attitude = {2.0 * kDeg, -3.0 * kDeg, 35.0 * kDeg};
+  sc.lat_rad = 36.37 * kDeg;
+  sc.height_m = 80.0;
+  sc.duration_s = 600.0;
+  sc.gps_sigma_euler_rad = Eigen::Vector3d(0.3, 0.3, 0.1) * kDeg;
+  sc.imu = ultratrack::ins::imu_preset("hg1700ae");
+  const pl::StationaryInputs in = pl::simulate_stationary_inputs(sc, 3);
+  fs::create_directories(dir / "align");
+  ultratrack::ins::write_imu_csv(dir / "align" / "imu.csv", in.imu);
+  std::ofstream a(dir / "align" / "attitude.csv");
+  a << "gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,fixed,ratio\n";
+  for (const auto& g : in.gps)
+    a << fmt::format("2190,{:.3f},{:.6f},{:.6f},{:.6f},0.3,0.3,0.1,9,1,8.5\n", 518400.0 + g.t_s,
+                     g.euler_a.roll_rad / kDeg, g.euler_a.pitch_rad / kDeg, g.euler_a.yaw_rad / kDeg);
+}
+
 const Inputs& inputs() {
   static const Inputs in = [] {
     Inputs r;
-    r.dir = ultratrack::test::scratch_dir() / "interrupt_inputs";
-    fs::create_directories(r.dir);
-    std::ofstream(r.dir / "s.toml") << "[signal]\nsample_rate_hz = 2.6e6\nduration_s = 8.0\n[time]\ngps_week = 2190\n"
-                                       "tow_s = 518400.0\n[navigation]\nconstellation = \"nominal\"\n"
-                                       "[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n"
-                                       "[trajectory]\nprofile = \"static\"\nduration_s = 8.0\nimu_rate_hz = 100.0\n"
-                                       "[imu]\npreset = \"hg1700ae\"\n";
-    run_program({"simulate", "--quiet", "--scenario", (r.dir / "s.toml").string(), "--out", (r.dir / "sim").string()});
+    r.dir = ultratrack::test::shared_inputs("interrupt_commands", make_inputs);
     r.recording = r.dir / "sim" / "antenna0.i8.bin";
-    run_program({"imusim", "--profile", "circle", "--duration", "1200", "--rate", "100", "--preset", "hg1700ae",
-                 "--out", (r.dir / "imu").string()});
     r.imu_long = r.dir / "imu" / "imu.csv";
     r.truth_long = r.dir / "imu" / "truth.csv";
     r.gnss_long = r.dir / "gnss.csv";
-    run_program({"gnsssim", "--truth", r.truth_long.string(), "--rate", "1", "--out", r.gnss_long.string()});
     return r;
   }();
   return in;
@@ -253,7 +275,6 @@ const Inputs& inputs() {
 class Interrupt : public ::testing::TestWithParam<int> {
  protected:
   int sig() const { return GetParam(); }
-  // The inputs are made once, in the suite's folder (scratch_dir() outside a test; removed at exit).
   static void SetUpTestSuite() { inputs(); }
   fs::path out(const std::string& name) const {
     const fs::path d = ultratrack::test::scratch_dir() / (name + "_" + std::to_string(sig()));
@@ -389,28 +410,7 @@ TEST_P(Interrupt, Gnsssim) {
 // the writes, with both files whole).
 TEST_P(Interrupt, Align) {
   const fs::path d = out("align");
-  namespace pl = ultratrack::pipelines;
-  static constexpr double kDeg = ultratrack::io::kRadPerDeg;
-  static const fs::path inputs_dir = [] {  // made once for both signals: 600 s at rest, attitude at 10 Hz
-    const fs::path dir = inputs().dir / "align";
-    fs::create_directories(dir);
-    pl::StationaryScenario sc;
-    sc.attitude = {2.0 * kDeg, -3.0 * kDeg, 35.0 * kDeg};
-    sc.lat_rad = 36.37 * kDeg;
-    sc.height_m = 80.0;
-    sc.duration_s = 600.0;
-    sc.gps_sigma_euler_rad = Eigen::Vector3d(0.3, 0.3, 0.1) * kDeg;
-    sc.imu = ultratrack::ins::imu_preset("hg1700ae");
-    const pl::StationaryInputs in = pl::simulate_stationary_inputs(sc, 3);
-    ultratrack::ins::write_imu_csv(dir / "imu.csv", in.imu);
-    std::ofstream a(dir / "attitude.csv");
-    a << "gps_week,tow_s,roll_deg,pitch_deg,yaw_deg,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg,num_sats,fixed,"
-         "ratio\n";
-    for (const auto& g : in.gps)
-      a << fmt::format("2190,{:.3f},{:.6f},{:.6f},{:.6f},0.3,0.3,0.1,9,1,8.5\n", 518400.0 + g.t_s,
-                       g.euler_a.roll_rad / kDeg, g.euler_a.pitch_rad / kDeg, g.euler_a.yaw_rad / kDeg);
-    return dir;
-  }();
+  const fs::path inputs_dir = inputs().dir / "align";
   const Child c = start_program(
       {"align", "--imu", (inputs_dir / "imu.csv").string(), "--attitude", (inputs_dir / "attitude.csv").string(),
        "--attitude-origin", "2190", "518400", "--position", "36.37", "127.36", "80", "--duration", "0",
