@@ -2,8 +2,11 @@
 #include "io/numeric_csv.hpp"
 
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <fstream>
+#include <sstream>
+#include <system_error>
 
 #include "io/input_error.hpp"
 
@@ -70,11 +73,42 @@ std::optional<double> parse_csv_number(const std::string& file, int line, std::s
   return v;
 }
 
+namespace {
+
+// The file as it is when opened: its bytes up to the size read then; a file that shrinks meanwhile is an error. A
+// last line without its newline is left out while the file is being written (it grew while read, or changed less
+// than 2 s ago: a logger may pause mid-line for a buffer's worth of rows), since its cut may fall inside a number.
+// A finished file without a final newline keeps its last row.
+std::string csv_snapshot(const std::filesystem::path& file, std::string_view what) {
+  const std::string name = file.string();
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(name, "cannot open " + std::string(what));
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  if (ec) throw InputError(name, "cannot read the size of the " + std::string(what) + ": " + ec.message());
+  std::string text(size, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(size));
+  if (in.gcount() != static_cast<std::streamsize>(size))
+    throw InputError(name, std::string(what) + " shrank while being read (" + std::to_string(in.gcount()) + " of " +
+                               std::to_string(size) + " bytes)");
+  if (!text.empty() && text.back() != '\n') {
+    const bool grew = std::filesystem::file_size(file, ec) > size && !ec;
+    const auto modified = std::filesystem::last_write_time(file, ec);
+    const bool recent = !ec && std::filesystem::file_time_type::clock::now() - modified < std::chrono::seconds(2);
+    if (grew || recent) {
+      const auto last_newline = text.find_last_of('\n');
+      text.erase(last_newline == std::string::npos ? 0 : last_newline + 1);
+    }
+  }
+  return text;
+}
+
+}  // namespace
+
 int read_csv_rows(const std::filesystem::path& file, std::string_view what, const std::vector<std::string>& columns,
                   const CsvFieldsHandler& row) {
   const std::string name = file.string();
-  std::ifstream in(file);
-  if (!in) throw InputError(name, "cannot open " + std::string(what));
+  std::istringstream in(csv_snapshot(file, what));
   std::vector<std::string_view> fields(columns.size());
   std::string line;
   int line_no = 0, rows = 0;

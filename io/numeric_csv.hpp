@@ -2,6 +2,9 @@
 // Strict reading of numeric CSV files (IMU increments, navigation/truth rows, trajectories, segments):
 // a header row naming the columns, then rows of exactly that many finite numbers. Blank lines and lines
 // starting with '#' are skipped; anything else that is wrong is an InputError naming the file and line.
+// A file is read as it is when opened (its size then): rows appended meanwhile are not read, a last line without its
+// newline is left out while the file is being written (it grew while read or changed in the last 2 s), and a file
+// that shrinks meanwhile is an InputError.
 #pragma once
 
 #include <filesystem>

@@ -341,7 +341,11 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     if (result.odometer) result.odometer->estimate = out.odometer;
   };
   emit(integration.output());
-  for (; k < imu.size() && !stop.stop_requested(); ++k) {
+  for (; k < imu.size(); ++k) {
+    if (stop.stop_requested()) {
+      result.interrupted = true;
+      break;
+    }
     while (g < gnss.size() && gnss[g].t_s <= imu[k].t_s) {
       const GnssFixRow& r = gnss[g++];
       if (in_outage(s, r.t_s)) {

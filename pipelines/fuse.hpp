@@ -107,6 +107,7 @@ struct FuseResult {
   AttitudeUse attitude;
   long long fixes_after_gnss_until = 0;
   std::optional<OdometerUse> odometer;  // with odometer rows
+  bool interrupted = false;             // a stop request ended the run before the last IMU row
 };
 
 // The odometer rows as speed windows of about window_s (whole rows; each window ends at a row's time): what fuse

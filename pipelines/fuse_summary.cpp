@@ -65,6 +65,7 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   j += fmt::format("  \"imu_file\": \"{}\",\n  \"gnss_file\": \"{}\",\n", io::json_escape(imu_file),
                    io::json_escape(gnss_file));
   if (!truth_file.empty()) j += fmt::format("  \"truth_file\": \"{}\",\n", io::json_escape(truth_file));
+  if (r.interrupted) j += "  \"interrupted\": true,\n";  // the rows up to the stop; absent from a complete run
   j += fmt::format(
       "  \"coupling\": \"loose\",\n  \"filter\": \"{}\",\n  \"align\": \"{}\",\n  \"imu_preset\": \"{}\",\n",
       s.filter == fusion::FilterKind::Ekf ? "ekf" : "ukf", align, s.config.imu_preset);

@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "config/fuse_config_toml.hpp"
 #include "ins/imu_csv.hpp"
+#include "interrupt_guard.hpp"
 #include "io/atomic_file.hpp"
 #include "io/input_error.hpp"
 #include "io/units.hpp"
@@ -81,6 +82,9 @@ void run_align_command(const AlignCommandOptions& o) {
                imu.back().t_s, attitude.size(), o.filter, o.duration_s);
 
   const pipelines::AlignRunResult r = pipelines::run_alignment(imu, attitude, s);
+  // The filter runs in memory: a signal before here ends the program with nothing written; from here it waits
+  // until both files are complete (the exit status then says the run was stopped).
+  const InterruptGuard writing;
   fs::create_directories(o.out_dir);
   io::write_file_atomically(fs::path(o.out_dir) / "alignment.csv", pipelines::alignment_csv(r));
   io::write_file_atomically(fs::path(o.out_dir) / "alignment.json", pipelines::alignment_json(r, s));

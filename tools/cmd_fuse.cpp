@@ -113,11 +113,11 @@ void run_fuse_command(const FuseCommandOptions& o) {
                imu.front().t_s, imu.back().t_s, gnss.size(), gnss.empty() ? 0.0 : gnss.front().t_s,
                gnss.empty() ? 0.0 : gnss.back().t_s, o.filter, o.align);
 
+  InterruptGuard interrupt;  // Ctrl-C ends the run early; nav.csv and summary.json cover it so far
   fs::create_directories(o.out_dir);
   pipelines::FusedNavCsvWriter nav(fs::path(o.out_dir) / "nav.csv");
   long long rows = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  InterruptGuard interrupt;  // Ctrl-C ends the run early; nav.csv and summary.json cover it so far
   const pipelines::FuseResult r = [&] {
     try {
       return pipelines::fuse(

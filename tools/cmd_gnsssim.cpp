@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "interrupt_guard.hpp"
 #include "io/input_error.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
 #include "pipelines/gnss_fix_simulation.hpp"
@@ -44,6 +45,7 @@ void run_gnsssim(const GnssSimOptions& o) {
   const ins::TruthInterpolator truth(pipelines::truth_samples_from_nav(nav));
   const auto fixes = pipelines::simulate_gnss_fixes(truth, s);
   if (fixes.empty()) throw io::InputError(o.truth_file, "no fix time falls inside the truth span");
+  const InterruptGuard writing;  // a signal during the write waits for the whole file (no .partial left)
   pipelines::write_gnss_csv(o.out_file, fixes);
   fmt::print("gnsssim: {} fixes at {} Hz from {:.3f} s to {:.3f} s; wrote {}\n", fixes.size(), o.rate_hz,
              fixes.front().t_s, fixes.back().t_s, o.out_file);

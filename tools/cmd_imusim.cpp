@@ -66,6 +66,7 @@ void run_imusim(const ImuSimOptions& o) {
   }
   const ins::ImuErrorSpec error_spec = ins::imu_preset(o.preset);
 
+  InterruptGuard interrupt;  // Ctrl-C ends the run; imu.csv and truth.csv hold the trajectory so far
   fs::create_directories(o.out_dir);
   ins::NavCsvWriter truth_out(fs::path(o.out_dir) / "truth.csv");
   ins::ImuCsvWriter imu_out(fs::path(o.out_dir) / "imu.csv");
@@ -77,7 +78,6 @@ void run_imusim(const ImuSimOptions& o) {
     if (o.odometer) truth_for_odometer.push_back(t);
   };
   callbacks.on_progress = [](int percent) { fmt::print(stderr, "imusim: IMU {}%\n", percent); };
-  InterruptGuard interrupt;  // Ctrl-C ends the run; imu.csv and truth.csv hold the trajectory so far
   const sim::ImuSimulationResult r =
       sim::simulate_imu(spec, o.rate_hz, error_spec, o.seed, callbacks, interrupt.token());
   imu_out.commit();

@@ -113,6 +113,7 @@ void run_ins(const InsOptions& o) {
     first = end;
   }
 
+  InterruptGuard interrupt;  // Ctrl-C ends the run; nav.csv and summary.json cover it so far (no .partial left)
   fs::create_directories(o.out_dir);
   ins::Strapdown nav(init);
   if (o.aid_height) nav.set_height_aiding(init.height_m);
@@ -129,7 +130,6 @@ void run_ins(const InsOptions& o) {
   const double nominal_dt = imu.size() > first + 1 ? imu[first + 1].t_s - imu[first].t_s : 0.0;
   const auto t_start = std::chrono::steady_clock::now();
   std::size_t steps = 0;
-  InterruptGuard interrupt;  // Ctrl-C ends the run; nav.csv and summary.json cover it so far
   for (std::size_t k = first; k < imu.size() && !interrupt.interrupted(); ++k) {
     const double dt = imu[k].t_s - nav.state().t_s;
     if (nominal_dt > 0.0 && dt > 3.0 * nominal_dt) nav.reset_history();  // data gap: no coning history across it

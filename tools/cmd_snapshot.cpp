@@ -19,6 +19,7 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "format_options.hpp"
+#include "interrupt_guard.hpp"
 #include "io/units.hpp"
 #include "io/why_invalid.hpp"
 #include "pipelines/snapshot_file.hpp"
@@ -97,6 +98,9 @@ void run_snapshot(const SnapshotArgs& args) {
     fmt::print(stderr, "ultratrack snapshot: {} holds {:.1f} ms; using all of it instead of {:g} ms\n", args.input,
                result.used_ms, job.snapshot_ms);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  // The search runs in memory: a signal before here ends the program with nothing written; from here it waits
+  // until both files are complete (the exit status then says the run was stopped).
+  const InterruptGuard writing;
   pipelines::write_snapshot_outputs(args.out, job, result, args.format.format, wall_s);
   const receiver::SnapshotSolution& solution = result.solution;
   if (!solution.valid) throw CommandExit(3, "ultratrack snapshot: no fix: " + solution.failure);

@@ -17,8 +17,12 @@ namespace {
 // is, waits on it and requests a stop on every live guard's source.
 sem_t g_posted;
 volatile std::sig_atomic_t g_closing = 0;
+volatile std::sig_atomic_t g_signal = 0;  // the last SIGINT/SIGTERM a guard caught
 
-extern "C" void ultratrack_interrupt_guard_sigint(int) { sem_post(&g_posted); }
+extern "C" void ultratrack_interrupt_guard_sigint(int sig) {
+  g_signal = sig;
+  sem_post(&g_posted);
+}
 
 struct Registry {
   std::mutex mutex;
@@ -45,6 +49,8 @@ void watch() {
 }
 
 }  // namespace
+
+int interrupt_signal() { return g_signal; }
 
 InterruptGuard::InterruptGuard() {
   Registry& r = registry();

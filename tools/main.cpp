@@ -4,13 +4,28 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "ins/ins_error.hpp"
+#include "interrupt_guard.hpp"
 #include "io/input_error.hpp"
+
+namespace {
+
+// A command a signal stopped has finished its outputs up to the stop; its exit status says it was stopped.
+int stopped_or(int code) {
+  const int sig = ultratrack::tools::interrupt_signal();
+  if (sig == 0) return code;
+  fmt::print(stderr, "ultratrack: stopped by {}; the outputs cover the run up to the stop\n",
+             sig == SIGINT ? "SIGINT" : "SIGTERM");
+  return 128 + sig;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"ultratrack: GPS L1 C/A software receiver with inertial aiding"};
@@ -23,7 +38,7 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const ultratrack::tools::CommandExit& e) {
     fmt::print(stderr, "ultratrack: {}\n", e.what());
-    return e.code;
+    return stopped_or(e.code);
   } catch (const ultratrack::io::InputError& e) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 2;
@@ -31,5 +46,5 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "ultratrack: error: {}\n", e.what());
     return 1;
   }
-  return 0;
+  return stopped_or(0);
 }
