@@ -356,7 +356,7 @@ void read_navigation_key(const Reader& r, const std::string& key, const std::str
   } else if (key == "field_rounding") {
     const std::string v = r.string(n, name);
     if (v != "nearest" && v != "toward_zero") r.fail(n, name, "must be \"nearest\" or \"toward_zero\"");
-    s.nav_field_rounding = v == "nearest" ? signals::FieldRounding::nearest : signals::FieldRounding::toward_zero;
+    s.nav_field_rounding = v == "nearest" ? signals::FieldRounding::kNearest : signals::FieldRounding::kTowardZero;
   } else if (key == "pages") {
     const std::string v = r.string(n, name);
     if (v != "almanac" && v != "random") r.fail(n, name, "must be \"almanac\" or \"random\"");

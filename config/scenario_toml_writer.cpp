@@ -71,7 +71,7 @@ std::string static_toml(const Scenario& s) {
   }
   out += fmt::format("elevation_mask_deg = {}\ninclude_unhealthy = {}\n", toml_float(s.elevation_mask_deg),
                      s.include_unhealthy);
-  if (s.nav_field_rounding == signals::FieldRounding::toward_zero) out += "field_rounding = \"toward_zero\"\n";
+  if (s.nav_field_rounding == signals::FieldRounding::kTowardZero) out += "field_rounding = \"toward_zero\"\n";
   if (s.nav_random_pages) out += "pages = \"random\"\n";
   out += "\n[receiver]\n";
   if (!s.trajectory.empty()) {

@@ -8,10 +8,10 @@
 namespace ultratrack::fusion {
 
 ClockNoiseModel clock_noise_from_allan(const OscillatorAllan& allan, const ClockNoiseModel& base) {
-  constexpr double c2 = signals::kSpeedOfLight_mps * signals::kSpeedOfLight_mps;
+  constexpr double kC2 = signals::kSpeedOfLight_mps * signals::kSpeedOfLight_mps;
   ClockNoiseModel out = base;
-  out.bias_psd_m2_per_s = c2 * allan.h0 / 2.0;
-  out.drift_psd_m2_per_s3 = c2 * 2.0 * std::numbers::pi * std::numbers::pi * allan.h_minus2;
+  out.bias_psd_m2_per_s = kC2 * allan.h0 / 2.0;
+  out.drift_psd_m2_per_s3 = kC2 * 2.0 * std::numbers::pi * std::numbers::pi * allan.h_minus2;
   return out;
 }
 

@@ -78,7 +78,7 @@ class Ukf {
     const Matrix Qs = G * model.Qc() * G.transpose();
     const DiscreteProcess<N> d = discretise<N>(F, Qs, dt, opt_.discretisation);
     if constexpr (LinearProcessModel<M, N>) {
-      const Matrix Phi = model.transition(dt);
+      const Matrix& Phi = model.transition(dt);  // a reference: some models return their own
       x_ = Phi * x_;
       P_ = Phi * P_ * Phi.transpose() + d.Qd;
       keep_psd();
@@ -109,8 +109,8 @@ class Ukf {
     using ZVector = Eigen::Matrix<double, K, 1>;
     using ZMatrix = Eigen::Matrix<double, K, K>;
     UpdateResult r;
-    const ZVector z = model.z();
-    const ZMatrix R = model.R();
+    const ZVector& z = model.z();
+    const ZMatrix& R = model.R();
     const int k = static_cast<int>(z.size());
     r.dof = k;
     const Sigmas X = sigma_points();

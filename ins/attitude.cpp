@@ -61,10 +61,10 @@ Eigen::Vector3d attitude_error_n(const Eigen::Quaterniond& q_nb_est, const Eigen
 }
 
 double wrap_pi(double a) {
-  constexpr double two_pi = 2.0 * std::numbers::pi;
-  a = std::fmod(a, two_pi);
-  if (a <= -std::numbers::pi) a += two_pi;
-  if (a > std::numbers::pi) a -= two_pi;
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  a = std::fmod(a, kTwoPi);
+  if (a <= -std::numbers::pi) a += kTwoPi;
+  if (a > std::numbers::pi) a -= kTwoPi;
   return a;
 }
 

@@ -95,8 +95,8 @@ Acquisition::Acquisition(const AcquisitionOptions& options) : options_(options) 
   const double whole = std::round(per_fft_bin);
   rotation_ = whole >= 1.0 && std::abs(per_fft_bin - whole) < 1e-6 ? static_cast<std::size_t>(whole) : 0;
   segment_ = static_cast<std::size_t>(std::max<long long>(1, std::llround(options_.fs_hz * 1e-4)));
-  forward_ = FftwPlan(fft_size_, FftwPlan::Direction::forward);
-  backward_ = FftwPlan(fft_size_, FftwPlan::Direction::backward);
+  forward_ = FftwPlan(fft_size_, FftwPlan::Direction::kForward);
+  backward_ = FftwPlan(fft_size_, FftwPlan::Direction::kBackward);
   scratch_.push_back(std::make_unique<Scratch>(fft_size_, lags_));
   code_spectra_.resize(signals::kMaxPrn);
 }

@@ -45,17 +45,17 @@ Eigen::Matrix3d rotation_from_vector(const Eigen::Vector3d& v) {
 }
 
 Eigen::Matrix3d euler_covariance(const Eigen::Matrix3d& C_nb, const Eigen::Matrix3d& P_n) {
-  constexpr double h = 1e-6;
+  constexpr double kStep = 1e-6;
   Eigen::Matrix3d J;
   for (int i = 0; i < 3; ++i) {
     Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    d(i) = h;
+    d(i) = kStep;
     const EulerAngles p = euler_from_C_nb(rotation_from_vector(d) * C_nb);
     const EulerAngles m = euler_from_C_nb(rotation_from_vector(-d) * C_nb);
     double dyaw = p.yaw_rad - m.yaw_rad;
     if (dyaw > std::numbers::pi) dyaw -= 2.0 * std::numbers::pi;
     if (dyaw < -std::numbers::pi) dyaw += 2.0 * std::numbers::pi;
-    J.col(i) << (p.roll_rad - m.roll_rad) / (2 * h), (p.pitch_rad - m.pitch_rad) / (2 * h), dyaw / (2 * h);
+    J.col(i) << (p.roll_rad - m.roll_rad) / (2 * kStep), (p.pitch_rad - m.pitch_rad) / (2 * kStep), dyaw / (2 * kStep);
   }
   return J * P_n * J.transpose();
 }

@@ -62,7 +62,7 @@ FftwPlan::FftwPlan(std::size_t n, Direction direction) : size_(n) {
   auto plan = [&](unsigned flags) {
     return fftwf_plan_dft_1d(static_cast<int>(n), reinterpret_cast<fftwf_complex*>(in.data()),
                              reinterpret_cast<fftwf_complex*>(out.data()),
-                             direction == Direction::forward ? FFTW_FORWARD : FFTW_BACKWARD, flags);
+                             direction == Direction::kForward ? FFTW_FORWARD : FFTW_BACKWARD, flags);
   };
   // With a wisdom file: FFTW_PATIENT plans (1.4-2.3x faster transforms at 2600 and 16000 points than
   // FFTW_ESTIMATE, measured, docs/performance.md) from the file, measured once (seconds) and saved when

@@ -43,7 +43,7 @@ class FftwBuffer {
 // execute() may be called on any pair of FftwBuffers of size n (out of place: in and out distinct), from any thread.
 class FftwPlan {
  public:
-  enum class Direction { forward, backward };
+  enum class Direction { kForward, kBackward };
   FftwPlan() = default;
   FftwPlan(std::size_t n, Direction direction);
   ~FftwPlan();

@@ -137,13 +137,13 @@ std::vector<IntegerCandidate> lambda_search(const Eigen::VectorXd& a_float, cons
     }
   }
 
-  const Eigen::MatrixXd ZinvT = red.Z.transpose().fullPivLu().inverse().array().round().matrix();
+  const Eigen::MatrixXd Z_inv_T = red.Z.transpose().fullPivLu().inverse().array().round().matrix();
   std::vector<std::size_t> order(found_z.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return found_dist[a] < found_dist[b]; });
   out.reserve(order.size());
   for (std::size_t i : order) {
-    out.push_back({(ZinvT * found_z[i] + a_int).array().round().matrix(), found_dist[i]});
+    out.push_back({(Z_inv_T * found_z[i] + a_int).array().round().matrix(), found_dist[i]});
   }
   return out;
 }

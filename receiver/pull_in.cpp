@@ -85,7 +85,9 @@ double PullIn::search_frequency_offset_hz() const {
     for (int b = 0; b < blocks; ++b) {
       std::complex<double> block{};
       for (int k = 0; k < kBlock; ++k) {
-        block += std::complex<double>(search_prompts_[static_cast<std::size_t>(b * kBlock + k)]) * rotation;
+        block +=
+            std::complex<double>(search_prompts_[static_cast<std::size_t>(b) * kBlock + static_cast<std::size_t>(k)]) *
+            rotation;
         rotation *= step;
       }
       sum += std::norm(block);

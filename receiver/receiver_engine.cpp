@@ -158,7 +158,7 @@ void ReceiverEngine::feed_channels(std::span<const std::complex<float>> samples,
 
 // Once per part, on this thread, shared read-only by every channel (5 Gsamples/s: ~1 % of a channel's work).
 void ReceiverEngine::convert_part_to_i16(int n) {
-  const auto need = static_cast<std::size_t>(2 * n * options_.num_antennas);
+  const auto need = 2 * static_cast<std::size_t>(n) * static_cast<std::size_t>(options_.num_antennas);
   if (i16_block_.size() < need) i16_block_.resize(need);  // only while parts grow
   for (int a = 0; a < options_.num_antennas; ++a) {
     std::int16_t* re = i16_block_.data() + static_cast<std::ptrdiff_t>(2 * a * n);

@@ -26,7 +26,7 @@ WorkerPool::~WorkerPool() {
 }
 
 void WorkerPool::run_task(BackgroundTask& task, std::unique_lock<std::mutex>& lock) {
-  task.state_ = BackgroundTask::State::running;
+  task.state_ = BackgroundTask::State::kRunning;
   lock.unlock();
   try {
     task.run();
@@ -34,7 +34,7 @@ void WorkerPool::run_task(BackgroundTask& task, std::unique_lock<std::mutex>& lo
     task.error_ = std::current_exception();
   }
   lock.lock();
-  task.state_ = BackgroundTask::State::done;
+  task.state_ = BackgroundTask::State::kDone;
   done_.notify_all();
 }
 
@@ -102,7 +102,7 @@ void WorkerPool::run_batch(int n, void* job, Call call) {
 void WorkerPool::start(BackgroundTask& task) {
   std::lock_guard lock(mutex_);
   if (queued_ != nullptr) throw std::logic_error("WorkerPool::start: a task is already queued");
-  task.state_ = BackgroundTask::State::queued;
+  task.state_ = BackgroundTask::State::kQueued;
   task.error_ = nullptr;
   if (workers_.empty()) return;  // wait() runs it
   queued_ = &task;
@@ -111,13 +111,13 @@ void WorkerPool::start(BackgroundTask& task) {
 
 void WorkerPool::wait(BackgroundTask& task) {
   std::unique_lock lock(mutex_);
-  if (task.state_ == BackgroundTask::State::queued) {
+  if (task.state_ == BackgroundTask::State::kQueued) {
     if (queued_ == &task) queued_ = nullptr;
     run_task(task, lock);
   }
-  done_.wait(lock,
-             [&] { return task.state_ == BackgroundTask::State::done || task.state_ == BackgroundTask::State::idle; });
-  task.state_ = BackgroundTask::State::idle;
+  done_.wait(
+      lock, [&] { return task.state_ == BackgroundTask::State::kDone || task.state_ == BackgroundTask::State::kIdle; });
+  task.state_ = BackgroundTask::State::kIdle;
   if (task.error_) std::rethrow_exception(std::exchange(task.error_, nullptr));
 }
 

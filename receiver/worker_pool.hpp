@@ -22,8 +22,8 @@ class BackgroundTask {
 
  private:
   friend class WorkerPool;
-  enum class State { idle, queued, running, done };
-  State state_ = State::idle;
+  enum class State { kIdle, kQueued, kRunning, kDone };
+  State state_ = State::kIdle;
   std::exception_ptr error_;
 };
 

@@ -74,7 +74,7 @@ LnavUpdate LnavDecoder::add(const LnavSubframe& sf) {
   ++counters_.accepted;
   const double start_tow = sf.start_tow_s();
   // Time of week running backwards by more than half a week: the stream crossed a week boundary.
-  if (last_start_ && start_tow < last_start_->tow_s - kSecondsPerWeek / 2) ++week_;
+  if (last_start_ && start_tow < last_start_->tow_s - 0.5 * kSecondsPerWeek) ++week_;
   if (sf.subframe_id == 1) {
     week_ = resolve_week_rollover(static_cast<int>(get(sf.words, kWeek)), week_);
     week_known_ = true;
@@ -120,7 +120,7 @@ void LnavDecoder::decode_almanac(const LnavSubframe& sf) {
   a.toa_s = static_cast<double>(get(w, kAlmToa) << kAlmToaScale);
   const double sent = sf.start_tow_s();
   const double dt = a.toa_s - sent;
-  a.week = week_ + (dt < -kSecondsPerWeek / 2 ? 1 : 0) - (dt > kSecondsPerWeek / 2 ? 1 : 0);
+  a.week = week_ + (dt < -0.5 * kSecondsPerWeek ? 1 : 0) - (dt > 0.5 * kSecondsPerWeek ? 1 : 0);
   a.e = uns(w, kAlmE, kAlmEScale);
   a.i_rad = (kAlmReferenceInclination_sc + sgn(w, kAlmDeltaI, kAlmDeltaIScale)) * kPi;
   a.omega_dot_radps = sgn(w, kAlmOmegaDot, kAlmOmegaDotScale) * kPi;
@@ -185,7 +185,7 @@ void LnavDecoder::try_complete_ephemeris() {
 
   // WN is the week of transmission; toe may lie in the neighbouring week near a week boundary.
   const double dt = e.toe_s - sf_[0]->start_tow_s();
-  e.week = sf1_week_ + (dt < -kSecondsPerWeek / 2 ? 1 : 0) - (dt > kSecondsPerWeek / 2 ? 1 : 0);
+  e.week = sf1_week_ + (dt < -0.5 * kSecondsPerWeek ? 1 : 0) - (dt > 0.5 * kSecondsPerWeek ? 1 : 0);
 
   const bool changed = !ephemeris_ || ephemeris_->iodc != e.iodc || ephemeris_->iode != e.iode ||
                        ephemeris_->toe_s != e.toe_s || ephemeris_->week != e.week;

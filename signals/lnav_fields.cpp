@@ -56,7 +56,7 @@ std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_
 
 namespace {
 double quantised(double scaled, FieldRounding rounding) {
-  return rounding == FieldRounding::nearest ? std::nearbyint(scaled) : std::trunc(scaled);
+  return rounding == FieldRounding::kNearest ? std::nearbyint(scaled) : std::trunc(scaled);
 }
 }  // namespace
 
@@ -86,7 +86,7 @@ std::uint32_t lnav_angle(double radians, int scale_log2, int bits, FieldRounding
   sc -= 2.0 * std::floor((sc + 1.0) / 2.0);  // [-1, 1)
   const double scaled = std::ldexp(sc, -scale_log2);
   const auto r =
-      static_cast<std::int64_t>(rounding == FieldRounding::nearest ? std::round(scaled) : std::trunc(scaled));
+      static_cast<std::int64_t>(rounding == FieldRounding::kNearest ? std::round(scaled) : std::trunc(scaled));
   // +1 semicircle after rounding is the same angle as -1: the mask wraps it.
   return static_cast<std::uint32_t>(r) & low_mask(bits);
 }

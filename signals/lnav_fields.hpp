@@ -25,16 +25,16 @@ std::uint32_t get_lnav_split(const LnavDataWords& words, int msb_first, int msb_
 
 // How a value becomes a whole number of LSBs: to nearest (our encoder, and what recovers the RINEX value best),
 // or toward zero (a C cast, as some other generators quantise: a different last bit in ~half the fields).
-enum class FieldRounding { nearest, toward_zero };
+enum class FieldRounding { kNearest, kTowardZero };
 
 // Fixed-point encoding of value (in units of the scale factor 2^scale_log2) to an n-bit two's complement
 // or unsigned field. Throws InputError naming `what` when it does not fit.
 std::uint32_t lnav_signed(double value, int scale_log2, int bits, std::string_view what,
-                          FieldRounding rounding = FieldRounding::nearest);
+                          FieldRounding rounding = FieldRounding::kNearest);
 std::uint32_t lnav_unsigned(double value, int scale_log2, int bits, std::string_view what,
-                            FieldRounding rounding = FieldRounding::nearest);
+                            FieldRounding rounding = FieldRounding::kNearest);
 // An angle in radians as a two's complement semicircle field, wrapped into [-1, 1) semicircles first.
-std::uint32_t lnav_angle(double radians, int scale_log2, int bits, FieldRounding rounding = FieldRounding::nearest);
+std::uint32_t lnav_angle(double radians, int scale_log2, int bits, FieldRounding rounding = FieldRounding::kNearest);
 
 // Throws InputError("LNAV encoder", problem): a value that cannot be broadcast.
 [[noreturn]] void throw_lnav_encoding_error(const std::string& problem);

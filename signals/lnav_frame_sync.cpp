@@ -39,7 +39,7 @@ std::optional<LnavFrameSyncOutput> LnavFrameSync::push(std::uint8_t bit) {
 
   // Searching: most positions fail on the 8-bit preamble before any parity work.
   std::uint32_t preamble = 0;
-  for (int i = 0; i < 8; ++i) preamble = (preamble << 1) | window_[static_cast<std::size_t>(2 + i)];
+  for (int i = 0; i < 8; ++i) preamble = (preamble << 1) | window_[2 + static_cast<std::size_t>(i)];
   if (preamble != kLnavPreamble && preamble != (~kLnavPreamble & 0xFFu)) return std::nullopt;
   auto out = decode_window();
   if (out->result.status != LnavStatus::kOk) return std::nullopt;

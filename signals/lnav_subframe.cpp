@@ -39,7 +39,7 @@ LnavSubframeResult decode_lnav_subframe(std::span<const std::uint8_t, 300> bits,
   }
   LnavSubframe& sf = result.subframe;
   for (int i = 0; i < 10; ++i) {
-    const std::uint32_t word = pack_bits(bits.subspan(static_cast<std::size_t>(30 * i), 30)) ^ flip30;
+    const std::uint32_t word = pack_bits(bits.subspan(30 * static_cast<std::size_t>(i), 30)) ^ flip30;
     const auto data = check_word(word, d29, d30);
     if (!data) {
       result.status = LnavStatus::kParityError;

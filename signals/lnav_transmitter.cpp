@@ -24,15 +24,15 @@ int bits_of(Field f) { return f.length; }
 int bits_of(SplitField f) { return f.msb_length + f.lsb_length; }
 // Fields of the ephemeris subframes take the transmitter's rounding convention; the pages round to nearest.
 template <class F>
-std::uint32_t sgn(double v, int scale, F f, const char* what, FieldRounding r = FieldRounding::nearest) {
+std::uint32_t sgn(double v, int scale, F f, const char* what, FieldRounding r = FieldRounding::kNearest) {
   return lnav_signed(v, scale, bits_of(f), what, r);
 }
 template <class F>
-std::uint32_t uns(double v, int scale, F f, const char* what, FieldRounding r = FieldRounding::nearest) {
+std::uint32_t uns(double v, int scale, F f, const char* what, FieldRounding r = FieldRounding::kNearest) {
   return lnav_unsigned(v, scale, bits_of(f), what, r);
 }
 template <class F>
-std::uint32_t ang(double rad, int scale, F f, FieldRounding r = FieldRounding::nearest) {
+std::uint32_t ang(double rad, int scale, F f, FieldRounding r = FieldRounding::kNearest) {
   return lnav_angle(rad, scale, bits_of(f), r);
 }
 

@@ -35,7 +35,7 @@ int lnav_page_at(double tow_s);
 //   receiver cannot predict from any nav file), marked as dummy-SV pages (SV ID 0) so that no decoder takes
 //   them for almanacs or health; page 18 (ionosphere and UTC, SV ID 56) keeps its content.
 struct LnavConventions {
-  FieldRounding field_rounding = FieldRounding::nearest;
+  FieldRounding field_rounding = FieldRounding::kNearest;
   bool random_pages = false;
   std::uint64_t page_seed = 0;  // random_pages: with the PRN and the subframe's time, fixes the bits
 };

@@ -18,11 +18,11 @@ namespace {
 // Round half away from zero and saturate to [lo, hi]; NaN becomes 0.
 template <typename Int>
 inline Int quantise(float x) {
-  constexpr float lo = static_cast<float>(std::numeric_limits<Int>::min());
-  constexpr float hi = static_cast<float>(std::numeric_limits<Int>::max());
+  constexpr float kLo = static_cast<float>(std::numeric_limits<Int>::min());
+  constexpr float kHi = static_cast<float>(std::numeric_limits<Int>::max());
   // Branch-free so the loops vectorise: NaN -> 0, then round half away from zero, clamp, truncate.
   const float v = (x == x) ? x : 0.0f;
-  const float r = std::clamp(v + std::copysign(0.5f, v), lo, hi);
+  const float r = std::clamp(v + std::copysign(0.5f, v), kLo, kHi);
   return static_cast<Int>(r);
 }
 

@@ -79,22 +79,22 @@ struct ZigguratTables {
   std::array<std::int64_t, 128> kn{};
   std::array<double, 128> wn{}, fn{};
   ZigguratTables() {
-    constexpr double m1 = 2147483648.0;
-    constexpr double vn = 9.91256303526217e-3;
+    constexpr double kM1 = 2147483648.0;
+    constexpr double kVn = 9.91256303526217e-3;
     double dn = 3.442619855899, tn = dn;
-    const double q = vn / std::exp(-0.5 * dn * dn);
-    kn[0] = static_cast<std::int64_t>((dn / q) * m1);
+    const double q = kVn / std::exp(-0.5 * dn * dn);
+    kn[0] = static_cast<std::int64_t>((dn / q) * kM1);
     kn[1] = 0;
-    wn[0] = q / m1;
-    wn[127] = dn / m1;
+    wn[0] = q / kM1;
+    wn[127] = dn / kM1;
     fn[0] = 1.0;
     fn[127] = std::exp(-0.5 * dn * dn);
     for (int i = 126; i >= 1; --i) {
-      dn = std::sqrt(-2.0 * std::log(vn / dn + std::exp(-0.5 * dn * dn)));
-      kn[i + 1] = static_cast<std::int64_t>((dn / tn) * m1);
+      dn = std::sqrt(-2.0 * std::log(kVn / dn + std::exp(-0.5 * dn * dn)));
+      kn[i + 1] = static_cast<std::int64_t>((dn / tn) * kM1);
       tn = dn;
       fn[i] = std::exp(-0.5 * dn * dn);
-      wn[i] = dn / m1;
+      wn[i] = dn / kM1;
     }
   }
 };

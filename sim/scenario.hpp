@@ -54,7 +54,7 @@ struct Scenario {
   bool include_unhealthy = false;
   // How the LNAV message is made (signals/lnav_transmitter.hpp): ephemeris fields rounded to nearest or toward
   // zero; subframe 4/5 pages with almanacs or with random content no nav file predicts.
-  signals::FieldRounding nav_field_rounding = signals::FieldRounding::nearest;
+  signals::FieldRounding nav_field_rounding = signals::FieldRounding::kNearest;
   bool nav_random_pages = false;
 
   // Receiver: a static position (with optional extra antennas, one file each) or a trajectory CSV.

@@ -60,17 +60,17 @@ TEST(TroposphereRate, MatchesTheNumericalDerivativeOfTheModelForMovingSatelliteA
 
   const auto now = satellites_at(eph, t, r0, true);
   ASSERT_GE(now.size(), 5u);
-  constexpr double dt = 0.5;
+  constexpr double kDt = 0.5;
   int low = 0;
   for (const SatelliteObservable& s : now) {
     for (const Eigen::Vector3d& v : {v_still, v_ant}) {
-      const auto before = satellites_at(eph, signals::add_seconds(t, -dt), r0 - v * dt, true);
-      const auto after = satellites_at(eph, signals::add_seconds(t, dt), r0 + v * dt, true);
+      const auto before = satellites_at(eph, signals::add_seconds(t, -kDt), r0 - v * kDt, true);
+      const auto after = satellites_at(eph, signals::add_seconds(t, kDt), r0 + v * kDt, true);
       const SatelliteObservable *a = find(before, s.prn), *b = find(after, s.prn);
       ASSERT_TRUE(a && b) << s.prn;
-      const double numerical = (b->atmosphere_m - a->atmosphere_m) / (2.0 * dt);
+      const double numerical = (b->atmosphere_m - a->atmosphere_m) / (2.0 * kDt);
       const double analytic = troposphere_rate_mps(s, r0, v);
-      // Central difference error ~ dt^2 / 6 x third derivative (< 1e-6 m/s here); the analytic vertical's turn on
+      // Central difference error ~ kDt^2 / 6 x third derivative (< 1e-6 m/s here); the analytic vertical's turn on
       // a sphere against the ellipsoid's normal: < 0.5 % of the antenna's share. 1 % + 2 um/s.
       EXPECT_NEAR(analytic, numerical, 0.01 * std::abs(numerical) + 2e-6)
           << "PRN " << s.prn << " elevation " << s.elevation_rad * 180.0 / M_PI << " deg, moving " << v.norm();

@@ -94,13 +94,13 @@ double sculling_drift(bool corrected, double theta0, double A, double w, double 
                       double* a_body) {
   const double g = gravity_n(kLat, 0.0).z();
   // body f_y = cos(roll) a_E - sin(roll) g ~ (a_E - g theta0) sin(Wt): choose a_E amplitude to give A
-  const double aE = A + g * theta0;
+  const double a_E = A + g * theta0;
   *a_body = A;
   auto q_nb = [&](double t) { return quaternion_from_euler({theta0 * std::sin(w * t), 0.0, 0.0}); };
-  auto v_n = [&](double t) { return Eigen::Vector3d(0.0, -aE / w * std::cos(w * t), 0.0); };
+  auto v_n = [&](double t) { return Eigen::Vector3d(0.0, -a_E / w * std::cos(w * t), 0.0); };
   const Eigen::Vector3d w_ie = earth_rate_n(kLat), g_n = gravity_n(kLat, 0.0);
   auto f_b = [&](double t) {
-    const Eigen::Vector3d a_n(0.0, aE * std::sin(w * t), 0.0);
+    const Eigen::Vector3d a_n(0.0, a_E * std::sin(w * t), 0.0);
     const Eigen::Vector3d w_en = transport_rate_n(kLat, 0.0, v_n(t));
     return Eigen::Vector3d(q_nb(t).conjugate() * (a_n + (2 * w_ie + w_en).cross(v_n(t)) - g_n));
   };

@@ -59,7 +59,7 @@ struct PhaseSimulator {
     r_master_e = Eigen::Vector3d(x, y, z);
     Eigen::Matrix3d C_e_enu;  // columns: east, north, up in ECEF (GeographicLib's M is row-major ENU -> ECEF)
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) C_e_enu(i, j) = M[static_cast<std::size_t>(3 * i + j)];
+      for (int j = 0; j < 3; ++j) C_e_enu(i, j) = M[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(j)];
     }
     C_en.col(0) = C_e_enu.col(1);
     C_en.col(1) = C_e_enu.col(0);
@@ -78,7 +78,9 @@ struct PhaseSimulator {
     for (auto& r : range_offset) r = offset(rng);
   }
 
-  long& ambiguity(int antenna, int prn) { return integer_ambiguity[static_cast<std::size_t>(antenna * 64 + prn)]; }
+  long& ambiguity(int antenna, int prn) {
+    return integer_ambiguity[static_cast<std::size_t>(antenna) * 64 + static_cast<std::size_t>(prn)];
+  }
 
   // A random sky of n satellites above min_elevation (elevation uniform in sin, azimuth uniform).
   std::vector<Sky> random_sky(int n, double min_elevation_rad = 15.0 * io::kRadPerDeg) {

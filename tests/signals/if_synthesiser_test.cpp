@@ -442,7 +442,7 @@ TEST(IfSynthesiser, HeldParametersLagTheGeometryByTheClosedForm) {
               per_interval);
   ASSERT_GT(std::abs(per_interval), 0.05);  // a geometry that shows the effect
   for (int k = 1; k <= 11; ++k) {
-    const double measured = error_ms[static_cast<std::size_t>(100 * k)] - error_ms[0];
+    const double measured = error_ms[100 * static_cast<std::size_t>(k)] - error_ms[0];
     // Within the interval's first millisecond the held and exact phases differ by < fdot h^2 / 2 (< 1e-4).
     EXPECT_NEAR(measured, k * per_interval, 0.02 * std::abs(k * per_interval) + 2e-3) << "after " << k << " intervals";
     if (k == 10) std::printf("after 1 s: %.4f cycles measured, %.4f closed form\n", measured, k * per_interval);

@@ -484,7 +484,7 @@ TEST(LnavDecoder, AlmanacRoundTripOfAWholeMasterFrame) {
 // about half of the fields (the half whose remainder is >= LSB/2).
 TEST(LnavTransmitter, TowardZeroRoundingDecodesWithinOneLsbTowardZero) {
   LnavConventions truncating;
-  truncating.field_rounding = FieldRounding::toward_zero;
+  truncating.field_rounding = FieldRounding::kTowardZero;
   int differing_words = 0, words = 0;
   for (const Ephemeris& e : brdc_2022_001_ephemerides()) {
     const LnavTransmitter nearest = make_transmitter(e);

@@ -110,7 +110,7 @@ TEST(TwoBitFormat, DecodesEveryByteAsThePeersDo) {
   ASSERT_EQ(tw.size(), 1024u);
   for (int b = 0; b < 256; ++b) {
     for (int j = 0; j < 4; ++j) {
-      const auto i = static_cast<std::size_t>(4 * b + j);
+      const auto i = 4 * static_cast<std::size_t>(b) + static_cast<std::size_t>(j);
       EXPECT_EQ(tw[i], twos(field(b, j))) << b << " " << j;
       EXPECT_EQ(twm[i], twos(field(b, 3 - j))) << b << " " << j;
       EXPECT_EQ(sm[i], signmag(field(b, j))) << b << " " << j;

@@ -118,11 +118,11 @@ TEST(Scenario, OtherGeneratorConventionsParseAndEcho) {
       "[signal]\nparameter_update_s = 0.1\n[navigation]\nfield_rounding = \"toward_zero\"\npages = \"random\"\n",
       "/data/s.toml");
   EXPECT_DOUBLE_EQ(s.parameter_update_s, 0.1);
-  EXPECT_EQ(s.nav_field_rounding, signals::FieldRounding::toward_zero);
+  EXPECT_EQ(s.nav_field_rounding, signals::FieldRounding::kTowardZero);
   EXPECT_TRUE(s.nav_random_pages);
   const Scenario back = parse_scenario(to_toml(s), "/data/s.toml");
   EXPECT_DOUBLE_EQ(back.parameter_update_s, 0.1);
-  EXPECT_EQ(back.nav_field_rounding, signals::FieldRounding::toward_zero);
+  EXPECT_EQ(back.nav_field_rounding, signals::FieldRounding::kTowardZero);
   EXPECT_TRUE(back.nav_random_pages);
   const std::string plain = to_toml(parse_scenario("[signal]\nduration_s = 2\n", "/data/s.toml"));
   EXPECT_EQ(plain.find("parameter_update_s"), std::string::npos);
