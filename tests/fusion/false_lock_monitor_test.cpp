@@ -82,7 +82,7 @@ TEST(FalseLockMonitor, BlockMeansOfLockedNoiseStayNearTheBiasAndARampIsCaughtWit
   for (int k = 0; k < 500 && caught < 0; ++k)
     if (ramp.add(8.0 * (k + 0.5) * kT, kT) && std::abs(ramp.mean_hz()) > 5.0) {
       caught = k;
-      EXPECT_NEAR(ramp.mean_hz(), 8.0 * (static_cast<double>(k / 50) + 0.5), 1e-9);
+      EXPECT_NEAR(ramp.mean_hz(), 8.0 * (std::floor(k / 50.0) + 0.5), 1e-9);
       EXPECT_NEAR(ramp.recent_hz(), 8.0 * (k - 2.0 + 0.5) * kT, 1e-9);
     }
   EXPECT_EQ(caught, 99);  // the second block (mean 12 Hz; 15.6 Hz now)

@@ -183,7 +183,7 @@ void expect_complete_outputs(const fs::path& dir) {
   ASSERT_TRUE(fs::is_directory(dir)) << dir;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     if (!e.is_regular_file()) continue;
-    const fs::path p = e.path();
+    const fs::path& p = e.path();
     EXPECT_EQ(p.filename().string().find(".part"), std::string::npos) << "temporary file left: " << p;
     if (p.extension() == ".csv") {
       const std::string t = read_text(p);
