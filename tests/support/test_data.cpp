@@ -57,6 +57,33 @@ void remove_suite_dirs() {
   for (const auto& dir : suite_dirs()) std::filesystem::remove_all(dir, ignored);
 }
 
+// A test's folder is removed when the test passes and kept, for inspection, when it fails (or with
+// ULTRATRACK_KEEP_TEST_DIRS set): a whole run otherwise leaves gigabytes of samples in the temp folder.
+class RemovePassedTestFolders : public ::testing::EmptyTestEventListener {
+ public:
+  void watch(std::filesystem::path dir) { dirs_.push_back(std::move(dir)); }
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    const bool keep = !info.result()->Passed() || std::getenv("ULTRATRACK_KEEP_TEST_DIRS") != nullptr;
+    std::error_code ignored;
+    if (!keep)
+      for (const auto& dir : dirs_) std::filesystem::remove_all(dir, ignored);
+    dirs_.clear();
+  }
+
+ private:
+  std::vector<std::filesystem::path> dirs_;
+};
+
+// Registered with GoogleTest on first use; GoogleTest owns (and deletes) it.
+RemovePassedTestFolders& test_folder_janitor() {
+  static RemovePassedTestFolders* janitor = [] {
+    auto* listener = new RemovePassedTestFolders;
+    ::testing::UnitTest::GetInstance()->listeners().Append(listener);
+    return listener;
+  }();
+  return *janitor;
+}
+
 }  // namespace
 
 std::filesystem::path scratch_dir() {
@@ -70,6 +97,7 @@ std::filesystem::path scratch_dir() {
   std::filesystem::path dir;
   if (info) {
     dir = root / (std::string(info->test_suite_name()) + "." + info->name());
+    test_folder_janitor().watch(dir);
   } else {
     const auto* suite = unit->current_test_suite();
     dir = root / ((suite ? std::string(suite->name()) : std::string("suite")) + ".pid" + std::to_string(::getpid()));
