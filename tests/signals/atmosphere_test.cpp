@@ -15,10 +15,11 @@ using namespace ultratrack::signals;
 
 namespace {
 
-KlobucharParameters brdc0010_params() {
+// The broadcast parameters of the shipped tests/data/brdc3540_0000-0200.14n (ION ALPHA / ION BETA of its header).
+KlobucharParameters brdc3540_params() {
   KlobucharParameters k;
-  const double a[4] = {0.1211e-07, -0.7451e-08, -0.5960e-07, 0.1192e-06};
-  const double b[4] = {0.1167e+06, -0.2458e+06, -0.6554e+05, 0.1114e+07};
+  const double a[4] = {0.2887e-07, 0.2235e-07, -0.1192e-06, 0.5960e-07};
+  const double b[4] = {0.1536e+06, -0.1966e+06, -0.6554e+05, 0.3932e+06};
   for (int i = 0; i < 4; ++i) {
     k.alpha[i] = a[i];
     k.beta[i] = b[i];
@@ -32,7 +33,7 @@ double obliquity(double elevation_rad) { return 1.0 + 16.0 * std::pow(0.53 - ele
 }  // namespace
 
 TEST(Klobuchar, NightTimeIsFiveNanosecondsTimesObliquity) {
-  const KlobucharParameters k = brdc0010_params();
+  const KlobucharParameters k = brdc3540_params();
   // Receiver at longitude 0: local time = GPS time of day (plus a few minutes for the pierce point).
   // At 02:00 the phase |x| is far beyond 1.57 for any period >= 72000 s.
   for (double el_deg : {5.0, 15.0, 30.0, 60.0, 90.0}) {
@@ -49,7 +50,7 @@ TEST(Klobuchar, NightTimeIsFiveNanosecondsTimesObliquity) {
 TEST(Klobuchar, PeakAtFourteenHoursLocalIsFloorPlusAlpha0AtGeomagneticEquator) {
   // Choose geometry so that the pierce point has geomagnetic latitude 0 (phi_i = 0 and
   // lambda_i = 1.617 - 0.5 semicircles) and local time 50400 s: then delay = F (5 ns + alpha_0).
-  const KlobucharParameters k = brdc0010_params();
+  const KlobucharParameters k = brdc3540_params();
   const double el = 0.5 * kPi;  // zenith: psi = 0.0137/0.61 - 0.022 semicircles
   const double psi = 0.0137 / (0.5 + 0.11) - 0.022;
   const double az = 0.5 * kPi;  // due east: phi_i = phi_u, lambda_i = lambda_u + psi

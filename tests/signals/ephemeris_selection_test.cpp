@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Ephemeris selection: health, IODE/IODC consistency, fit interval and nearest toe, on the shipped
-// brdc3540_0000-0200.14n (PRN 8 unhealthy, 01:59:44 sets), on brdc0010.22n's known cases (PRN 14/18 IODC, PRN 28
-// unhealthy; shared data) and on hand-made sets for the rules.
+// brdc3540_0000-0200.14n (PRN 8 unhealthy, 01:59:44 sets), on a copy of it with edited IODCs (high bits set, a
+// mismatch) and on hand-made sets for the rules.
 #include "signals/ephemeris_selection.hpp"
 
 #include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
 
 #include "signals/rinex_nav.hpp"
 #include "support/test_data.hpp"
@@ -77,33 +80,49 @@ TEST(EphemerisSelection, UnhealthyOnlyWhenAsked) {
   EXPECT_TRUE(select_ephemeris({e}, 4, e.toe(), {.include_unhealthy = true}).has_value());
 }
 
-TEST(EphemerisSelection, Brdc0010KnownCases) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(path, "brdc0010.22n");
-  const RinexNavData nav = read_rinex_nav(path);
-  const GpsTime t{2190, 518400.0};
-  // PRN 14 and 18: IODC differs from IODE in the high bits; they must be accepted.
-  for (int prn : {14, 18}) {
-    const auto e = select_ephemeris(nav.ephemerides, prn, t);
-    ASSERT_TRUE(e.has_value()) << "PRN " << prn;
-    EXPECT_NE(e->iodc, e->iode);
-    EXPECT_EQ(e->iodc & 0xff, e->iode);
-    EXPECT_DOUBLE_EQ(e->toe_s, 518400.0);
+// A real file whose IODC differs from the IODE in its two high bits (as brdc0010.22n's PRN 14 and 18 do), and one whose
+// IODC does not match at all: the shipped file with PRN 1's 00:00 record edited (IODE 92; the IODC field, last of the
+// record's seventh line, 92 in the file) to 348 = 256 + 92, and PRN 3's (IODE 70) to 71.
+TEST(EphemerisSelection, ShippedFileWithEditedIodcs) {
+  const auto edited = ultratrack::test::scratch_dir() / "iodc.14n";
+  {
+    std::ifstream in(ultratrack::test::shipped_nav_file());
+    std::ofstream out(edited);
+    std::string line;
+    int record_line = -1;  // 0-7 within a record after the header
+    int edit_prn = 0;      // PRN of the record being read when it is one to edit, else 0
+    while (std::getline(in, line)) {
+      if (record_line >= 0) {
+        record_line = (record_line + 1) % 8;
+        if (record_line == 0) {
+          const int prn = std::stoi(line.substr(0, 2));
+          const bool at_midnight = line.substr(2, 20) == " 14 12 20  0  0  0.0";
+          edit_prn = at_midnight && (prn == 1 || prn == 3) ? prn : 0;
+        }
+        if (record_line == 6 && edit_prn != 0) {
+          EXPECT_EQ(line.substr(60, 19), edit_prn == 1 ? " 0.920000000000D+02" : " 0.700000000000D+02");
+          line.replace(60, 19, edit_prn == 1 ? " 0.348000000000D+03" : " 0.710000000000D+02");
+        }
+      } else if (line.find("END OF HEADER") != std::string::npos) {
+        record_line = 7;  // the next line starts a record
+      }
+      out << line << '\n';
+    }
   }
-  EXPECT_FALSE(select_ephemeris(nav.ephemerides, 28, t).has_value());
-  EXPECT_TRUE(select_ephemeris(nav.ephemerides, 28, t, {.include_unhealthy = true}).has_value());
-  // Every healthy PRN has a set at 00:00 and the chosen toe is the nearest one (00:00 exactly).
-  int found = 0;
-  for (int prn = 1; prn <= 32; ++prn) {
-    const auto e = select_ephemeris(nav.ephemerides, prn, t);
-    if (!e) continue;
-    ++found;
-    EXPECT_LE(std::abs(seconds_between(t, e->toe())), 3600.0) << "PRN " << prn;
-  }
-  EXPECT_GE(found, 29);
-  // At 01:59 the 02:00 set is the nearest for PRN 1.
-  const auto e1 = select_ephemeris(nav.ephemerides, 1, {2190, 518400.0 + 7140.0});
-  ASSERT_TRUE(e1.has_value());
-  EXPECT_DOUBLE_EQ(e1->toe_s, 525600.0);
+  const RinexNavData nav = read_rinex_nav(edited);
+  const GpsTime t{ultratrack::test::shipped_nav_week, ultratrack::test::shipped_nav_tow_s};
+  // PRN 1: IODC 348 carries IODE 92 in its low eight bits: accepted, the 00:00 set.
+  const auto one = select_ephemeris(nav.ephemerides, 1, t);
+  ASSERT_TRUE(one.has_value());
+  EXPECT_EQ(one->iodc, 348);
+  EXPECT_EQ(one->iode, 92);
+  EXPECT_DOUBLE_EQ(one->toe_s, 518400.0);
+  // PRN 3: IODC 71 against IODE 70: that set is refused and the nearest consistent one, the 01:59:44 set (7184 s
+  // ahead, inside its 2 h half fit interval), is taken instead.
+  const auto three = select_ephemeris(nav.ephemerides, 3, t);
+  ASSERT_TRUE(three.has_value());
+  EXPECT_EQ(three->iodc & 0xff, three->iode);
+  EXPECT_DOUBLE_EQ(three->toe_s, 525584.0);
 }
 
 // The shipped brdc3540_0000-0200.14n (tests/data/README.md): PRN 8 is flagged unhealthy; PRNs 1, 3, 12 and 22 have

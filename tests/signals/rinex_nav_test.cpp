@@ -170,65 +170,6 @@ TEST(RinexNav, Reads211WithDExponentsTwoDigitYearsAndShortLines) {
   EXPECT_EQ(nav.utc.delta_t_ls_s, 18);
 }
 
-TEST(RinexNav, ReadsBrdc0010_22n) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(path, "brdc0010.22n");
-  const RinexNavData nav = read_rinex_nav(path);
-  EXPECT_NEAR(nav.version, 2.0, 1e-12);
-  EXPECT_EQ(nav.ephemerides.size(), 422u);  // (3384 - 8 header lines) / 8
-  // First record, PRN 1, checked field by field against the file text.
-  const Ephemeris& e = nav.ephemerides.at(0);
-  EXPECT_EQ(e.prn, 1);
-  EXPECT_EQ(e.week, 2190);
-  EXPECT_DOUBLE_EQ(e.toc_s, 518400.0);
-  EXPECT_DOUBLE_EQ(e.af0_s, 0.469126738608e-03);
-  EXPECT_DOUBLE_EQ(e.af1_sps, -0.100044417195e-10);
-  EXPECT_DOUBLE_EQ(e.af2_sps2, 0.0);
-  EXPECT_EQ(e.iode, 39);
-  EXPECT_DOUBLE_EQ(e.crs_m, -0.141125000000e+03);
-  EXPECT_DOUBLE_EQ(e.delta_n_radps, 0.398838041777e-08);
-  EXPECT_DOUBLE_EQ(e.m0_rad, -0.624294238235e+00);
-  EXPECT_DOUBLE_EQ(e.cuc_rad, -0.736303627491e-05);
-  EXPECT_DOUBLE_EQ(e.e, 0.112181392033e-01);
-  EXPECT_DOUBLE_EQ(e.cus_rad, 0.469572842121e-05);
-  EXPECT_DOUBLE_EQ(e.sqrt_a_sqrtm, 0.515367499542e+04);
-  EXPECT_DOUBLE_EQ(e.toe_s, 518400.0);
-  EXPECT_DOUBLE_EQ(e.cic_rad, -0.316649675369e-07);
-  EXPECT_DOUBLE_EQ(e.omega0_rad, -0.103661124009e+01);
-  EXPECT_DOUBLE_EQ(e.cis_rad, 0.195577740669e-06);
-  EXPECT_DOUBLE_EQ(e.i0_rad, 0.986418769490e+00);
-  EXPECT_DOUBLE_EQ(e.crc_m, 0.299750000000e+03);
-  EXPECT_DOUBLE_EQ(e.omega_rad, 0.884087601569e+00);
-  EXPECT_DOUBLE_EQ(e.omega_dot_radps, -0.813355308085e-08);
-  EXPECT_DOUBLE_EQ(e.idot_radps, -0.377872882780e-09);
-  EXPECT_EQ(e.code_on_l2, 1);
-  EXPECT_EQ(e.l2p_data_flag, 0);
-  EXPECT_EQ(e.ura_index, 0);
-  EXPECT_EQ(e.health, 0);
-  EXPECT_DOUBLE_EQ(e.tgd_s, 0.512227416039e-08);
-  EXPECT_EQ(e.iodc, 39);
-  EXPECT_DOUBLE_EQ(nav.transmit_tow_s.at(0), 511218.0);
-  EXPECT_EQ(e.fit_interval_flag, 0);
-  // Header.
-  EXPECT_TRUE(nav.klobuchar.valid);
-  EXPECT_DOUBLE_EQ(nav.klobuchar.alpha[3], 0.1192e-06);
-  EXPECT_DOUBLE_EQ(nav.klobuchar.beta[0], 0.1167e+06);
-  EXPECT_DOUBLE_EQ(nav.utc.a0_s, 0.279396772385e-08);
-  EXPECT_DOUBLE_EQ(nav.utc.a1_sps, 0.799360577730e-14);
-  EXPECT_EQ(nav.utc.tot_s, 147456);
-  EXPECT_EQ(nav.utc.wnt, 2191);
-  EXPECT_EQ(nav.utc.delta_t_ls_s, 18);
-  // The last record (PRN 32, file end) and the unhealthy PRN 28 named in the data README.
-  EXPECT_EQ(nav.ephemerides.back().prn, 32);
-  EXPECT_DOUBLE_EQ(nav.transmit_tow_s.back(), 601398.0);
-  bool saw28 = false;
-  for (const Ephemeris& x : nav.ephemerides)
-    if (x.prn == 28) {
-      saw28 = true;
-      EXPECT_EQ(x.health, 63);
-    }
-  EXPECT_TRUE(saw28);
-}
-
 // The broadcast ephemeris shipped with the tests (tests/data/README.md): a RINEX 2 file as CDDIS merged it,
 // header and the records of 00:00-02:00, checked field by field against the file text.
 TEST(RinexNav, ReadsShippedBrdc3540) {
