@@ -232,25 +232,26 @@ TEST(ReceiveVectorFll, TwoGTurnKeepsEveryChannelWithTheCommandedDopplerOnTheTrut
 }
 
 // Coasting in FLL mode: the blockage scenario of ReceiveVector.ChannelsCoastThroughFadesAndReLockWithoutAcquisition
-// (every signal absent 14-17 s, PRN 24 alone 18.5-20.5 s). FLL channels are filter-driven as the aided ones: a
-// faded channel is declared absent by its presence test (1 s windows: coasting from 1-2 s into the fade, not
-// before a window could end) and coasts on the filter's commanded carrier and code; with nothing to re-lock it is
-// bit-synced again once two presence windows, or its C/N0 estimate 3 dB above the loss threshold, find the signal.
-// Bounds as there (issue 7's): no satellite acquired twice or lost, each coasting window starting 1-3 s into the
-// blockage (PRN 24's within its 2 s fade) and ending within 1 s of the return, fixes resuming, 2 m 3-D RMS.
-// Stays on the shared brdc0010.22n (week 2190): on the shipped file's sky (fading PRN 6) every coasting and
-// return bound holds but the fixes' 3-D RMS is 2.10 m (the short-window spread of ReceiveVector's first test).
+// (every signal absent 14-17 s, PRN 10 alone 18.5-20.5 s, on the shipped file's second sky). FLL channels are
+// filter-driven as the aided ones: a faded channel is declared absent by its presence test (1 s windows: coasting from
+// 1-2 s into the fade, not before a window could end) and coasts on the filter's commanded carrier and code; with
+// nothing to re-lock it is bit-synced again once two presence windows, or its C/N0 estimate 3 dB above the loss
+// threshold, find the signal. Bounds as there (issue 7's): no satellite acquired twice or lost, each coasting window
+// starting 1-3 s into the blockage (PRN 10's within its 2 s fade) and ending within 1 s of the return, fixes resuming,
+// 2 m 3-D RMS (second sky: last return 0.18 s after the signal, 85 fixes, 1.24 m; at the first sky, 518772 with PRN 6
+// fading, every coasting and return bound held but the fixes' 3-D RMS was 2.10 m: the short-window spread of
+// ReceiveVector's first test).
 TEST(ReceiveVectorFll, ChannelsCoastThroughFadesAndReturnWithoutAcquisition) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
   constexpr double kGapStart = 14.0, kGapEnd = 17.0, kFadeStart = 18.5, kFadeEnd = 20.5;
-  constexpr int kFaded = 24;
+  constexpr int kFaded = 10;
   std::ofstream(dir / "gap.toml") << ultratrack::test::vector_carrier_scenario(
       brdc, 100.0, 22.0,
       "[[blockage]]\nantenna = 0\nstart_s = 14.0\nduration_s = 3.0\n"
-      "[[cycle_slip]]\nantenna = 0\nprn = 24\ntime_s = 18.5\ncycles = 0.0\n"
+      "[[cycle_slip]]\nantenna = 0\nprn = 10\ntime_s = 18.5\ncycles = 0.0\n"
       "fade_s = 2.0\n",
-      2190);
+      ultratrack::test::kSecondSkyTow_s);
   const auto sim = dir / "sim", fll = dir / "fll";
   ultratrack::test::simulate_scenario(dir / "gap.toml", sim);
   ultratrack::test::receive_vector_carrier(sim, brdc, fll, "fll");

