@@ -5,26 +5,36 @@
 # and IMU seed per run, received by `ultratrack attitude`, aligned by `ultratrack align` (100 s from the first fixed
 # attitude, EKF, filter 1 Hz); final roll/pitch/yaw errors against the truth (0/0/0), RMS over the runs beside the
 # filter's 1-sigma and seed 000 Table 2. About 1 min of CPU and 1.7 GB of scratch per run (deleted as it goes).
-# Usage: benchmarks/alignment_if.sh [RUNS] [FIRST_SEED]   (needs build/tools/ultratrack, /work/shared/data or
-# ULTRATRACK_NAV=brdc0010.22n)
+# Usage: benchmarks/alignment_if.sh [--brdc FILE --week W --tow-shift S] [RUNS] [FIRST_SEED]   (needs
+# build/tools/ultratrack; the ephemeris: benchmarks/ephemeris_option.sh, the shipped file by default)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+source "$root/benchmarks/ephemeris_option.sh"
 U="$root/build/tools/ultratrack"
+while [[ $# -gt 0 && $1 == --* ]]; do
+  case $1 in
+    --brdc) brdc=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
+    *) echo "alignment_if.sh: unknown option $1" >&2; exit 2 ;;
+  esac
+done
 runs=${1:-20}
 first=${2:-1}
-nav=${ULTRATRACK_NAV:-$root/../shared/data/brdc0010.22n}
-[ -f "$nav" ] || nav=/work/shared/data/brdc0010.22n
+[ -f "$brdc" ] || { echo "alignment_if.sh: broadcast ephemeris $brdc missing (--brdc FILE)" >&2; exit 2; }
+brdc=$(realpath "$brdc")
+nav=$brdc
 work=${ULTRATRACK_WORK:-$(mktemp -d)}
 mkdir -p "$work"
 results="$work/results.txt"
 : > "$results"
 for k in $(seq "$first" $((first + runs - 1))); do
-  sed -e "s|\"../../shared/data/brdc0010.22n\"|\"$nav\"|" -e "s|^seed = 11|seed = $((100 + k))|" \
-      -e "s|^seed = 7|seed = $((200 + k))|" "$root/scenarios/align_static_if.toml" > "$work/s.toml"
+  retime_scenario "$root/scenarios/align_static_if.toml" | sed -e "s|^seed = 11|seed = $((100 + k))|" \
+      -e "s|^seed = 7|seed = $((200 + k))|" > "$work/s.toml"
   "$U" simulate --scenario "$work/s.toml" --out "$work/sim" >/dev/null
   "$U" attitude --input "$work"/sim/antenna{0,1,2}.i8.bin --format i8 --fs 2.6e6 \
       --antennas "$root/scenarios/attitude_antennas.toml" --nav "$nav" --out "$work/rx" >/dev/null
-  "$U" align --imu "$work/sim/imu.csv" --attitude "$work/rx/attitude.csv" --attitude-origin 2190 518396 \
+  "$U" align --imu "$work/sim/imu.csv" --attitude "$work/rx/attitude.csv" --attitude-origin "$(brdc_week_or 1823)" "$(brdc_tow_plus 530396)" \
       --position 35.274016 137.013759 100 --quiet --out "$work/al" >/dev/null
   python3 - "$work/al/alignment.json" "$k" >> "$results" <<'PY'
 import json, sys

@@ -10,14 +10,18 @@
 # simulator's truth (GNSS-SDR logs one fix per second, ultratrack writes ten).
 #
 #   benchmarks/compare_gnss_sdr.sh [--build DIR] [--scratch DIR] [--runs N] [--threads N]
+#       [--brdc FILE --week W --tow-shift S]
 #
-# The file: 8 satellites (brdc0010.22n, Nagoya, the demo scenario's start), 60 s, 2.6 MHz i8, 45 dB-Hz, with
+# The file: Nagoya from tow 530772 on the shipped ephemeris (benchmarks/ephemeris_option.sh; mask 9 deg: 10
+# satellites there, 8 on brdc0010.22n from 518772, where the [E] figures were measured), 60 s, 2.6 MHz i8, 45 dB-Hz, with
 # ionosphere and troposphere in the signal so that both receivers' models apply; synthesised once into the
 # scratch folder (default ${ULTRATRACK_BENCH_DIR:-/tmp/ultratrack_bench}). Where the machine has more than 2 cores,
 # both receivers are pinned to cores 0-1 (taskset) for the issue's 2-core figure. Exits 0 with a message when
 # gnss-sdr is not installed.
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
+root=$here
+source "$here/benchmarks/ephemeris_option.sh"
 if ! command -v gnss-sdr >/dev/null; then
   echo "compare_gnss_sdr.sh: gnss-sdr is not installed (apt-get install gnss-sdr): comparison skipped"
   exit 0
@@ -29,13 +33,16 @@ while [[ $# -gt 0 ]]; do
     --scratch) scratch=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
+    --brdc) brdc=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
     *) echo "compare_gnss_sdr.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
 ut=$build/tools/ultratrack
 [[ -x $ut ]] || { echo "compare_gnss_sdr.sh: $ut not built" >&2; exit 2; }
 [[ -x /usr/bin/time ]] || { echo "compare_gnss_sdr.sh: /usr/bin/time missing (apt-get install time)" >&2; exit 2; }
-brdc=$(realpath "${ULTRATRACK_BRDC:-$here/../shared/data/brdc0010.22n}")
+brdc=$(realpath "$brdc")
 pin=()
 if [[ $(nproc) -gt 2 ]] && command -v taskset >/dev/null; then pin=(taskset -c 0,1); fi
 
@@ -47,8 +54,8 @@ duration_s = 60.0
 cn0_dbhz = 45.0
 seed = 1
 [time]
-gps_week = 2190
-tow_s = 518772.0
+gps_week = $(brdc_week_or 1823)
+tow_s = $(brdc_tow_plus 530772.0)
 [navigation]
 rinex = \"$brdc\"
 elevation_mask_deg = 9.0
@@ -110,7 +117,7 @@ for ((r = 0; r < runs; r++)); do
   uout=$dir/ultratrack
   rm -rf "$uout"
   "${pin[@]}" /usr/bin/time -v -o "$dir/time.txt" "$ut" receive --input "$input" --format i8 --fs 2.6e6 --out "$uout" \
-    --quiet --channels 8 --threads "$threads" --reference-week 2190 >/dev/null
+    --quiet --channels 8 --threads "$threads" --reference-week "$(brdc_week_or 1823)" >/dev/null
   u_rt+=("$(python3 -c "import json; print(json.load(open('$uout/summary.json'))['realtime_factor'])")")
   u_mb+=("$(awk '/Maximum resident set size/ {print $NF / 1024}' "$dir/time.txt")")
   u_cpu+=("$(cpu_rt "$dir/time.txt")")

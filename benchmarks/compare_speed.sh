@@ -5,15 +5,17 @@
 # realtime_factor) and their ratio B / A.
 #
 #   benchmarks/compare_speed.sh --a BIN_A --b BIN_B [--rounds N] [--scratch DIR] [--brdc FILE]
+#   (--brdc: the ephemeris output_identity.sh simulated with; the shipped tests/data file by default)
 #
 # BIN_A / BIN_B: two `ultratrack` binaries. Jobs, on the files benchmarks/output_identity.sh simulates (same scratch
 # folder, ${ULTRATRACK_IDENTITY_DIR:-/tmp/ultratrack_identity}; run that script first): sat8 (8 satellites, 60 s,
-# 2.6 MHz i8, scalar) and ultratight (40 s of the seed-001 straight trajectory, UKF, pipelined), --threads 2.
+# 2.6 MHz i8, scalar; 10 satellites on the shipped file) and ultratight (40 s of the seed-001 straight trajectory, UKF, pipelined), --threads 2.
 set -euo pipefail
 rounds=5
 scratch=${ULTRATRACK_IDENTITY_DIR:-/tmp/ultratrack_identity}
 here=$(cd "$(dirname "$0")/.." && pwd)
-brdc=${ULTRATRACK_BRDC:-$here/../shared/data/brdc0010.22n}
+root=$here
+source "$here/benchmarks/ephemeris_option.sh"
 a=""; b=""
 while [[ $# -gt 0 ]]; do
   case $1 in
@@ -26,7 +28,9 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 [[ -x $a && -x $b ]] || { echo "compare_speed.sh: --a and --b must name two ultratrack binaries" >&2; exit 2; }
-[[ -f $scratch/sim_sat8/antenna0.i8.bin && -f $scratch/sim_straight/imu.csv ]] ||
+key=""  # output_identity.sh's cache key
+[[ $(basename "$brdc") == brdc0010.22n ]] || key=_$(basename "$brdc")
+[[ -f $scratch/sim_sat8$key/antenna0.i8.bin && -f $scratch/sim_straight$key/imu.csv ]] ||
   { echo "compare_speed.sh: run benchmarks/output_identity.sh first (files in $scratch)" >&2; exit 2; }
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 
@@ -34,10 +38,10 @@ run_job() {  # binary job -> realtime factor on stdout
   local bin=$1 job=$2 dir=$out/run
   rm -rf "$dir"
   case $job in
-    sat8) "$bin" receive --input "$scratch/sim_sat8/antenna0.i8.bin" --format i8 --fs 2.6e6 --threads 2 --quiet \
+    sat8) "$bin" receive --input "$scratch/sim_sat8$key/antenna0.i8.bin" --format i8 --fs 2.6e6 --threads 2 --quiet \
             --out "$dir" >/dev/null ;;
-    ultratight) "$bin" receive --input "$scratch/sim_straight/antenna0.i8.bin" --format i8 --fs 2.6e6 --nav "$brdc" \
-            --imu "$scratch/sim_straight/imu.csv" --coupling ultra-tight --filter ukf --threads 2 --quiet \
+    ultratight) "$bin" receive --input "$scratch/sim_straight$key/antenna0.i8.bin" --format i8 --fs 2.6e6 --nav "$brdc" \
+            --imu "$scratch/sim_straight$key/imu.csv" --coupling ultra-tight --filter ukf --threads 2 --quiet \
             --out "$dir" >/dev/null ;;
   esac
   python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["realtime_factor"])' "$dir/summary.json"

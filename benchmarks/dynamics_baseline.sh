@@ -25,11 +25,13 @@
 #   benchmarks/dynamics_baseline.sh [--scenarios "straight circle s spiral 10g_turn tunnel"] [--levels "45 35"]
 #       [--duration S (cap the signal duration)] [--out DIR] [--ultratrack build/tools/ultratrack]
 #       [--receive-args "..."] [--keep] [--report-only DIR (re-analyse the kept folders of a run)]
+#       [--brdc FILE --week W --tow-shift S (benchmarks/ephemeris_option.sh; the shipped file by default)]
 # CPU: simulate + receive, roughly 0.5-1 s of CPU per second of signal on one core at 2.6 MHz. Sample files are
 # deleted after their receive unless --keep (2.6 MHz i8 = 5.2 MB/s).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
+source "$root/benchmarks/ephemeris_option.sh"
 scenarios="straight circle s spiral 10g_turn tunnel"; levels="45 35"; duration=""; out=/tmp/ultratrack_dynamics
 ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; report_only=0
 while [ $# -gt 0 ]; do
@@ -41,14 +43,17 @@ while [ $# -gt 0 ]; do
     --ultratrack) ultratrack=$2; shift 2 ;;
     --receive-args) receive_args=$2; shift 2 ;;
     --keep) keep=1; shift ;;
+    --brdc|--nav) brdc=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
     -h|--help) sed -n '2,20p' "$0"; exit 0 ;;
     *) echo "dynamics_baseline.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-nav=$(realpath -m "$root/../shared/data/brdc0010.22n")
+nav=$(realpath -m "$brdc")
 if [ "$report_only" = 0 ] && [ ! -f "$nav" ]; then
-  echo "dynamics_baseline.sh: $nav not found (../shared/data/brdc0010.22n): skipped"; exit 0
+  echo "dynamics_baseline.sh: $nav not found (--brdc FILE)" >&2; exit 2
 fi
 [ -x "$ultratrack" ] || { echo "dynamics_baseline.sh: $ultratrack not built" >&2; exit 2; }
 mkdir -p "$out"; out=$(realpath "$out")
@@ -157,8 +162,8 @@ for sc in $( [ "$report_only" = 1 ] || echo $scenarios ); do
     name=${sc}_cn0_${level}; sim=$out/$name.sim; rx=$out/$name.rx
     rm -rf "$sim" "$rx"; mkdir -p "$sim"
     # the scenario with its C/N0, absolute paths (the copy lives in $out) and the optional duration cap
-    sed -e "s|^cn0_dbhz = .*|cn0_dbhz = $level|" -e "s|^rinex = .*|rinex = \"$nav\"|" \
-        -e "s|^file = \"\(.*\)\"|file = \"$root/scenarios/\1\"|" "$src" > "$sim.toml"
+    retime_scenario "$src" | sed -e "s|^cn0_dbhz = .*|cn0_dbhz = $level|" \
+        -e "s|^file = \"\(.*\)\"|file = \"$root/scenarios/\1\"|" > "$sim.toml"
     if [ -n "$duration" ]; then
       python3 - "$sim.toml" "$duration" <<'PY'
 import re, sys

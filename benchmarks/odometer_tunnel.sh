@@ -7,23 +7,30 @@
 # horizontal error against truth.csv at the tunnel's entry (30 s) and exit (90 s) and its RMS over the blockage
 # (benchmarks/nav_error_stats.py), and the odometer object's estimates.
 # CPU: ~10 s simulate + ~1 s per receive on one core; 400 MB of samples in --out (deleted unless --keep).
-# Usage: benchmarks/odometer_tunnel.sh [--build DIR] [--out DIR] [--nav RINEX] [--keep]
-#   --nav: the scenario's broadcast ephemerides (default ../shared/data/brdc0010.22n beside the checkout)
+# Usage: benchmarks/odometer_tunnel.sh [--build DIR] [--out DIR] [--brdc RINEX --week W --tow-shift S] [--keep]
+#   --brdc (or --nav): the scenario's broadcast ephemerides (default the shipped tests/data file;
+#   benchmarks/ephemeris_option.sh)
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
-build="$here/build"; out="${TMPDIR:-/tmp}/odometer_tunnel"; nav="$here/../shared/data/brdc0010.22n"; keep=0
+root=$here
+source "$here/benchmarks/ephemeris_option.sh"
+build="$here/build"; out="${TMPDIR:-/tmp}/odometer_tunnel"; keep=0
 while [ $# -gt 0 ]; do
   case "$1" in
-    --build) build="$2"; shift 2 ;; --out) out="$2"; shift 2 ;; --nav) nav="$2"; shift 2 ;; --keep) keep=1; shift ;;
+    --build) build="$2"; shift 2 ;; --out) out="$2"; shift 2 ;; --keep) keep=1; shift ;;
+    --brdc|--nav) brdc=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
-[ -f "$nav" ] || { echo "odometer_tunnel.sh: no $nav (--nav RINEX)" >&2; exit 2; }
+[ -f "$brdc" ] || { echo "odometer_tunnel.sh: no $brdc (--brdc RINEX)" >&2; exit 2; }
+brdc=$(realpath "$brdc"); nav=$brdc
 U="$build/tools/ultratrack"
 mkdir -p "$out"
 # the scenario with absolute paths (the copy lives in $out)
-sed -e "s|^rinex = .*|rinex = \"$nav\"|" -e "s|^file = \"\(.*\)\"|file = \"$here/scenarios/\1\"|" \
-  "$here/scenarios/odometer_tunnel.toml" > "$out/tunnel.toml"
+retime_scenario "$here/scenarios/odometer_tunnel.toml" |
+  sed -e "s|^file = \"\(.*\)\"|file = \"$here/scenarios/\1\"|" > "$out/tunnel.toml"
 rm -rf "$out/sim"
 nice -n 5 "$U" simulate --scenario "$out/tunnel.toml" --out "$out/sim" --quiet > "$out/sim.log"
 prns=$(tail -n +2 "$out/sim/satellites.csv" | cut -d, -f1 | paste -sd, -)

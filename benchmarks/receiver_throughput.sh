@@ -7,15 +7,20 @@
 # fixes against the simulator's truth.
 #
 #   benchmarks/receiver_throughput.sh [--build DIR] [--scratch DIR] [--runs N] [--threads N] [--only REGEX]
+#       [--brdc FILE --week W --tow-shift S]
 #
 # Standard set: 8 and 12 satellites x 2.6 / 4 / 16 MHz x i8 / i16, complex baseband, 45 dB-Hz, static receiver,
-# broadcast ephemeris ../shared/data/brdc0010.22n on 2022-01-01 (8 satellites: Nagoya from tow 518772, the demo
-# scenario's start, first fix ~36 s in, simulator elevation mask 9 deg; 12 satellites: 70 N 90 W from tow 518398,
-# 2 s before a frame, first fix ~20 s in, one satellite below the receiver's 10 deg mask). 60 s of signal, 40 s
+# the shipped broadcast ephemeris tests/data/brdc3540_0000-0200.14n of 2014-12-20 (benchmarks/ephemeris_option.sh)
+# (set "8": Nagoya from tow 530772, 6 s before subframe 4 page 18, first fix ~36 s in, simulator elevation mask
+# 9 deg: 10 satellites here, 8 on brdc0010.22n where the set was named; set "12": 70 N 90 W from tow 530398, 2 s
+# before a frame, first fix ~20 s in, mask 0: 11 satellites here, three below the receiver's 10 deg mask; 12 on
+# brdc0010.22n with one below it). 60 s of signal, 40 s
 # at 16 MHz (2.6 GB for i16). Defaults: build/, ${ULTRATRACK_BENCH_DIR:-/tmp/ultratrack_bench}, 3 runs,
 # --threads 2 (the issue's 2 cores; --threads none for builds without the option). Needs python3 and /usr/bin/time (Debian package `time`).
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
+root=$here
+source "$here/benchmarks/ephemeris_option.sh"
 build=$here/build; scratch=${ULTRATRACK_BENCH_DIR:-/tmp/ultratrack_bench}; runs=3; threads=2; only=.
 while [[ $# -gt 0 ]]; do
   case $1 in
@@ -24,14 +29,16 @@ while [[ $# -gt 0 ]]; do
     --runs) runs=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
     --only) only=$2; shift 2 ;;
+    --brdc) brdc=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
     *) echo "receiver_throughput.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
 ut=$build/tools/ultratrack
 [[ -x $ut ]] || { echo "receiver_throughput.sh: $ut not built (cmake --build build --target ultratrack)" >&2; exit 2; }
 [[ -x /usr/bin/time ]] || { echo "receiver_throughput.sh: /usr/bin/time missing (apt-get install time)" >&2; exit 2; }
-brdc=${ULTRATRACK_BRDC:-$here/../shared/data/brdc0010.22n}
-[[ -f $brdc ]] || { echo "receiver_throughput.sh: $brdc missing (set ULTRATRACK_BRDC)" >&2; exit 2; }
+[[ -f $brdc ]] || { echo "receiver_throughput.sh: $brdc missing (--brdc FILE)" >&2; exit 2; }
 brdc=$(realpath "$brdc")
 mkdir -p "$scratch"
 threads_flag=(--threads "$threads")
@@ -51,8 +58,9 @@ set_list() {
 
 synthesise() {  # name sats fs format duration -> the IF file path on stdout
   local name=$1 sats=$2 fs=$3 fmt=$4 duration=$5 dir=$scratch/$1
-  local llh="35.274016, 137.013759, 100.0" mask=9 tow=518772.0
-  [[ $sats == 12 ]] && { llh="70.0, -90.0, 100.0"; mask=0; tow=518398.0; }
+  local llh="35.274016, 137.013759, 100.0" mask=9 tow
+  tow=$(brdc_tow_plus 530772.0)
+  [[ $sats == 12 ]] && { llh="70.0, -90.0, 100.0"; mask=0; tow=$(brdc_tow_plus 530398.0); }
   local scenario
   scenario=$(cat <<TOML
 [signal]
@@ -62,7 +70,7 @@ duration_s = $duration
 cn0_dbhz = 45.0
 seed = 1
 [time]
-gps_week = 2190
+gps_week = $(brdc_week_or 1823)
 tow_s = $tow
 [navigation]
 rinex = "$brdc"
@@ -96,7 +104,7 @@ while read -r name sats fs fmt duration; do
     out=$scratch/$name/rx
     rm -rf "$out"
     /usr/bin/time -v -o "$scratch/$name/time.txt" "$ut" receive --input "$input" --format "$fmt" --fs "$fs" \
-      --out "$out" --quiet ${threads_flag[@]+"${threads_flag[@]}"} --reference-week 2190 --troposphere off >/dev/null
+      --out "$out" --quiet ${threads_flag[@]+"${threads_flag[@]}"} --reference-week "$(brdc_week_or 1823)" --troposphere off >/dev/null
     read -r rt cpu kb e < <(python3 - "$out" "$scratch/$name/time.txt" "$scratch/$name/sim/truth.csv" <<'PY'
 import csv, json, math, sys
 out, timing, truth = sys.argv[1:]

@@ -4,7 +4,8 @@
 # and solves each with `ultratrack snapshot` WITHOUT an approximate position, from an approximate time that is
 # off by a uniform random error within +-TIME_ERROR s. Case classes: C/N0 45 and 35 dB-Hz x static and an aircraft
 # at 250 m/s (level flight, random heading, 2-11 km) x 20 and 100 ms; CASES per class (default 7: 56 cases).
-# Every case: a random place (latitude -60..70 deg), start time in 2022-01-01 (brdc0010.22n), receiver clock bias
+# Every case: a random place (latitude -60..70 deg), start time inside the ephemeris file's validity (shipped
+# tests/data file: week 1823, TOW 511800-532200; --week/--tow-min/--tow-max for another), receiver clock bias
 # (+-0.3 ms) and drift (+-0.5 ppm), sample format in turn i8 at 2.6 MHz, r2 (2-bit real) at 20 MHz with a 4.1 MHz
 # IF, i16 at 4 MHz. Truth: the scenario's start position and time (the snapshot's first sample).
 # Prints one row per case and the table per class: cases, fixes within 10 m (3-D), fixes flagged by the
@@ -12,13 +13,15 @@
 # and the fixes within their own 95 % error bound (snapshot.json error_bound_3d_95_m).
 #
 #   benchmarks/snapshot_mc.sh [--cases 7] [--seed0 1] [--time-error 10] [--out DIR] [--ultratrack build/tools/ultratrack]
-#       [--nav FILE] [--keep] [--snapshot-args "..."] [--cn0 "45 35"]   (more options for every `snapshot`; levels)
-# Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3. CPU: a few seconds per case.
+#       [--nav FILE --week W --tow-min A --tow-max B] [--keep] [--snapshot-args "..."] [--cn0 "45 35"]
+#       (more options for every `snapshot`; levels). brdc0010.22n, where the [E] figures were measured:
+#       --nav FILE --week 2190 --tow-min 519000 --tow-max 603000.
+# Needs python3. CPU: a few seconds per case.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 cases=7 seed0=1 time_error=10 out="" keep=0 snapshot_args="" levels="45 35"
 ut="$here/../build/tools/ultratrack"
-nav="$here/../../shared/data/brdc0010.22n"
+nav="$here/../tests/data/brdc3540_0000-0200.14n"; week=1823 tow_min=511800 tow_max=532200
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --cases) cases="$2"; shift 2 ;;
@@ -26,7 +29,10 @@ while [[ $# -gt 0 ]]; do
     --time-error) time_error="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --ultratrack) ut="$2"; shift 2 ;;
-    --nav) nav="$2"; shift 2 ;;
+    --nav|--brdc) nav="$2"; shift 2 ;;
+    --week) week="$2"; shift 2 ;;
+    --tow-min) tow_min="$2"; shift 2 ;;
+    --tow-max) tow_max="$2"; shift 2 ;;
     --keep) keep=1; shift ;;
     --snapshot-args) snapshot_args="$2"; shift 2 ;;
     --cn0) levels="$2"; shift 2 ;;
@@ -39,12 +45,13 @@ done
 mkdir -p "$out"
 nav="$(cd "$(dirname "$nav")" && pwd)/$(basename "$nav")"
 
-python3 - "$ut" "$nav" "$out" "$cases" "$seed0" "$time_error" "$keep" "$snapshot_args" "$levels" <<'EOF'
+python3 - "$ut" "$nav" "$out" "$cases" "$seed0" "$time_error" "$keep" "$snapshot_args" "$levels" "$week" "$tow_min" "$tow_max" <<'EOF'
 import json, math, os, random, shutil, statistics, subprocess, sys
 
 ut, nav, out, cases, seed0, time_error, keep = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), int(sys.argv[5]), float(sys.argv[6]), sys.argv[7] == "1"
 extra = sys.argv[8].split()
 levels = [float(x) for x in sys.argv[9].split()]
+week, tow_min, tow_max = int(sys.argv[10]), float(sys.argv[11]), float(sys.argv[12])
 
 def ecef(lat, lon, h):
     a, f = 6378137.0, 1 / 298.257223563
@@ -66,7 +73,7 @@ for cn0 in levels:
                 index += 1
                 lat, lon = rng.uniform(-60, 70), rng.uniform(-180, 180)
                 h = rng.uniform(0, 500) if motion == "static" else rng.uniform(2000, 11000)
-                tow = rng.uniform(519000, 603000)
+                tow = rng.uniform(tow_min, tow_max)
                 err = rng.uniform(-time_error, time_error)
                 case = os.path.join(out, f"case{seed:04d}")
                 os.makedirs(case, exist_ok=True)
@@ -78,7 +85,7 @@ duration_s = {ms / 1000 + 0.002}
 cn0_dbhz = {cn0}
 seed = {seed}
 [time]
-gps_week = 2190
+gps_week = {week}
 tow_s = {tow:.6f}
 [navigation]
 rinex = "{nav}"
@@ -109,7 +116,7 @@ imu_rate_hz = 100.0
                     continue
                 approx = tow + err
                 args = [ut, "snapshot", "--input", os.path.join(case, "sim", f"antenna0.{fmt_name}.bin"), "--format", fmt_name,
-                        "--fs", str(fs), "--if", str(if_hz), "--nav", nav, "--time", f"2190:{approx:.6f}", "--time-sigma-s", "10",
+                        "--fs", str(fs), "--if", str(if_hz), "--nav", nav, "--time", f"{week}:{approx:.6f}", "--time-sigma-s", "10",
                         "--ms", str(ms), "--doppler-max", "8000", "--out", os.path.join(case, "snap")] + extra
                 snap = subprocess.run(args, capture_output=True, text=True)
                 result = {"seed": seed, "cn0": cn0, "motion": motion, "ms": ms, "format": fmt_name, "exit": snap.returncode,

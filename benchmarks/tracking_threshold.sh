@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Tracking threshold: the C/N0 at which 90 % of 60 s tracking runs keep lock (issue 3). For every C/N0 level it
-# synthesises FILES static files (`ultratrack simulate`, brdc0010.22n, different seeds and start times, every
+# synthesises FILES static files (`ultratrack simulate`, the shipped tests/data ephemeris by default, different
+# seeds and start times, every
 # satellite above the horizon at that C/N0: each satellite of each file is one run), receives them hot
 # (`--nav`, so ephemerides are known and nothing but tracking happens after acquisition), and classifies every
 # satellite-run from tracking.csv:
@@ -27,8 +28,9 @@
 #       [--seed0 100] [--out DIR] [--ultratrack build/tools/ultratrack] [--receive-args "..."]
 #       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep] [--coupling scalar|vector]
 #       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--filter ekf|ukf]
-#       [--scenario FILE] [--reuse]
-# Needs ../shared/data/brdc0010.22n (or --nav FILE) and python3 (the report). CPU: about 15 s per file at
+#       [--scenario FILE] [--reuse] [--week W --tow-shift S]
+# The ephemeris: benchmarks/ephemeris_option.sh (--nav or --brdc FILE; the shipped file by default; the files start
+# at tow 530400 + 90 k). Needs python3 (the report). CPU: about 15 s per file at
 # 2.6 MHz on one core. Files are deleted after their receive unless --keep. --reuse: a file kept by an earlier
 # --keep run in the same --out (same level, file number and options: the same seed and content) is received
 # again instead of simulated (e.g. a further coupling on the same files); runs.csv and positions.csv are
@@ -59,8 +61,9 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
+source "$root/benchmarks/ephemeris_option.sh"
 levels="24 26 28 30 32"; files=4; duration=60; fs=2.6e6; seed0=100; out=/tmp/ultratrack_threshold
-ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$root/../shared/data/brdc0010.22n
+ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$brdc
 lock_deadline_s=5; extra_config=""; report_only=0; reuse=0
 strong_s=0; strong_cn0=45; couplings=""; scenario=""; filter=ekf
 while [ $# -gt 0 ]; do
@@ -74,7 +77,9 @@ while [ $# -gt 0 ]; do
     --ultratrack) ultratrack=$2; shift 2 ;;
     --receive-args) receive_args=$2; shift 2 ;;
     --coupling) receive_args="$receive_args --coupling $2"; shift 2 ;;  # scalar (default) or vector (issue 7)
-    --nav) nav=$2; shift 2 ;;
+    --nav|--brdc) nav=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
     --lock-deadline) lock_deadline_s=$2; shift 2 ;;
     --config-extra) extra_config=$(realpath "$2"); shift 2 ;;
     --strong-s) strong_s=$2; shift 2 ;;
@@ -90,7 +95,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 if [ "$report_only" = 0 ] && [ ! -f "$nav" ]; then
-  echo "tracking_threshold.sh: $nav not found (../shared/data/brdc0010.22n): skipped"
+  echo "tracking_threshold.sh: $nav not found (--nav FILE)"
   exit 0
 fi
 [ -x "$ultratrack" ] || { echo "tracking_threshold.sh: $ultratrack not built" >&2; exit 2; }
@@ -126,7 +131,7 @@ skipped=" "
 for level in $levels; do
   for ((k = 0; k < files; ++k)); do
     seed=$((seed0 + k))
-    tow=$((518400 + 90 * k))  # different nav-bit content and geometry per file, inside the ephemerides' fit
+    tow=$((530400 + brdc_tow_shift + 90 * k))  # different nav-bit content and geometry per file, inside the fit
     name=cn0_${level}_file_${k}
     sim=$out/$name.sim
     reused=0
@@ -166,7 +171,7 @@ duration_s = $file_s
 cn0_dbhz = $file_cn0
 seed = $seed
 [time]
-gps_week = 2190
+gps_week = $(brdc_week_or 1823)
 tow_s = $tow.0
 [navigation]
 rinex = "$nav"

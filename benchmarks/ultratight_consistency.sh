@@ -19,12 +19,14 @@
 #          [--filters "ekf ukf"] [--cn0 45] [--seed0 1000] [--out DIR] [--receive-args "..."]
 #          [--ultratrack build/tools/ultratrack] [--atmosphere off (neither simulated nor corrected)]
 #          [--coupling tight (the tight filter alone, nav.csv from it throughout)] [--report-only DIR]
+#          [--brdc FILE --week W --tow-shift S (benchmarks/ephemeris_option.sh; the shipped file by default)]
 # Cost (2 MHz i8, --threads 2): per 60 s seed, simulate 5-12 s wall, each receive 1.1-3.2 s; 40 seeds of 60 s with
 # both filters took 7.3 min on the project's 2-core machine shared with 3 other jobs (load ~5). Only nav.csv,
 # truth.csv and summary.json are kept per run (the sample file is deleted after its receives).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/.." && pwd)
+source "$root/benchmarks/ephemeris_option.sh"
 runs=40; duration=60; times="10.5 11 12 14 16 20 25 30 40 50 59.5"; filters="ekf ukf"; cn0=45; seed0=1000
 out=/tmp/ultratrack_consistency; ultratrack=$root/build/tools/ultratrack; receive_args=""; report_only=0; atmosphere=on; coupling=ultra-tight
 while [ $# -gt 0 ]; do
@@ -40,15 +42,18 @@ while [ $# -gt 0 ]; do
     --ultratrack) ultratrack=$2; shift 2 ;;
     --atmosphere) atmosphere=$2; shift 2 ;;
     --coupling) coupling=$2; shift 2 ;;
+    --brdc|--nav) brdc=$2; shift 2 ;;
+    --week) brdc_week=$2; shift 2 ;;
+    --tow-shift) brdc_tow_shift=$2; shift 2 ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
     -h|--help) sed -n '2,23p' "$0"; exit 0 ;;
     *) echo "ultratight_consistency.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
-nav=$(realpath -m "$root/../shared/data/brdc0010.22n")
+nav=$(realpath -m "$brdc")
 mkdir -p "$out"; out=$(realpath "$out")
 if [ "$report_only" = 0 ]; then
-  [ -f "$nav" ] || { echo "ultratight_consistency.sh: $nav not found (../shared/data/brdc0010.22n): skipped"; exit 0; }
+  [ -f "$nav" ] || { echo "ultratight_consistency.sh: $nav not found (--brdc FILE)" >&2; exit 2; }
   [ -x "$ultratrack" ] || { echo "ultratight_consistency.sh: $ultratrack not built" >&2; exit 2; }
   printf '[alignment]\nmotion_window_s = 1.0\n' > "$out/motion.toml"
   atmo=true; rx_config=()
@@ -69,8 +74,8 @@ duration_s = $duration
 cn0_dbhz = $cn0
 seed = $((seed0 + k))
 [time]
-gps_week = 2190
-tow_s = 518776.0
+gps_week = $(brdc_week_or 1823)
+tow_s = $(brdc_tow_plus 530776.0)
 [navigation]
 rinex = "$nav"
 [receiver]

@@ -219,7 +219,7 @@ TEST(UltratightScenarios, TunnelBlockageSilencesTheReceiver) {
   const std::filesystem::path nav = ultratrack::test::shipped_nav_file();
   Scenario s = read_scenario(scenarios_dir() / "ultratight_tunnel.toml");
   s.rinex = nav.string();
-  s.gps_week = ultratrack::test::shipped_nav_week;  // the scenario's tow_s (518776) on the shipped file's week
+  s.gps_week = ultratrack::test::shipped_nav_week;  // the scenario's own (its tow_s 530776 is inside the shipped file)
   s.noise = false;
   s.cn0_dbhz = 80.0;  // so that the noiseless signal survives i8 quantisation
   s.duration_s = 0.008;
