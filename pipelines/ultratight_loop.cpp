@@ -462,6 +462,8 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
   for (const auto& in : epoch.channels) {
     ChannelState& st = channel(in.prn);
     if (st.was_coasting && !in.coasting && in.vector_mode) ++relocks_;
+    if (in.coasting) nis_.forget(in.prn);  // a new arc after the re-lock
+    st.since_relock_s = in.coasting ? 0.0 : st.since_relock_s + ut_.period_s;
     st.was_coasting = in.coasting;
   }
   last_sample_ = epoch.sample;
@@ -470,7 +472,9 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
 }
 
 void UltraTightLoop::nis_tests(double t_s) {
-  for (const auto& u : driver_->last_updates()) nis_.add(u.prn, u.nis, static_cast<int>(u.innovation.size()));
+  for (const auto& u : driver_->last_updates())
+    if (channel(u.prn).since_relock_s >= ut_.nis_settle_s)
+      nis_.add(u.prn, u.nis, static_cast<int>(u.innovation.size()));
   const fusion::NisVerdict v = nis_.evaluate();
   if (v.filter) {
     // Most channels contradict the filter at once: the filter is wrong, not they. Its covariance re-opens (what

@@ -66,6 +66,10 @@ struct UltraTightLoopOptions {
   // velocity and clock drift at least reopen_velocity_sigma_mps (well inside the I&Q model's pull-in: +-1 chip of
   // code, +-25 Hz of carrier at 20 ms), attitude at fusion::LockoutRecoveryOptions' defaults.
   fusion::NisReleaseOptions nis;
+  // A channel's window restarts when it coasts and takes no update until this long after its re-lock: in the first
+  // second after a re-lock the PLL's residual phase makes the gate refuse a third of its updates at 45 dB-Hz (a
+  // transient of the model, not a wrong prediction: docs/validation.md), which alone filled a window to 4.4 x its dof.
+  double nis_settle_s = 1.0;
   double reopen_position_sigma_m = 15.0;
   double reopen_velocity_sigma_mps = 1.0;
 };
@@ -93,6 +97,7 @@ class UltraTightLoop final : public receiver::VectorLoop {
     double coast_s = 0.0;
     bool ever = false;
     bool was_coasting = false;
+    double since_relock_s = 1e9;      // time since the channel last stopped coasting (NIS settling)
     PromptPowerAverage prompt_power;  // the I&Q model's amplitude
     double aid_hz = NAN;              // the carrier aiding sent (changes by the INS propagation only)
     // The command sent last (vector): a pipelined loop's is still pending when the next inputs are taken.

@@ -101,9 +101,9 @@ TEST(WindowedNis, SumsOfChiSquareNisFollowTheClosedForm) {
 }
 
 // Eight channels of the ultra-tight I&Q form (6 dof per 20 ms update) with the defaults (1 s windows, 1e-6,
-// margin 2, the 0.9999 gate). From update 100 on, PRN 5's prediction is 6 sigma off on one tap (NIS ~42, mostly
+// margin 3, the 0.9999 gate). From update 100 on, PRN 5's prediction is 6 sigma off on one tap (NIS ~42, mostly
 // at the gate's cap c = 27.9). From a window of clean updates (mean m0 = 6) the release comes once
-// k (c - m0) > L - W m0, L = 2 q(300, 1e-6): after k ~ 26 updates.
+// k (c - m0) > L - W m0, L = 3 q(300, 1e-6): after k ~ 45 updates, within one window (each above L / W = 26).
 TEST(NisRelease, AContradictedChannelIsReleasedWithinTheBudgetAndTheOthersStay) {
   NisReleaseOptions o;
   NisReleaseMonitor m(o);
@@ -127,8 +127,8 @@ TEST(NisRelease, AContradictedChannelIsReleasedWithinTheBudgetAndTheOthersStay) 
   EXPECT_LE(released_at - 100 + 1, o.window);  // each contradicting update above L / W: within one window
 }
 
-// Six of eight channels contradicted at once: the pooled windows pass their band (at ~22 updates: 8 x 300 + 6 k
-// (27.9 - 6) > 2 q(2400, 1e-6)) before any channel's own (~26): one filter event, no channel blamed; while the
+// Six of eight channels contradicted at once: the pooled windows pass their band (at ~42 updates: 8 x 300 + 6 k
+// (27.9 - 6) > 3 q(2400, 1e-6)) before any channel's own (~45): one filter event, no channel blamed; while the
 // contradiction lasts, nothing more (the pool stays out: logged once); once it ends and the pool is back inside,
 // channels are judged again.
 TEST(NisRelease, MostChannelsOutsideAtOnceIsTheFilterLoggedOnce) {
@@ -155,7 +155,7 @@ TEST(NisRelease, MostChannelsOutsideAtOnceIsTheFilterLoggedOnce) {
 
 // A consistent filter: 10 channels for 3000 updates each (a minute at 50 Hz) with 6 dof, and 10 with 2 (the
 // vector filter's pseudorange and rate rows): no release. Per full window a consistent filter passes
-// q(W dof, 1e-6) with probability 1e-6; margin 2 leaves a real filter's over-dispersion room besides.
+// q(W dof, 1e-6) with probability 1e-6; margin 3 leaves a real filter's over-dispersion room besides.
 TEST(NisRelease, AMinuteOfConsistentUpdatesReleasesNothing) {
   for (int dof : {6, 2}) {
     NisReleaseMonitor m(NisReleaseOptions{});
