@@ -7,7 +7,6 @@
 #include <cmath>
 
 #include "fusion/ins_error_state.hpp"
-#include "receiver/chi_square.hpp"
 
 namespace ultratrack::fusion {
 
@@ -26,11 +25,24 @@ bool LockoutRecoveryOptions::IsValid(std::string* why) const {
   return true;
 }
 
+namespace {
+
+WindowedNisOptions window_options(const LockoutRecoveryOptions& o) {
+  WindowedNisOptions w;
+  w.window = std::max(o.nis_window, 1);  // (0: the test is off, observe never adds)
+  w.probability = o.nis_window_probability;
+  w.cap_per_dof = 100.0;  // one outlier alone cannot fill the window's budget
+  return w;
+}
+
+}  // namespace
+
+LockoutMonitor::LockoutMonitor(const LockoutRecoveryOptions& options)
+    : opt_(options), window_(window_options(options)) {}
+
 void LockoutMonitor::reset() {
   rejections_ = 0;
-  window_.clear();
-  window_nis_ = 0.0;
-  window_dof_ = 0;
+  window_.reset();
 }
 
 std::optional<RecoveryEvent> LockoutMonitor::observe(double t_s, bool accepted, double nis, int dof) {
@@ -47,21 +59,9 @@ std::optional<RecoveryEvent> LockoutMonitor::observe(double t_s, bool accepted, 
     return e;
   }
   if (opt_.nis_window == 0 || dof <= 0) return std::nullopt;
-  // A rejected update's NIS can be huge: capped so that one outlier alone cannot fill the window's budget.
-  const double capped = std::isfinite(nis) ? std::min(nis, 100.0 * dof) : 100.0 * dof;
-  window_.emplace_back(capped, dof);
-  window_nis_ += capped;
-  window_dof_ += dof;
-  if (static_cast<int>(window_.size()) > opt_.nis_window) {
-    window_nis_ -= window_.front().first;
-    window_dof_ -= window_.front().second;
-    window_.pop_front();
-  }
-  if (static_cast<int>(window_.size()) < opt_.nis_window) return std::nullopt;
-  const double limit = receiver::chi_square_upper_quantile(window_dof_, opt_.nis_window_probability);
-  if (window_nis_ <= limit) return std::nullopt;
-  RecoveryEvent e{t_s, fmt::format("windowed NIS {:.0f} over {} updates (limit {:.0f})", window_nis_,
-                                   static_cast<int>(window_.size()), limit)};
+  if (!window_.add(nis, dof)) return std::nullopt;
+  RecoveryEvent e{t_s, fmt::format("windowed NIS {:.0f} over {} updates (limit {:.0f})", window_.sum(),
+                                   window_.updates(), window_.limit())};
   reset();
   return e;
 }

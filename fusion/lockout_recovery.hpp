@@ -3,17 +3,17 @@
 // innovation gate, and then nothing can bring it back (a MEMS unit after an outage, a bad start, a burst of bad
 // fixes that got in). LockoutMonitor watches the updates of one measurement stream and says when the filter must
 // re-open: a run of consecutive rejections spanning some time, or a windowed NIS far above its chi-square band
-// (the state is wrong although each update just passes the gate). inflate_for_recovery then opens the
-// covariance of what the measurements observe (position, velocity, attitude, and the clock in tight mode) so the
-// next update is accepted and pulls the state back; biases and their correlations are kept. Units SI; error
-// state layout of fusion/ins_error_state.hpp.
+// (fusion/windowed_nis.hpp: the state is wrong although each update just passes the gate). inflate_for_recovery then
+// opens the covariance of what the measurements observe (position, velocity, attitude, and the clock in tight mode) so
+// the next update is accepted and pulls the state back; biases and their correlations are kept. Units SI; error state
+// layout of fusion/ins_error_state.hpp.
 #pragma once
 
 #include <Eigen/Core>
-#include <deque>
 #include <optional>
 #include <string>
-#include <utility>
+
+#include "fusion/windowed_nis.hpp"
 
 namespace ultratrack::fusion {
 
@@ -37,7 +37,7 @@ struct RecoveryEvent {
 
 class LockoutMonitor {
  public:
-  explicit LockoutMonitor(const LockoutRecoveryOptions& options) : opt_(options) {}
+  explicit LockoutMonitor(const LockoutRecoveryOptions& options);
 
   // One update (or, tight, one epoch: accepted when any satellite was) at t_s with its NIS and dof. Returns the
   // event when the filter must re-open now; the monitor then starts afresh.
@@ -48,9 +48,7 @@ class LockoutMonitor {
   LockoutRecoveryOptions opt_;
   int rejections_ = 0;
   double first_rejection_t_s_ = 0.0;
-  std::deque<std::pair<double, int>> window_;  // NIS, dof
-  double window_nis_ = 0.0;
-  int window_dof_ = 0;
+  WindowedNis window_;  // nis_window updates (one when the test is off), each NIS capped at 100 dof
 };
 
 // Opens P (n x n, n >= 9) for a recovery: position variances at least 4 innovation^2 per NED axis (pos_innovation;

@@ -2,6 +2,7 @@
 #include "fusion/ultratight_integration.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -46,6 +47,7 @@ struct UltraTightCoreBase {
   virtual void finish_period(const std::vector<ChannelCorrelation>& c) = 0;
   virtual NominalState nominal() const = 0;
   virtual Eigen::MatrixXd covariance() const = 0;
+  virtual void set_covariance(const Eigen::MatrixXd& P) = 0;
   std::vector<ReplicaCommand> replicas;
   std::vector<UltraTightSatelliteUpdate> last_updates;
   IntegrationOutput output;
@@ -293,6 +295,10 @@ class UltraTightCore final : public UltraTightCoreBase {
 
   NominalState nominal() const override { return nominal_; }
   Eigen::MatrixXd covariance() const override { return filter_.P(); }
+  void set_covariance(const Eigen::MatrixXd& P) override {
+    filter_.set_P(StateMatrix<17>(P));
+    fill_output();
+  }
 
  private:
   // Satellites above the mask predicted from the current nominal (antenna position, clock): two passes of
@@ -478,6 +484,14 @@ const std::vector<ReplicaCommand>& UltraTightIntegration::replicas() const { ret
 const IntegrationOutput& UltraTightIntegration::output() const { return impl_->core->output; }
 NominalState UltraTightIntegration::nominal() const { return impl_->core->nominal(); }
 Eigen::MatrixXd UltraTightIntegration::covariance() const { return impl_->core->covariance(); }
+void UltraTightIntegration::set_covariance(const Eigen::MatrixXd& P) {
+  if (P.rows() != 17 || P.cols() != 17 || !P.allFinite() || !P.isApprox(P.transpose()))
+    throw std::invalid_argument("ultra-tight: a covariance must be a finite symmetric 17 x 17 matrix");
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(P);
+  if (!(eig.eigenvalues().minCoeff() > 0.0))
+    throw std::invalid_argument("ultra-tight: a covariance must be positive definite");
+  impl_->core->set_covariance(P);
+}
 const UltraTightCounters& UltraTightIntegration::counters() const { return impl_->core->counters; }
 const std::vector<UltraTightSatelliteUpdate>& UltraTightIntegration::last_updates() const {
   return impl_->core->last_updates;

@@ -152,6 +152,10 @@ class UltraTightIntegration {
   const IntegrationOutput& output() const;
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;  // 17 x 17
+  // Replaces the error covariance (17 x 17, symmetric positive definite; std::invalid_argument otherwise): a loop
+  // re-opening a filter its measurements contradict (fusion/lockout_recovery.hpp's inflate_for_recovery). The
+  // state and the replicas of the open period are kept.
+  void set_covariance(const Eigen::MatrixXd& P);
   const UltraTightCounters& counters() const;
   // The updates of the latest finish_period (satellites with a usable measurement), in replica order.
   const std::vector<UltraTightSatelliteUpdate>& last_updates() const;

@@ -141,7 +141,17 @@ ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorSt
   return p;
 }
 
-VectorTrackingFilter::VectorTrackingFilter(const VectorTrackingOptions& options) : opt_(options) {
+namespace {
+
+NisReleaseOptions with_gate(NisReleaseOptions o, const GateOptions& gate) {
+  o.gate_probability = gate.probability;
+  return o;
+}
+
+}  // namespace
+
+VectorTrackingFilter::VectorTrackingFilter(const VectorTrackingOptions& options)
+    : opt_(options), nis_(with_gate(options.nis, options.gate)) {
   model_.noise = opt_.process;
   phase_.fill(VectorCarrierPhase(opt_.pll));
   prn_.fill(fresh_prn_state());
@@ -201,6 +211,7 @@ bool VectorTrackingFilter::initialise(const receiver::VectorEpochInput& in) {
   starved_s_ = 0.0;
   prn_.fill(fresh_prn_state());
   phase_.fill(VectorCarrierPhase(opt_.pll));
+  nis_.reset();
   ++initialisations_;
   return true;
 }
@@ -246,6 +257,17 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       log.replica_phase_mid_cycles = ch.replica_carrier_phase_mid_cycles;
     }
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
+    const auto k = static_cast<std::size_t>(ch.prn);
+    epoch_nis_[k] = 0.0;
+    epoch_dof_[k] = 0;
+    if (!ch.synchronised && nis_released_[k]) {  // lost: a new track starts afresh
+      nis_released_[k] = false;
+      nis_.forget(ch.prn);
+    }
+    if (nis_released_[k]) {  // its rows contradicted the filter: scalar, not used
+      st = {};
+      continue;
+    }
     const bool strong = usable(ch, st);
     // A faded channel the filter commands keeps its standing (it coasts, commanded below); others restart.
     const bool joined = st.accepted >= opt_.join_after_updates && ch.vector_mode;
@@ -281,6 +303,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log.pr_innovation_m = r.innovation.size() ? r.innovation(0) : NAN;
     log.pr_sigma_m = sigma_pr;
     log.pr_used = r.accepted;
+    epoch_nis_[k] += r.nis;
+    epoch_dof_[k] += r.dof;
     if (r.accepted) {
       ++st.accepted;
       st.rejections = 0;
@@ -306,6 +330,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       const bool weak = opt_.carrier == VectorCarrier::kAidedPll && cn0 < ratio_hz(opt_.false_lock_below_dbhz);
       if (!(weak && std::abs(st.doppler_bias.mean_hz()) > opt_.doppler_bias_hz)) {
         const UpdateResult rr = ekf_->update(m);
+        epoch_nis_[k] += rr.nis;
+        epoch_dof_[k] += rr.dof;
         log.rate_innovation_mps = rr.innovation.size() ? rr.innovation(0) : NAN;
         log.rate_used = rr.accepted;
       }
@@ -313,6 +339,8 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
       log.measured_doppler_hz = ch.measured_doppler_hz;
     }
   }
+
+  nis_tests(in);
 
   // Too few satellites for an observable filter: after reset_after_s, restart from the next fix.
   starved_s_ = used >= opt_.min_satellites ? 0.0 : starved_s_ + step_s;
@@ -336,6 +364,7 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     PrnState& st = prn_[static_cast<std::size_t>(ch.prn)];
     const bool strong = usable(ch, st);
     if (!ch.synchronised || (!strong && st.accepted < opt_.join_after_updates)) continue;
+    if (nis_released_[static_cast<std::size_t>(ch.prn)]) continue;
     // Coasting: no measurement to keep it honest, only the prediction (bounded in time and uncertainty).
     const bool coasting = !strong || !log.pr_used;
     st.coast_s = coasting ? st.coast_s + step_s : 0.0;
@@ -431,6 +460,31 @@ void VectorTrackingFilter::update(const receiver::VectorEpochInput& in,
     log_epoch_.used = used;
     log_epoch_.vector = vector;
     log_(log_epoch_);
+  }
+}
+
+void VectorTrackingFilter::nis_tests(const receiver::VectorEpochInput& in) {
+  for (const auto& ch : in.channels) {
+    const auto k = static_cast<std::size_t>(ch.prn);
+    if (epoch_dof_[k] > 0) nis_.add(ch.prn, epoch_nis_[k], epoch_dof_[k]);
+  }
+  const NisVerdict v = nis_.evaluate();
+  const double t_s = static_cast<double>(in.sample) / in.fs_hz;
+  if (v.filter) {
+    // The channels together contradict the filter: its state is wrong. Its covariance re-opens to at least its
+    // initial sigmas (correlations cleared), so that their measurements pull it back; the channels stay commanded.
+    Eigen::Matrix<double, 8, 1> s;
+    s << Eigen::Vector3d::Constant(opt_.initial_sigma_pos_m), Eigen::Vector3d::Constant(opt_.initial_sigma_vel_mps),
+        opt_.initial_sigma_bias_m, opt_.initial_sigma_drift_mps;
+    const Eigen::Matrix<double, 8, 1> var = ekf_->P().diagonal().cwiseMax(s.array().square().matrix());
+    ekf_->set_P(StateMatrix<8>(var.asDiagonal()));
+    release_log_.add(t_s, 0, "filter_nis", v.reasons.front());
+  }
+  for (std::size_t i = 0; i < v.released.size(); ++i) {
+    const auto k = static_cast<std::size_t>(v.released[i]);
+    nis_released_[k] = true;
+    prn_[k] = fresh_prn_state();
+    release_log_.add(t_s, v.released[i], "channel_nis", v.reasons[i]);
   }
 }
 

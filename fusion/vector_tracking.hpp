@@ -15,6 +15,7 @@
 
 #include "fusion/ekf.hpp"
 #include "fusion/false_lock_monitor.hpp"
+#include "fusion/nis_release.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "fusion/vector_carrier_phase.hpp"
 #include "receiver/vector_loop.hpp"
@@ -155,6 +156,11 @@ struct VectorTrackingOptions {
   double doppler_bias_average_s = 0.5;
   double doppler_bias_hz = 4.0;
   double false_lock_hz = 7.0;
+  // Windowed NIS (fusion/nis_release.hpp) of each channel's rows (one entry per epoch: its pseudorange row and,
+  // when used, its rate row). A channel far outside its band is released to its scalar loops and its rows are left
+  // out until it loses synchronisation; the channels' pooled windows outside their band re-open the filter's
+  // covariance (to at least its initial sigmas). The gate probability is gate.probability's.
+  NisReleaseOptions nis;
   double initial_sigma_pos_m = 10.0, initial_sigma_vel_mps = 0.5;
   double initial_sigma_bias_m = 10.0, initial_sigma_drift_mps = 0.5;
 };
@@ -200,6 +206,7 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   void update(const receiver::VectorEpochInput& epoch, std::span<receiver::VectorChannelCommand> commands) override;
 
   bool initialised() const { return ekf_.has_value(); }
+  const VectorTrackingOptions& options() const { return opt_; }
   const VectorState& x() const { return ekf_->x(); }
   const StateMatrix<8>& P() const { return ekf_->P(); }
   int resets() const { return resets_; }
@@ -209,6 +216,9 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   // kPll: phase arcs started (hand-overs and re-entries) and phase locks lost (fallbacks to the FLL).
   int phase_arcs() const { return phase_arcs_; }
   int phase_losses() const { return phase_losses_; }
+  // Releases with time (receiver time, s), PRN (0: the filter re-opened) and reason ("channel_nis", "filter_nis"),
+  // counted per reason.
+  const ReleaseLog& release_log() const { return release_log_; }
   // Called at the end of every update once the filter runs.
   void set_log(std::function<void(const VectorEpochLog&)> log) { log_ = std::move(log); }
 
@@ -232,6 +242,8 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   // kPll: one channel's carrier states (discriminator update, lock test, fallback/re-entry) and its carrier
   // command; doppler_at(sample) is the filter's predicted Doppler of the channel at a receiver sample, with error
   // variance prediction_variance_hz2.
+  // The windowed NIS tests after an epoch's updates.
+  void nis_tests(const receiver::VectorEpochInput& in);
   void command_pll(const receiver::VectorChannelInput& ch, const std::function<double(std::int64_t)>& doppler_at,
                    double prediction_variance_hz2, bool usable_now, double cn0_hz, double step_s, double fs_hz,
                    receiver::VectorChannelCommand& command, VectorChannelLog& log);
@@ -246,6 +258,11 @@ class VectorTrackingFilter final : public receiver::VectorLoop {
   int phase_arcs_ = 0, phase_losses_ = 0;
   std::array<PrnState, 33> prn_{};
   std::array<VectorCarrierPhase, 33> phase_{};  // kPll, per PRN
+  std::array<bool, 33> nis_released_{};         // by PRN, until the channel loses synchronisation
+  std::array<double, 33> epoch_nis_{};          // this epoch's NIS and dof per PRN (summed over its rows)
+  std::array<int, 33> epoch_dof_{};
+  NisReleaseMonitor nis_;
+  ReleaseLog release_log_;
   VectorEpochLog log_epoch_;
   std::function<void(const VectorEpochLog&)> log_;
 };

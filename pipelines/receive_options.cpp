@@ -16,6 +16,7 @@ bool ReceiveOptions::IsValid(std::string* error) const {
   if (std::string why = io::why_invalid(receiver); !why.empty()) return fail(why);
   if (coupling != Coupling::kVector && vector_carrier != fusion::VectorCarrier::kAidedPll)
     return fail("--vector-carrier needs --coupling vector");
+  if (std::string why; !nis_release.IsValid(&why)) return fail(why);
   if (!uses_imu(coupling)) return true;
   const auto& names = ins::imu_preset_names();
   if (std::find(names.begin(), names.end(), navigation.imu_preset) == names.end())

@@ -2,7 +2,8 @@
 // Everything a receive pipeline (pipelines/receiver_pipeline.hpp) needs to know before the first sample: the
 // receiver's options, the coupling, the vector filter's carrier mode, and for the GNSS/INS couplings the filter,
 // the alignment, the navigation settings and the IMU's time origin; for ultra-tight the measurement form and
-// whether the loop runs pipelined. Validated once with IsValid (as ceres' Options).
+// whether the loop runs pipelined; for vector and ultra-tight the windowed NIS release test. Validated once with
+// IsValid (as ceres' Options).
 #pragma once
 
 #include <string>
@@ -43,6 +44,9 @@ struct ReceiveOptions {
   // between blocks, its commands at the epoch that produced them (slower with 2 or more threads).
   fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;
   bool ut_pipelined = true;
+  // kVector, kUltraTight: the windowed NIS test that releases channels (and re-opens or resets the filter):
+  // --nis-window, --nis-probability (fusion/nis_release.hpp).
+  fusion::NisReleaseOptions nis_release;
 
   // True when the options fit together; otherwise false and *error (when given) says why, naming the setting as
   // the configuration file or the command line calls it.

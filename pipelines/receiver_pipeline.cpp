@@ -42,8 +42,13 @@ struct Receiver::Impl {
         engine(o.receiver, fusion ? static_cast<receiver::ReceiverObserver&>(*fusion) : observer) {
     if (fusion) fusion->attach(engine);
     if (!nav.ephemerides.empty()) engine.add_navigation(nav.ephemerides, nav.klobuchar, nav.utc);
-    if (o.coupling == Coupling::kVector) vector.emplace(o.receiver, sink, o.vector_carrier).attach(engine);
-    if (o.coupling == Coupling::kUltraTight) ultratight.emplace(*fusion, sink).attach(engine);
+    if (o.coupling == Coupling::kVector)
+      vector.emplace(o.receiver, sink, o.vector_carrier, o.nis_release).attach(engine);
+    if (o.coupling == Coupling::kUltraTight) {
+      UltraTightLoopOptions ut;
+      ut.nis = o.nis_release;
+      ultratight.emplace(*fusion, sink, ut).attach(engine);
+    }
   }
 };
 

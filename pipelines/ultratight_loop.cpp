@@ -8,6 +8,7 @@
 
 #include "fusion/clock_model.hpp"
 #include "fusion/ins_error_model.hpp"
+#include "fusion/lockout_recovery.hpp"
 #include "fusion/loose_measurements.hpp"
 #include "fusion/tight_measurements.hpp"
 #include "ins/earth_model.hpp"
@@ -27,7 +28,7 @@ constexpr double kEpochChips = 20.0 * 1023.0;  // a 20 ms channel epoch of C/A c
 }  // namespace
 
 UltraTightLoop::UltraTightLoop(GnssInsCoupler& fusion, ReceiveSink& sink, UltraTightLoopOptions ut)
-    : fusion_(fusion), sink_(sink), options_(fusion.options().receiver), ut_(ut) {}
+    : fusion_(fusion), sink_(sink), options_(fusion.options().receiver), ut_(ut), nis_(ut.nis) {}
 
 UltraTightLoop::ChannelState& UltraTightLoop::channel(int prn) {
   auto [it, made] = channels_.try_emplace(prn);
@@ -96,6 +97,9 @@ void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) 
   o.sigma_att_rad = floor(out.sigma_att_rad, 1e-4);
   o.gate = c.gate;
   o.ukf = c.ukf;
+  fusion::NisReleaseOptions nis = ut_.nis;
+  nis.gate_probability = c.gate.probability;  // an update counts at most the threshold of the filter's own gate
+  nis_ = fusion::NisReleaseMonitor(nis);
   // Commanded above command_mask_deg, measured above the PVT's mask. (Used for updates, the two low satellites of
   // the 10 g turn, at 6.5 and 8.4 deg, made the position diverge to 10 m RMS in the turn: docs/validation.md; left
   // scalar, they were lost wherever the scalar loops are.)
@@ -138,6 +142,7 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
     if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
     if (!(in.iq_scale > 0.0)) continue;                                   // no noise estimate
+    if (channel(in.prn).nis_released) continue;  // its correlations contradict the filter: not used
     const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
     const double t_start_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz;
     // A channel whose PLL ran away from the prediction correlates mostly noise against a replica carrier tens of
@@ -327,7 +332,8 @@ void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k
       const double prediction_m = r.pseudorange_m + r.range_rate_mps * dt - shift_m;
       jump = (replica_m - prediction_m) / kChip_m;  // replica too far away: advance it
       st.coast_s = in.coasting ? st.coast_s + ut_.period_s : 0.0;
-      vector = std::abs(jump) <= ut_.max_jump_chips && st.coast_s <= ut_.max_coast_s && !st.runaway_given_up;
+      vector = std::abs(jump) <= ut_.max_jump_chips && st.coast_s <= ut_.max_coast_s && !st.runaway_given_up &&
+               !st.nis_released;
       if (vector) {
         commands[i].vector = true;
         commands[i].filter_driven = true;
@@ -359,8 +365,21 @@ void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k
         if (in.coasting) ++coasting_channel_epochs_;
       }
     }
-    if (st.commanded && !vector) ++releases_;
-    if (!in.synchronised) st.runaway_given_up = false;  // lost: a new track starts afresh
+    if (st.commanded && !vector) {
+      ++releases_;
+      const char* why = !in.synchronised                ? "lost"
+                        : rep == period_replicas_.end() ? "not_predicted"
+                        : st.nis_released               ? "channel_nis"
+                        : st.runaway_given_up           ? "runaway"
+                        : st.coast_s > ut_.max_coast_s  ? "coast"
+                                                        : "jump";
+      release_log_.add(log_.time_s, in.prn, why, st.nis_released ? st.nis_detail : "");
+    }
+    if (!in.synchronised) {  // lost: a new track starts afresh
+      st.runaway_given_up = false;
+      if (st.nis_released) nis_.forget(in.prn);
+      st.nis_released = false;
+    }
     if (!vector) {
       st.runaway_repeats = 0;
       st.runaway.reset();
@@ -425,7 +444,10 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
   feed_imu_to(t_k);
   const std::map<int, double> aid_change = propagated_doppler_change();
   for (auto& [prn, st] : channels_) st.last_offset_hz = NAN;  // set again by this epoch's measurements
-  if (period_open_) driver_->finish_period(correlations(epoch, t_k));
+  if (period_open_) {
+    driver_->finish_period(correlations(epoch, t_k));
+    nis_tests(static_cast<double>(epoch.sample) / epoch.fs_hz);
+  }
   // Sets decoded since the hand-over (the engine appends them): a satellite without one at the hand-over, or a new
   // IODE, is predicted from them from this period on (each from the set valid at its transmit time).
   if (epoch.ephemerides && epoch.ephemerides->size() > ephemerides_seen_) {
@@ -440,11 +462,36 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
   for (const auto& in : epoch.channels) {
     ChannelState& st = channel(in.prn);
     if (st.was_coasting && !in.coasting && in.vector_mode) ++relocks_;
+    if (in.coasting) nis_.forget(in.prn);  // a new arc after the re-lock
+    st.since_relock_s = in.coasting ? 0.0 : st.since_relock_s + ut_.period_s;
     st.was_coasting = in.coasting;
   }
   last_sample_ = epoch.sample;
   last_t_s_ = t_k;
   command(epoch, t_k, commands, aid_change);
+}
+
+void UltraTightLoop::nis_tests(double t_s) {
+  for (const auto& u : driver_->last_updates())
+    if (channel(u.prn).since_relock_s >= ut_.nis_settle_s)
+      nis_.add(u.prn, u.nis, static_cast<int>(u.innovation.size()));
+  const fusion::NisVerdict v = nis_.evaluate();
+  if (v.filter) {
+    // Most channels contradict the filter at once: the filter is wrong, not they. Its covariance re-opens (what
+    // the correlations observe: position, velocity, attitude, clock; biases kept) so that they pull it back.
+    const double p = 0.5 * ut_.reopen_position_sigma_m, v_mps = 0.5 * ut_.reopen_velocity_sigma_mps;
+    driver_->set_covariance(fusion::inflate_for_recovery(
+        driver_->covariance(), Eigen::Vector3d::Constant(p),
+        std::optional<Eigen::Vector3d>(Eigen::Vector3d::Constant(v_mps)), 1.0, fusion::LockoutRecoveryOptions{}, p));
+    ++filter_reopens_;
+    release_log_.add(t_s, 0, "filter_nis", v.reasons.front());
+    return;
+  }
+  for (std::size_t i = 0; i < v.released.size(); ++i) {
+    ChannelState& st = channel(v.released[i]);
+    st.nis_released = true;
+    st.nis_detail = v.reasons[i];
+  }
 }
 
 void UltraTightLoop::finish(std::int64_t end_sample) {
@@ -476,6 +523,8 @@ std::string UltraTightLoop::summary_json() const {
       handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_, coasting_channel_epochs_,
       relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates, k.accepted, k.rejected,
       k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_, runaway_releases_);
+  j += fmt::format(", \"nis_window\": {}, \"nis_probability\": {:g}, \"filter_reopens\": {}, {}", ut_.nis.window,
+                   ut_.nis.probability, filter_reopens_, release_log_.json_members());
   j += fmt::format(
       ", \"final_sigma\": {{\"north_m\": {:.6g}, \"east_m\": {:.6g}, \"down_m\": {:.6g}, "
       "\"clock_bias_m\": {:.6g}, \"clock_drift_mps\": {:.6g}}}}}",
@@ -493,11 +542,12 @@ std::string UltraTightLoop::report() const {
   return fmt::format(
       "receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
       "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
-      "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}",
+      "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}; "
+      "released by their NIS {}, filter re-opened {}",
       fusion_.options().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
       fusion_.options().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators", handover_t_s_, channels,
       channel_epochs_, coasting_channel_epochs_, relocks_, releases_, k.accepted, k.rejected, k.aided_only,
-      runaway_recentres_, runaway_releases_);
+      runaway_recentres_, runaway_releases_, release_log_.count("channel_nis"), filter_reopens_);
 }
 
 }  // namespace ultratrack::pipelines

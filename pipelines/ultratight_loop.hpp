@@ -9,11 +9,14 @@
 // and carrier aiding (predicted Doppler; the channel's Costas PLL stays closed, so carrier phase stays continuous).
 // A channel that loses lock coasts on the prediction and re-locks without acquisition. A weak channel whose PLL
 // runs away from the predicted Doppler (fusion/false_lock_monitor.hpp) is left out of the filter, stepped back onto the
-// prediction and its carrier phase flagged as slipped; one that keeps running away is released. Every vector epoch
-// after the hand-over goes to the sink (UltraTightEpochLog: ultratight.csv), the navigation rows through the
-// coupler's sink (nav.csv).
-// Time: the driver's t_s is IMU time (GPS time minus the IMU time origin); its clock bias is against the receiver
-// clock with the engine's clock jumps since the hand-over taken out. Units: s, m, m/s, Hz, chips.
+// prediction and its carrier phase flagged as slipped; one that keeps running away is released. A channel whose
+// windowed NIS is far outside its band (fusion/nis_release.hpp: its correlations contradict the prediction) is
+// released to its scalar loops and left out of the filter until it loses synchronisation; the channels' pooled
+// windows outside their band re-open the filter's covariance instead. Every release is logged (summary.json). Every
+// vector epoch after the hand-over goes to the sink (UltraTightEpochLog: ultratight.csv), the navigation rows through
+// the coupler's sink (nav.csv). Time: the driver's t_s is IMU time (GPS time minus the IMU time origin); its clock bias
+// is against the receiver clock with the engine's clock jumps since the hand-over taken out. Units: s, m, m/s, Hz,
+// chips.
 #pragma once
 
 #include <algorithm>
@@ -26,6 +29,7 @@
 #include <string>
 
 #include "fusion/false_lock_monitor.hpp"
+#include "fusion/nis_release.hpp"
 #include "fusion/ultratight_integration.hpp"
 #include "pipelines/gnss_ins_coupler.hpp"
 #include "pipelines/prompt_power_average.hpp"
@@ -57,6 +61,17 @@ struct UltraTightLoopOptions {
   // A channel still beyond runaway_hz in the 1 s after each of this many re-centrings in a row is not locked (its
   // PLL cannot hold the signal): the loop releases it (scalar, then lost) instead of keeping it "bit-synced".
   int runaway_max_recentres = 3;
+  // Windowed NIS per channel and for the whole filter (fusion/nis_release.hpp). A filter event re-opens the
+  // covariance (fusion::inflate_for_recovery): position and clock bias 1-sigma at least reopen_position_sigma_m,
+  // velocity and clock drift at least reopen_velocity_sigma_mps (well inside the I&Q model's pull-in: +-1 chip of
+  // code, +-25 Hz of carrier at 20 ms), attitude at fusion::LockoutRecoveryOptions' defaults.
+  fusion::NisReleaseOptions nis;
+  // A channel's window restarts when it coasts and takes no update until this long after its re-lock: in the first
+  // second after a re-lock the PLL's residual phase makes the gate refuse a third of its updates at 45 dB-Hz (a
+  // transient of the model, not a wrong prediction: docs/validation.md), which alone filled a window to 4.4 x its dof.
+  double nis_settle_s = 1.0;
+  double reopen_position_sigma_m = 15.0;
+  double reopen_velocity_sigma_mps = 1.0;
 };
 
 class UltraTightLoop final : public receiver::VectorLoop {
@@ -72,6 +87,7 @@ class UltraTightLoop final : public receiver::VectorLoop {
   bool handed_over() const { return driver_.has_value(); }
   long long channel_epochs() const { return channel_epochs_; }  // channel-epochs commanded by the loop
   const fusion::UltraTightIntegration* driver() const { return driver_ ? &*driver_ : nullptr; }
+  const fusion::ReleaseLog& release_log() const { return release_log_; }
   std::string summary_json() const;  // the "ultratight" member of summary.json
   std::string report() const;        // one line for stdout
 
@@ -81,6 +97,7 @@ class UltraTightLoop final : public receiver::VectorLoop {
     double coast_s = 0.0;
     bool ever = false;
     bool was_coasting = false;
+    double since_relock_s = 1e9;      // time since the channel last stopped coasting (NIS settling)
     PromptPowerAverage prompt_power;  // the I&Q model's amplitude
     double aid_hz = NAN;              // the carrier aiding sent (changes by the INS propagation only)
     // The command sent last (vector): a pipelined loop's is still pending when the next inputs are taken.
@@ -92,6 +109,8 @@ class UltraTightLoop final : public receiver::VectorLoop {
     double pending_step_hz = 0.0;
     int runaway_repeats = 0;        // re-centrings in a row each followed by a 1 s mean still beyond runaway_hz
     bool runaway_given_up = false;  // released for that; commanded again only after a new synchronisation
+    bool nis_released = false;      // released by its windowed NIS: scalar and out of the filter until then too
+    std::string nis_detail;         // the release's reason
     double last_offset_hz = NAN;    // the latest epoch's replica minus predicted Doppler (ultratight.csv)
   };
   ChannelState& channel(int prn);  // made on first use
@@ -105,6 +124,8 @@ class UltraTightLoop final : public receiver::VectorLoop {
   bool runaway_check(const receiver::VectorChannelInput& in, double t_mid_s);
   void command(const receiver::VectorEpochInput& epoch, double t_k, std::span<receiver::VectorChannelCommand> out,
                const std::map<int, double>& aid_change);
+  // The windowed NIS tests after a period's updates (t_s: receiver time for the log).
+  void nis_tests(double t_s);
 
   GnssInsCoupler& fusion_;
   ReceiveSink& sink_;
@@ -131,6 +152,9 @@ class UltraTightLoop final : public receiver::VectorLoop {
   long long vector_epochs_ = 0, channel_epochs_ = 0, coasting_channel_epochs_ = 0, releases_ = 0, relocks_ = 0;
   long long measurements_ = 0, known_bits_ = 0, not_wiped_ = 0;
   long long runaway_recentres_ = 0, runaway_left_out_ = 0, runaway_releases_ = 0;
+  fusion::NisReleaseMonitor nis_;
+  fusion::ReleaseLog release_log_;
+  long long filter_reopens_ = 0;
 };
 
 }  // namespace ultratrack::pipelines

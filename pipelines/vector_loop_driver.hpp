@@ -14,13 +14,15 @@ namespace ultratrack::pipelines {
 
 // The filter's options for a receiver configuration (the PVT's atmosphere models, the channels' E-L spacing).
 fusion::VectorTrackingOptions vector_tracking_options(const receiver::ReceiverOptions& options,
-                                                      fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
+                                                      fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll,
+                                                      const fusion::NisReleaseOptions& nis = {});
 
 class VectorLoopDriver {
  public:
   // sink: receives every vector epoch (must outlive this).
   VectorLoopDriver(const receiver::ReceiverOptions& options, ReceiveSink& sink,
-                   fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll);
+                   fusion::VectorCarrier carrier = fusion::VectorCarrier::kAidedPll,
+                   const fusion::NisReleaseOptions& nis = {});
   // Attach before the first process() call; the object must outlive the engine's use of it.
   void attach(receiver::ReceiverEngine& engine, double interval_s = 0.02);
   const fusion::VectorTrackingFilter& filter() const { return filter_; }
@@ -31,7 +33,8 @@ class VectorLoopDriver {
   long long coasting_channel_epochs() const { return coasting_channel_epochs_; }
   // summary.json member: "vector": {carrier mode, epochs, channel-epochs in vector mode and coasting, filter
   // starts, resets, carrier-aiding steps of false PLL locks (frequency_resets), vector-PLL phase arcs and phase
-  // locks lost (phase_arcs, phase_losses)}.
+  // locks lost (phase_arcs, phase_losses), the NIS test's window and probability, the releases per reason and
+  // their log (fusion::ReleaseLog)}.
   std::string summary_json() const;
   std::string report() const;  // one line for stdout
 

@@ -55,6 +55,15 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
                   "with --coupling vector: aided-pll (default: each channel's PLL, aided), fll (the filter "
                   "commands the carrier NCOs: vector FLL) or pll (the filter commands the carrier NCOs' frequency "
                   "and phase from per-channel carrier states its Costas discriminators update: vector PLL)");
+  a.nis_window_option =
+      cmd->add_option("--nis-window", a.nis_window,
+                      "with --coupling vector or ultra-tight: updates (20 ms each) in each channel's windowed NIS test "
+                      "(default 50); a channel whose window is far outside its chi-square band is released to scalar "
+                      "tracking; all channels' windows pooled far outside theirs re-open the filter's covariance");
+  a.nis_probability_option =
+      cmd->add_option("--nis-probability", a.nis_probability,
+                      "with --coupling vector or ultra-tight: false-alarm probability of one full NIS window of a "
+                      "consistent filter (default 1e-6), in (0, 1)");
 }
 
 void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveOptions& s) {
@@ -64,6 +73,14 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     throw io::InputError("command line",
                          "--coupling must be scalar, vector, loose, tight or ultra-tight, got '" + a.coupling + "'");
   s.coupling = *coupling;
+  const bool window_given = a.nis_window_option && a.nis_window_option->count() > 0;
+  const bool probability_given = a.nis_probability_option && a.nis_probability_option->count() > 0;
+  if ((window_given || probability_given) && s.coupling != Coupling::kVector && s.coupling != Coupling::kUltraTight)
+    throw io::InputError("command line", "--nis-window and --nis-probability need --coupling vector or ultra-tight");
+  if (window_given) s.nis_release.window = a.nis_window;
+  if (probability_given) s.nis_release.probability = a.nis_probability;
+  if (std::string why; !s.nis_release.IsValid(&why))
+    throw io::InputError("command line", "--nis-window / --nis-probability: " + why);
   if (!a.vector_carrier.empty()) {
     if (s.coupling != Coupling::kVector)
       throw io::InputError("command line", "--vector-carrier needs --coupling vector");

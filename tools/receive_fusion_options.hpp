@@ -24,6 +24,11 @@ struct ReceiveFusionArgs {
   // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
   bool ut_pipelined = true;
   const CLI::Option* ut_pipelined_option = nullptr;  // set by add_receive_fusion_options: was it given?
+  // --nis-window N, --nis-probability P (vector, ultra-tight); not given: fusion::NisReleaseOptions' defaults.
+  int nis_window = 0;
+  double nis_probability = 0.0;
+  const CLI::Option* nis_window_option = nullptr;
+  const CLI::Option* nis_probability_option = nullptr;
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 

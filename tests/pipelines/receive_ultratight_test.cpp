@@ -69,8 +69,10 @@ Sim& tunnel() {
 
 // The receive of the tunnel file into rx: hot start (the ephemeris file), in-motion alignment over 1 s windows,
 // ultra-tight coupling with the given filter, measurement form and loop, `threads` worker threads (0: all cores).
+// perturb_prn: that satellite's broadcast clock (af0) in the receiver's ephemerides is off by perturb_m of range (the
+// signal is simulated from the true one): its predicted replica contradicts its correlations.
 pipelines::ReceiveFileResult receive(const fs::path& rx, fusion::FilterKind filter, fusion::UltraTightForm form,
-                                     bool serial, int threads = 0) {
+                                     bool serial, int threads = 0, int perturb_prn = 0, double perturb_m = 0.0) {
   const auto& s = tunnel();
   pipelines::ReceiveFileJob job;
   job.input = s.sim / "antenna0.i8.bin";
@@ -78,6 +80,8 @@ pipelines::ReceiveFileResult receive(const fs::path& rx, fusion::FilterKind filt
   job.source.fs_hz = job.options.receiver.fs_hz = 2.0e6;
   job.options.receiver.threads = threads;
   job.navigation = signals::read_rinex_nav(s.nav);
+  for (auto& e : job.navigation.ephemerides)
+    if (e.prn == perturb_prn) e.af0_s += perturb_m / 299792458.0;
   pipelines::date_recording(job.options.receiver, job.navigation, 0);
   job.imu = ins::read_imu_csv(s.sim / "imu.csv");
   job.options.coupling = pipelines::Coupling::kUltraTight;
@@ -199,6 +203,11 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
   EXPECT_GT(handover_s, 9.0);
   EXPECT_LT(handover_s, kGapStart_s - 1.0);
   EXPECT_EQ(json_number(summary, "releases"), 0.0);
+  // The windowed NIS test (1 s windows, 1e-6, margin 3) releases nothing at 45 dB-Hz and never re-opens the filter:
+  // its 1 s sums stay below 1.9 x the dof there (docs/validation.md) against a band of 3 x q(300, 1e-6) = 4.3 x;
+  // a consistent filter would pass it with probability 1e-6 per window (~3.5e-3 over this run's ~3500 windows).
+  EXPECT_EQ(summary.find("channel_nis"), std::string::npos) << summary;
+  EXPECT_EQ(json_number(summary, "filter_reopens"), 0.0);
   // The carrier-runaway check (below 30 dB-Hz only) leaves a 45 dB-Hz run alone; per channel below.
   std::printf("carrier re-centres %g, left out %g\n", json_number(summary, "carrier_recentres"),
               json_number(summary, "runaway_left_out"));
@@ -355,6 +364,61 @@ TEST(ReceiveUltraTight, SerialEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFoll
 
 TEST(ReceiveUltraTight, SerialUkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
   check_run(fusion::FilterKind::Ukf, fusion::UltraTightForm::Discriminator, true);
+}
+
+// One satellite's broadcast clock 100 m off in the receiver's ephemerides (0.34 chip: the hand-over still commands
+// it, within max_jump_chips): the filter's replica of it is 100 m from its signal, its I&Q updates contradict the
+// prediction from its first update on (NIS in the thousands, each counted at the gate's 27.9) and the windowed NIS
+// test releases it to scalar tracking with its first full window: 50 x 27.9 = 1393 > 3 q(300, 1e-6) = 1293 (from a
+// window of clean updates it would take k = (1293 - 50 x 6) / (27.9 - 6) = 45 updates; any run of 50 updates above
+// 1293 / 50 = 26 trips it within one window), 1 s after the hand-over plus the loop's one or two 20 ms periods of
+// latency; it is then left out of the filter. The others stay commanded to the end and the filter is never re-opened;
+// its position stays on the truth.
+TEST(ReceiveUltraTight, AChannelWhoseEphemerisContradictsItsSignalIsReleasedAndTheOthersStay) {
+  // The highest satellite (the most weight in the solution; measured, far above the masks).
+  int prn = 0;
+  double best = -90.0;
+  {
+    std::ifstream in(tunnel().sim / "satellites.csv");
+    std::string line;
+    std::getline(in, line);
+    while (std::getline(in, line)) {
+      const auto f = test::split_csv_line(line);
+      if (std::stod(f.at(1)) > best) best = std::stod(f.at(1)), prn = std::stoi(f.at(0));
+    }
+  }
+  ASSERT_GT(best, 30.0);
+  const auto rx = tunnel().dir / "rx_contradicted";
+  receive(rx, fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq, false, 0, prn, 100.0);
+  const std::string summary = test::read_text_file(rx / "summary.json");
+  const double handover_s = json_number(summary, "handover_t_s");
+  EXPECT_EQ(json_number(summary, "releases"), 1.0) << summary;
+  EXPECT_EQ(json_number(summary, "filter_reopens"), 0.0);
+  ASSERT_NE(summary.find("\"releases_by_reason\": {\"channel_nis\": 1}"), std::string::npos) << summary;
+  const auto at = summary.find("\"release_log\": [{\"t_s\": ");
+  ASSERT_NE(at, std::string::npos);
+  const double released_s = json_number(summary.substr(at + 16), "t_s");
+  EXPECT_EQ(json_number(summary.substr(at + 16), "prn"), static_cast<double>(prn));
+  // Receiver time (from sample 0) against the hand-over (IMU time = GPS time - the file's start: the same to
+  // within the clock bias, microseconds).
+  std::printf("PRN %d (%.1f deg) released %.2f s after the hand-over at %.2f s\n", prn, best, released_s - handover_s,
+              handover_s);
+  EXPECT_GT(released_s - handover_s, 0.98);        // not before the window is full
+  EXPECT_LT(released_s - handover_s, 1.0 + 0.07);  // one window, and the loop's latency
+  const auto log = read_log(rx);
+  for (const auto& [p, rows] : log) {
+    if (rows.empty() || !rows.front().ultratight) continue;
+    for (const Row& r : rows) {
+      if (p != prn) EXPECT_TRUE(r.ultratight) << "PRN " << p << " at " << r.t;
+      if (p == prn && r.t > released_s + 0.05) {
+        EXPECT_FALSE(r.ultratight) << "PRN " << p << " commanded again at " << r.t;
+        EXPECT_FALSE(r.updated) << "PRN " << p << " updates the filter again at " << r.t;
+      }
+    }
+  }
+  const NavError e = nav_error(rx, handover_s + 0.5);
+  std::printf("contradicted PRN %d: nav 3-D RMS %.3f m over %d rows\n", prn, e.rms_m, e.rows);
+  EXPECT_LT(e.rms_m, 2.0);
 }
 
 namespace {

@@ -100,6 +100,11 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
 
   EXPECT_NE(ultratrack::test::read_text_file(vector / "summary.json").find("\"coupling\": \"vector\""),
             std::string::npos);
+  // The windowed NIS test (fusion/nis_release.hpp: 1 s windows, 1e-6, margin 3) releases nothing at 45 dB-Hz
+  // and never resets the filter (a consistent filter: 1e-6 per window, ~1e-2 over this run's ~10^4 windows).
+  EXPECT_NE(
+      ultratrack::test::read_text_file(vector / "summary.json").find("\"releases_by_reason\": {}, \"release_log\": []"),
+      std::string::npos);
   EXPECT_NE(ultratrack::test::read_text_file(scalar / "summary.json").find("\"coupling\": \"scalar\""),
             std::string::npos);
 

@@ -103,4 +103,10 @@ TEST(ReceiveUltraTightCli, BadOptionsAreOneInputError) {
                "--ut-measurement must be iq or discriminator");
   expect_error("bad_coupling", {"--coupling", "ultratight"}, "ultra-tight");
   expect_error("missing_imu_file", {"--imu", (s.dir / "none.csv").string(), "--coupling", "ultra-tight"}, "not found");
+  expect_error("nis_scalar", {"--nis-window", "20"}, "--nis-window and --nis-probability need --coupling vector");
+  expect_error("nis_window_zero",
+               {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--nis-window", "0"},
+               "the window must hold at least 1 update");
+  expect_error("nis_probability_one", {"--coupling", "vector", "--nis-probability", "1"},
+               "the probability must lie in (0, 1)");
 }
