@@ -7,6 +7,44 @@
 # exported package (every layer is listed in the global property ULTRATRACK_LAYERS, which
 # cmake/UltratrackInstall.cmake installs). With ULTRATRACK_LAYERS_PIC the libraries are position-independent (the
 # Python module links them).
+# ultratrack_precompile(TARGET GROUP [EIGEN] [FMT] [GTEST] [CLI] [TOML] [HEADERS h...]) precompiles the standard and third-party
+# headers that the target's sources include (never the project's own headers, which change while one works):
+# parsing them is most of a source's compile time (Eigen, GoogleTest and CLI11 take 1.5-3 s each per file), so a
+# cold build, which is what CI pays, takes much less. Targets of one GROUP have the same flags and share the first
+# one's precompiled header (building one costs ~6 s). The build is the same with ULTRATRACK_PRECOMPILE_HEADERS=OFF:
+# every source still includes what it uses.
+option(ULTRATRACK_PRECOMPILE_HEADERS "Precompile the system headers of each target (faster cold builds)" ON)
+function(ultratrack_precompile target group)
+  if(NOT ULTRATRACK_PRECOMPILE_HEADERS)
+    return()
+  endif()
+  get_property(owner GLOBAL PROPERTY ULTRATRACK_PCH_OWNER_${group})
+  if(owner)
+    target_precompile_headers(${target} REUSE_FROM ${owner})
+    return()
+  endif()
+  cmake_parse_arguments(ARG "EIGEN;FMT;GTEST;CLI;TOML" "" "HEADERS" ${ARGN})
+  set(headers <algorithm> <array> <chrono> <cmath> <complex> <cstdint> <filesystem> <fstream> <functional> <map>
+              <memory> <optional> <sstream> <stdexcept> <string> <string_view> <utility> <vector>)
+  if(ARG_EIGEN)
+    list(APPEND headers <Eigen/Dense> <Eigen/Geometry>)
+  endif()
+  if(ARG_FMT)
+    list(APPEND headers <fmt/format.h>)
+  endif()
+  if(ARG_GTEST)
+    list(APPEND headers <gtest/gtest.h>)
+  endif()
+  if(ARG_CLI)
+    list(APPEND headers <CLI/CLI.hpp>)
+  endif()
+  if(ARG_TOML)
+    list(APPEND headers <toml++/toml.h>)
+  endif()
+  target_precompile_headers(${target} PRIVATE ${headers} ${ARG_HEADERS})
+  set_property(GLOBAL PROPERTY ULTRATRACK_PCH_OWNER_${group} ${target})
+endfunction()
+
 function(ultratrack_layer name)
   cmake_parse_arguments(ARG "" "" "DEPS;EXTERNAL" ${ARGN})
   set(include_root "${CMAKE_BINARY_DIR}/layer_include/${name}")
@@ -22,6 +60,11 @@ function(ultratrack_layer name)
     target_include_directories(ultratrack_${name} PUBLIC ${include_dirs})
     target_compile_options(ultratrack_${name} PRIVATE -Wall -Wextra -Wpedantic)
     target_link_libraries(ultratrack_${name} PUBLIC ${ARG_DEPS} ${ARG_EXTERNAL})
+    if(name STREQUAL "config")  # the only layer that reads TOML
+      ultratrack_precompile(ultratrack_${name} config EIGEN FMT TOML)
+    elseif(NOT name STREQUAL "io")  # io: five small files, nothing to gain
+      ultratrack_precompile(ultratrack_${name} layers EIGEN FMT)
+    endif()
   else()  # a layer that has only headers so far
     add_library(ultratrack_${name} INTERFACE)
     target_include_directories(ultratrack_${name} INTERFACE ${include_dirs})
@@ -42,5 +85,6 @@ function(ultratrack_test name)
   add_executable(${name} ${ARG_SOURCES})
   target_compile_options(${name} PRIVATE -Wall -Wextra)
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} GTest::gtest_main ultratrack_test_support)
+  ultratrack_precompile(${name} tests EIGEN FMT GTEST)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
 endfunction()

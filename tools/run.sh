@@ -9,7 +9,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-dev libcli11-dev
+packages=(g++ cmake make ninja-build pkg-config libeigen3-dev libfftw3-dev libgeographiclib-dev libcli11-dev
           libtomlplusplus-dev libfmt-dev libgtest-dev libgmock-dev libbenchmark-dev)
 # The test suite also runs RTKLIB (convbin, rnx2rtkp) on our RINEX output as an independent reader.
 # python3: ctest docs.file_map checks docs/architecture.md's module tables against the code; pybind11-dev,
@@ -22,6 +22,10 @@ packages=(g++ cmake make pkg-config libeigen3-dev libfftw3-dev libgeographiclib-
 [[ "${1:-build}" == test ]] &&
   packages+=(rtklib python3 pybind11-dev python3-dev python3-numpy python3-matplotlib python3-pytest chromium
              munge slurmctld slurmd slurm-client)
+# Each phase prints its wall time (CI keeps the log: the slow phase is then known, not guessed).
+phase_start=$SECONDS
+phase_done() { echo "tools/run.sh: $1 took $((SECONDS - phase_start)) s"; phase_start=$SECONDS; }
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -32,16 +36,23 @@ if ((${#missing[@]})); then
   [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -qq
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+  phase_done "installing ${#missing[@]} packages"
 fi
 
 build_dir=${ULTRATRACK_BUILD_DIR:-build}
 jobs=${ULTRATRACK_JOBS:-2}
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# A new build folder uses Ninja: a layer's sources compile while the layers below still do (make waits for each
+# library), which keeps both cores busy in a cold build. An existing folder keeps the generator it was made with.
+generator=()
+[[ -f "$build_dir/CMakeCache.txt" ]] || generator=(-G Ninja)
+cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build_dir" -j"$jobs"
+phase_done "the build"
 
 case "${1:-build}" in
   demo) shift; exec "$build_dir/tools/ultratrack" demo "$@" ;;
-  test) exec ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" ;;
+  test) status=0; ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" || status=$?
+        phase_done "ctest"; exit "$status" ;;
   lint) exec tools/lint.sh --build "$build_dir" --jobs "$jobs" ;;
   build) ;;
   *) echo "usage: tools/run.sh demo|test|build|lint" >&2; exit 2 ;;

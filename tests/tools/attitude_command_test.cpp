@@ -5,7 +5,6 @@
 // sigma, and the files as documented. The long runs (100 s static, moving, faults) are in docs/validation.md.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -15,6 +14,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "run_command.hpp"
 #include "signals/input_error.hpp"
 #include "support/test_data.hpp"
 
@@ -23,12 +23,7 @@ namespace fs = std::filesystem;
 namespace {
 
 void run(const std::string& command, std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_simulate_command(app);
-  ultratrack::tools::add_attitude_command(app);
-  args.insert(args.begin(), command);
-  std::reverse(args.begin(), args.end());
-  app.parse(args);
+  ultratrack::test_support::run_command(command, std::move(args), /*quiet=*/false);
 }
 
 std::string read(const fs::path& p) {

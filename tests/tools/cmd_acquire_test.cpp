@@ -4,7 +4,6 @@
 // signals::SampleWriter (2.6 MHz complex i16, 6.5 MHz real r16 at an IF) give their satellites' truth.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -14,6 +13,7 @@
 
 #include "commands.hpp"
 #include "receiver/synthetic_ca_signal.hpp"
+#include "run_command.hpp"
 #include "signals/input_error.hpp"
 #include "signals/sample_writer.hpp"
 #include "support/test_data.hpp"
@@ -23,11 +23,7 @@ using ultratrack::signals::SampleFormat;
 namespace {
 
 void run(std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_acquire_command(app);
-  args.insert(args.begin(), "acquire");
-  std::reverse(args.begin(), args.end());  // CLI11 takes the vector in reverse order
-  app.parse(args);
+  ultratrack::test_support::run_command("acquire", std::move(args), /*quiet=*/false);
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 // ../shared/data is absent) are acquired and tracked to their end with C/N0 reported.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +16,7 @@
 #include "command_exit.hpp"
 #include "commands.hpp"
 #include "config/receive_config_toml.hpp"
+#include "run_command.hpp"
 #include "signals/input_error.hpp"
 #include "support/test_data.hpp"
 
@@ -26,14 +26,7 @@ using ultratrack::tools::CommandExit;
 
 namespace {
 
-void run(std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_receive_command(app);
-  args.insert(args.begin(), "receive");
-  args.push_back("--quiet");
-  std::reverse(args.begin(), args.end());  // CLI11 takes the vector in reverse order
-  app.parse(args);
-}
+void run(std::vector<std::string> args) { ultratrack::test_support::run_command("receive", std::move(args)); }
 
 int files_in(const fs::path& dir) {
   if (!fs::exists(dir)) return 0;

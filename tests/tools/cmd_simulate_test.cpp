@@ -3,24 +3,21 @@
 // (exit 2 in main) naming the scenario file; a good one writes the outputs into --out.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
+#include <CLI/Error.hpp>  // CLI::ParseError only: the whole of CLI11 is run_command.cpp's
 #include <algorithm>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "commands.hpp"
+#include "run_command.hpp"
 #include "signals/input_error.hpp"
 #include "support/test_data.hpp"
 
 namespace {
 
 void run(std::vector<std::string> args) {
-  CLI::App app;
-  ultratrack::tools::add_simulate_command(app);
-  args.insert(args.begin(), "simulate");
-  std::reverse(args.begin(), args.end());  // CLI11 takes the vector in reverse order
-  app.parse(args);
+  ultratrack::test_support::run_command("simulate", std::move(args), /*quiet=*/false);
 }
 
 std::string input_error(std::vector<std::string> args) {

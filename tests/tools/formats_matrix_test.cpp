@@ -7,7 +7,6 @@
 // truth.csv. docs/validation.md has the long-run table (20 s each, fixes) that this keeps alive in CI.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,6 @@
 // InputError with file and line.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -24,6 +23,7 @@
 #include "io/units.hpp"
 #include "pipelines/gnss_fix_simulation.hpp"
 #include "pipelines/gps_attitude_csv.hpp"
+#include "run_command.hpp"
 #include "signals/gps_time.hpp"
 #include "sim/truth_csv.hpp"
 #include "support/test_data.hpp"
@@ -35,15 +35,7 @@ namespace {
 
 const ultratrack::signals::GpsTime kOrigin{2190, 604790.0};  // IMU t = 0; the week rolls over 10 s in
 
-void run(std::vector<std::string> args) {
-  CLI::App app{"ultratrack"};
-  app.require_subcommand(1);
-  ultratrack::tools::add_imusim_command(app);
-  ultratrack::tools::add_gnsssim_command(app);
-  ultratrack::tools::add_fuse_command(app);
-  std::vector<std::string> rev(args.rbegin(), args.rend());
-  app.parse(rev);
-}
+void run(const std::vector<std::string>& args) { ultratrack::test_support::run_program(args); }
 
 std::string read_text(const fs::path& f) {
   std::ifstream in(f);

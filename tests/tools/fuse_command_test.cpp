@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -23,6 +22,7 @@
 #include "io/input_error.hpp"
 #include "pipelines/fused_nav_csv.hpp"
 #include "pipelines/gnss_fix_csv.hpp"
+#include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
@@ -30,15 +30,7 @@ using ultratrack::io::InputError;
 
 namespace {
 
-void run(std::vector<std::string> args) {
-  CLI::App app{"ultratrack"};
-  app.require_subcommand(1);
-  ultratrack::tools::add_imusim_command(app);
-  ultratrack::tools::add_gnsssim_command(app);
-  ultratrack::tools::add_fuse_command(app);
-  std::vector<std::string> rev(args.rbegin(), args.rend());  // CLI11 parses a reversed vector
-  app.parse(rev);
-}
+void run(const std::vector<std::string>& args) { ultratrack::test_support::run_program(args); }
 
 std::string read_text(const fs::path& f) {
   std::ifstream in(f);

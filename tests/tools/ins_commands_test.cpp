@@ -3,7 +3,6 @@
 // own truth; coarse alignment mode runs from the stationary start; bad input is a typed error.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -15,21 +14,14 @@
 #include "commands.hpp"
 #include "ins/ins_error.hpp"
 #include "ins/nav_csv.hpp"
+#include "run_command.hpp"
 #include "support/test_data.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-void run(std::vector<std::string> args) {
-  CLI::App app{"ultratrack"};
-  app.require_subcommand(1);
-  ultratrack::tools::add_ins_command(app);
-  ultratrack::tools::add_imusim_command(app);
-  ultratrack::tools::add_simulate_command(app);
-  std::vector<std::string> rev(args.rbegin(), args.rend());  // CLI11 parses a reversed vector
-  app.parse(rev);
-}
+void run(const std::vector<std::string>& args) { ultratrack::test_support::run_program(args); }
 
 double json_number(const fs::path& file, const std::string& key) {
   std::ifstream in(file);

@@ -6,7 +6,6 @@
 // unknown-format files: cmd_receive_test.cpp.)
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>

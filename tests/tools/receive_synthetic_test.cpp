@@ -7,7 +7,6 @@
 // Atmosphere off in both simulation and receiver: the errors measured are the receiver's own.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
@@ -107,13 +106,6 @@ ionosphere = false
 troposphere = false
 )";
   const auto sim = dir / "sim";
-  {
-    // Until the synthesiser (issue 2) is merged, `simulate` is a placeholder without options.
-    CLI::App probe;
-    ultratrack::tools::add_simulate_command(probe);
-    if (probe.get_subcommand("simulate")->get_option_no_throw("--scenario") == nullptr)
-      GTEST_SKIP() << "ultratrack simulate is not merged yet";
-  }
   run("simulate", {"--scenario", scenario.string(), "--out", sim.string()});
   const auto out = dir / "rx";
   run("receive", {"--input", (sim / "antenna0.i8.bin").string(), "--format", "i8", "--fs", "2.6e6", "--out",

@@ -5,7 +5,6 @@
 // before a frame start) reaches a first fix and runs blind re-acquisitions in the background every 2 s.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>

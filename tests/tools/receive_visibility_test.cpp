@@ -6,7 +6,6 @@
 // ephemeris alone; the simulator transmits only the satellites above its 9 degree mask.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <complex>
@@ -20,6 +19,7 @@
 
 #include "commands.hpp"
 #include "receiver/receiver_engine.hpp"
+#include "run_command.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/look_angles.hpp"
 #include "signals/rinex_nav.hpp"
@@ -55,12 +55,7 @@ TEST(ReceiveVisibility, SearchesOnlyPredictedVisiblePrnsOnceTheClockIsSet) {
                           << brdc.string()
                           << "\"\nelevation_mask_deg = 9\n[receiver]\nllh_deg_m = [35.274016, 137.013759, 100.0]\n";
   const auto sim = dir / "sim";
-  {
-    CLI::App app;
-    tools::add_simulate_command(app);
-    std::vector<std::string> args = {"--quiet", sim.string(), "--out", scenario.string(), "--scenario", "simulate"};
-    app.parse(args);
-  }
+  ultratrack::test_support::run_command("simulate", {"--scenario", scenario.string(), "--out", sim.string()});
   // Truth position from the simulator's truth.csv (first row: x, y, z ECEF columns by name).
   std::ifstream truth(sim / "truth.csv");
   std::string header, row;
