@@ -19,7 +19,6 @@
 // range and iono delay at t = 0.
 #include <gtest/gtest.h>
 
-#include <CLI/CLI.hpp>
 #include <GeographicLib/Geocentric.hpp>
 #include <algorithm>
 #include <cmath>
@@ -31,12 +30,12 @@
 #include <vector>
 
 #include "brute_force_fine_search.hpp"
-#include "commands.hpp"
 #include "config/scenario_toml.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/sample_reader.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
+#include "run_command.hpp"
 #include "simulation_run.hpp"
 #include "support/test_data.hpp"
 
@@ -129,13 +128,8 @@ const std::filesystem::path& simulated_output() {
     const auto dir = test::scratch_dir();
     const auto scenario = dir / "gpssim_scenario.toml";
     std::ofstream(scenario) << scenario_text(test::shipped_nav_file());
-    CLI::App app;
-    add_simulate_command(app);
-    std::vector<std::string> args = {"simulate", "--scenario",           scenario.string(),
-                                     "--out",    (dir / "out").string(), "--quiet"};
-    std::reverse(args.begin(), args.end());  // CLI11 takes the vector in reverse order
     testing::internal::CaptureStdout();
-    app.parse(args);
+    test_support::run_command("simulate", {"--scenario", scenario.string(), "--out", (dir / "out").string()});
     testing::internal::GetCapturedStdout();
     return dir / "out";
   }();
