@@ -7,23 +7,20 @@ normalised estimation error squared of each 3-vector with the filter's diagonal 
 terms): position NED, velocity NED, attitude as the psi angles NED (C_nb_est = (I - [psi x]) C_nb_true). Averaged
 over the M runs at each time, a consistent filter's value is chi-square with 3M degrees of freedom over M; the
 two-sided 95 % band is [chi2(0.025, 3M) / M, chi2(0.975, 3M) / M]. Prints one JSON object: per block the NEES
-averaged over runs and times, the band, and the share of times whose run average lies inside the band.
+averaged over runs and times, the band, the share of times whose run average lies inside the band, and each axis's
+mean squared normalised error (1 when consistent).
 
     benchmarks/nav_nees.py --from-s 60 NAV1.csv TRUTH1.csv [NAV2.csv TRUTH2.csv ...]
 """
 import argparse
-import csv
 import json
+import csv
 import math
+import os
 import sys
 
-A = 6378137.0
-E2 = 6.69437999014e-3
-
-
-def rows(path):
-    with open(path, newline="") as f:
-        return [{k: float(v) for k, v in r.items() if v not in ("", None)} for r in csv.DictReader(f)]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from nav_error_stats import ned_error, rows  # noqa: E402
 
 
 def dcm_nb(roll, pitch, yaw):
@@ -47,26 +44,23 @@ def psi(est, tru):
 def run_nees(nav_path, truth_path, from_s):
     truth = {round(r["t_s"] * 1e6): r for r in rows(truth_path)}
     out = {}
-    for r in rows(nav_path):
-        if r["t_s"] < from_s:
-            continue
-        key = round(r["t_s"] * 1e6)
-        tr = truth.get(key)
-        if tr is None:
-            continue
-        lat = math.radians(tr["lat_deg"])
-        w = math.sqrt(1.0 - E2 * math.sin(lat) ** 2)
-        rm = A * (1.0 - E2) / w**3 + tr["height_m"]
-        rn = A / w + tr["height_m"]
-        dp = [math.radians(r["lat_deg"] - tr["lat_deg"]) * rm,
-              math.radians(r["lon_deg"] - tr["lon_deg"]) * rn * math.cos(lat),
-              -(r["height_m"] - tr["height_m"])]
-        dv = [r[f"vel_{a}_mps"] - tr[f"vel_{a}_mps"] for a in "ned"]
-        da = psi(r, tr)
-        sp = [r[f"sigma_{a}_m"] for a in "ned"]
-        sv = [r[f"sigma_v{a}_mps"] for a in "ned"]
-        sa = [math.radians(r[f"sigma_att_{a}_deg"]) for a in "ned"]
-        out[key] = tuple(sum((e / s) ** 2 for e, s in zip(err, sig)) for err, sig in ((dp, sp), (dv, sv), (da, sa)))
+    with open(nav_path, newline="") as f:
+        reader = csv.reader(f)
+        names = next(reader)
+        for values in reader:  # only the rows at truth times are converted (nav.csv is at the IMU rate)
+            t = float(values[0])
+            key = round(t * 1e6)
+            tr = truth.get(key)
+            if t < from_s or tr is None:
+                continue
+            r = {k: float(v) for k, v in zip(names, values) if v}
+            dp = ned_error(r, tr)
+            dv = [r[f"vel_{a}_mps"] - tr[f"vel_{a}_mps"] for a in "ned"]
+            da = psi(r, tr)
+            sp = [r[f"sigma_{a}_m"] for a in "ned"]
+            sv = [r[f"sigma_v{a}_mps"] for a in "ned"]
+            sa = [math.radians(r[f"sigma_att_{a}_deg"]) for a in "ned"]
+            out[key] = [(e / s) ** 2 for err, sig in ((dp, sp), (dv, sv), (da, sa)) for e, s in zip(err, sig)]
     return out
 
 
@@ -111,10 +105,13 @@ def main():
     lo, hi = chi2_quantile(0.025, 3 * m) / m, chi2_quantile(0.975, 3 * m) / m
     result = {"runs": m, "times": len(common), "band_95": [round(lo, 3), round(hi, 3)]}
     for b, name in enumerate(("position", "velocity", "attitude")):
-        per_time = [sum(r[t][b] for r in runs) / m for t in common]
+        per_time = [sum(sum(r[t][3 * b:3 * b + 3]) for r in runs) / m for t in common]
         mean = sum(per_time) / len(per_time)
         inside = sum(lo <= v <= hi for v in per_time) / len(per_time)
-        result[name] = {"mean_nees": round(mean, 3), "in_band": lo <= mean <= hi, "times_inside_band": round(inside, 3)}
+        # Each axis's mean squared normalised error (1 when consistent): which axis is off.
+        axes = [round(sum(r[t][3 * b + i] for r in runs for t in common) / (m * len(common)), 3) for i in range(3)]
+        result[name] = {"mean_nees": round(mean, 3), "in_band": lo <= mean <= hi, "times_inside_band": round(inside, 3),
+                        "per_axis_ned": axes}
     print(json.dumps(result))
 
 
