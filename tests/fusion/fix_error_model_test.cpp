@@ -114,8 +114,8 @@ TEST(FixErrorModel, MeasurementJacobianMatchesNumericalDerivative) {
     const Eigen::VectorXd num = (m.h(xp) - m.h(xm)) / (2.0 * h);
     EXPECT_LT((num - H.col(j)).cwiseAbs().maxCoeff(), 1e-4) << "column " << j;
   }
-  EXPECT_EQ(H.block<3, 3>(0, 15), -Eigen::Matrix3d::Identity());  // position rows: minus the fix-error state
-  EXPECT_EQ(H.block<3, 3>(3, 15), Eigen::Matrix3d::Zero());       // velocity rows: no fix error
+  EXPECT_TRUE(H.block(0, 15, 3, 3) == -Eigen::Matrix3d::Identity());  // position rows: minus the fix-error state
+  EXPECT_TRUE(H.block(3, 15, 3, 3) == Eigen::Matrix3d::Zero());       // velocity rows: no fix error
 }
 
 // Share of GNSS epochs (after the first 60 s) with every position axis inside 3 sigma, and the horizontal RMS.
