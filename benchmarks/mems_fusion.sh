@@ -8,20 +8,26 @@
 #       [--scenario S.toml (default scenarios/mems_drive_adis16405.toml)] [--fuse-config C.toml (default
 #       scenarios/mems_datasheet_fuse.toml)] [--from-s 60]
 #       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--correlation S] [--interval S] [--told-correlation S]
+#       [--told-sigma "N E D"] [--outage "START DURATION"] [--clean]
 # --correlation: the fixes' errors first-order Gauss-Markov with that time (gnsssim); --interval: the filter's
 # decorrelating interval between fixes used ([gnss] update_interval_s); --told-correlation: the correlation
-# time the filter is told ([gnss] error_correlation_time_s).
+# time the filter is told ([gnss] error_correlation_time_s); --told-sigma: with it, the Gauss-Markov 1-sigma the
+# filter carries as fix-error states ([gnss] error_sigma_ned_m; without: the fixes' variance is inflated).
+# --outage: no fixes in [START, START + DURATION) (fuse --outage); the errors are then reported before the outage
+# (before_*) and from 30 s after its end (after_*) besides the whole run. --clean: delete each run's imu.csv once
+# fused (Monte Carlos of many seeds).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="$here/build"; seeds="1 2 3 4 5"; out="${TMPDIR:-/tmp}/mems_fusion"; fixes=vel; filter=ekf; nhc=on
-sigma="0.5 0.5 1.0"; correlation=0; interval=0; told=0
+sigma="0.5 0.5 1.0"; correlation=0; interval=0; told=0; told_sigma=""; outage=""; clean=0
 scenario="$here/scenarios/mems_drive_adis16405.toml"; fuse_config="$here/scenarios/mems_datasheet_fuse.toml"; from_s=60
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build="$2"; shift 2 ;; --seeds) seeds="$2"; shift 2 ;; --out) out="$2"; shift 2 ;;
     --fixes) fixes="$2"; shift 2 ;; --filter) filter="$2"; shift 2 ;; --nhc) nhc="$2"; shift 2 ;;
     --sigma) sigma="$2"; shift 2 ;; --correlation) correlation="$2"; shift 2 ;; --interval) interval="$2"; shift 2 ;;
-    --told-correlation) told="$2"; shift 2 ;;
+    --told-correlation) told="$2"; shift 2 ;; --told-sigma) told_sigma="$2"; shift 2 ;;
+    --outage) outage="$2"; shift 2 ;; --clean) clean=1; shift ;;
     --scenario) scenario="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
     --fuse-config) fuse_config="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
     --from-s) from_s="$2"; shift 2 ;;
@@ -39,8 +45,13 @@ if [ "$nhc" = on ]; then
   else printf '\n[vehicle]\nnhc = true\n' >> "$config"; fi
 fi
 printf '\n[gnss]\nupdate_interval_s = %s\nerror_correlation_time_s = %s\n' "$interval" "$told" >> "$config"
+if [ -n "$told_sigma" ]; then
+  # shellcheck disable=SC2086
+  printf 'error_sigma_ned_m = [%s]\n' "$(echo $told_sigma | tr ' ' ',')" >> "$config"
+fi
+outage_flag=""; [ -n "$outage" ] && outage_flag="--outage $outage"
 velocity_flag=""; [ "$fixes" = pos ] && velocity_flag="--no-velocity"
-echo "fixes $fixes ($sigma m, correlation ${correlation} s, used every ${interval} s, filter told ${told} s), filter $filter, nhc $nhc"
+echo "fixes $fixes ($sigma m, correlation ${correlation} s, used every ${interval} s, filter told ${told} s${told_sigma:+ as states of $told_sigma m}), filter $filter, nhc $nhc${outage:+, outage $outage}"
 for seed in $seeds; do
   run="$out/seed$seed"
   sed "s/^seed = .*/seed = $seed/" "$scenario" > "$out/scenario_$seed.toml"
@@ -48,9 +59,19 @@ for seed in $seeds; do
   # shellcheck disable=SC2086
   "$U" gnsssim --truth "$run/sim/truth.csv" --rate 5 --first 0.137 --sigma $sigma --correlation "$correlation" \
       $velocity_flag --seed "$seed" --out "$run/gnss.csv" >/dev/null
+  # shellcheck disable=SC2086
   "$U" fuse --imu "$run/sim/imu.csv" --gnss "$run/gnss.csv" --config "$config" --filter "$filter" --align motion \
-      --out "$run/fuse" --quiet >/dev/null
+      $outage_flag --out "$run/fuse" --quiet >/dev/null
+  [ "$clean" = 1 ] && rm -f "$run/sim/imu.csv"
   stats=$(python3 "$here/benchmarks/nav_error_stats.py" "$run/fuse/nav.csv" "$run/sim/truth.csv" --from-s "$from_s")
+  if [ -n "$outage" ]; then
+    read -r o_start o_len <<< "$outage"
+    before=$(python3 "$here/benchmarks/nav_error_stats.py" "$run/fuse/nav.csv" "$run/sim/truth.csv" --from-s "$from_s" \
+        --to-s "$o_start")
+    after=$(python3 "$here/benchmarks/nav_error_stats.py" "$run/fuse/nav.csv" "$run/sim/truth.csv" \
+        --from-s "$(python3 -c "print($o_start + $o_len + 30)")")
+    stats=$(python3 -c "import json,sys; d=json.loads(sys.argv[1]); [d.update({p + '_' + k: v for k, v in json.loads(a).items()}) for p, a in (('before', sys.argv[2]), ('after', sys.argv[3]))]; print(json.dumps(d))" "$stats" "$before" "$after")
+  fi
   extra=$(python3 -c "import json,sys; s=json.load(open('$run/fuse/summary.json')); print(json.dumps({'rejected': s['fix_updates_rejected'], 'used': s['fixes_used'], 'recoveries': s['lockout_recoveries']}))")
   echo "seed $seed $stats $extra"
 done | tee "$out/runs.txt"
@@ -66,10 +87,12 @@ for line in open(sys.argv[1]):
     d.update(json.loads("{" + b))
     rows.append(d)
 keys = ["horizontal_rms_m", "height_rms_m", "roll_rms_deg", "pitch_rms_deg", "yaw_rms_deg", "within_3sigma"]
+if "before_horizontal_rms_m" in rows[0]:
+    keys += [p + k for p in ("before_", "after_") for k in ("horizontal_rms_m", "yaw_rms_deg", "within_3sigma")]
 print("| | " + " | ".join(keys) + " | rejected fixes | recoveries |")
 print("|---" * (len(keys) + 3) + "|")
 for name, f in (("median", statistics.median), ("worst", max)):
-    vals = [f(r[k] for r in rows) if not (name == "worst" and k == "within_3sigma") else min(r[k] for r in rows) for k in keys]
+    vals = [f(r[k] for r in rows) if not (name == "worst" and k.endswith("within_3sigma")) else min(r[k] for r in rows) for k in keys]
     rej = f(r["rejected"] / r["used"] for r in rows)
     rec = f(r["recoveries"] for r in rows)
     print(f"| {name} of {len(rows)} | " + " | ".join(f"{v:.3f}" for v in vals) + f" | {100 * rej:.1f} % | {rec} |")

@@ -23,6 +23,17 @@ def rows(path):
         return [{k: float(v) for k, v in r.items() if v not in ("", None)} for r in csv.DictReader(f)]
 
 
+def ned_error(r, tr):
+    """Position error north, east, down (m) of a row against a truth row (lat_deg, lon_deg, height_m)."""
+    lat = math.radians(tr["lat_deg"])
+    w = math.sqrt(1.0 - E2 * math.sin(lat) ** 2)
+    rm = A * (1.0 - E2) / w**3 + tr["height_m"]
+    rn = A / w + tr["height_m"]
+    dn = math.radians(r["lat_deg"] - tr["lat_deg"]) * rm
+    de = math.radians(r["lon_deg"] - tr["lon_deg"]) * rn * math.cos(lat)
+    return dn, de, -(r["height_m"] - tr["height_m"])
+
+
 def wrap(d):
     return (d + 180.0) % 360.0 - 180.0
 
@@ -45,13 +56,7 @@ def main():
         tr = truth.get(round(t * 1e6))
         if tr is None:
             continue
-        lat = math.radians(tr["lat_deg"])
-        w = math.sqrt(1.0 - E2 * math.sin(lat) ** 2)
-        rm = A * (1.0 - E2) / w**3 + tr["height_m"]
-        rn = A / w + tr["height_m"]
-        dn = math.radians(r["lat_deg"] - tr["lat_deg"]) * rm
-        de = math.radians(r["lon_deg"] - tr["lon_deg"]) * rn * math.cos(lat)
-        dd = -(r["height_m"] - tr["height_m"])
+        dn, de, dd = ned_error(r, tr)
         n += 1
         h2 += dn * dn + de * de
         v2 += dd * dd

@@ -113,6 +113,7 @@ const std::map<std::string, Table>& sections() {
         {"use_velocity", [](const Value& v, C& c) { c.use_velocity = v.boolean(); }},
         {"update_interval_s", [](const Value& v, C& c) { c.fix_min_interval_s = v.non_negative(); }},
         {"error_correlation_time_s", [](const Value& v, C& c) { c.fix_error_correlation_s = v.non_negative(); }},
+        {"error_sigma_ned_m", [](const Value& v, C& c) { c.fix_error_sigma_ned_m = v.vector3(true); }},
         {"lever_arm_body_m", [](const Value& v, C& c) { c.lever_arm_b = v.vector3(); }}}},
       {"filter",
        {{"ukf_alpha", [](const Value& v, C& c) { c.ukf.alpha = v.positive(); }},

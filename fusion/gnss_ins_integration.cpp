@@ -81,6 +81,11 @@ bool IntegrationOptions::IsValid(std::string* why) const {
     return fail("integration: the fix interval and error correlation time must be >= 0");
   if (std::string inner; !o.recovery.IsValid(&inner)) return fail("integration: " + inner);
   if (std::string inner; o.odometer.enabled && !o.odometer.IsValid(&inner)) return fail("integration: " + inner);
+  if (std::string inner; o.fix_error.enabled && !o.fix_error.IsValid(&inner)) return fail("integration: " + inner);
+  if (o.fix_error.enabled && o.coupling != Coupling::kLoose)
+    return fail("integration: Gauss-Markov fix-error states are for the loose coupling (fixes) only");
+  if (o.fix_error.enabled && o.fix_error_correlation_s > 0.0)
+    return fail("integration: fix errors either as Gauss-Markov states or by an inflated variance, not both");
   if (o.odometer.enabled && o.coupling != Coupling::kLoose)
     return fail("integration: odometer aiding is implemented for the loose coupling only");
   if (o.land.nhc &&
@@ -114,27 +119,41 @@ struct CoreBase {
 
 namespace {
 
-// 15: loose; 17: tight (clock bias, drift); 18: tight with height aiding (+ terrain height, height_aiding.hpp);
-// 19: loose with odometer aiding (+ VMS delay, misalignment, scale factor; odometer_error_model.hpp).
-template <int N>
-using ProcessModelFor = std::conditional_t<N == 18, TerrainAugmentedModel,
-                                           std::conditional_t<N == 19, OdometerAugmentedModel, InsErrorModel<N>>>;
+// The filter's states: the INS errors (15; 17 with the receiver clock in tight mode), then what is appended.
+// Tight with height aiding: + the terrain height [17] (height_aiding.hpp). Loose with odometer aiding: + VMS delay,
+// misalignment, scale factor [15, 19) (odometer_error_model.hpp). Loose with Gauss-Markov fix errors: + three NED
+// fix-error states after all the others (fix_error_model.hpp).
+template <bool Tight, bool Terrain, bool Odometer, bool FixError>
+struct Layout {
+  static constexpr bool clock = Tight, terrain = Terrain, odometer = Odometer, fix_error = FixError;
+  static constexpr int kNav = Tight ? 17 : 15;                                 // INS (and clock) error states
+  static constexpr int kBase = kNav + (Terrain ? 1 : 0) + (Odometer ? 4 : 0);  // before the fix-error states
+  static constexpr int kFix = kBase;                                           // first fix-error state
+  static constexpr int N = kBase + (FixError ? 3 : 0);
+};
 
-// A measurement model written for 15 or 17 states, as the filter of N states takes it.
-template <int N, class M>
+template <class L>
+using BaseModelFor =
+    std::conditional_t<L::terrain, TerrainAugmentedModel,
+                       std::conditional_t<L::odometer, OdometerAugmentedModel, InsErrorModel<L::kNav>>>;
+template <class L>
+using ProcessModelFor =
+    std::conditional_t<L::fix_error, FixErrorAugmentedModel<BaseModelFor<L>, L::kBase>, BaseModelFor<L>>;
+
+// A measurement model written for NIn states (the INS/clock errors unless said), as the filter of L::N takes it.
+template <class L, int NIn = L::kNav, class M>
 auto for_filter(M m) {
-  if constexpr (N == 18)
-    return TerrainPadded<M>(std::move(m));
-  else if constexpr (N == 19)
-    return PaddedMeasurement<M, 15, 19>(std::move(m));
-  else
+  if constexpr (L::N == NIn)
     return m;
+  else
+    return PaddedMeasurement<M, NIn, L::N>(std::move(m));
 }
 
-template <int N, class Filter>
+template <class L, class Filter>
 class Core final : public CoreBase {
-  static constexpr int kNav = N == 18 ? 17 : N == 19 ? 15 : N;  // INS/clock error states (no terrain, odometer)
-  static constexpr bool kClock = N == 17 || N == 18;
+  static constexpr int N = L::N;
+  static constexpr int kNav = L::kNav;
+  static constexpr bool kClock = L::clock;
 
  public:
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
@@ -146,7 +165,7 @@ class Core final : public CoreBase {
     nominal_.nav = ins_.state();
     nominal_.accel_bias_b = opt.initial_accel_bias_b;
     nominal_.gyro_bias_b = opt.initial_gyro_bias_b;
-    if constexpr (N == 18) {
+    if constexpr (L::terrain) {
       if (opt.height_aiding.fixed_height_m) {
         terrain_ref_m_ = terrain_m_ = *opt.height_aiding.fixed_height_m;  // P0: sigma_t^2, uncorrelated
       } else {
@@ -208,11 +227,11 @@ class Core final : public CoreBase {
       apply(node.mapped());
     }
     if (inc.t_s - t > kTimeEpsilon_s) ins_step(dth, dv, inc.t_s - t);
-    if constexpr (N == 15 || N == 17 || N == 19) {
+    if constexpr (!L::terrain) {
       if (opt_.land.nhc && nominal_.nav.t_s - last_nhc_t_s_ >= opt_.land.nhc_interval_s - kTimeEpsilon_s) {
         last_nhc_t_s_ = nominal_.nav.t_s;
         propagate();
-        ++(update(for_filter<N>(NhcMeasurement<kNav>(nominal_, imu_steps_.w_ib_b, opt_.land)), -3)
+        ++(update(for_filter<L>(NhcMeasurement<kNav>(nominal_, imu_steps_.w_ib_b, opt_.land)), -3)
                ? counters.nhc_accepted
                : counters.nhc_rejected);
       }
@@ -231,11 +250,12 @@ class Core final : public CoreBase {
     ins_.step(dth, dv, dt);
     nominal_.nav = ins_.state();
     if constexpr (kClock) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
-    if constexpr (N == 18)  // the nominal terrain follows the Gauss-Markov mean back to the reference
+    if constexpr (L::terrain)  // the nominal terrain follows the Gauss-Markov mean back to the reference
       terrain_m_ =
           terrain_ref_m_ + (terrain_m_ - terrain_ref_m_) * std::exp(-dt / opt_.height_aiding.terrain_correlation_s);
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
-    if constexpr (N == 19) record_history();
+    if constexpr (L::fix_error) fix_error_n_ = propagate_fix_error(fix_error_n_, dt, opt_.fix_error.correlation_time_s);
+    if constexpr (L::odometer) record_history();
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
 
@@ -256,10 +276,12 @@ class Core final : public CoreBase {
       return false;
     }
     ++counters.accepted;
-    // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock, terrain), reset.
+    // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock, terrain, odometer,
+    // fix error), reset.
     nominal_ = corrected<kNav>(nominal_, filter_.x().template head<kNav>());
-    if constexpr (N == 18) terrain_m_ -= filter_.x()(ix::kTerrain);
-    if constexpr (N == 19) odometer_ = corrected(odometer_, filter_.x());
+    if constexpr (L::terrain) terrain_m_ -= filter_.x()(ix::kTerrain);
+    if constexpr (L::odometer) odometer_ = corrected(odometer_, StateVector<19>(filter_.x().template head<19>()));
+    if constexpr (L::fix_error) fix_error_n_ -= filter_.x().template segment<3>(L::kFix);
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<N>::Zero());
     return true;
@@ -268,7 +290,7 @@ class Core final : public CoreBase {
   void apply(const Pending& p) {
     propagate();  // covariance up to the measurement time
     if (const auto* o = std::get_if<PendingOdometer>(&p)) {
-      if constexpr (N == 19) apply_odometer(o->speed);
+      if constexpr (L::odometer) apply_odometer(o->speed);
       return;
     }
     if (const auto* a = std::get_if<PendingAttitude>(&p)) {
@@ -277,7 +299,7 @@ class Core final : public CoreBase {
         ++counters.attitude_unusable;
         return;
       }
-      if (update(for_filter<N>(AttitudeMeasurement<kNav>(nominal_, a->attitude, opt_.attitude)), -1)) {
+      if (update(for_filter<L>(AttitudeMeasurement<kNav>(nominal_, a->attitude, opt_.attitude)), -1)) {
         ++counters.attitude_accepted;
         attitude_since_fix_ = true;
       } else {
@@ -300,12 +322,12 @@ class Core final : public CoreBase {
     if (!attitude_since_fix_) ++counters.fixes_without_attitude;
     attitude_since_fix_ = false;
     if (const auto* f = std::get_if<PendingFix>(&p)) {
-      if constexpr (N == 15 || N == 19) {
+      if constexpr (!L::clock) {
         if (f->fix.has_position || f->fix.has_velocity) {
           GnssFix fix = f->fix;
           fix.sigma_pos_ned_m *= std::sqrt(fix_variance_factor);
-          const bool accepted =
-              update(for_filter<N>(LooseMeasurement<kNav>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b)), 0);
+          if constexpr (L::fix_error) fix.sigma_pos_ned_m = fix_white_sigma(fix.sigma_pos_ned_m, opt_.fix_error);
+          const bool accepted = update_fix(fix);
           ++(accepted ? counters.fix_accepted : counters.fix_rejected);
           const UpdateResult r = records.back().result;
           if (auto event = monitor_.observe(nominal_.nav.t_s, accepted, r.nis, r.dof)) {
@@ -313,11 +335,9 @@ class Core final : public CoreBase {
             const Eigen::Vector3d dp = pos_rows ? Eigen::Vector3d(r.innovation.head<3>()) : Eigen::Vector3d::Zero();
             std::optional<Eigen::Vector3d> dv;
             if (fix.has_velocity) dv = r.innovation.segment<3>(pos_rows);
-            recover(*event, dp, dv, 0.0);
+            recover(*event, dp, dv, std::nullopt);
             // The fix that tripped the monitor, again through the opened filter (counted as accepted if it passes).
-            if (!accepted &&
-                update(for_filter<N>(LooseMeasurement<kNav>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b)), 0))
-              ++counters.fix_accepted;
+            if (!accepted && update_fix(fix)) ++counters.fix_accepted;
           }
         }
       }
@@ -334,7 +354,7 @@ class Core final : public CoreBase {
       if (few) ++counters.epochs_few_satellites;
       // Height first: the satellites' rows are then linearised about the aided height.
       // (0.99: epochs come on the receiver clock, slightly off 1 s in true time.)
-      if constexpr (N == 18) {
+      if constexpr (L::terrain) {
         if (few && nominal_.nav.t_s - last_aid_t_s_ >= 0.99 * ha.min_interval_s) {
           last_aid_t_s_ = nominal_.nav.t_s;
           if (update(TerrainHeightMeasurement(nominal_, terrain_m_, ha.sigma0_m), -2))
@@ -353,10 +373,19 @@ class Core final : public CoreBase {
                                                antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight));
         }
       }
-      if constexpr (N == 18) {  // full geometry: this epoch's height is the terrain reference from now on
+      if constexpr (L::terrain) {  // full geometry: this epoch's height is the terrain reference from now on
         if (!few && !ha.fixed_height_m) hold_terrain();
       }
     }
+  }
+
+  // One loose fix update (position rows with the fix-error states when the filter carries them).
+  bool update_fix(const GnssFix& fix) {
+    auto m = for_filter<L>(LooseMeasurement<kNav>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b));
+    if constexpr (L::fix_error)
+      return update(FixErrorMeasurement<decltype(m), N, L::kFix>(std::move(m), fix.has_position, fix_error_n_), 0);
+    else
+      return update(m, 0);
   }
 
   void fill_output() {
@@ -370,13 +399,17 @@ class Core final : public CoreBase {
     o.gyro_bias_b = nominal_.gyro_bias_b;
     o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
     o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
-    if constexpr (N == 18) {
+    if constexpr (L::terrain) {
       o.terrain_height_m = terrain_m_;
       o.sigma_terrain_height_m = sd(ix::kTerrain);
     }
-    if constexpr (N == 19) {
+    if constexpr (L::odometer) {
       o.odometer.value = odometer_;
       o.odometer.sigma = {sd(ix::kOdoDelay), sd(ix::kOdoPitch), sd(ix::kOdoYaw), sd(ix::kOdoScale)};
+    }
+    if constexpr (L::fix_error) {
+      o.fix_error_ned_m = fix_error_n_;
+      o.sigma_fix_error_ned_m = sd.template segment<3>(L::kFix);
     }
     if constexpr (kClock) {
       o.clock_bias_m = nominal_.clock_bias_m;
@@ -386,13 +419,19 @@ class Core final : public CoreBase {
     }
   }
 
-  static ProcessModelFor<N> make_model(const IntegrationOptions& o) {
-    if constexpr (N == 18)
+  static BaseModelFor<L> make_base_model(const IntegrationOptions& o) {
+    if constexpr (L::terrain)
       return TerrainAugmentedModel(o.model, o.height_aiding);
-    else if constexpr (N == 19)
+    else if constexpr (L::odometer)
       return OdometerAugmentedModel(o.model, o.odometer);
     else
-      return InsErrorModel<N>(o.model);
+      return InsErrorModel<kNav>(o.model);
+  }
+  static ProcessModelFor<L> make_model(const IntegrationOptions& o) {
+    if constexpr (L::fix_error)
+      return ProcessModelFor<L>(make_base_model(o), o.fix_error, o.model.discretisation);
+    else
+      return make_base_model(o);
   }
 
   // One epoch's satellite updates, and what the lock-out monitor needs of them.
@@ -404,7 +443,7 @@ class Core final : public CoreBase {
   EpochUpdates update_satellites(const std::vector<SatelliteObservable>& sats) {
     EpochUpdates u;
     for (const auto& s : sats) {
-      u.any_accepted |= update(for_filter<N>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
+      u.any_accepted |= update(for_filter<L>(SatelliteMeasurement17(nominal_, s, opt_.lever_arm_b, imu_steps_.w_ib_b,
                                                                     opt_.tight.use_range_rate)),
                                s.prn);
       const UpdateResult& r = records.back().result;
@@ -417,7 +456,7 @@ class Core final : public CoreBase {
 
   // Lock-out recovery: open the covariance of what the measurements observe, log the event.
   void recover(const RecoveryEvent& event, const Eigen::Vector3d& dp, const std::optional<Eigen::Vector3d>& dv,
-               double clock_innovation_m) {
+               std::optional<double> clock_innovation_m) {
     ++counters.recoveries;
     recovery_events.push_back(event);
     const double span = opt_.recovery.min_span_s;
@@ -427,7 +466,7 @@ class Core final : public CoreBase {
 
   // The INS height becomes the terrain reference; the terrain error is the negative INS down error.
   void hold_terrain() {
-    if constexpr (N == 18) {
+    if constexpr (L::terrain) {
       StateMatrix<18> P = filter_.P();
       hold_terrain_at_ins_height(P, opt_.height_aiding.sigma0_m);
       filter_.set_P(P);
@@ -452,7 +491,7 @@ class Core final : public CoreBase {
 
   // One odometer window ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
   void apply_odometer(const OdometerSpeed& speed) {
-    if constexpr (N == 19) {
+    if constexpr (L::odometer) {
       const double t0 = nominal_.nav.t_s - speed.window_s;
       if (history_.empty() || history_.front().t_s > t0 + 1e-6) {
         ++counters.odometer_unusable;
@@ -469,7 +508,8 @@ class Core final : public CoreBase {
       const Eigen::Vector3d a_n =
           span > 0.0 ? Eigen::Vector3d((nominal_.nav.v_n - it->v_n) / span) : Eigen::Vector3d::Zero();
       const Eigen::Vector3d a_b = nominal_.nav.q_nb.conjugate() * a_n;
-      ++(update(VmsMeasurement(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer), -4)
+      ++(update(for_filter<L, 19>(VmsMeasurement(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer)),
+                -4)
              ? counters.odometer_accepted
              : counters.odometer_rejected);
     }
@@ -477,7 +517,7 @@ class Core final : public CoreBase {
 
   IntegrationOptions opt_;
   ins::Strapdown ins_;
-  ProcessModelFor<N> model_;
+  ProcessModelFor<L> model_;
   Filter filter_;
   NominalState nominal_;
   std::multimap<double, Pending> pending_;
@@ -490,24 +530,31 @@ class Core final : public CoreBase {
   double last_nhc_t_s_ = -1e300;
   double last_fix_t_s_ = -1e300;
   OdometerNominal odometer_;
+  Eigen::Vector3d fix_error_n_ = Eigen::Vector3d::Zero();  // Gauss-Markov fix error estimate, NED [m]
   std::deque<HistoryPoint> history_;
 };
 
-template <int N>
+template <class L>
 std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const IntegrationOptions& o) {
+  constexpr int N = L::N;
   InsErrorModelOptions mo = o.model;
   mo.discretisation = o.discretisation;
   IntegrationOptions oo = o;
   oo.model = mo;
-  StateMatrix<N> P0;
-  if constexpr (N == 18)
-    P0 = TerrainAugmentedModel(mo, o.height_aiding)
-             .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
-  else if constexpr (N == 19)
-    P0 = OdometerAugmentedModel(mo, o.odometer)
-             .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  StateMatrix<L::kBase> P_base;
+  if constexpr (L::terrain)
+    P_base = TerrainAugmentedModel(mo, o.height_aiding)
+                 .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  else if constexpr (L::odometer)
+    P_base = OdometerAugmentedModel(mo, o.odometer)
+                 .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else
-    P0 = InsErrorModel<N>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+    P_base = InsErrorModel<L::kNav>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
+  StateMatrix<N> P0;
+  if constexpr (L::fix_error)
+    P0 = with_fix_error_states<L::kBase>(P_base, o.fix_error);
+  else
+    P0 = P_base;
   // Biases from an alignment: their own 1-sigma (cross terms with the other states stay zero).
   if (o.sigma_initial_accel_bias_b)
     P0.template block<3, 3>(ix::kAccelBias, ix::kAccelBias) = o.sigma_initial_accel_bias_b->cwiseAbs2().asDiagonal();
@@ -515,8 +562,8 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
     P0.template block<3, 3>(ix::kGyroBias, ix::kGyroBias) = o.sigma_initial_gyro_bias_b->cwiseAbs2().asDiagonal();
   const StateVector<N> x0 = StateVector<N>::Zero();
   if (o.filter == FilterKind::Ekf)
-    return std::make_unique<Core<N, Ekf<N>>>(initial, oo, Ekf<N>(x0, P0, EkfOptions{o.discretisation, o.gate}));
-  return std::make_unique<Core<N, Ukf<N>>>(initial, oo, Ukf<N>(x0, P0, UkfOptions{o.ukf, o.discretisation, o.gate}));
+    return std::make_unique<Core<L, Ekf<N>>>(initial, oo, Ekf<N>(x0, P0, EkfOptions{o.discretisation, o.gate}));
+  return std::make_unique<Core<L, Ukf<N>>>(initial, oo, Ukf<N>(x0, P0, UkfOptions{o.ukf, o.discretisation, o.gate}));
 }
 
 }  // namespace
@@ -530,14 +577,18 @@ GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const Integ
     : impl_(std::make_unique<Impl>()) {
   if (std::string why; !options.IsValid(&why)) throw std::invalid_argument(why);
   impl_->options = options;
-  if (options.coupling == Coupling::kLoose && options.odometer.enabled)
-    impl_->core = make_core<19>(initial, options);
-  else if (options.coupling == Coupling::kLoose)
-    impl_->core = make_core<15>(initial, options);
-  else if (options.height_aiding.enabled)
-    impl_->core = make_core<18>(initial, options);
+  const bool odometer = options.odometer.enabled, fix_error = options.fix_error.enabled;
+  if (options.coupling == Coupling::kTight)
+    impl_->core = options.height_aiding.enabled ? make_core<Layout<true, true, false, false>>(initial, options)
+                                                : make_core<Layout<true, false, false, false>>(initial, options);
+  else if (odometer && fix_error)
+    impl_->core = make_core<Layout<false, false, true, true>>(initial, options);
+  else if (odometer)
+    impl_->core = make_core<Layout<false, false, true, false>>(initial, options);
+  else if (fix_error)
+    impl_->core = make_core<Layout<false, false, false, true>>(initial, options);
   else
-    impl_->core = make_core<17>(initial, options);
+    impl_->core = make_core<Layout<false, false, false, false>>(initial, options);
 }
 
 GnssInsIntegration::~GnssInsIntegration() = default;

@@ -15,7 +15,8 @@
 // Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides; with height aiding 18 (+ the
 // terrain height). Loose with odometer aiding: 19 (+ VMS delay, misalignment, scale factor; [KimVMS]), odometer
-// speeds through add_odometer, gated by fusion/vms_measurement.hpp's rule. EKF or UKF.
+// speeds through add_odometer, gated by fusion/vms_measurement.hpp's rule. Loose with Gauss-Markov fix errors:
+// + 3 NED fix-error states after all others (18, or 22 with the odometer; fusion/fix_error_model.hpp). EKF or UKF.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,6 +28,7 @@
 #include "fusion/attitude_measurement.hpp"
 #include "fusion/coupling.hpp"
 #include "fusion/ekf.hpp"
+#include "fusion/fix_error_model.hpp"
 #include "fusion/height_aiding.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/ins_error_state.hpp"
@@ -72,7 +74,11 @@ struct IntegrationOptions {
   // Loose: the correlation time of the fixes' position errors (first-order Gauss-Markov; 0: white). Their
   // variance is inflated by 1 + 2 tau / dt (dt: the time since the previous fix), the factor by which the variance
   // of a mean of correlated errors exceeds that of white ones, so the filter does not average them down.
+  // Honest but it discards most of each fix; fix_error carries the correlated part as states instead (not both).
   double fix_error_correlation_s = 0.0;
+  // Loose: the fixes' position errors as three Gauss-Markov states in NED (fusion/fix_error_model.hpp; off by
+  // default).
+  FixErrorOptions fix_error;
   // Land vehicles: non-holonomic constraints (fusion/nhc_measurement.hpp), off by default.
   LandVehicleOptions land;
   // Land vehicles: odometer (VMS) aiding, [KimVMS] (loose coupling only; off by default).
@@ -113,6 +119,8 @@ struct IntegrationOutput {
   double sigma_clock_bias_m = 0.0, sigma_clock_drift_mps = 0.0;
   double terrain_height_m = 0.0, sigma_terrain_height_m = 0.0;  // tight with height aiding (else 0)
   OdometerEstimate odometer;                                    // odometer aiding (else 0)
+  // Gauss-Markov fix-error states (else 0): the estimate of the fixes' current position error, NED [m].
+  Eigen::Vector3d fix_error_ned_m = Eigen::Vector3d::Zero(), sigma_fix_error_ned_m = Eigen::Vector3d::Zero();
 };
 
 struct IntegrationCounters {
@@ -181,7 +189,7 @@ class GnssInsIntegration {
 
   const IntegrationOutput& output() const;
   // Current nominal (nav + bias estimates + clock) and the error covariance (15 x 15 or 17 x 17; with height
-  // aiding the terrain state is left out: output().sigma_terrain_height_m; with the odometer the odometer states).
+  // aiding the terrain state is left out: output().sigma_terrain_height_m; likewise the odometer and fix-error states).
   NominalState nominal() const;
   Eigen::MatrixXd covariance() const;
   const IntegrationCounters& counters() const;

@@ -68,7 +68,7 @@ std::optional<RecoveryEvent> LockoutMonitor::observe(double t_s, bool accepted, 
 
 Eigen::MatrixXd inflate_for_recovery(const Eigen::MatrixXd& P_in, const Eigen::Vector3d& dp,
                                      const std::optional<Eigen::Vector3d>& dv, double span_s,
-                                     const LockoutRecoveryOptions& o, double clock_innovation_m) {
+                                     const LockoutRecoveryOptions& o, std::optional<double> clock_innovation_m) {
   Eigen::MatrixXd P = P_in;
   const int n = static_cast<int>(P.rows());
   Eigen::VectorXd var = P.diagonal();
@@ -81,8 +81,9 @@ Eigen::MatrixXd inflate_for_recovery(const Eigen::MatrixXd& P_in, const Eigen::V
   }
   std::vector<int> opened{ix::kPos,     ix::kPos + 1, ix::kPos + 2, ix::kVel,    ix::kVel + 1,
                           ix::kVel + 2, ix::kAtt,     ix::kAtt + 1, ix::kAtt + 2};
-  if (n >= 17) {
-    var(ix::kClockBias) = std::max(var(ix::kClockBias), 4.0 * clock_innovation_m * clock_innovation_m + 1.0);
+  if (clock_innovation_m && n >= 17) {
+    const double dc = *clock_innovation_m;
+    var(ix::kClockBias) = std::max(var(ix::kClockBias), 4.0 * dc * dc + 1.0);
     var(ix::kClockDrift) = std::max(var(ix::kClockDrift), 4.0 * v_from_p * v_from_p + 1.0);
     opened.push_back(ix::kClockBias);
     opened.push_back(ix::kClockDrift);

@@ -54,10 +54,12 @@ class LockoutMonitor {
 // Opens P (n x n, n >= 9) for a recovery: position variances at least 4 innovation^2 per NED axis (pos_innovation;
 // zero where unknown) plus 1 m^2, velocity at least 4 vel_innovation^2 (or (2 |pos_innovation| / span_s)^2 when no
 // velocity was measured) plus 1 (m/s)^2, attitude at least options.attitude_sigma_rad^2; the cross-covariances of
-// these nine states with everything are cleared. Tight (n >= 17): the clock bias like a position axis (clock
-// innovation: the mean pseudorange innovation), the drift like velocity.
+// these nine states with everything are cleared. Tight (a clock innovation given: the mean pseudorange innovation;
+// n >= 17): the clock bias like a position axis, the drift like velocity. Other states (biases, and what a filter
+// appends after them) keep their variances.
 Eigen::MatrixXd inflate_for_recovery(const Eigen::MatrixXd& P, const Eigen::Vector3d& pos_innovation_ned_m,
                                      const std::optional<Eigen::Vector3d>& vel_innovation_ned_mps, double span_s,
-                                     const LockoutRecoveryOptions& options, double clock_innovation_m = 0.0);
+                                     const LockoutRecoveryOptions& options,
+                                     std::optional<double> clock_innovation_m = std::nullopt);
 
 }  // namespace ultratrack::fusion

@@ -35,6 +35,9 @@ struct FuseConfig {
   double velocity_sigma_mps = 0.1;
   double fix_min_interval_s = 0.0;       // [gnss] update_interval_s: a decorrelating interval between fixes used
   double fix_error_correlation_s = 0.0;  // [gnss] error_correlation_time_s: fixes' errors Gauss-Markov (0: white)
+  // [gnss] error_sigma_ned_m: with a correlation time, the Gauss-Markov part's 1-sigma, carried as filter states
+  // (fusion/fix_error_model.hpp) instead of inflating the fixes' variance.
+  std::optional<Eigen::Vector3d> fix_error_sigma_ned_m;
   bool use_velocity = true;
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();
   fusion::UkfParameters ukf;

@@ -84,6 +84,13 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
                    r.counters.fix_rejected);
   j += fmt::format("  \"fixes_skipped_by_interval\": {},\n", r.counters.fixes_skipped);
+  if (s.config.fix_error_correlation_s > 0.0) {
+    const auto& sg = s.config.fix_error_sigma_ned_m;
+    j += fmt::format("  \"fix_error_model\": {{\"correlation_time_s\": {}, ", s.config.fix_error_correlation_s);
+    j += sg ? fmt::format("\"kind\": \"gauss_markov_states\", \"sigma_ned_m\": [{}, {}, {}]}},\n", sg->x(), sg->y(),
+                          sg->z())
+            : std::string("\"kind\": \"inflated_variance\"},\n");
+  }
   if (s.gnss_until_s)
     j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,
                      r.fixes_after_gnss_until);

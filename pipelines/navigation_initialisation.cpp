@@ -141,6 +141,12 @@ fusion::IntegrationOptions integration_options(const NavigationStart& start, con
   o.land = c.land;
   o.fix_min_interval_s = c.fix_min_interval_s;
   o.fix_error_correlation_s = c.fix_error_correlation_s;
+  if (c.fix_error_sigma_ned_m && c.fix_error_correlation_s > 0.0 && coupling == fusion::Coupling::kLoose) {
+    o.fix_error.enabled = true;  // the correlated part as states, instead of the inflated variance
+    o.fix_error.correlation_time_s = c.fix_error_correlation_s;
+    o.fix_error.sigma_ned_m = *c.fix_error_sigma_ned_m;
+    o.fix_error_correlation_s = 0.0;
+  }
   o.ukf = c.ukf;
   o.propagation_interval_s = c.propagation_interval_s;
   return o;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The fuse configuration's datasheet IMU keys, lock-out recovery and land-vehicle keys: values reach the
+// The fuse configuration's datasheet IMU keys, lock-out recovery, land-vehicle and GNSS error keys: values reach the
 // FuseConfig, the filter's model is the preset with them put in, and bad values name the file, line and key.
 #include "config/fuse_config_toml.hpp"
 
@@ -73,6 +73,15 @@ TEST(FuseConfigToml, OdometerKeys) {
   EXPECT_FALSE(c.odometer.enabled);  // fuse --odometer turns it on
 }
 
+TEST(FuseConfigToml, GnssErrorKeys) {
+  const auto p = write("gnss.toml", "[gnss]\nerror_correlation_time_s = 30\nerror_sigma_ned_m = [1, 1.5, 2]\n");
+  const FuseConfig c = read_fuse_config(p);
+  EXPECT_EQ(c.fix_error_correlation_s, 30.0);
+  ASSERT_TRUE(c.fix_error_sigma_ned_m);
+  EXPECT_EQ(*c.fix_error_sigma_ned_m, Eigen::Vector3d(1.0, 1.5, 2.0));
+  EXPECT_FALSE(read_fuse_config(write("gnss0.toml", "[gnss]\nerror_correlation_time_s = 30\n")).fix_error_sigma_ned_m);
+}
+
 TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
   struct Case {
     std::string text, what;
@@ -93,6 +102,7 @@ TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
       {"[odometer]\n\nupdate_rate_hz = 0\n", "odometer.update_rate_hz", 3},
       {"[odometer]\nlever_arm_body_m = [1, 2]\n", "odometer.lever_arm_body_m", 2},
       {"[odometer]\nyaw_rate_dps = 1\n", "unknown key 'odometer.yaw_rate_dps'", 2},
+      {"[gnss]\nerror_sigma_ned_m = [1, 0, 2]\n", "gnss.error_sigma_ned_m", 2},
   };
   for (const auto& c : cases) {
     const auto p = write("bad.toml", c.text);

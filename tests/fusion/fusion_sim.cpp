@@ -159,6 +159,7 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
   opt.sigma_vel_n_mps = cfg.sigma0_vel_mps;
   opt.sigma_att_rad = cfg.sigma0_att_rad;
   opt.recovery = cfg.recovery;
+  opt.fix_error = cfg.fix_error;
   opt.gps_time_origin = origin;
   opt.tight.sigma_range_zenith_m = cfg.sigma_range_m;
   opt.tight.sigma_rate_zenith_mps = cfg.sigma_rate_mps;
@@ -196,6 +197,8 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
     return std::hypot(e.x(), e.y());
   };
   bool outage_measured = cfg.outage_length_s <= 0.0;
+  Eigen::Vector3d fix_error = Eigen::Vector3d::Zero();
+  double fix_error_t_s = -1e300;
 
   for (std::size_t k = 0; k + 1 < run.truth.size(); ++k) {
     const double t_end = run.truth[k + 1].t_s;
@@ -217,6 +220,14 @@ RunResult run_simulation(const SimConfig& cfg, fusion::Coupling coupling, fusion
         const ins::EcefMotion ant = interp.antenna(t_true, cfg.lever_arm_b);
         if (!tight) {
           Eigen::Vector3d noise = cfg.sigma_pos_ned_m.cwiseProduct(gauss3());
+          if (cfg.fix_error_correlation_s > 0.0) {  // Gauss-Markov from a stationary start
+            if (fix_error_t_s > -1e299) {
+              const double phi = std::exp(-(t_true - fix_error_t_s) / cfg.fix_error_correlation_s);
+              noise = phi * fix_error + std::sqrt(1.0 - phi * phi) * noise;
+            }
+            fix_error = noise;
+            fix_error_t_s = t_true;
+          }
           if (t_true >= cfg.bias_start_s && t_true < cfg.bias_start_s + cfg.bias_length_s)
             noise += cfg.bias_offset_ned_m;
           double lat, lon, h;

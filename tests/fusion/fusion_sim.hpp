@@ -30,7 +30,9 @@ struct SimConfig {
   Eigen::Vector3d sigma_pos_ned_m{2.0, 2.0, 4.0};
   Eigen::Vector3d sigma_vel_n_mps{0.05, 0.05, 0.1};
   bool velocity = true;
-  double outage_start_s = 1e9;  // no GNSS in [start, start + length)
+  double fix_error_correlation_s = 0.0;  // loose: fix position errors first-order Gauss-Markov (0: white)
+  fusion::FixErrorOptions fix_error;     // loose: the filter's fix-error states (off by default)
+  double outage_start_s = 1e9;           // no GNSS in [start, start + length)
   double outage_length_s = 0.0;
   // Initial error 1-sigma (drawn) and what the filter is told.
   Eigen::Vector3d sigma0_pos_m{3.0, 3.0, 5.0};
