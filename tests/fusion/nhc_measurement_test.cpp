@@ -31,7 +31,7 @@ TEST(NhcMeasurement, IsZeroForMotionAlongTheBodyAxis) {
 }
 
 TEST(NhcMeasurement, JacobianMatchesCentralDifferences) {
-  for (const Eigen::Vector3d lever : {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(-1.2, 0.4, 0.8)}) {
+  for (const Eigen::Vector3d& lever : {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(-1.2, 0.4, 0.8)}) {
     LandVehicleOptions o;
     o.lever_arm_b = lever;
     const Eigen::Vector3d w_ib_b(0.01, -0.02, 0.15);

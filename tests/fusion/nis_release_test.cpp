@@ -145,7 +145,9 @@ TEST(NisRelease, MostChannelsOutsideAtOnceIsTheFilterLoggedOnce) {
       if (first_event < 0) first_event = epoch;
       EXPECT_NE(v.reasons.front().find("of 8 channels"), std::string::npos) << v.reasons.front();
     }
-    if (epoch == 399) EXPECT_TRUE(m.filter_out());
+    if (epoch == 399) {
+      EXPECT_TRUE(m.filter_out());
+    }
   }
   EXPECT_EQ(filter_events, 1);
   EXPECT_NEAR(first_event - 60 + 1,

@@ -57,21 +57,26 @@ void remove_suite_dirs() {
   for (const auto& dir : suite_dirs()) std::filesystem::remove_all(dir, ignored);
 }
 
-// A test's folder is removed when the test passes and kept, for inspection, when it fails (or with
-// ULTRATRACK_KEEP_TEST_DIRS set): a whole run otherwise leaves gigabytes of samples in the temp folder.
+// A test's folder is removed when the test passed and kept, for inspection, when it failed (or with
+// ULTRATRACK_KEEP_TEST_DIRS set): a whole run otherwise leaves gigabytes of samples in the temp folder. Removal waits
+// for the end of the program: a test may leave data that later tests of the same process read (a simulation made
+// once per process in the first test's folder), and ctest runs one test per process anyway.
 class RemovePassedTestFolders : public ::testing::EmptyTestEventListener {
  public:
   void watch(std::filesystem::path dir) { dirs_.push_back(std::move(dir)); }
   void OnTestEnd(const ::testing::TestInfo& info) override {
     const bool keep = !info.result()->Passed() || std::getenv("ULTRATRACK_KEEP_TEST_DIRS") != nullptr;
-    std::error_code ignored;
-    if (!keep)
-      for (const auto& dir : dirs_) std::filesystem::remove_all(dir, ignored);
+    if (!keep) passed_.insert(passed_.end(), dirs_.begin(), dirs_.end());
     dirs_.clear();
+  }
+  void OnTestProgramEnd(const ::testing::UnitTest&) override {
+    std::error_code ignored;
+    for (const auto& dir : passed_) std::filesystem::remove_all(dir, ignored);
+    passed_.clear();
   }
 
  private:
-  std::vector<std::filesystem::path> dirs_;
+  std::vector<std::filesystem::path> dirs_, passed_;
 };
 
 // Registered with GoogleTest on first use; GoogleTest owns (and deletes) it.

@@ -31,11 +31,11 @@
 
 #include "brute_force_fine_search.hpp"
 #include "config/scenario_toml.hpp"
+#include "run_command.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/sample_reader.hpp"
 #include "sim/navigation_source.hpp"
 #include "sim/scenario_models.hpp"
-#include "run_command.hpp"
 #include "simulation_run.hpp"
 #include "support/test_data.hpp"
 
