@@ -48,7 +48,7 @@ struct CoreBase {
 // fix-error states after all the others (fix_error_model.hpp).
 template <bool Tight, bool Terrain, bool Odometer, bool FixError>
 struct Layout {
-  static constexpr bool clock = Tight, terrain = Terrain, odometer = Odometer, fix_error = FixError;
+  static constexpr bool kHasClock = Tight, kHasTerrain = Terrain, kHasOdometer = Odometer, kHasFixError = FixError;
   static constexpr int kNav = Tight ? 17 : 15;                                 // INS (and clock) error states
   static constexpr int kBase = kNav + (Terrain ? 1 : 0) + (Odometer ? 4 : 0);  // before the fix-error states
   static constexpr int kFix = kBase;                                           // first fix-error state

@@ -44,11 +44,11 @@ inline bool finite(const Pending& p) {
 
 template <class L>
 using BaseModelFor =
-    std::conditional_t<L::terrain, TerrainAugmentedModel,
-                       std::conditional_t<L::odometer, OdometerAugmentedModel, InsErrorModel<L::kNav>>>;
+    std::conditional_t<L::kHasTerrain, TerrainAugmentedModel,
+                       std::conditional_t<L::kHasOdometer, OdometerAugmentedModel, InsErrorModel<L::kNav>>>;
 template <class L>
 using ProcessModelFor =
-    std::conditional_t<L::fix_error, FixErrorAugmentedModel<BaseModelFor<L>, L::kBase>, BaseModelFor<L>>;
+    std::conditional_t<L::kHasFixError, FixErrorAugmentedModel<BaseModelFor<L>, L::kBase>, BaseModelFor<L>>;
 
 // A measurement model written for NIn states (the INS/clock errors unless said), as the filter of L::N takes it.
 template <class L, int NIn = L::kNav, class M>
@@ -63,7 +63,7 @@ template <class L, class Filter>
 class Core final : public CoreBase {
   static constexpr int N = L::N;
   static constexpr int kNav = L::kNav;
-  static constexpr bool kClock = L::clock;
+  static constexpr bool kClock = L::kHasClock;
 
  public:
   Core(const ins::NavState& initial, const IntegrationOptions& opt, Filter filter)
@@ -75,7 +75,7 @@ class Core final : public CoreBase {
     nominal_.nav = ins_.state();
     nominal_.accel_bias_b = opt.initial_accel_bias_b;
     nominal_.gyro_bias_b = opt.initial_gyro_bias_b;
-    if constexpr (L::terrain) {
+    if constexpr (L::kHasTerrain) {
       if (opt.height_aiding.fixed_height_m) {
         terrain_ref_m_ = terrain_m_ = *opt.height_aiding.fixed_height_m;  // P0: sigma_t^2, uncorrelated
       } else {
@@ -137,7 +137,7 @@ class Core final : public CoreBase {
       apply(node.mapped());
     }
     if (inc.t_s - t > kTimeEpsilon_s) ins_step(dth, dv, inc.t_s - t);
-    if constexpr (!L::terrain) {
+    if constexpr (!L::kHasTerrain) {
       if (opt_.land.nhc && nominal_.nav.t_s - last_nhc_t_s_ >= opt_.land.nhc_interval_s - kTimeEpsilon_s) {
         last_nhc_t_s_ = nominal_.nav.t_s;
         propagate();
@@ -160,12 +160,13 @@ class Core final : public CoreBase {
     ins_.step(dth, dv, dt);
     nominal_.nav = ins_.state();
     if constexpr (kClock) nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
-    if constexpr (L::terrain)  // the nominal terrain follows the Gauss-Markov mean back to the reference
+    if constexpr (L::kHasTerrain)  // the nominal terrain follows the Gauss-Markov mean back to the reference
       terrain_m_ =
           terrain_ref_m_ + (terrain_m_ - terrain_ref_m_) * std::exp(-dt / opt_.height_aiding.terrain_correlation_s);
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
-    if constexpr (L::fix_error) fix_error_n_ = propagate_fix_error(fix_error_n_, dt, opt_.fix_error.correlation_time_s);
-    if constexpr (L::odometer) record_history();
+    if constexpr (L::kHasFixError)
+      fix_error_n_ = propagate_fix_error(fix_error_n_, dt, opt_.fix_error.correlation_time_s);
+    if constexpr (L::kHasOdometer) record_history();
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
 
@@ -189,9 +190,9 @@ class Core final : public CoreBase {
     // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock, terrain, odometer,
     // fix error), reset.
     nominal_ = corrected<kNav>(nominal_, filter_.x().template head<kNav>());
-    if constexpr (L::terrain) terrain_m_ -= filter_.x()(ix::kTerrain);
-    if constexpr (L::odometer) odometer_ = corrected(odometer_, StateVector<19>(filter_.x().template head<19>()));
-    if constexpr (L::fix_error) fix_error_n_ -= filter_.x().template segment<3>(L::kFix);
+    if constexpr (L::kHasTerrain) terrain_m_ -= filter_.x()(ix::kTerrain);
+    if constexpr (L::kHasOdometer) odometer_ = corrected(odometer_, StateVector<19>(filter_.x().template head<19>()));
+    if constexpr (L::kHasFixError) fix_error_n_ -= filter_.x().template segment<3>(L::kFix);
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<N>::Zero());
     return true;
@@ -200,7 +201,7 @@ class Core final : public CoreBase {
   void apply(const Pending& p) {
     propagate();  // covariance up to the measurement time
     if (const auto* o = std::get_if<PendingOdometer>(&p)) {
-      if constexpr (L::odometer) apply_odometer(o->speed);
+      if constexpr (L::kHasOdometer) apply_odometer(o->speed);
       return;
     }
     if (const auto* a = std::get_if<PendingAttitude>(&p)) {
@@ -232,11 +233,11 @@ class Core final : public CoreBase {
     if (!attitude_since_fix_) ++counters.fixes_without_attitude;
     attitude_since_fix_ = false;
     if (const auto* f = std::get_if<PendingFix>(&p)) {
-      if constexpr (!L::clock) {
+      if constexpr (!L::kHasClock) {
         if (f->fix.has_position || f->fix.has_velocity) {
           GnssFix fix = f->fix;
           fix.sigma_pos_ned_m *= std::sqrt(fix_variance_factor);
-          if constexpr (L::fix_error) fix.sigma_pos_ned_m = fix_white_sigma(fix.sigma_pos_ned_m, opt_.fix_error);
+          if constexpr (L::kHasFixError) fix.sigma_pos_ned_m = fix_white_sigma(fix.sigma_pos_ned_m, opt_.fix_error);
           const bool accepted = update_fix(fix);
           ++(accepted ? counters.fix_accepted : counters.fix_rejected);
           const UpdateResult r = records.back().result;
@@ -264,7 +265,7 @@ class Core final : public CoreBase {
       if (few) ++counters.epochs_few_satellites;
       // Height first: the satellites' rows are then linearised about the aided height.
       // (0.99: epochs come on the receiver clock, slightly off 1 s in true time.)
-      if constexpr (L::terrain) {
+      if constexpr (L::kHasTerrain) {
         if (few && nominal_.nav.t_s - last_aid_t_s_ >= 0.99 * ha.min_interval_s) {
           last_aid_t_s_ = nominal_.nav.t_s;
           if (update(TerrainHeightMeasurement(nominal_, terrain_m_, ha.sigma0_m), -2))
@@ -283,7 +284,7 @@ class Core final : public CoreBase {
                                                antenna_position_e(nominal_.nav, opt_.lever_arm_b), opt_.tight));
         }
       }
-      if constexpr (L::terrain) {  // full geometry: this epoch's height is the terrain reference from now on
+      if constexpr (L::kHasTerrain) {  // full geometry: this epoch's height is the terrain reference from now on
         if (!few && !ha.fixed_height_m) hold_terrain();
       }
     }
@@ -292,7 +293,7 @@ class Core final : public CoreBase {
   // One loose fix update (position rows with the fix-error states when the filter carries them).
   bool update_fix(const GnssFix& fix) {
     auto m = for_filter<L>(LooseMeasurement<kNav>(nominal_, fix, opt_.lever_arm_b, imu_steps_.w_ib_b));
-    if constexpr (L::fix_error)
+    if constexpr (L::kHasFixError)
       return update(FixErrorMeasurement<decltype(m), N, L::kFix>(std::move(m), fix.has_position, fix_error_n_), 0);
     else
       return update(m, 0);
@@ -309,15 +310,15 @@ class Core final : public CoreBase {
     o.gyro_bias_b = nominal_.gyro_bias_b;
     o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
     o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
-    if constexpr (L::terrain) {
+    if constexpr (L::kHasTerrain) {
       o.terrain_height_m = terrain_m_;
       o.sigma_terrain_height_m = sd(ix::kTerrain);
     }
-    if constexpr (L::odometer) {
+    if constexpr (L::kHasOdometer) {
       o.odometer.value = odometer_;
       o.odometer.sigma = {sd(ix::kOdoDelay), sd(ix::kOdoPitch), sd(ix::kOdoYaw), sd(ix::kOdoScale)};
     }
-    if constexpr (L::fix_error) {
+    if constexpr (L::kHasFixError) {
       o.fix_error_ned_m = fix_error_n_;
       o.sigma_fix_error_ned_m = sd.template segment<3>(L::kFix);
     }
@@ -330,15 +331,15 @@ class Core final : public CoreBase {
   }
 
   static BaseModelFor<L> make_base_model(const IntegrationOptions& o) {
-    if constexpr (L::terrain)
+    if constexpr (L::kHasTerrain)
       return TerrainAugmentedModel(o.model, o.height_aiding);
-    else if constexpr (L::odometer)
+    else if constexpr (L::kHasOdometer)
       return OdometerAugmentedModel(o.model, o.odometer);
     else
       return InsErrorModel<kNav>(o.model);
   }
   static ProcessModelFor<L> make_model(const IntegrationOptions& o) {
-    if constexpr (L::fix_error)
+    if constexpr (L::kHasFixError)
       return ProcessModelFor<L>(make_base_model(o), o.fix_error, o.model.discretisation);
     else
       return make_base_model(o);
@@ -376,7 +377,7 @@ class Core final : public CoreBase {
 
   // The INS height becomes the terrain reference; the terrain error is the negative INS down error.
   void hold_terrain() {
-    if constexpr (L::terrain) {
+    if constexpr (L::kHasTerrain) {
       StateMatrix<18> P = filter_.P();
       hold_terrain_at_ins_height(P, opt_.height_aiding.sigma0_m);
       filter_.set_P(P);
@@ -401,7 +402,7 @@ class Core final : public CoreBase {
 
   // One odometer window ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
   void apply_odometer(const OdometerSpeed& speed) {
-    if constexpr (L::odometer) {
+    if constexpr (L::kHasOdometer) {
       const double t0 = nominal_.nav.t_s - speed.window_s;
       if (history_.empty() || history_.front().t_s > t0 + 1e-6) {
         ++counters.odometer_unusable;
@@ -452,16 +453,16 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
   IntegrationOptions oo = o;
   oo.model = mo;
   StateMatrix<L::kBase> P_base;
-  if constexpr (L::terrain)
+  if constexpr (L::kHasTerrain)
     P_base = TerrainAugmentedModel(mo, o.height_aiding)
                  .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
-  else if constexpr (L::odometer)
+  else if constexpr (L::kHasOdometer)
     P_base = OdometerAugmentedModel(mo, o.odometer)
                  .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else
     P_base = InsErrorModel<L::kNav>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   StateMatrix<N> P0;
-  if constexpr (L::fix_error)
+  if constexpr (L::kHasFixError)
     P0 = with_fix_error_states<L::kBase>(P_base, o.fix_error);
   else
     P0 = P_base;
