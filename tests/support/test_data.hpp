@@ -22,9 +22,9 @@ std::filesystem::path scenarios_dir();
 std::filesystem::path shipped_nav_file();
 inline constexpr int shipped_nav_week = 1823;          // full GPS week of 2014-12-20
 inline constexpr double shipped_nav_tow_s = 518400.0;  // 2014-12-20 00:00:00 GPST
-// A fresh empty folder under the system temp dir, unique to the calling test and removed when the test passes (kept
-// when it fails, or with ULTRATRACK_KEEP_TEST_DIRS set); called outside a test (in SetUpTestSuite) unique to the suite
-// and this process, and removed when the process exits.
+// A fresh empty folder under the system temp dir, unique to the calling test and removed at the end of the program
+// when the test passed (kept when it failed, or with ULTRATRACK_KEEP_TEST_DIRS set); called outside a test (in
+// SetUpTestSuite) unique to the suite and this process, and removed when the process exits.
 std::filesystem::path scratch_dir();
 
 // A whole text file as one string (empty when it cannot be read).
