@@ -62,7 +62,9 @@ generator=()
 [[ -f "$build_dir/CMakeCache.txt" ]] || generator=(-G Ninja)
 cmake -S . -B "$build_dir" "${generator[@]}" "${build_options[@]}" >/dev/null
 if [[ "${1:-build}" == fuzz ]]; then  # the fuzz targets and what they link, not the program's other parts
-  cmake --build "$build_dir" -j"$jobs" --target $(cd tests/fuzz && ls fuzz_*.cpp | sed 's/\.cpp$//')
+  fuzz_targets=()
+  for f in tests/fuzz/fuzz_*.cpp; do fuzz_targets+=("$(basename "$f" .cpp)"); done
+  cmake --build "$build_dir" -j"$jobs" --target "${fuzz_targets[@]}"
 else
   cmake --build "$build_dir" -j"$jobs"
 fi
