@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/open_failure.hpp"
 #include "io/why_invalid.hpp"
 #include "signals/input_error.hpp"
 
@@ -31,7 +32,7 @@ double number(const std::string& file, const toml::node& n, const std::string& k
 AntennaConfig read_antenna_config(const std::filesystem::path& path) {
   const std::string file = path.string();
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(file, "cannot open the antenna file");
+  if (!in) throw InputError(file, "cannot open the antenna file: " + io::open_failure_reason());
   std::stringstream text;
   text << in.rdbuf();
   toml::table root;

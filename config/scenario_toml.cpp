@@ -17,6 +17,7 @@
 #include "ins/imu_error_model.hpp"
 #include "ins/trajectory.hpp"
 #include "io/input_error.hpp"
+#include "io/open_failure.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/oscillator_allan.hpp"
 
@@ -641,7 +642,7 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
 
 Scenario read_scenario(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "cannot open the scenario file");
+  if (!in) throw InputError(path.string(), "cannot open the scenario file: " + io::open_failure_reason());
   std::stringstream ss;
   ss << in.rdbuf();
   return parse_scenario(ss.str(), path);

@@ -11,6 +11,7 @@
 #include "ins/ins_error.hpp"
 #include "io/atomic_file.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/open_failure.hpp"
 
 namespace ultratrack::ins {
 namespace {
@@ -49,7 +50,7 @@ bool header_is(std::string_view text, const std::vector<std::string>& names) {
 
 ImuCsvForm imu_csv_form(const std::filesystem::path& file) {
   std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "cannot open IMU file");
+  if (!in) throw InputError(file.string(), "cannot open IMU file: " + io::open_failure_reason());
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {

@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "io/input_error.hpp"
+#include "io/open_failure.hpp"
 
 namespace ultratrack::io {
 
@@ -11,7 +12,7 @@ AtomicFile::AtomicFile(std::filesystem::path path, bool binary)
     : path_(std::move(path)), partial_path_(path_.string() + ".partial") {
   stream_.open(partial_path_,
                binary ? std::ios::out | std::ios::binary | std::ios::trunc : std::ios::out | std::ios::trunc);
-  if (!stream_) throw InputError(path_.string(), "cannot open for writing");
+  if (!stream_) throw InputError(path_.string(), "cannot open for writing: " + open_failure_reason());
 }
 
 AtomicFile::~AtomicFile() {

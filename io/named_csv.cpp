@@ -8,6 +8,7 @@
 
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/open_failure.hpp"
 
 namespace ultratrack::io {
 namespace {
@@ -39,7 +40,7 @@ NamedCsv read_named_csv(const std::filesystem::path& path) {
   NamedCsv csv;
   csv.file = path.string();
   std::ifstream in(path);
-  if (!in) throw InputError(csv.file, "cannot open the file");
+  if (!in) throw InputError(csv.file, "cannot open the file: " + open_failure_reason());
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {

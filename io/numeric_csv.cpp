@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "io/input_error.hpp"
+#include "io/open_failure.hpp"
 
 namespace ultratrack::io {
 
@@ -82,7 +83,7 @@ namespace {
 std::string csv_snapshot(const std::filesystem::path& file, std::string_view what) {
   const std::string name = file.string();
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(name, "cannot open " + std::string(what));
+  if (!in) throw InputError(name, "cannot open " + std::string(what) + ": " + open_failure_reason());
   std::error_code ec;
   const auto size = std::filesystem::file_size(file, ec);
   if (ec) throw InputError(name, "cannot read the size of the " + std::string(what) + ": " + ec.message());

@@ -13,6 +13,7 @@
 #include "ins/earth_model.hpp"
 #include "io/input_error.hpp"
 #include "io/json_text.hpp"
+#include "io/open_failure.hpp"
 #include "io/units.hpp"
 
 namespace ultratrack::pipelines {
@@ -221,7 +222,7 @@ std::string alignment_csv(const AlignRunResult& r) {
 AlignmentFileStart read_alignment_json(const std::filesystem::path& file) {
   const std::string name = file.string();
   std::ifstream in(file);
-  if (!in) throw io::InputError(name, "cannot open the alignment file");
+  if (!in) throw io::InputError(name, "cannot open the alignment file: " + io::open_failure_reason());
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string text = ss.str();

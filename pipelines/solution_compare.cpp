@@ -15,6 +15,7 @@
 
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/open_failure.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::pipelines {
@@ -39,7 +40,7 @@ void read_named_columns(const std::filesystem::path& file, const std::string& wh
                         const std::function<void(int, const std::vector<double>&)>& row) {
   const std::string name = file.string();
   std::ifstream in(file);
-  if (!in) throw io::InputError(name, "cannot open the " + what);
+  if (!in) throw io::InputError(name, "cannot open the " + what + ": " + io::open_failure_reason());
   std::string line;
   int line_no = 0;
   std::vector<int> index;

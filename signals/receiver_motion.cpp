@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "io/open_failure.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::signals {
@@ -42,7 +43,7 @@ AntennaState TrajectoryMotion::antenna_state(int, double t_s) const {
 std::vector<TrajectorySample> read_trajectory_csv(const std::filesystem::path& path) {
   const std::string name = path.string();
   std::ifstream in(path);
-  if (!in) throw InputError(name, "cannot open the trajectory file");
+  if (!in) throw InputError(name, "cannot open the trajectory file: " + io::open_failure_reason());
   std::vector<TrajectorySample> out;
   std::string line;
   int line_no = 0;

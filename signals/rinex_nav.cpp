@@ -18,6 +18,7 @@
 #include <optional>
 #include <sstream>
 
+#include "io/open_failure.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/gps_time.hpp"
 #include "signals/input_error.hpp"
@@ -347,7 +348,7 @@ RinexNavData read_rinex_nav(std::istream& in, const std::string& name) {
 
 RinexNavData read_rinex_nav(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string(), "cannot open the RINEX navigation file (missing or unreadable)");
+  if (!in) throw InputError(path.string(), "cannot open the RINEX navigation file: " + io::open_failure_reason());
   return read_rinex_nav(in, path.string());
 }
 

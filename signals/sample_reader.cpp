@@ -6,6 +6,7 @@
 #include <string>
 #include <system_error>
 
+#include "io/open_failure.hpp"
 #include "signals/input_error.hpp"
 
 namespace ultratrack::signals {
@@ -53,7 +54,7 @@ SampleReader::SampleReader(std::filesystem::path path, SampleFormat format, std:
                                std::to_string(total_samples_) + " samples)");
   }
   file_.open(path_, std::ios::binary);
-  if (!file_) throw InputError(name, "cannot open the sample file for reading");
+  if (!file_) throw InputError(name, "cannot open the sample file for reading: " + io::open_failure_reason());
   file_.seekg(static_cast<std::streamoff>(start_sample) * static_cast<std::streamoff>(bps));
   if (!file_) throw InputError(name, "cannot seek to start sample " + std::to_string(start_sample));
   position_ = start_sample;
@@ -77,7 +78,7 @@ void SampleReader::open_packed(std::uintmax_t size, std::int64_t start_sample, T
     }
   }
   file_.open(path_, std::ios::binary);
-  if (!file_) throw InputError(name, "cannot open the sample file for reading");
+  if (!file_) throw InputError(name, "cannot open the sample file for reading: " + io::open_failure_reason());
   const auto per_byte = static_cast<std::int64_t>(per_byte_);
   file_.seekg(static_cast<std::streamoff>(start_sample / per_byte));
   if (!file_) throw InputError(name, "cannot seek to start sample " + std::to_string(start_sample));

@@ -14,6 +14,7 @@
 #include "ins/nav_csv.hpp"
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/open_failure.hpp"
 #include "io/units.hpp"
 
 namespace ultratrack::sim {
@@ -34,7 +35,7 @@ std::vector<ins::NavState> read_truth_csv(const std::filesystem::path& file) {
   {
     // The first non-blank line tells the format: simulate's truth.csv or a plain nav CSV.
     std::ifstream in(file);
-    if (!in) throw io::InputError(name, "cannot open the truth file");
+    if (!in) throw io::InputError(name, "cannot open the truth file: " + io::open_failure_reason());
     std::string line;
     while (std::getline(in, line) && io::trim(line).empty()) {
     }

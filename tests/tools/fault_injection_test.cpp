@@ -1,10 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Faults around `ultratrack receive` (issue 21's fault injection): an input that is a directory, an output folder
-// that cannot be made (its parent is a file), and a disk that fills mid-run (a file-size limit, RLIMIT_FSIZE, with
-// SIGXFSZ ignored so that the write fails as on a full disk). Each gives one error naming the path and the
-// problem; the file being written is removed, never left half-written under its final name or as a .partial.
+// Faults around `ultratrack receive`: an input that is a directory, an input without read permission, an output
+// folder that cannot be made (its parent is a file, or a folder without write permission), an output folder whose
+// files cannot be created, and a disk that fills mid-run (a file-size limit, RLIMIT_FSIZE, with SIGXFSZ ignored so
+// that the write fails as on a full disk). Each gives one error naming the path and the problem (the system's
+// reason where there is one); the file being written is removed, never left half-written under its final name or
+// as a .partial. The permission cases run in a child process without the capabilities that let root ignore
+// permission bits (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH), so they bind there as they bind any user.
 #include <gtest/gtest.h>
+#include <linux/capability.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <csignal>
 #include <filesystem>
@@ -41,6 +48,37 @@ std::string error_of(const std::vector<std::string>& args) {
   return "(no error)";
 }
 
+// Drops CAP_DAC_OVERRIDE and CAP_DAC_READ_SEARCH from this process's effective set (a no-op for a user without
+// them). True on success.
+bool drop_permission_override() {
+  __user_cap_header_struct header{_LINUX_CAPABILITY_VERSION_3, 0};
+  __user_cap_data_struct data[2]{};
+  if (syscall(SYS_capget, &header, data) != 0) return false;
+  data[0].effective &= ~((1u << CAP_DAC_OVERRIDE) | (1u << CAP_DAC_READ_SEARCH));
+  return syscall(SYS_capset, &header, data) == 0;
+}
+
+// error_of(args) in a forked child that has dropped the permission override; its message comes back by a pipe.
+std::string error_without_permission_override(const std::vector<std::string>& args) {
+  int fds[2];
+  if (pipe(fds) != 0) return "(pipe failed)";
+  const pid_t child = fork();
+  if (child == 0) {
+    close(fds[0]);
+    const std::string message = drop_permission_override() ? error_of(args) : "(capset failed)";
+    const ssize_t written = write(fds[1], message.data(), message.size());
+    _exit(written == static_cast<ssize_t>(message.size()) ? 0 : 1);
+  }
+  close(fds[1]);
+  std::string message;
+  char buffer[512];
+  for (ssize_t n; (n = read(fds[0], buffer, sizeof buffer)) > 0;) message.append(buffer, static_cast<std::size_t>(n));
+  close(fds[0]);
+  int status = 0;
+  waitpid(child, &status, 0);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? message : "(child failed) " + message;
+}
+
 TEST(FaultInjection, InputThatIsADirectoryIsNamed) {
   const auto dir = ultratrack::test::scratch_dir();
   const std::string e =
@@ -57,6 +95,46 @@ TEST(FaultInjection, OutputFolderUnderAFileIsNamed) {
   const std::string e = error_of({"--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--out", out.string()});
   EXPECT_NE(e.find(out.string()), std::string::npos) << e;
   EXPECT_NE(e.find("cannot create the output folder"), std::string::npos) << e;
+}
+
+TEST(FaultInjection, UnreadableInputIsNamedWithTheReason) {
+  const auto dir = ultratrack::test::scratch_dir();
+  const fs::path input = simulate(dir);
+  fs::permissions(input, fs::perms::none);
+  const std::string e = error_without_permission_override(
+      {"--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--out", (dir / "rx").string()});
+  fs::permissions(input, fs::perms::owner_read | fs::perms::owner_write);
+  EXPECT_NE(e.find(input.string() + ": cannot open the sample file for reading: Permission denied"), std::string::npos)
+      << e;
+  EXPECT_FALSE(fs::exists(dir / "rx"));
+}
+
+TEST(FaultInjection, OutputFolderInAFolderWithoutWritePermissionIsNamed) {
+  const auto dir = ultratrack::test::scratch_dir();
+  const fs::path input = simulate(dir);
+  const fs::path locked = dir / "locked";
+  fs::create_directory(locked);
+  fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec);
+  const fs::path out = locked / "rx";
+  const std::string e = error_without_permission_override(
+      {"--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--out", out.string()});
+  EXPECT_NE(e.find(out.string() + ": cannot create the output folder: Permission denied"), std::string::npos) << e;
+  EXPECT_FALSE(fs::exists(out));
+  fs::permissions(locked, fs::perms::owner_all);
+}
+
+TEST(FaultInjection, OutputFolderWithoutWritePermissionIsNamedAndLeavesNothing) {
+  const auto dir = ultratrack::test::scratch_dir();
+  const fs::path input = simulate(dir);
+  const fs::path out = dir / "rx";
+  fs::create_directory(out);
+  fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec);
+  const std::string e = error_without_permission_override(
+      {"--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--out", out.string()});
+  fs::permissions(out, fs::perms::owner_all);
+  EXPECT_NE(e.find(": cannot open for writing: Permission denied"), std::string::npos) << e;
+  EXPECT_NE(e.find(out.string() + "/"), std::string::npos) << e;
+  EXPECT_TRUE(fs::is_empty(out));
 }
 
 TEST(FaultInjection, DiskFullMidRunLeavesNoHalfWrittenFile) {
