@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <stop_token>
 #include <string>
 #include <vector>
 
@@ -80,8 +81,9 @@ void acquire_and_compare(const fs::path& samples, const sim::Scenario& scenario,
 }
 
 // Receives the simulated file with the receiver's defaults for this scenario and compares the fixes with the
-// scenario's static position.
-void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario, const fs::path& out) {
+// scenario's static position. A stop request (Ctrl-C, SIGTERM) ends the run early; its outputs are finished.
+void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario, const fs::path& out,
+                         std::stop_token stop) {
   receiver::SampleSourceOptions source_options;
   source_options.fs_hz = scenario.sample_rate_hz;
   source_options.if_hz = scenario.if_hz;
@@ -96,7 +98,12 @@ void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario,
   receiver::ReceiverEngine engine(options, outputs);
   std::vector<std::complex<float>> block(static_cast<std::size_t>(std::llround(0.05 * options.fs_hz)));
   const auto start = std::chrono::steady_clock::now();
+  bool interrupted = false;
   for (;;) {
+    if (stop.stop_requested()) {
+      interrupted = true;
+      break;
+    }
     const receiver::SampleBlock got = source.read(block);
     if (got.count == 0) break;
     engine.process(std::span<const std::complex<float>>(block.data(), got.count), got.first_sample);
@@ -107,16 +114,18 @@ void receive_and_compare(const fs::path& samples, const sim::Scenario& scenario,
   run.fs_hz = options.fs_hz;
   run.if_hz = scenario.if_hz;
   run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.interrupted = interrupted;
   outputs.finish(engine, run);
   const auto& stats = engine.stats();
   fmt::print("  {:.1f} s of signal in {:.1f} s ({:.1f}x real time); {} ephemerides decoded; {} fixes\n",
              receiver::processed_seconds(engine), run.wall_time_s,
              receiver::processed_seconds(engine) / std::max(run.wall_time_s, 1e-9), engine.decoded_ephemerides().size(),
              stats.fixes);
-  if (stats.fixes == 0) {
+  if (stats.fixes == 0 && !interrupted) {
     fmt::print("  no fix: the signal ended before subframes 1-3 of four satellites were received\n");
     return;
   }
+  if (stats.fixes == 0) return;
   const auto& earth = GeographicLib::Geocentric::WGS84();
   double x = 0, y = 0, z = 0;
   earth.Forward(scenario.llh_deg_m[0], scenario.llh_deg_m[1], scenario.llh_deg_m[2], x, y, z);
@@ -148,11 +157,20 @@ void run_demo(const DemoArgs& args) {
   fmt::print("  {:.1f} s of signal in {:.1f} s ({:.1f}x real time), {} satellites in view\n", sim.signal_s, sim.wall_s,
              sim.signal_s / std::max(sim.wall_s, 1e-9), sim.satellites.size());
 
+  if (interrupt.interrupted()) {  // the simulation's outputs are complete up to the stop; nothing more is run
+    fmt::print("\nstopped (the simulation's outputs end where it stopped)\n");
+    return;
+  }
+
   fmt::print("\n2. acquire");
   acquire_and_compare(sim.sample_files.front(), scenario, sim);
 
   fmt::print("\n3. receive -> {}\n", (out / "receiver").string());
-  receive_and_compare(sim.sample_files.front(), scenario, out / "receiver");
+  receive_and_compare(sim.sample_files.front(), scenario, out / "receiver", interrupt.token());
+  if (interrupt.interrupted()) {
+    fmt::print("\nstopped (the receiver's outputs end where it stopped; the sample file is kept)\n");
+    return;
+  }
 
   if (!args.keep_samples) {
     for (const auto& f : sim.sample_files) fs::remove(f);

@@ -6,8 +6,8 @@
 // valid, summary.json saying "interrupted": true where the command writes one, and no temporary (.partial) file
 // left. Commands that compute in memory and write their outputs at the end (align, snapshot) end at once: nothing
 // is written, or, when the signal lands during the writes, the writes complete first.
-// Skipped (they finish in milliseconds on any input they accept): acquire, compare, covariance, demo's steps are
-// simulate + receive. gnsssim is covered (its output is one file written at the end).
+// Skipped (they finish in milliseconds on any input they accept): acquire, compare, covariance. gnsssim is covered
+// (its output is one file written at the end); demo is stopped in its simulation and in its receive.
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -447,6 +447,31 @@ TEST_P(Interrupt, Snapshot) {
               (WIFEXITED(status) && WEXITSTATUS(status) == 128 + sig()))
       << read_text(c.log);
   if (fs::exists(d / "o")) expect_complete_outputs(d / "o");
+}
+
+// demo stopped while it simulates: the simulation's outputs end at the stop and nothing else runs.
+TEST(InterruptDemo, SigintInTheSimulationStopsThere) {
+  const fs::path d = ultratrack::test::scratch_dir();
+  const Child c = start_program({"demo", "--duration", "30", "--out", (d / "o").string()}, d / "log");
+  if (!wait_until(c, [&] { return fs::exists(d / "o" / "simulation"); })) return;
+  std::this_thread::sleep_for(300ms);
+  expect_stopped_exit(stop(c, SIGINT), SIGINT, c);
+  expect_complete_outputs(d / "o" / "simulation");
+  expect_summary_interrupted(d / "o" / "simulation" / "summary.json");
+  EXPECT_FALSE(fs::exists(d / "o" / "receiver"));
+}
+
+// demo stopped while it receives (a short simulation first): the receiver's outputs are finished and say so.
+TEST(InterruptDemo, SigtermInTheReceiveFinishesItsOutputs) {
+  const fs::path d = ultratrack::test::scratch_dir();
+  const Child c = start_program({"demo", "--duration", "4", "--out", (d / "o").string()}, d / "log");
+  if (!wait_until(
+          c, [&] { return fs::exists(d / "o" / "receiver"); }, 120s))
+    return;
+  expect_stopped_exit(stop(c, SIGTERM), SIGTERM, c);
+  expect_complete_outputs(d / "o" / "receiver");
+  expect_summary_interrupted(d / "o" / "receiver" / "summary.json");
+  EXPECT_TRUE(fs::exists(d / "o" / "simulation" / "antenna0.i8.bin"));  // kept: the run did not end
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),
