@@ -39,6 +39,13 @@ fs::path simulate(const fs::path& dir) {
   return dir / "sim" / "antenna0.i8.bin";
 }
 
+// 0.1 s of zeros at 2.6 MHz i8: a valid recording (with nothing in it) for faults met before the first sample.
+fs::path zeros_recording(const fs::path& dir) {
+  const fs::path file = dir / "zeros.i8.bin";
+  std::ofstream(file, std::ios::binary) << std::string(520000, '\0');
+  return file;
+}
+
 std::string error_of(const std::vector<std::string>& args) {
   try {
     run("receive", args);
@@ -90,7 +97,7 @@ TEST(FaultInjection, InputThatIsADirectoryIsNamed) {
 
 TEST(FaultInjection, OutputFolderUnderAFileIsNamed) {
   const auto dir = ultratrack::test::scratch_dir();
-  const fs::path input = simulate(dir);
+  const fs::path input = zeros_recording(dir);
   const fs::path out = input / "rx";  // a folder inside a regular file
   const std::string e = error_of({"--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--out", out.string()});
   EXPECT_NE(e.find(out.string()), std::string::npos) << e;
@@ -99,7 +106,7 @@ TEST(FaultInjection, OutputFolderUnderAFileIsNamed) {
 
 TEST(FaultInjection, UnreadableInputIsNamedWithTheReason) {
   const auto dir = ultratrack::test::scratch_dir();
-  const fs::path input = simulate(dir);
+  const fs::path input = zeros_recording(dir);
   fs::permissions(input, fs::perms::none);
   const std::string e = error_without_permission_override(
       {"--input", input.string(), "--format", "i8", "--fs", "2.6e6", "--out", (dir / "rx").string()});
@@ -111,7 +118,7 @@ TEST(FaultInjection, UnreadableInputIsNamedWithTheReason) {
 
 TEST(FaultInjection, OutputFolderInAFolderWithoutWritePermissionIsNamed) {
   const auto dir = ultratrack::test::scratch_dir();
-  const fs::path input = simulate(dir);
+  const fs::path input = zeros_recording(dir);
   const fs::path locked = dir / "locked";
   fs::create_directory(locked);
   fs::permissions(locked, fs::perms::owner_read | fs::perms::owner_exec);
@@ -125,7 +132,7 @@ TEST(FaultInjection, OutputFolderInAFolderWithoutWritePermissionIsNamed) {
 
 TEST(FaultInjection, OutputFolderWithoutWritePermissionIsNamedAndLeavesNothing) {
   const auto dir = ultratrack::test::scratch_dir();
-  const fs::path input = simulate(dir);
+  const fs::path input = zeros_recording(dir);
   const fs::path out = dir / "rx";
   fs::create_directory(out);
   fs::permissions(out, fs::perms::owner_read | fs::perms::owner_exec);
