@@ -12,6 +12,7 @@
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
 #include "io/units.hpp"
+#include "io/whole_number.hpp"
 
 namespace ultratrack::pipelines {
 namespace {
@@ -47,18 +48,16 @@ std::vector<AttitudeCsvRow> read_attitude_csv(const std::filesystem::path& file)
     for (int i : {0, 1, 8, 9, 10})
       if (!std::isfinite(v[static_cast<std::size_t>(i)]))
         fail(attitude_header()[static_cast<std::size_t>(i)] + " is not finite");
-    if (v[0] < 0.0 || v[0] != std::floor(v[0])) fail("gps_week must be a non-negative integer");
     if (!(v[1] >= 0.0 && v[1] < 604800.0)) fail("tow_s outside [0, 604800)");
-    if (v[8] < 0.0 || v[8] != std::floor(v[8])) fail("num_sats must be a non-negative integer");
     if (v[9] != 0.0 && v[9] != 1.0) fail("fixed must be 0 or 1");
     AttitudeCsvRow r;
     r.line = line;
-    r.time = signals::GpsTime{static_cast<int>(v[0]), v[1]};
+    r.time = signals::GpsTime{io::whole_number_field(v[0], 0, io::kMaxGpsWeek, name, line, "gps_week"), v[1]};
     r.euler = {v[2] * io::kRadPerDeg, v[3] * io::kRadPerDeg, v[4] * io::kRadPerDeg};
     r.sigma_roll_rad = v[5] * io::kRadPerDeg;
     r.sigma_pitch_rad = v[6] * io::kRadPerDeg;
     r.sigma_yaw_rad = v[7] * io::kRadPerDeg;
-    r.num_sats = static_cast<int>(v[8]);
+    r.num_sats = io::whole_number_field(v[8], 0, 999, name, line, "num_sats");
     r.fixed = v[9] == 1.0;
     r.ratio = v[10];
     if (r.fixed) {

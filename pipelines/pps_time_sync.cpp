@@ -8,6 +8,7 @@
 
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
+#include "io/whole_number.hpp"
 
 namespace ultratrack::pipelines {
 
@@ -16,11 +17,10 @@ std::vector<PpsEdge> read_pps_csv(const std::filesystem::path& file) {
   std::vector<PpsEdge> edges;
   io::read_numeric_csv(
       file, "PPS file", {"local_s", "gps_week", "gps_tow_s"}, [&](int line, std::span<const double> v) {
-        if (v[1] < 0.0 || v[1] != std::floor(v[1]))
-          throw io::InputError(name, "gps_week must be a whole number >= 0", line);
         if (!(v[2] >= 0.0 && v[2] < 604800.0) || std::abs(v[2] - std::round(v[2])) > 1e-6)
           throw io::InputError(name, "gps_tow_s must be a whole second in [0, 604800) (a PPS edge)", line);
-        PpsEdge e{line, v[0], {static_cast<int>(v[1]), std::round(v[2])}};
+        const int week = io::whole_number_field(v[1], 0, io::kMaxGpsWeek, name, line, "gps_week");
+        PpsEdge e{line, v[0], {week, std::round(v[2])}};
         if (!edges.empty()) {
           if (!(e.local_s > edges.back().local_s)) throw io::InputError(name, "local_s must increase", line);
           if (!(signals::seconds_between(e.gps, edges.back().gps) > 0.0))

@@ -16,6 +16,7 @@
 #include "io/input_error.hpp"
 #include "io/numeric_csv.hpp"
 #include "io/open_failure.hpp"
+#include "io/whole_number.hpp"
 #include "signals/gps_constants.hpp"
 
 namespace ultratrack::pipelines {
@@ -93,14 +94,14 @@ std::vector<SolutionFix> read_solution_csv(const std::filesystem::path& file) {
   read_named_columns(file, "solution file",
                      {"gps_week", "tow_s", "ecef_x_m", "ecef_y_m", "ecef_z_m", "vel_e_mps", "vel_n_mps", "vel_u_mps",
                       "clock_bias_m", "num_sats"},
-                     [&](int, const std::vector<double>& v) {
+                     [&](int line, const std::vector<double>& v) {
                        SolutionFix f;
-                       f.gps_week = static_cast<int>(v[0]);
+                       f.gps_week = io::whole_number_field(v[0], 0, io::kMaxGpsWeek, file.string(), line, "gps_week");
                        f.tow_s = v[1];
                        f.r_e_m = {v[2], v[3], v[4]};
                        f.v_enu_mps = {v[5], v[6], v[7]};
                        f.clock_bias_m = v[8];
-                       f.num_sats = static_cast<int>(v[9]);
+                       f.num_sats = io::whole_number_field(v[9], 0, 999, file.string(), line, "num_sats");
                        out.push_back(f);
                      });
   return out;
@@ -113,7 +114,7 @@ std::vector<TruthPoint> read_simulation_truth_csv(const std::filesystem::path& f
       {"gps_week", "tow_s", "ecef_x_m", "ecef_y_m", "ecef_z_m", "vel_n_mps", "vel_e_mps", "vel_d_mps"},
       [&](int line, const std::vector<double>& v) {
         TruthPoint p;
-        p.gps_week = static_cast<int>(v[0]);
+        p.gps_week = io::whole_number_field(v[0], 0, io::kMaxGpsWeek, file.string(), line, "gps_week");
         p.tow_s = v[1];
         p.r_e_m = {v[2], v[3], v[4]};
         p.v_ned_mps = {v[5], v[6], v[7]};

@@ -11,6 +11,7 @@
 #include <functional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "ins/imu_csv.hpp"
@@ -144,6 +145,30 @@ TEST(CsvFaults, GpsTimeBackwardsInPpsAndAttitudeWeekNamesFileAndLine) {
     const fs::path file = write(dir, c.name + "_week_backwards.csv", c, rows);
     SCOPED_TRACE(c.name);
     ultratrack::test::expect_error_at([&] { c.read(file); }, file, 4, "");
+  }
+}
+
+// A GPS week or a count too large for an int (a corrupt line; found by fuzz_csv_inputs, whose input is kept in
+// tests/fuzz/regressions/): an error naming the column, not a cast of a double outside int's range.
+TEST(CsvFaults, GpsWeekOrCountBeyondAnIntNamesTheColumn) {
+  const fs::path dir = ultratrack::test::scratch_dir();
+  for (const auto& c : cases()) {
+    if (c.name != "pps" && c.name != "attitude") continue;
+    for (const auto& [column, value, what] :
+         {std::tuple<std::size_t, std::string, std::string>{0, "2.1925e11", "gps_week"},
+          {0, "10000", "gps_week"},
+          {0, "2190.5", "gps_week"},
+          {8, "1e300", "num_sats"}}) {
+      if (c.name == "pps" && what == "num_sats") continue;
+      auto rows = c.rows;
+      auto f = split(rows[2]);
+      const std::size_t index = c.name == "pps" && what == "gps_week" ? 1 : column;
+      f[index] = value;
+      rows[2] = join(f);
+      const fs::path file = write(dir, c.name + "_" + what + "_" + value + ".csv", c, rows);
+      SCOPED_TRACE(c.name + " " + what + " = " + value);
+      ultratrack::test::expect_error_at([&] { c.read(file); }, file, 4, what + " must be a whole number in [0, ");
+    }
   }
 }
 
