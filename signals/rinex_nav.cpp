@@ -236,7 +236,17 @@ Ephemeris parse_gps_record(LineReader& r, const std::string& epoch_line, int maj
                          record_start, k + 1));
     for (int j = 0; j < 4; ++j) v[k][j] = r.number(line, orbit0 + 19 * j, 19, "orbit parameter");
   }
-  e.iode = static_cast<int>(std::lround(v[0][0]));
+  const auto bad = [&](const std::string& what) {
+    throw InputError(r.name(), fmt::format("record for G{:02d} (line {}): {}", e.prn, record_start, what),
+                     record_start);
+  };
+  // An integer field, range-checked as the number it was written as: rounding a value beyond int first would wrap
+  // it (a week of 2^32 + 2190 would read as 2190).
+  const auto whole = [&](double x, int lo, int hi, const char* what) {
+    if (!(x >= lo - 0.5 && x < hi + 0.5)) bad(fmt::format("{} {} out of range", what, x));
+    return static_cast<int>(std::lround(x));
+  };
+  e.iode = whole(v[0][0], 0, 255, "IODE");
   e.crs_m = v[0][1];
   e.delta_n_radps = v[0][2];
   e.m0_rad = v[0][3];
@@ -253,29 +263,21 @@ Ephemeris parse_gps_record(LineReader& r, const std::string& epoch_line, int maj
   e.omega_rad = v[3][2];
   e.omega_dot_radps = v[3][3];
   e.idot_radps = v[4][0];
-  e.code_on_l2 = static_cast<int>(std::lround(v[4][1]));
-  e.week = static_cast<int>(std::lround(v[4][2]));
-  e.l2p_data_flag = static_cast<int>(std::lround(v[4][3]));
+  e.code_on_l2 = whole(v[4][1], 0, 3, "codes on L2");
+  e.week = whole(v[4][2], 0, 9999, "GPS week");
+  e.l2p_data_flag = whole(v[4][3], 0, 1, "L2 P data flag");
   e.ura_index = ura_index_from_metres(v[5][0]);
-  e.health = static_cast<int>(std::lround(v[5][1]));
+  e.health = whole(v[5][1], 0, 63, "SV health");
   e.tgd_s = v[5][2];
-  e.iodc = static_cast<int>(std::lround(v[5][3]));
+  e.iodc = whole(v[5][3], 0, 1023, "IODC");
   transmit_tow = v[6][0];
   const double fit_hours = v[6][1];
   e.fit_interval_flag = fit_hours > 4.0 + 1e-6 ? 1 : 0;
 
-  const auto bad = [&](const std::string& what) {
-    throw InputError(r.name(), fmt::format("record for G{:02d} (line {}): {}", e.prn, record_start, what),
-                     record_start);
-  };
   if (!(e.sqrt_a_sqrtm > 1000.0 && e.sqrt_a_sqrtm < 10000.0))
     bad(fmt::format("sqrt(A) = {} m^0.5 is not a GPS orbit", e.sqrt_a_sqrtm));
   if (!(e.e >= 0.0 && e.e < 0.1)) bad(fmt::format("eccentricity {} out of range", e.e));
   if (!(e.toe_s >= 0.0 && e.toe_s < kSecondsPerWeek)) bad(fmt::format("toe {} s out of range", e.toe_s));
-  if (e.week < 0 || e.week > 9999) bad(fmt::format("GPS week {} out of range", e.week));
-  if (e.iode < 0 || e.iode > 255) bad(fmt::format("IODE {} out of range", e.iode));
-  if (e.iodc < 0 || e.iodc > 1023) bad(fmt::format("IODC {} out of range", e.iodc));
-  if (e.health < 0 || e.health > 63) bad(fmt::format("SV health {} out of range", e.health));
 
   // toc: seconds of the ephemeris week (the broadcast toc and toe share a week; a toc in the neighbouring
   // week is expressed relative to the toe week so that Ephemeris::toc() is the same instant).

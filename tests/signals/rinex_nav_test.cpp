@@ -360,6 +360,17 @@ TEST(RinexNav, MalformedInputNamesFileLineAndProblem) {
   expect_error_at(
       replace_line(kMixed304, 25, "     1.587718725204E-06 5.822420492768E-03 9.916350245476E-06 0.000000000000E+00"),
       23, "sqrt(A)");
+  // A week of 2^32 + 2190: range-checked as written, not wrapped to 2190 by the conversion to int.
+  expect_error_at(
+      replace_line(kMixed304, 28, "    -6.153827668773E-10 1.000000000000E+00 4.294969486000E+09 0.000000000000E+00"),
+      23, "GPS week 4294969486 out of range");
+  // A NaN-free but absurd IODC, and a health word beyond its 6 bits.
+  expect_error_at(
+      replace_line(kMixed304, 29, "     2.000000000000E+00 0.000000000000E+00-1.024454832077E-08 1.000000000000E+30"),
+      23, "IODC 1e+30 out of range");
+  expect_error_at(
+      replace_line(kMixed304, 29, "     2.000000000000E+00 6.400000000000E+01-1.024454832077E-08 5.400000000000E+01"),
+      23, "SV health 64 out of range");
 }
 
 TEST(RinexNav, MissingFileThrowsInputErrorNamingIt) {
