@@ -7,8 +7,8 @@
 #   tools/run.sh lint   the same build, then tools/lint.sh on the whole tree (clang-format, SPDX lines, clang-tidy)
 #   tools/run.sh sanitize  the test suite built with AddressSanitizer + UndefinedBehaviorSanitizer (build-sanitize,
 #                       RelWithDebInfo, no benchmarks or Python module) and run through ctest: any report fails a test
-#   tools/run.sh fuzz [SECONDS]  the libFuzzer targets (clang, build-fuzz), each run SECONDS (default 600) from the
-#                       committed corpora by tests/fuzz/run.sh; exit 1 on any finding
+#   tools/run.sh fuzz [SECONDS [TARGET...]]  the libFuzzer targets (clang, build-fuzz), each (or those named) run
+#                       SECONDS (default 600) from the committed corpora by tests/fuzz/run.sh; exit 1 on any finding
 # Idempotent: a second run installs nothing and rebuilds only what changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -74,8 +74,8 @@ case "${1:-build}" in
   demo) shift; exec "$build_dir/tools/ultratrack" demo "$@" ;;
   test|sanitize) status=0; ctest --test-dir "$build_dir" --output-on-failure -j"$jobs" || status=$?
         phase_done "ctest"; exit "$status" ;;
-  fuzz) ULTRATRACK_FUZZ_BUILD=$build_dir exec tests/fuzz/run.sh "${2:-600}" ;;
+  fuzz) ULTRATRACK_FUZZ_BUILD=$build_dir exec tests/fuzz/run.sh "${2:-600}" "${@:3}" ;;
   lint) exec tools/lint.sh --build "$build_dir" --jobs "$jobs" ;;
   build) ;;
-  *) echo "usage: tools/run.sh demo|test|build|lint|sanitize|fuzz [SECONDS]" >&2; exit 2 ;;
+  *) echo "usage: tools/run.sh demo|test|build|lint|sanitize|fuzz [SECONDS [TARGET...]]" >&2; exit 2 ;;
 esac
