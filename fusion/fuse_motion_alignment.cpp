@@ -125,20 +125,13 @@ std::optional<MotionAlignment> align_in_motion(std::span<const ins::ImuIncrement
     };
     // A bias b in the IMU: the increments measured are the true ones plus b dt, so the truth is the levelling of
     // the increments minus b dt and psi(b) = psi(level(measured), level(measured - b dt)).
-    r.psi_per_accel_bias = -psi_per(
-        [&](int axis, double d) {
-          WindowBias bias;
-          bias.accel_b[axis] = d;
-          return level_window(rows_used, a, b, bias);
-        },
-        1e-3);
-    r.psi_per_gyro_bias = -psi_per(
-        [&](int axis, double d) {
-          WindowBias bias;
-          bias.gyro_b[axis] = d;
-          return level_window(rows_used, a, b, bias);
-        },
-        1e-4);
+    const auto with_bias = [&](bool gyro, int axis, double d) {
+      WindowBias bias;
+      (gyro ? bias.gyro_b : bias.accel_b)[axis] = d;
+      return level_window(rows_used, a, b, bias);
+    };
+    r.psi_per_accel_bias = -psi_per([&](int axis, double d) { return with_bias(false, axis, d); }, 1e-3);
+    r.psi_per_gyro_bias = -psi_per([&](int axis, double d) { return with_bias(true, axis, d); }, 1e-4);
     // A GNSS velocity error e: the velocities used are the true ones plus e, the truth the levelling with them minus
     // e, so psi(e) = psi(level(used), level(used - e)): the opposite sign of the bias case.
     const auto with_velocity_error = [&](bool end, int axis, double d) {
