@@ -7,25 +7,28 @@
 #   benchmarks/mems_fusion.sh [--build DIR] [--seeds "1 2 3 4 5"] [--out DIR] [--fixes vel|pos] [--filter ekf|ukf]
 #       [--scenario S.toml (default scenarios/mems_drive_adis16405.toml)] [--fuse-config C.toml (default
 #       scenarios/mems_datasheet_fuse.toml)] [--from-s 60]
-#       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--correlation S] [--interval S] [--told-correlation S]
-#       [--told-sigma "N E D"] [--outage "START DURATION"] [--clean]
-# --correlation: the fixes' errors first-order Gauss-Markov with that time (gnsssim); --interval: the filter's
-# decorrelating interval between fixes used ([gnss] update_interval_s); --told-correlation: the correlation
-# time the filter is told ([gnss] error_correlation_time_s); --told-sigma: with it, the Gauss-Markov 1-sigma the
-# filter carries as fix-error states ([gnss] error_sigma_ned_m; without: the fixes' variance is inflated).
+#       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--velocity-sigma 0.05] [--correlation S] [--interval S]
+#       [--told-correlation S] [--told-sigma "N E D"] [--outage "START DURATION"] [--clean]
+# --velocity-sigma: the fixes' white velocity noise per axis (gnsssim), told to the filter as [gnss]
+# velocity_sigma_mps (the fix file carries the position sigmas only). --correlation: the fixes' errors first-order
+# Gauss-Markov with that time (gnsssim); --interval: the filter's decorrelating interval between fixes used ([gnss]
+# update_interval_s); --told-correlation: the correlation time the filter is told ([gnss] error_correlation_time_s);
+# --told-sigma: with it, the Gauss-Markov 1-sigma the filter carries as fix-error states ([gnss] error_sigma_ned_m;
+# without: the fixes' variance is inflated).
 # --outage: no fixes in [START, START + DURATION) (fuse --outage); the errors are then reported before the outage
 # (before_*) and from 30 s after its end (after_*) besides the whole run. --clean: delete each run's imu.csv once
 # fused (Monte Carlos of many seeds).
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="$here/build"; seeds="1 2 3 4 5"; out="${TMPDIR:-/tmp}/mems_fusion"; fixes=vel; filter=ekf; nhc=on
-sigma="0.5 0.5 1.0"; correlation=0; interval=0; told=0; told_sigma=""; outage=""; clean=0
+sigma="0.5 0.5 1.0"; velocity_sigma=0.05; correlation=0; interval=0; told=0; told_sigma=""; outage=""; clean=0
 scenario="$here/scenarios/mems_drive_adis16405.toml"; fuse_config="$here/scenarios/mems_datasheet_fuse.toml"; from_s=60
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build="$2"; shift 2 ;; --seeds) seeds="$2"; shift 2 ;; --out) out="$2"; shift 2 ;;
     --fixes) fixes="$2"; shift 2 ;; --filter) filter="$2"; shift 2 ;; --nhc) nhc="$2"; shift 2 ;;
-    --sigma) sigma="$2"; shift 2 ;; --correlation) correlation="$2"; shift 2 ;; --interval) interval="$2"; shift 2 ;;
+    --sigma) sigma="$2"; shift 2 ;; --velocity-sigma) velocity_sigma="$2"; shift 2 ;;
+    --correlation) correlation="$2"; shift 2 ;; --interval) interval="$2"; shift 2 ;;
     --told-correlation) told="$2"; shift 2 ;; --told-sigma) told_sigma="$2"; shift 2 ;;
     --outage) outage="$2"; shift 2 ;; --clean) clean=1; shift ;;
     --scenario) scenario="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -44,21 +47,23 @@ if [ "$nhc" = on ]; then
   if grep -q '^\[vehicle\]' "$config"; then sed -i 's/^\[vehicle\]/[vehicle]\nnhc = true/' "$config"
   else printf '\n[vehicle]\nnhc = true\n' >> "$config"; fi
 fi
-printf '\n[gnss]\nupdate_interval_s = %s\nerror_correlation_time_s = %s\n' "$interval" "$told" >> "$config"
+printf '\n[gnss]\nupdate_interval_s = %s\nerror_correlation_time_s = %s\nvelocity_sigma_mps = %s\n' "$interval" "$told" \
+    "$velocity_sigma" >> "$config"
 if [ -n "$told_sigma" ]; then
   # shellcheck disable=SC2086
   printf 'error_sigma_ned_m = [%s]\n' "$(echo $told_sigma | tr ' ' ',')" >> "$config"
 fi
 outage_flag=""; [ -n "$outage" ] && outage_flag="--outage $outage"
 velocity_flag=""; [ "$fixes" = pos ] && velocity_flag="--no-velocity"
-echo "fixes $fixes ($sigma m, correlation ${correlation} s, used every ${interval} s, filter told ${told} s${told_sigma:+ as states of $told_sigma m}), filter $filter, nhc $nhc${outage:+, outage $outage}"
+echo "fixes $fixes ($sigma m, velocity $velocity_sigma m/s, correlation ${correlation} s, used every ${interval} s," \
+    "filter told ${told} s${told_sigma:+ as states of $told_sigma m}), filter $filter, nhc $nhc${outage:+, outage $outage}"
 for seed in $seeds; do
   run="$out/seed$seed"
   sed "s/^seed = .*/seed = $seed/" "$scenario" > "$out/scenario_$seed.toml"
   "$U" simulate --scenario "$out/scenario_$seed.toml" --out "$run/sim" --quiet >/dev/null
   # shellcheck disable=SC2086
-  "$U" gnsssim --truth "$run/sim/truth.csv" --rate 5 --first 0.137 --sigma $sigma --correlation "$correlation" \
-      $velocity_flag --seed "$seed" --out "$run/gnss.csv" >/dev/null
+  "$U" gnsssim --truth "$run/sim/truth.csv" --rate 5 --first 0.137 --sigma $sigma --velocity-sigma "$velocity_sigma" \
+      --correlation "$correlation" $velocity_flag --seed "$seed" --out "$run/gnss.csv" >/dev/null
   # shellcheck disable=SC2086
   "$U" fuse --imu "$run/sim/imu.csv" --gnss "$run/gnss.csv" --config "$config" --filter "$filter" --align motion \
       $outage_flag --out "$run/fuse" --quiet >/dev/null

@@ -8,9 +8,11 @@ terms): position NED, velocity NED, attitude as the psi angles NED (C_nb_est = (
 over the M runs at each time, a consistent filter's value is chi-square with 3M degrees of freedom over M; the
 two-sided 95 % band is [chi2(0.025, 3M) / M, chi2(0.975, 3M) / M]. Prints one JSON object: per block the NEES
 averaged over runs and times, the band, the share of times whose run average lies inside the band, and each axis's
-mean squared normalised error (1 when consistent).
+mean squared normalised error (1 when consistent). With --window-s W, also "windows": per window [t, t + W) of the
+common times, each axis's mean squared normalised error, RMS error and RMS 1-sigma (which side is off, and when;
+position m, velocity m/s, attitude deg), and each axis's mean normalised error (a bias shared by the runs).
 
-    benchmarks/nav_nees.py --from-s 60 NAV1.csv TRUTH1.csv [NAV2.csv TRUTH2.csv ...]
+    benchmarks/nav_nees.py [--from-s 60] [--window-s 20] NAV1.csv TRUTH1.csv [NAV2.csv TRUTH2.csv ...]
 """
 import argparse
 import json
@@ -60,7 +62,33 @@ def run_nees(nav_path, truth_path, from_s):
             sp = [r[f"sigma_{a}_m"] for a in "ned"]
             sv = [r[f"sigma_v{a}_mps"] for a in "ned"]
             sa = [math.radians(r[f"sigma_att_{a}_deg"]) for a in "ned"]
-            out[key] = [(e / s) ** 2 for err, sig in ((dp, sp), (dv, sv), (da, sa)) for e, s in zip(err, sig)]
+            out[key] = [(e, s) for err, sig in ((dp, sp), (dv, sv), (da, sa)) for e, s in zip(err, sig)]
+    return out
+
+
+AXES = [f"{b}_{a}" for b in ("pos", "vel", "att") for a in "ned"]
+
+
+def windows(runs, common, width):
+    """Per window of the common times: each axis's NEES, RMS error, RMS sigma and mean normalised error."""
+    times = sorted(common)
+    out = []
+    start = times[0]
+    while start <= times[-1]:
+        ts = [t for t in times if start <= t < start + round(width * 1e6)]
+        start += round(width * 1e6)
+        if not ts:
+            continue
+        n = len(ts) * len(runs)
+        w = {"from_s": round(ts[0] * 1e-6, 3), "to_s": round(ts[-1] * 1e-6, 3)}
+        for i, name in enumerate(AXES):
+            scale = math.degrees(1.0) if name.startswith("att") else 1.0
+            es = [r[t][i] for r in runs for t in ts]
+            w[name] = {"nees": round(sum((e / s) ** 2 for e, s in es) / n, 3),
+                       "rms_error": round(scale * math.sqrt(sum(e * e for e, _ in es) / n), 4),
+                       "rms_sigma": round(scale * math.sqrt(sum(s * s for _, s in es) / n), 4),
+                       "mean_normalised": round(sum(e / s for e, s in es) / n, 3)}
+        out.append(w)
     return out
 
 
@@ -91,11 +119,14 @@ def chi2_quantile(p, k):
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--from-s", type=float, default=60.0)
+    p.add_argument("--window-s", type=float, default=0.0)
     p.add_argument("files", nargs="+")
     a = p.parse_args()
     if len(a.files) % 2:
         sys.exit("nav_nees: give NAV.csv TRUTH.csv pairs")
     runs = [run_nees(a.files[i], a.files[i + 1], a.from_s) for i in range(0, len(a.files), 2)]
+    errors = runs
+    runs = [{t: [(e / s) ** 2 for e, s in v] for t, v in r.items()} for r in errors]
     common = set(runs[0])
     for r in runs[1:]:
         common &= set(r)
@@ -112,6 +143,8 @@ def main():
         axes = [round(sum(r[t][3 * b + i] for r in runs for t in common) / (m * len(common)), 3) for i in range(3)]
         result[name] = {"mean_nees": round(mean, 3), "in_band": lo <= mean <= hi, "times_inside_band": round(inside, 3),
                         "per_axis_ned": axes}
+    if a.window_s > 0.0:
+        result["windows"] = windows(errors, common, a.window_s)
     print(json.dumps(result))
 
 

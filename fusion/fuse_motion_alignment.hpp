@@ -27,12 +27,19 @@ struct MotionAlignmentOptions {
 };
 
 struct MotionAlignment {
-  double t_s = 0.0;  // end of the window: the attitude and velocity hold here
+  double t_s = 0.0;        // end of the window: the attitude and velocity hold here
+  double t_start_s = 0.0;  // start of the window (the first GNSS velocity's time)
   ins::EulerAngles euler;
   Eigen::Quaterniond q_nb = Eigen::Quaterniond::Identity();
   Eigen::Vector3d v_n = Eigen::Vector3d::Zero();
   Eigen::Vector3d mean_f_b = Eigen::Vector3d::Zero();  // measured over the window [m/s^2]
   Eigen::Vector3d f_n = Eigen::Vector3d::Zero();       // the same specific force from GNSS [m/s^2]
+  // First-order sensitivities of the attitude error psi (NED, rad; C_nb_est = (I - [psi x]) C_nb_true) to an
+  // accelerometer bias [rad per m/s^2] and a gyro bias [rad per rad/s] (body axes, constant over the window), and
+  // to an error of the GNSS velocity at the window's start and at its end [rad per m/s, NED]: central
+  // differences of the same levelling.
+  Eigen::Matrix3d psi_per_accel_bias = Eigen::Matrix3d::Zero(), psi_per_gyro_bias = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d psi_per_velocity_start = Eigen::Matrix3d::Zero(), psi_per_velocity_end = Eigen::Matrix3d::Zero();
 };
 
 // Roll and pitch such that C_nb(roll, pitch, heading) f_b = f_n, for a known heading; of the two solutions

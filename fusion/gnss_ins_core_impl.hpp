@@ -471,6 +471,7 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
     P0.template block<3, 3>(ix::kAccelBias, ix::kAccelBias) = o.sigma_initial_accel_bias_b->cwiseAbs2().asDiagonal();
   if (o.sigma_initial_gyro_bias_b)
     P0.template block<3, 3>(ix::kGyroBias, ix::kGyroBias) = o.sigma_initial_gyro_bias_b->cwiseAbs2().asDiagonal();
+  if (!o.attitude_per_bias.isZero()) correlate_attitude_with_biases<N>(P0, o.attitude_per_bias);
   const StateVector<N> x0 = StateVector<N>::Zero();
   if (o.filter == FilterKind::Ekf)
     return std::make_unique<Core<L, Ekf<N>>>(initial, oo, Ekf<N>(x0, P0, EkfOptions{o.discretisation, o.gate}));

@@ -26,6 +26,7 @@ bool IntegrationOptions::IsValid(std::string* why) const {
       (o.sigma_initial_gyro_bias_b && !positive(*o.sigma_initial_gyro_bias_b)) || !o.initial_accel_bias_b.allFinite() ||
       !o.initial_gyro_bias_b.allFinite())
     return fail("integration: initial biases must be finite, their sigmas positive");
+  if (!o.attitude_per_bias.allFinite()) return fail("integration: the attitude's bias sensitivity must be finite");
   if (!(o.propagation_interval_s >= 0.0)) return fail("integration: negative propagation interval");
   if (!(o.gate.probability > 0.0 && o.gate.probability < 1.0))
     return fail("integration: gate probability must lie in (0, 1)");

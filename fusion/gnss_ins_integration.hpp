@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "fusion/attitude_bias_correlation.hpp"
 #include "fusion/attitude_measurement.hpp"
 #include "fusion/coupling.hpp"
 #include "fusion/ekf.hpp"
@@ -63,6 +64,9 @@ struct IntegrationOptions {
   Eigen::Vector3d initial_accel_bias_b = Eigen::Vector3d::Zero();
   Eigen::Vector3d initial_gyro_bias_b = Eigen::Vector3d::Zero();
   std::optional<Eigen::Vector3d> sigma_initial_accel_bias_b, sigma_initial_gyro_bias_b;
+  // An alignment's attitude error per unit of IMU bias (fusion/attitude_bias_correlation.hpp): sigma_att_rad is
+  // then the part independent of the biases, and the initial covariance correlates attitude and biases. Zero: none.
+  AttitudePerBias attitude_per_bias = AttitudePerBias::Zero();
   GateOptions gate;
   // No gate lock-out: a run of rejected fixes (loose) or of epochs with every satellite rejected (tight), or a
   // windowed NIS far above its band, re-opens the covariance of position, velocity, attitude (and clock) and

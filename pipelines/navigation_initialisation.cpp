@@ -77,8 +77,17 @@ std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu
   s.q_nb = a->q_nb;
   s.v_n = a->v_n;
   s.sigma_vel_n_mps = Eigen::Vector3d::Constant(position_only ? 1.0 : config.velocity_sigma_mps * 2.0);
-  s.sigma_att_rad = position_only ? Eigen::Vector3d(3.0 * io::kRadPerDeg, 3.0 * io::kRadPerDeg, 5.0 * io::kRadPerDeg)
-                                  : Eigen::Vector3d(1.0 * io::kRadPerDeg, 1.0 * io::kRadPerDeg, 3.0 * io::kRadPerDeg);
+  s.attitude_per_bias << a->psi_per_accel_bias, a->psi_per_gyro_bias;
+  if (position_only) {
+    s.sigma_att_rad = Eigen::Vector3d(3.0, 3.0, 5.0) * io::kRadPerDeg;
+  } else {  // white velocity noise at both ends of the window, independent of the biases
+    const double v2 = config.velocity_sigma_mps * config.velocity_sigma_mps;
+    const Eigen::Matrix3d P_e = v2 * (a->psi_per_velocity_start * a->psi_per_velocity_start.transpose() +
+                                      a->psi_per_velocity_end * a->psi_per_velocity_end.transpose());
+    s.sigma_att_rad = P_e.diagonal().cwiseSqrt();
+    // A levelling that failed when perturbed (sensitivities zero; geometry at its limit): the former margins.
+    if (!(s.sigma_att_rad.minCoeff() > 0.0)) s.sigma_att_rad = Eigen::Vector3d(1.0, 1.0, 3.0) * io::kRadPerDeg;
+  }
   s.note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
   return s;
 }
@@ -102,6 +111,7 @@ NavigationStart initialise_navigation(const AttitudeStart& a, const GnssPosition
   s.nav.v_n = a.v_n;
   s.sigma_vel_n_mps = a.sigma_vel_n_mps;
   s.sigma_att_rad = a.sigma_att_rad;
+  s.attitude_per_bias = a.attitude_per_bias;
   if (c.position_deg_m) {
     s.nav.lat_rad = c.position_deg_m->x() * io::kRadPerDeg;
     s.nav.lon_rad = c.position_deg_m->y() * io::kRadPerDeg;
@@ -118,7 +128,10 @@ NavigationStart initialise_navigation(const AttitudeStart& a, const GnssPosition
   }
   if (c.sigma_position_m) s.sigma_pos_ned_m = *c.sigma_position_m;
   if (c.sigma_velocity_mps) s.sigma_vel_n_mps = *c.sigma_velocity_mps;
-  if (c.sigma_attitude_deg) s.sigma_att_rad = *c.sigma_attitude_deg * io::kRadPerDeg;
+  if (c.sigma_attitude_deg) {
+    s.sigma_att_rad = *c.sigma_attitude_deg * io::kRadPerDeg;
+    s.attitude_per_bias.setZero();
+  }
   return s;
 }
 
@@ -132,6 +145,7 @@ fusion::IntegrationOptions integration_options(const NavigationStart& start, con
   o.sigma_pos_ned_m = start.sigma_pos_ned_m;
   o.sigma_vel_n_mps = start.sigma_vel_n_mps;
   o.sigma_att_rad = start.sigma_att_rad;
+  o.attitude_per_bias = start.attitude_per_bias;
   if (c.initial_accel_bias_mps2) o.initial_accel_bias_b = *c.initial_accel_bias_mps2;
   if (c.initial_gyro_bias_rps) o.initial_gyro_bias_b = *c.initial_gyro_bias_rps;
   o.sigma_initial_accel_bias_b = c.sigma_accel_bias_mps2;

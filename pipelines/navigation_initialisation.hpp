@@ -39,6 +39,9 @@ struct AttitudeStart {
   Eigen::Vector3d sigma_att_rad = Eigen::Vector3d::Zero();
   std::string note;
   double heading_sigma_rad = 0.0;  // static: the gyrocompassing's heading 1-sigma (before the margin)
+  // Motion: the attitude error per unit of IMU bias (fusion/attitude_bias_correlation.hpp); sigma_att_rad is then
+  // the part independent of the biases. Zero for the other alignments.
+  fusion::AttitudePerBias attitude_per_bias = fusion::AttitudePerBias::Zero();
 };
 
 // Static: the number of IMU rows in the span [t0_s, t0_s + config.static_duration_s] (rows past it must exist);
@@ -48,9 +51,12 @@ std::size_t static_span_end(std::span<const ins::ImuIncrement> imu, double t0_s,
 // Static over span (static_span_end's rows) from t0_s at lat_rad; velocity zero, 1-sigma 0.1 m/s.
 AttitudeStart align_static(std::span<const ins::ImuIncrement> span, double t0_s, double lat_rad,
                            const ins::ImuErrorSpec& preset);
-// Motion over the GNSS velocities (window_s: the velocity difference span). position_only: velocities from
-// positions, looser sigmas (velocity 1 m/s, attitude 3, 3, 5 deg) than from measured ones (2 x the fixes' velocity
-// sigma, 1, 1, 3 deg). Nothing when the GNSS never shows config.motion_min_speed_mps over the window.
+// Motion over the GNSS velocities (window_s: the velocity difference span). The attitude's error from the IMU
+// biases goes into attitude_per_bias (the filter correlates it with its bias states); sigma_att_rad holds the rest:
+// from measured velocities, the first-order effect of their white noise (config.velocity_sigma_mps at both ends of
+// the window: tilt about sqrt(2) sigma_v / (T g), heading sigma_v / speed), velocity 2 x that sigma; position_only
+// (velocities from positions, correlated between the window's ends): attitude 3, 3, 5 deg, velocity 1 m/s. Nothing
+// when the GNSS never shows config.motion_min_speed_mps over the window.
 std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu,
                                           std::span<const fusion::GnssVelocitySample> velocities,
                                           const FuseConfig& config, double window_s, bool position_only);
@@ -66,11 +72,13 @@ struct GnssPosition {
 struct NavigationStart {
   ins::NavState nav;  // at the IMU
   Eigen::Vector3d sigma_pos_ned_m, sigma_vel_n_mps, sigma_att_rad;
+  fusion::AttitudePerBias attitude_per_bias = fusion::AttitudePerBias::Zero();  // the alignment's (AttitudeStart)
 };
 
 // The INS start: the alignment's time, attitude and velocity; the position from config.position_deg_m (with
 // sigma_configured_position_m) or else from fix (which must then be given) moved by config.lever_arm_b (with
-// the fix's sigma); then config.sigma_position_m, sigma_velocity_mps and sigma_attitude_deg replace the sigmas.
+// the fix's sigma); then config.sigma_position_m, sigma_velocity_mps and sigma_attitude_deg replace the sigmas
+// (sigma_attitude_deg the whole attitude error: the alignment's bias sensitivity is then dropped).
 NavigationStart initialise_navigation(const AttitudeStart& alignment, const GnssPosition* fix, const FuseConfig& config,
                                       const Eigen::Vector3d& sigma_configured_position_m);
 
