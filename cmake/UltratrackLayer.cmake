@@ -60,6 +60,11 @@ function(ultratrack_layer name)
     target_include_directories(ultratrack_${name} PUBLIC ${include_dirs})
     target_compile_options(ultratrack_${name} PRIVATE -Wall -Wextra -Wpedantic)
     target_link_libraries(ultratrack_${name} PUBLIC ${ARG_DEPS} ${ARG_EXTERNAL})
+    if(ULTRATRACK_SANITIZE OR ULTRATRACK_FUZZ)
+      # Instrumented code needs the sanitizer runtime wherever it is linked: exported with the target, so that a
+      # program built against a sanitized install (examples/consumer in ctest install.consumer) links it too.
+      target_link_options(ultratrack_${name} INTERFACE -fsanitize=address,undefined)
+    endif()
     if(name STREQUAL "config")  # the only layer that reads TOML
       ultratrack_precompile(ultratrack_${name} config EIGEN FMT TOML)
     elseif(NOT name STREQUAL "io")  # io: five small files, nothing to gain
