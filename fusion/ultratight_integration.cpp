@@ -9,6 +9,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "fusion/carrier_rate_measurement.hpp"
 #include "fusion/ultratight_measurement_models.hpp"
 #include "ins/earth_model.hpp"
 #include "signals/gps_constants.hpp"
@@ -290,7 +291,68 @@ class UltraTightCore final : public UltraTightCoreBase {
       p.ch->end_phase_t_s = p.t_end;
     }
     if (common_var > 0.0) end_common_clock(P_prime, common_var, cov_xe);
+    carrier_rate_update(corr);
     fill_output();
+  }
+
+  // The period's carrier-phase rates (fusion/carrier_rate_measurement.hpp), after its I&Q updates: every usable
+  // satellite with a window ending now, in one update (their clock term is common). Each window's rate is carried
+  // from its middle to now along the nominal's predicted slope; a row whose innovation alone is beyond
+  // carrier_rate_screen_sigma is left out (a slipped or lost PLL), the rest face the filter's gate together.
+  void carrier_rate_update(const std::vector<ChannelCorrelation>& corr) {
+    std::vector<CarrierRateRow> rows;
+    double common_var = 0.0;
+    const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
+    const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
+                                  antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
+    const StateMatrix<17>& P = filter_.P();
+    for (const ReplicaCommand& command : replicas) {
+      if (command.aided_only) continue;
+      const ChannelCorrelation* c = nullptr;
+      const SatelliteObservable* s = nullptr;
+      for (const auto& x : corr)
+        if (x.prn == command.prn) c = &x;
+      for (const auto& x : now_)
+        if (x.prn == command.prn) s = &x;
+      if (!c || !s || !c->has_carrier_rate || !(c->cn0_dbhz >= opt_.coast_cn0_dbhz) ||
+          !(c->carrier_rate_window_s > 0.0))
+        continue;
+      const double t_u = nominal_.nav.t_s;
+      const double command_span = t_u - command.t_start_s;
+      const double slope = command_span > 0.0 ? (s->range_rate_mps - command.range_rate_mps) / command_span : 0.0;
+      CarrierRateRow row;
+      row.sat = *s;
+      row.rate_at_update_mps = c->carrier_rate_mps + slope * (t_u - c->carrier_rate_t_mid_s);
+      row.predicted_rate_mps = predicted_range_rate_mps(*s, r_ant, v_ant, nominal_.clock_drift_mps);
+      row.phase_noise_var_m2ps2 = c->carrier_rate_var_m2ps2 + opt_.carrier_rate_floor_mps * opt_.carrier_rate_floor_mps;
+      // The clock's random-walk FM between the window and now: its mean over the window against the drift now.
+      const double half = 0.5 * c->carrier_rate_window_s;
+      const double v = opt_.model.clock.drift_psd_m2_per_s3 *
+                       (std::max(0.0, t_u - c->carrier_rate_t_mid_s - half) + c->carrier_rate_window_s / 3.0);
+      const ReplicaErrors17 rep(nominal_, {*s}, opt_.lever_arm_b, imu_steps_.w_ib_b);
+      const Eigen::Matrix<double, 1, 17> J = rep.jacobian().row(1);
+      const double S = J * P * J.transpose() + row.phase_noise_var_m2ps2 + v;
+      const double y = row.predicted_rate_mps - row.rate_at_update_mps;
+      if (!(y * y <= opt_.carrier_rate_screen_sigma * opt_.carrier_rate_screen_sigma * S)) {
+        ++counters.rate_screened;
+        continue;
+      }
+      common_var = std::max(common_var, v);
+      rows.push_back(row);
+    }
+    if (rows.empty()) return;
+    ++counters.rate_updates;
+    counters.rate_rows += static_cast<long long>(rows.size());
+    period_dx_.setZero();
+    // update() counts into the I&Q counters: take the carrier-rate update out of them again.
+    const bool ok = update(CarrierRateMeasurement(nominal_, rows, opt_.lever_arm_b, imu_steps_.w_ib_b, common_var));
+    --counters.updates;
+    if (ok) {
+      --counters.accepted;
+      ++counters.rate_accepted;
+    } else {
+      --counters.rejected;
+    }
   }
 
   NominalState nominal() const override { return nominal_; }

@@ -57,6 +57,13 @@ struct UltraTightOptions {
   // triangle (the correlation-level simulator's truth).
   bool ca_code_correlation = false;
   double coast_cn0_dbhz = 14.0;  // below: no update, the channel coasts on the INS (on a ~1 s C/N0)
+  // A carrier-phase rate (ChannelCorrelation::has_carrier_rate) whose innovation alone lies beyond this many of its
+  // sigmas (a PLL that slipped or lets go) is left out of the period's carrier-rate update.
+  double carrier_rate_screen_sigma = 4.0;
+  // Added to each carrier-phase rate's phase-noise variance (as a 1-sigma, m/s): the PLL's phase lag moves within a
+  // window as its aiding error and the line-of-sight dynamics change (a 0.5 Hz aiding step moves a 10 Hz loop's
+  // phase by ~0.3 rad, 0.05 m/s over 0.2 s), which the thermal jitter leaves out.
+  double carrier_rate_floor_mps = 0.05;
   signals::GpsTime gps_time_origin;
   double initial_clock_bias_m = 0.0, initial_clock_drift_mps = 0.0;
   // IMU biases already estimated (e.g. by the tight filter the receiver hands over from); the filter's bias
@@ -108,6 +115,13 @@ struct ChannelCorrelation {
   // filter's rate-error profile after its update, with the measured phase's thermal variance (1 + 1 / A^2) / A^2
   // in place of start_phase_var_rad2. Otherwise (first epoch, a gap, false) start_phase_var_rad2 as above.
   bool continuous_carrier = false;
+  // The carrier-phase rate over a window ending at this epoch (fusion/carrier_rate_measurement.hpp): the channel's
+  // replica (its PLL closed, its NCO phase never jumped) ran through -range / lambda cycles over the window; its mean
+  // range rate (m/s), the window's middle (s, this time line) and length (s), and that rate's variance from the
+  // PLL's jitter at both ends (m^2/s^2). Used once per window, with the period's other windows in one update.
+  bool has_carrier_rate = false;
+  double carrier_rate_mps = 0.0, carrier_rate_t_mid_s = 0.0, carrier_rate_window_s = 0.0;
+  double carrier_rate_var_m2ps2 = 0.0;
 };
 
 // One satellite's update in the latest finish_period (for logs): the filter's innovation (Iq: I_E, I_P, I_L,
@@ -124,6 +138,9 @@ struct UltraTightCounters {
   long long updates = 0, accepted = 0, rejected = 0;
   long long coasting = 0;    // satellite-periods without a usable measurement
   long long aided_only = 0;  // satellite-periods below the measurement mask (commanded, not used)
+  // Carrier-phase rates (fusion/carrier_rate_measurement.hpp): updates (one per window, all satellites), their
+  // accepted ones, the rows used and the rows screened out (carrier_rate_screen_sigma).
+  long long rate_updates = 0, rate_accepted = 0, rate_rows = 0, rate_screened = 0;
 };
 
 class UltraTightIntegration {

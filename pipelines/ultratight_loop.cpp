@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fusion/carrier_rate_measurement.hpp"
 #include "fusion/clock_model.hpp"
 #include "fusion/ins_error_model.hpp"
 #include "fusion/lockout_recovery.hpp"
@@ -151,6 +152,7 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     // correlations are left out until it is back.
     if (runaway_check(in, t_start_s + half_s)) {
       ++runaway_left_out_;
+      channel(in.prn).rate_anchored = false;
       continue;
     }
     ++measurements_;
@@ -199,9 +201,41 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     c.replica_range_rate_mps = -kLambda_m * in.replica_carrier_frequency_hz;
     c.replica_t_start_s = t_start_s;
     c.replica_pseudorange_m = in.replica_pseudorange_mid_m + shift_m - c.replica_range_rate_mps * half_s;
+    carrier_rate(in, t_start_s + half_s, c.start_phase_var_rad2, st, c);
     out.push_back(c);
   }
   return out;
+}
+
+// The channel's carrier-phase rate window (UltraTightLoopOptions::carrier_rate_window_s): continued by an epoch
+// 20 ms after the previous one (the NCO's phase runs on: no jump in ultra-tight), else started afresh here. On the
+// vector epochs that close a window (every window / period), a window of at least half its length is handed to the
+// filter (ChannelCorrelation::has_carrier_rate) and the next starts where it ended.
+void UltraTightLoop::carrier_rate(const receiver::VectorChannelInput& in, double t_mid_s, double phase_var_rad2,
+                                  ChannelState& st, fusion::ChannelCorrelation& c) const {
+  if (!(ut_.carrier_rate_window_s > 0.0)) return;
+  const double phase = in.replica_carrier_phase_mid_cycles;
+  const bool contiguous =
+      st.rate_anchored && !in.coasting && std::abs(t_mid_s - st.rate_last_t_s - ut_.period_s) < 1e-4;
+  st.rate_last_t_s = t_mid_s;
+  if (!contiguous) {
+    st.rate_anchored = !in.coasting;
+    st.rate_t0_s = t_mid_s;
+    st.rate_phase0_cycles = phase;
+    st.rate_var0_rad2 = phase_var_rad2;
+    return;
+  }
+  const long long every = std::max(1LL, std::llround(ut_.carrier_rate_window_s / ut_.period_s));
+  const double window_s = t_mid_s - st.rate_t0_s;
+  if (vector_epochs_ % every != 0 || window_s < 0.5 * ut_.carrier_rate_window_s) return;
+  c.has_carrier_rate = true;
+  c.carrier_rate_mps = -kLambda_m * (phase - st.rate_phase0_cycles) / window_s;
+  c.carrier_rate_t_mid_s = 0.5 * (t_mid_s + st.rate_t0_s);
+  c.carrier_rate_window_s = window_s;
+  c.carrier_rate_var_m2ps2 = fusion::carrier_rate_phase_variance(st.rate_var0_rad2, phase_var_rad2, window_s);
+  st.rate_t0_s = t_mid_s;
+  st.rate_phase0_cycles = phase;
+  st.rate_var0_rad2 = phase_var_rad2;
 }
 
 // The filter's predicted Doppler of a satellite at IMU time t_s: linear through the starts of the open period's
@@ -523,6 +557,9 @@ std::string UltraTightLoop::summary_json() const {
       handover_t_s_, handover_sample_, o.nav.t_s, channels, vector_epochs_, channel_epochs_, coasting_channel_epochs_,
       relocks_, releases_, measurements_, known_bits_, not_wiped_, k.periods, k.updates, k.accepted, k.rejected,
       k.coasting, k.aided_only, runaway_recentres_, runaway_left_out_, runaway_releases_);
+  j += fmt::format(
+      ", \"carrier_rate\": {{\"window_s\": {:g}, \"updates\": {}, \"accepted\": {}, \"rows\": {}, \"screened\": {}}}",
+      ut_.carrier_rate_window_s, k.rate_updates, k.rate_accepted, k.rate_rows, k.rate_screened);
   j += fmt::format(", \"nis_window\": {}, \"nis_probability\": {:g}, \"filter_reopens\": {}, {}", ut_.nis.window,
                    ut_.nis.probability, filter_reopens_, release_log_.json_members());
   j += fmt::format(
@@ -543,11 +580,13 @@ std::string UltraTightLoop::report() const {
       "receive: ultra-tight {} ({}) from {:.3f} s: {} channels handed over, {} channel-epochs "
       "commanded ({} coasting), {} re-locks, {} releases; updates accepted {}, rejected {}; "
       "satellite-periods aided only (below the measurement mask) {}; carrier runaways re-centred {}, released {}; "
-      "released by their NIS {}, filter re-opened {}",
+      "released by their NIS {}, filter re-opened {}; carrier-phase rate updates accepted {} of {} ({} rows, {} "
+      "screened out)",
       fusion_.options().filter == fusion::FilterKind::Ekf ? "EKF" : "UKF",
       fusion_.options().ut_form == fusion::UltraTightForm::Iq ? "I&Q" : "discriminators", handover_t_s_, channels,
       channel_epochs_, coasting_channel_epochs_, relocks_, releases_, k.accepted, k.rejected, k.aided_only,
-      runaway_recentres_, runaway_releases_, release_log_.count("channel_nis"), filter_reopens_);
+      runaway_recentres_, runaway_releases_, release_log_.count("channel_nis"), filter_reopens_, k.rate_accepted,
+      k.rate_updates, k.rate_rows, k.rate_screened);
 }
 
 }  // namespace ultratrack::pipelines

@@ -72,6 +72,10 @@ struct UltraTightLoopOptions {
   double nis_settle_s = 1.0;
   double reopen_position_sigma_m = 15.0;
   double reopen_velocity_sigma_mps = 1.0;
+  // Carrier-phase rates (fusion/carrier_rate_measurement.hpp): every this many seconds each contiguously tracked
+  // channel's replica phase change over the window since its previous one updates the filter's range rates (and so
+  // the common clock drift, which a TCXO moves by ~1 Hz / sqrt(s): docs/validation.md). 0: off.
+  double carrier_rate_window_s = 0.2;
 };
 
 class UltraTightLoop final : public receiver::VectorLoop {
@@ -112,6 +116,10 @@ class UltraTightLoop final : public receiver::VectorLoop {
     bool nis_released = false;      // released by its windowed NIS: scalar and out of the filter until then too
     std::string nis_detail;         // the release's reason
     double last_offset_hz = NAN;    // the latest epoch's replica minus predicted Doppler (ultratight.csv)
+    // The carrier-phase rate window (ChannelCorrelation::has_carrier_rate): its start (IMU time of an epoch's middle,
+    // the replica's phase there, that phase's jitter variance) and the latest epoch that continued it.
+    bool rate_anchored = false;
+    double rate_t0_s = 0.0, rate_phase0_cycles = 0.0, rate_var0_rad2 = 0.0, rate_last_t_s = 0.0;
   };
   ChannelState& channel(int prn);  // made on first use
   void start(const receiver::VectorEpochInput& epoch, double t_k);
@@ -122,6 +130,8 @@ class UltraTightLoop final : public receiver::VectorLoop {
   std::map<int, double> propagated_doppler_change();
   double predicted_doppler_at(int prn, double t_s) const;
   bool runaway_check(const receiver::VectorChannelInput& in, double t_mid_s);
+  void carrier_rate(const receiver::VectorChannelInput& in, double t_mid_s, double phase_var_rad2, ChannelState& st,
+                    fusion::ChannelCorrelation& c) const;
   void command(const receiver::VectorEpochInput& epoch, double t_k, std::span<receiver::VectorChannelCommand> out,
                const std::map<int, double>& aid_change);
   // The windowed NIS tests after a period's updates (t_s: receiver time for the log).
