@@ -13,9 +13,11 @@
 #include "config/fuse_config_toml.hpp"
 #include "config/receive_config_toml.hpp"
 #include "config/scenario_toml.hpp"
+#include "fusion/vector_tracking.hpp"
 #include "ins/imu_error_model.hpp"
 #include "io/input_error.hpp"
 #include "io/units.hpp"
+#include "receiver/nav_bit_source.hpp"
 #include "signals/rinex_nav.hpp"
 
 namespace ultratrack::config {
@@ -376,6 +378,8 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
     r.coupling = table.text("coupling", r.coupling);
     r.filter = table.text("filter", r.filter);
     r.align = table.text("align", r.align);
+    r.nav_bits = table.text("nav_bits", r.nav_bits);
+    r.vector_carrier = table.text("vector_carrier", r.vector_carrier);
     r.threads = table.integer("threads", r.threads, 0);
     const std::string prns = table.text("prns", "simulated");
     if (prns != "simulated" && prns != "all") table.fail(*t->get("prns"), "prns", "must be \"simulated\" or \"all\"");
@@ -403,6 +407,11 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
         times.push_back(*v);
       }
       c.metrics.nav_z_times_s = times;
+    }
+    if (const toml::node* n = table.get("weak_part_from_s")) {
+      const auto v = n->value<double>();
+      if (!v || !(*v >= 0.0)) table.fail(*n, "weak_part_from_s", "must be a time >= 0 (s)");
+      c.metrics.weak_part_from_s = *v;
     }
     c.remove_after = table.texts("remove");
     for (const std::string& r : c.remove_after)
@@ -448,7 +457,8 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
       for (const std::string& arg : args) (void)fill_in(c, arg, runs.front(), file + ": [[step]]");
     for (const CampaignTemplateFile& f : c.files) (void)fill_in(c, f.text, runs.front(), f.source.string());
     if (c.alignment) (void)campaign_job(c, runs.front());
-    for (const std::string* text : {&c.receive.nav, &c.receive.coupling, &c.receive.filter, &c.receive.align})
+    for (const std::string* text : {&c.receive.nav, &c.receive.coupling, &c.receive.filter, &c.receive.align,
+                                    &c.receive.nav_bits, &c.receive.vector_carrier})
       (void)substitute(c, *text, runs.front(), file + ": [receive]");
   }
   return c;
@@ -560,6 +570,16 @@ pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::Camp
     throw io::InputError(where, "align must be static, motion or config, got '" + align + "'");
   o.align = *mode;
   if (!c.receive.fusion_config.empty()) o.navigation = read_fuse_config(resolve(c, c.receive.fusion_config));
+  if (const std::string bits = substitute(c, c.receive.nav_bits, run, where); !bits.empty())
+    o.receiver.nav_bits = receiver::parse_nav_bit_source(where + ": nav_bits", bits);
+  if (const std::string carrier = substitute(c, c.receive.vector_carrier, run, where); !carrier.empty()) {
+    if (o.coupling != pipelines::Coupling::kVector)
+      throw io::InputError(where, "vector_carrier '" + carrier + "' needs the vector coupling");
+    const auto parsed_carrier = fusion::vector_carrier_from_string(carrier);
+    if (!parsed_carrier)
+      throw io::InputError(where, "vector_carrier must be aided-pll, fll or pll, got '" + carrier + "'");
+    o.vector_carrier = *parsed_carrier;
+  }
   const std::string nav = substitute(c, c.receive.nav, run, where);
   if (!nav.empty()) job.receive.navigation = signals::read_rinex_nav(resolve(c, nav));
   return job;

@@ -24,8 +24,12 @@
 //   [receive]    nav = "brdc0010.22n" (hot start)  config = "receive.toml" (`receive --config`)
 //                fusion_config = "motion.toml"  coupling = "scalar"  filter = "ekf"  align = "motion"
 //                threads = 1  prns = "simulated" (search the simulated satellites) or "all"
-//                (nav, coupling, filter and align may name parameters, e.g. coupling = "{coupling}")
+//                nav_bits = "decoded"|"oracle"|... (`receive --nav-bits`)  vector_carrier = "aided-pll"|"fll"|"pll"
+//                (vector only; `--vector-carrier`); empty: the receiver's defaults
+//                (nav, coupling, filter, align, nav_bits and vector_carrier may name parameters: coupling =
+//                "{coupling}")
 //   [compute]    lock_outcomes = { lock_deadline_s = 5.0, strong_s = 0.0 }   nav_z_times_s = [10.5, 11.0]
+//                weak_part_from_s = 16.0 (the step protocol's position errors after the step: weak_rms_3d_m, ...)
 //                json = { drift_m = "f/summary.json:outages.0.horizontal_error_m" }   run scalars from a JSON file
 //                remove = ["s", "f/nav.csv"]   [[step]] runs: files or folders deleted once the scalars are read
 //   [[report]]   kind = "lock_threshold" (level = "cn0_dbhz")  or "nav_consistency"  or "stats" (value = "fixes")
@@ -50,6 +54,7 @@ namespace ultratrack::config {
 struct CampaignReceive {
   std::string nav, config, fusion_config;  // paths (nav templated), resolved against the base folder
   std::string coupling = "scalar", filter = "ekf", align = "motion";
+  std::string nav_bits, vector_carrier;  // empty: the receiver's defaults (decoded bits; the aided PLL)
   int threads = 1;
   bool prns_from_simulation = true;
 };

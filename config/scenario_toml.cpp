@@ -419,8 +419,11 @@ void read_receiver_clock_key(const Reader& r, const std::string& key, const std:
   } else if (key == "oscillator") {
     // A named oscillator sets both random walks from its Allan coefficients as a signal sees them
     // (signals/oscillator_allan.hpp: datasheet phase noise for the white frequency noise).
-    const auto allan = signals::oscillator_signal_preset(r.string(n, name));
-    if (!allan) r.fail(n, name, "unknown oscillator (" + joined(signals::oscillator_preset_names()) + ")");
+    // "ideal": a perfect clock (no phase noise, no wander), the default, named so that a campaign axis can hold it.
+    const std::string oscillator = r.string(n, name);
+    const auto allan =
+        oscillator == "ideal" ? signals::OscillatorAllan{0.0, 0.0} : signals::oscillator_signal_preset(oscillator);
+    if (!allan) r.fail(n, name, "unknown oscillator (ideal, " + joined(signals::oscillator_preset_names()) + ")");
     const signals::ReceiverClockModel noise = signals::receiver_clock_from_allan(*allan);
     s.clock_bias_noise_m_per_sqrt_s = noise.bias_noise_s_per_sqrt_s * signals::kSpeedOfLight_mps;
     s.clock_drift_noise_mps_per_sqrt_s = noise.drift_noise_sps_per_sqrt_s * signals::kSpeedOfLight_mps;

@@ -13,7 +13,7 @@
 //                 antenna_offsets_enu_m = [[0, 0, 0], [1.0, 0, 0]]   (static receiver: one file per antenna)
 //                 clock_bias_m = 0.0  clock_drift_mps = 0.0
 //                 clock_bias_noise_m_per_sqrt_s = 0.0  clock_drift_noise_mps_per_sqrt_s = 0.0
-//                 or  oscillator = "tcxo" | "ocxo"   (both random walks from the oscillator's Allan coefficients
+//                 or  oscillator = "ideal" | "tcxo" | "ocxo"   (both random walks from the Allan coefficients
 //                 as a signal sees them, signals/oscillator_allan.hpp; the written scenario carries the values)
 //   [atmosphere]  ionosphere = true  troposphere = false
 //   Another generator's conventions (signals/if_synthesiser.hpp, lnav_transmitter.hpp), all off by default:

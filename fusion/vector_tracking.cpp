@@ -57,6 +57,12 @@ const char* to_string(VectorCarrier carrier) {
   }
 }
 
+std::optional<VectorCarrier> vector_carrier_from_string(std::string_view text) {
+  for (const VectorCarrier c : {VectorCarrier::kAidedPll, VectorCarrier::kFll, VectorCarrier::kPll})
+    if (text == to_string(c)) return c;
+  return std::nullopt;
+}
+
 VectorState propagate(const VectorState& x, double dt) {
   VectorState y = x;
   y.segment<3>(vx::kPos) += dt * x.segment<3>(vx::kVel);

@@ -11,6 +11,7 @@
 #include <array>
 #include <functional>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "fusion/ekf.hpp"
@@ -109,6 +110,8 @@ ReplicaPrediction predict_replica(const SatelliteObservable& sat, const VectorSt
 // in kFll (and re-enters after VectorPllOptions::relock_after_s).
 enum class VectorCarrier { kAidedPll, kFll, kPll };
 const char* to_string(VectorCarrier carrier);
+// "aided-pll", "fll" or "pll" (to_string's names); nothing for another.
+std::optional<VectorCarrier> vector_carrier_from_string(std::string_view text);
 
 struct VectorTrackingOptions {
   VectorProcessNoise process;

@@ -161,6 +161,68 @@ std::vector<NavZ> nav_z_scores(const std::filesystem::path& nav_csv, const std::
   return out;
 }
 
+WeakPartPositions weak_part_positions(const std::filesystem::path& solution_csv, const std::filesystem::path& nav_csv,
+                                      const std::filesystem::path& truth_csv, double from_s) {
+  const NamedCsv truth = read_named_csv(truth_csv);
+  if (truth.rows.size() < 2) throw io::InputError(truth.file, "fewer than two rows");
+  const std::size_t truth_t = truth.column("t_s"), truth_tow = truth.column("tow_s");
+  const std::array<std::size_t, 3> truth_r{truth.column("ecef_x_m"), truth.column("ecef_y_m"),
+                                           truth.column("ecef_z_m")};
+  std::vector<double> tt;
+  for (std::size_t r = 0; r < truth.rows.size(); ++r) tt.push_back(truth.number(r, truth_t));
+  const double tow0 = truth.number(0, truth_tow) - tt.front();
+  // The truth position at t seconds since the first sample; false outside the truth's span.
+  const auto truth_at = [&](double t, std::array<double, 3>& p) {
+    if (!(t >= tt.front() && t <= tt.back())) return false;
+    const std::size_t i = std::clamp<std::size_t>(
+        static_cast<std::size_t>(std::lower_bound(tt.begin(), tt.end(), t) - tt.begin()), 1, tt.size() - 1);
+    const double w = (t - tt[i - 1]) / (tt[i] - tt[i - 1]);
+    for (int k = 0; k < 3; ++k)
+      p[k] = truth.number(i - 1, truth_r[k]) + w * (truth.number(i, truth_r[k]) - truth.number(i - 1, truth_r[k]));
+    return true;
+  };
+  const auto accumulate = [](double e2, double& sum, double& worst, int& n) {
+    sum += e2;
+    worst = std::max(worst, std::sqrt(e2));
+    ++n;
+  };
+  WeakPartPositions out;
+  double sum = 0.0, worst = 0.0;
+  if (std::filesystem::exists(solution_csv)) {
+    const NamedCsv sol = read_named_csv(solution_csv);
+    const std::size_t tow = sol.column("tow_s"), x = sol.column("ecef_x_m"), y = sol.column("ecef_y_m"),
+                      z = sol.column("ecef_z_m");
+    for (std::size_t r = 0; r < sol.rows.size(); ++r) {
+      double t = sol.number(r, tow) - tow0;
+      t -= 604800.0 * std::round(t / 604800.0);  // across a week rollover
+      std::array<double, 3> p{};
+      if (t < from_s - 1e-3 || !truth_at(t, p)) continue;
+      const double dx = sol.number(r, x) - p[0], dy = sol.number(r, y) - p[1], dz = sol.number(r, z) - p[2];
+      accumulate(dx * dx + dy * dy + dz * dz, sum, worst, out.fixes);
+    }
+  }
+  out.rms_3d_m = out.fixes > 0 ? std::sqrt(sum / out.fixes) : NAN;
+  out.max_3d_m = out.fixes > 0 ? worst : NAN;
+  sum = worst = 0.0;
+  if (std::filesystem::exists(nav_csv)) {
+    const NamedCsv nav = read_named_csv(nav_csv);
+    const std::size_t t_col = nav.column("t_s"), lat = nav.column("lat_deg"), lon = nav.column("lon_deg"),
+                      height = nav.column("height_m");
+    for (std::size_t r = 0; r < nav.rows.size(); ++r) {
+      const double t = nav.number(r, t_col);
+      std::array<double, 3> p{};
+      if (t < from_s || !truth_at(t, p)) continue;
+      const std::array<double, 3> q = ecef(nav.number(r, lat), nav.number(r, lon), nav.number(r, height));
+      double e2 = 0.0;
+      for (int k = 0; k < 3; ++k) e2 += (q[k] - p[k]) * (q[k] - p[k]);
+      accumulate(e2, sum, worst, out.nav_rows);
+    }
+  }
+  out.nav_rms_3d_m = out.nav_rows > 0 ? std::sqrt(sum / out.nav_rows) : NAN;
+  out.nav_max_3d_m = out.nav_rows > 0 ? worst : NAN;
+  return out;
+}
+
 namespace {
 const char* const kAxes[6] = {"pn", "pe", "pd", "vn", "ve", "vd"};
 }

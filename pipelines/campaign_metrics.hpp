@@ -3,7 +3,10 @@
 // report can be redone from the run folders alone:
 //   lock outcomes   each simulated satellite of a receive classified from tracking.csv (the tracking threshold);
 //   nav z-scores    the fused nav.csv against the simulation's truth.csv at fixed times, each NED position and
-//                   velocity error divided by nav.csv's own 1-sigma (the filter's consistency).
+//                   velocity error divided by nav.csv's own 1-sigma (the filter's consistency);
+//   weak part       the step protocol's position errors after the step: solution.csv's fixes and nav.csv's rows
+//                   from a time on, 3-D RMS and maximum against truth.csv (benchmarks/tracking_threshold.sh's
+//                   positions.csv and nav_positions.csv).
 // Units: s, m, m/s. Times are seconds since the first sample (tracking.csv time_s, nav.csv and truth.csv t_s).
 #pragma once
 
@@ -49,5 +52,18 @@ std::vector<NavZ> nav_z_scores(const std::filesystem::path& nav_csv, const std::
                                const std::vector<double>& times_s);
 void write_nav_z_csv(const std::filesystem::path& file, const std::vector<NavZ>& rows);
 std::vector<NavZ> read_nav_z_csv(const std::filesystem::path& file);
+
+// 3-D position errors (m) of the fixes (solution.csv, receiver time of week against truth.csv's tow_s) and of the
+// fused rows (nav.csv, t_s) at and after from_s seconds since the first sample, against truth.csv interpolated
+// linearly. rms and max are NaN where nothing was compared; a missing nav.csv counts no rows. Throws
+// io::InputError for a malformed file.
+struct WeakPartPositions {
+  int fixes = 0;
+  double rms_3d_m = 0.0, max_3d_m = 0.0;
+  int nav_rows = 0;
+  double nav_rms_3d_m = 0.0, nav_max_3d_m = 0.0;
+};
+WeakPartPositions weak_part_positions(const std::filesystem::path& solution_csv, const std::filesystem::path& nav_csv,
+                                      const std::filesystem::path& truth_csv, double from_s);
 
 }  // namespace ultratrack::pipelines

@@ -12,9 +12,9 @@
 //                    median, standard deviation, minimum and maximum;
 //   rms, table, error_stats   the fuse and alignment Monte Carlos' tables (pipelines/campaign_tables.hpp).
 // The step protocol (LockOutcomeOptions::strong_s) adds the not_locked_at_step column when a satellite was not
-// locked at its step; the threshold script's position RMS columns are not computed. Each reduction may split the
-// runs by parameters (`group`): one table per combination, in the sorted order of their values (as the scripts
-// sort couplings and filters).
+// locked at its step; its position RMS columns are run scalars ([compute] weak_part_from_s) for `stats`. Each
+// reduction may split the runs by parameters (`group`): one table per combination, in the sorted order of their
+// values (as the scripts sort couplings and filters).
 #pragma once
 
 #include <filesystem>

@@ -3,6 +3,7 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -104,6 +105,23 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
   if (job.metrics.nav_z_times_s && s.navigation_started) {
     if (truth.empty()) throw io::InputError("campaign", "nav z-scores need a truth file ([[recording]] truth)");
     write_nav_z_csv(run_dir / "nav_z.csv", nav_z_scores(run_dir / "rx" / "nav.csv", truth, *job.metrics.nav_z_times_s));
+  }
+  if (job.metrics.weak_part_from_s) {
+    if (truth.empty()) throw io::InputError("campaign", "weak-part positions need a truth file ([[recording]] truth)");
+    const WeakPartPositions w = weak_part_positions(run_dir / "rx" / "solution.csv", run_dir / "rx" / "nav.csv", truth,
+                                                    *job.metrics.weak_part_from_s);
+    // A value nothing was compared for is left out (the stats reduction counts the runs that have it).
+    const auto put = [&](const char* name, double v) {
+      if (std::isfinite(v)) scalars[name] = fmt::format("{:.3f}", v);
+    };
+    scalars["weak_fixes"] = std::to_string(w.fixes);
+    put("weak_rms_3d_m", w.rms_3d_m);
+    put("weak_max_3d_m", w.max_3d_m);
+    if (fs::exists(run_dir / "rx" / "nav.csv")) {
+      scalars["nav_weak_rows"] = std::to_string(w.nav_rows);
+      put("nav_weak_rms_3d_m", w.nav_rms_3d_m);
+      put("nav_weak_max_3d_m", w.nav_max_3d_m);
+    }
   }
   if (!job.keep_samples)
     for (const fs::path& file : sample_files) fs::remove(file);

@@ -5,7 +5,8 @@
 //   parameters.csv    the run's parameters (name,value), written first
 //   sim/              the simulation's files (the IF sample file deleted after the receive unless kept)
 //   rx/               the receive's outputs
-//   lock_outcomes.csv, nav_z.csv   the metrics asked for ([compute] json scalars go into complete.csv); with
+//   lock_outcomes.csv, nav_z.csv   the metrics asked for ([compute] json and weak-part scalars go into complete.csv);
+//   with
 //                     lock_outcomes of a simulated run also truth_lock_outcomes.csv (pipelines/truth_lock_rule.hpp)
 //   complete.csv      the marker, written last (atomically, by rename): the run's scalars (name,value)
 //   failed.txt        instead of complete.csv when the run threw: the message (a failed run is redone on resume)
@@ -31,7 +32,10 @@ namespace ultratrack::pipelines {
 struct CampaignMetrics {
   std::optional<LockOutcomeOptions> lock_outcomes;
   std::optional<std::vector<double>> nav_z_times_s;  // nav z-scores at these times (needs a truth.csv and nav.csv)
-  std::vector<CampaignJsonScalar> json_scalars;      // run scalars read from the run's JSON files
+  // The step protocol's weak part from this time on (s since the first sample; needs a truth.csv): scalars weak_fixes,
+  // weak_rms_3d_m, weak_max_3d_m and, with a nav.csv, nav_weak_rows, nav_weak_rms_3d_m, nav_weak_max_3d_m.
+  std::optional<double> weak_part_from_s;
+  std::vector<CampaignJsonScalar> json_scalars;  // run scalars read from the run's JSON files
 };
 
 // Everything one run does, resolved (config/campaign_toml.hpp builds it from the campaign file and the run).

@@ -84,16 +84,11 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   if (!a.vector_carrier.empty()) {
     if (s.coupling != Coupling::kVector)
       throw io::InputError("command line", "--vector-carrier needs --coupling vector");
-    if (a.vector_carrier == "aided-pll") {
-      s.vector_carrier = fusion::VectorCarrier::kAidedPll;
-    } else if (a.vector_carrier == "fll") {
-      s.vector_carrier = fusion::VectorCarrier::kFll;
-    } else if (a.vector_carrier == "pll") {
-      s.vector_carrier = fusion::VectorCarrier::kPll;
-    } else {
+    const auto carrier = fusion::vector_carrier_from_string(a.vector_carrier);
+    if (!carrier)
       throw io::InputError("command line",
                            "--vector-carrier must be aided-pll, fll or pll, got '" + a.vector_carrier + "'");
-    }
+    s.vector_carrier = *carrier;
   }
   if (!pipelines::uses_imu(s.coupling)) {
     if (!a.imu.empty() || !a.filter.empty() || !a.align.empty() || !a.config.empty() || !a.time_origin.empty() ||

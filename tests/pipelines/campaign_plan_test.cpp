@@ -174,4 +174,60 @@ TEST(CampaignToml, MalformedFilesNameTheFileAndTheKey) {
   EXPECT_NE(e.find("s.toml"), std::string::npos) << e;
 }
 
+// [receive] nav_bits and vector_carrier (templated like coupling) reach the job's options; [compute]
+// weak_part_from_s the metrics; a carrier for a coupling other than vector, or an unknown name, is an error naming it.
+TEST(CampaignToml, ReceiveBitsCarrierAndWeakPart) {
+  const auto dir = ultratrack::test::scratch_dir();
+  const std::string campaign = R"(
+[[axis]]
+name = "mode"
+values = ["fll", "oracle"]
+coupling = ["vector", "scalar"]
+bits = ["decoded", "oracle"]
+carrier = ["fll", ""]
+[simulate]
+scenario = "s.toml"
+[receive]
+coupling = "{coupling}"
+nav_bits = "{bits}"
+vector_carrier = "{carrier}"
+[compute]
+weak_part_from_s = 16.0
+)";
+  const auto c = ultratrack::config::read_campaign(write_campaign(dir, campaign, "[signal]\nseed = 1\n"));
+  ASSERT_TRUE(c.metrics.weak_part_from_s);
+  EXPECT_EQ(*c.metrics.weak_part_from_s, 16.0);
+  const auto runs = expand_campaign(c.axes);
+  ASSERT_EQ(runs.size(), 2u);
+  const auto fll = ultratrack::config::campaign_job(c, runs[0]);
+  EXPECT_EQ(fll.receive.options.coupling, ultratrack::fusion::Coupling::kVector);
+  EXPECT_EQ(fll.receive.options.vector_carrier, ultratrack::fusion::VectorCarrier::kFll);
+  EXPECT_EQ(fll.receive.options.receiver.nav_bits, ultratrack::receiver::NavBitSource::kDecoded);
+  const auto oracle = ultratrack::config::campaign_job(c, runs[1]);
+  EXPECT_EQ(oracle.receive.options.coupling, ultratrack::fusion::Coupling::kScalar);
+  EXPECT_EQ(oracle.receive.options.receiver.nav_bits, ultratrack::receiver::NavBitSource::kOracle);
+
+  const auto job_error = [&](const std::string& receive) {
+    const auto d = ultratrack::test::scratch_dir();
+    const auto file =
+        write_campaign(d, "[[axis]]\nname = \"seed\"\nvalues = [1]\n[simulate]\nscenario = \"s.toml\"\n" + receive,
+                       "[signal]\nseed = {seed}\n");
+    try {
+      const auto cc = ultratrack::config::read_campaign(file);
+      (void)ultratrack::config::campaign_job(cc, expand_campaign(cc.axes).front());
+    } catch (const ultratrack::io::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no InputError");
+  };
+  EXPECT_NE(job_error("[receive]\nvector_carrier = \"fll\"\n").find("needs the vector coupling"), std::string::npos);
+  EXPECT_NE(job_error("[receive]\ncoupling = \"vector\"\nvector_carrier = \"dll\"\n").find("got 'dll'"),
+            std::string::npos);
+  EXPECT_NE(job_error("[receive]\nnav_bits = \"psychic\"\n").find("nav_bits"), std::string::npos);
+  EXPECT_NE(error_of("[[axis]]\nname = \"seed\"\nvalues = [1]\n[simulate]\nscenario = \"s.toml\"\n"
+                     "[compute]\nweak_part_from_s = -1.0\n")
+                .find("weak_part_from_s"),
+            std::string::npos);
+}
+
 }  // namespace

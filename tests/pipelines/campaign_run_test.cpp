@@ -13,6 +13,7 @@
 
 #include "config/campaign_toml.hpp"
 #include "config/scenario_toml.hpp"
+#include "ins/earth_model.hpp"
 #include "io/atomic_file.hpp"
 #include "pipelines/campaign_metrics.hpp"
 #include "pipelines/campaign_report.hpp"
@@ -181,6 +182,47 @@ TEST(CampaignReport, LockThresholdTableMatchesHandCounts) {
   const auto [lo, hi] = pipelines::wilson_interval(0, 19, 1.0);
   EXPECT_DOUBLE_EQ(lo, 0.0);
   EXPECT_NEAR(hi, 1.0 / 20.0, 1e-15);  // k = 0, z = 1: the upper bound is 1 / (n + 1)
+}
+
+// The step protocol's weak part against hand-made files: truth.csv a receiver moving east along a parallel (tow
+// 1000 s at t = 0), fixes 5 m off (3, 4, 0) from t = 4 s and 100 m off before, nav.csv rows 2 m high from t = 4.5 s
+// and 50 m high before: 3-D RMS and maximum 5 m and 2 m over the rows at and after 4 s only.
+TEST(CampaignMetrics, WeakPartPositionsCountOnlyTheRowsAfterTheStep) {
+  const fs::path dir = test::scratch_dir();
+  const double lat = 0.6, lon0 = 2.4, h = 50.0;
+  const auto lon = [&](double t) { return lon0 + 2.0 * t / (6.4e6 * std::cos(lat)); };  // ~2 m/s east
+  std::string truth = "t_s,tow_s,ecef_x_m,ecef_y_m,ecef_z_m\n", sol = "tow_s,ecef_x_m,ecef_y_m,ecef_z_m\n";
+  std::string nav = "t_s,lat_deg,lon_deg,height_m\n";
+  for (int k = 0; k <= 100; ++k) {
+    const double t = 0.1 * k;
+    const Eigen::Vector3d r = ins::ecef_from_geodetic(lat, lon(t), h);
+    truth += fmt::format("{:.1f},{:.1f},{:.6f},{:.6f},{:.6f}\n", t, 1000.0 + t, r.x(), r.y(), r.z());
+  }
+  for (int k = 1; k <= 9; ++k) {  // fixes at t = 1..9 s, nav rows at t + 0.5
+    const double t = k;
+    const Eigen::Vector3d off = t >= 4.0 ? Eigen::Vector3d(3.0, 4.0, 0.0) : Eigen::Vector3d(100.0, 0.0, 0.0);
+    const Eigen::Vector3d r = ins::ecef_from_geodetic(lat, lon(t), h) + off;
+    sol += fmt::format("{:.1f},{:.6f},{:.6f},{:.6f}\n", 1000.0 + t, r.x(), r.y(), r.z());
+    nav += fmt::format("{:.1f},{:.12f},{:.12f},{:.4f}\n", t + 0.5, lat * 180.0 / M_PI, lon(t + 0.5) * 180.0 / M_PI,
+                       h + (t + 0.5 >= 4.0 ? 2.0 : 50.0));
+  }
+  io::write_file_atomically(dir / "truth.csv", truth);
+  io::write_file_atomically(dir / "solution.csv", sol);
+  io::write_file_atomically(dir / "nav.csv", nav);
+  const pipelines::WeakPartPositions w =
+      pipelines::weak_part_positions(dir / "solution.csv", dir / "nav.csv", dir / "truth.csv", 4.0);
+  EXPECT_EQ(w.fixes, 6);  // t = 4..9
+  EXPECT_NEAR(w.rms_3d_m, 5.0, 1e-3);
+  EXPECT_NEAR(w.max_3d_m, 5.0, 1e-3);
+  EXPECT_EQ(w.nav_rows, 6);  // t = 4.5..9.5
+  EXPECT_NEAR(w.nav_rms_3d_m, 2.0, 1e-3);
+  EXPECT_NEAR(w.nav_max_3d_m, 2.0, 1e-3);
+  // Nothing after the end: NaN, no rows; no nav.csv: no rows.
+  const pipelines::WeakPartPositions none =
+      pipelines::weak_part_positions(dir / "solution.csv", dir / "absent.csv", dir / "truth.csv", 20.0);
+  EXPECT_EQ(none.fixes, 0);
+  EXPECT_TRUE(std::isnan(none.rms_3d_m));
+  EXPECT_EQ(none.nav_rows, 0);
 }
 
 }  // namespace

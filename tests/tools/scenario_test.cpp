@@ -105,9 +105,13 @@ TEST(Scenario, OscillatorSetsTheClockRandomWalks) {
   const Scenario s = parse_scenario("[receiver]\noscillator = \"tcxo\"\n", "/data/s.toml");
   EXPECT_NEAR(s.clock_bias_noise_m_per_sqrt_s, 0.002050, 0.000001);
   EXPECT_NEAR(s.clock_drift_noise_mps_per_sqrt_s, 0.18837, 0.00001);
+  // "ideal": no noise at all (a campaign axis beside tcxo and ocxo).
+  const Scenario ideal = parse_scenario("[receiver]\noscillator = \"ideal\"\n", "/data/s.toml");
+  EXPECT_EQ(ideal.clock_bias_noise_m_per_sqrt_s, 0.0);
+  EXPECT_EQ(ideal.clock_drift_noise_mps_per_sqrt_s, 0.0);
   auto e = error_of("[receiver]\noscillator = \"rubidium\"\n");
   EXPECT_NE(e.find("receiver.oscillator"), std::string::npos) << e;
-  EXPECT_NE(e.find("tcxo, ocxo"), std::string::npos) << e;
+  EXPECT_NE(e.find("ideal, tcxo, ocxo"), std::string::npos) << e;
   e = error_of("[receiver]\noscillator = \"ocxo\"\nclock_bias_noise_m_per_sqrt_s = 0.1\n");
   EXPECT_NE(e.find("not both"), std::string::npos) << e;
 }
