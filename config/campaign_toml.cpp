@@ -457,8 +457,8 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
       for (const std::string& arg : args) (void)fill_in(c, arg, runs.front(), file + ": [[step]]");
     for (const CampaignTemplateFile& f : c.files) (void)fill_in(c, f.text, runs.front(), f.source.string());
     if (c.alignment) (void)campaign_job(c, runs.front());
-    for (const std::string* text : {&c.receive.nav, &c.receive.coupling, &c.receive.filter, &c.receive.align,
-                                    &c.receive.nav_bits, &c.receive.vector_carrier})
+    for (const std::string* text : {&c.receive.nav, &c.receive.config, &c.receive.coupling, &c.receive.filter,
+                                    &c.receive.align, &c.receive.nav_bits, &c.receive.vector_carrier})
       (void)substitute(c, *text, runs.front(), file + ": [receive]");
   }
   return c;
@@ -552,9 +552,10 @@ pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::Camp
     job.imu_csv = param("imu");
   }
   pipelines::ReceiveOptions& o = job.receive.options;
-  if (!c.receive.config.empty()) apply_receive_config(resolve(c, c.receive.config), o.receiver);
-  o.receiver.threads = c.receive.threads;
   const std::string where = file + ": [receive]";
+  if (const std::string config = substitute(c, c.receive.config, run, where); !config.empty())
+    apply_receive_config(resolve(c, config), o.receiver);
+  o.receiver.threads = c.receive.threads;
   const std::string coupling = substitute(c, c.receive.coupling, run, where);
   const auto parsed = pipelines::coupling_from_string(coupling);
   if (!parsed)

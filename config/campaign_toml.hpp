@@ -26,7 +26,7 @@
 //                threads = 1  prns = "simulated" (search the simulated satellites) or "all"
 //                nav_bits = "decoded"|"oracle"|... (`receive --nav-bits`)  vector_carrier = "aided-pll"|"fll"|"pll"
 //                (vector only; `--vector-carrier`); empty: the receiver's defaults
-//                (nav, coupling, filter, align, nav_bits and vector_carrier may name parameters: coupling =
+//                (nav, config, coupling, filter, align, nav_bits and vector_carrier may name parameters: coupling =
 //                "{coupling}")
 //   [compute]    lock_outcomes = { lock_deadline_s = 5.0, strong_s = 0.0 }   nav_z_times_s = [10.5, 11.0]
 //                weak_part_from_s = 16.0 (the step protocol's position errors after the step: weak_rms_3d_m, ...)
