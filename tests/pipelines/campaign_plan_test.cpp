@@ -230,4 +230,26 @@ weak_part_from_s = 16.0
             std::string::npos);
 }
 
+// Every campaign the repository ships (campaigns/*.toml with a [campaign] table; the others are their templates)
+// reads, expands and builds the job of its first and last run: a campaign file broken by a renamed key or template
+// parameter fails here, not in a user's hour-long run.
+TEST(CampaignToml, EveryShippedCampaignReadsAndBuildsItsJobs) {
+  const std::filesystem::path dir = ultratrack::test::scenarios_dir().parent_path() / "campaigns";
+  int campaigns = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.path().extension() != ".toml") continue;
+    if (ultratrack::test::read_text_file(entry.path()).find("\n[campaign]") == std::string::npos) continue;
+    SCOPED_TRACE(entry.path().string());
+    const auto c = ultratrack::config::read_campaign(entry.path());
+    const auto runs = expand_campaign(c.axes);
+    ASSERT_FALSE(runs.empty());
+    if (c.steps.empty()) {  // [[step]] campaigns build their files and arguments when they run
+      (void)ultratrack::config::campaign_job(c, runs.front());
+      (void)ultratrack::config::campaign_job(c, runs.back());
+    }
+    ++campaigns;
+  }
+  EXPECT_GE(campaigns, 11);
+}
+
 }  // namespace
