@@ -20,6 +20,15 @@ namespace {
 constexpr double kC = signals::kSpeedOfLight_mps;
 constexpr double kLambda_m = signals::kL1Wavelength_m;
 
+// The entry of a satellite in a list by PRN (the last one, should it appear twice); nullptr when absent.
+template <class T>
+const T* find_prn(const std::vector<T>& list, int prn) {
+  const T* found = nullptr;
+  for (const T& x : list)
+    if (x.prn == prn) found = &x;
+  return found;
+}
+
 }  // namespace
 
 bool UltraTightOptions::IsValid(std::string* why) const {
@@ -150,12 +159,8 @@ class UltraTightCore final : public UltraTightCoreBase {
     now_t_s_ = nominal_.nav.t_s;
     const std::vector<SatelliteObservable>& now = now_;
     auto lookup = [&](int prn, const ChannelCorrelation*& c, const SatelliteObservable*& s) {
-      c = nullptr;
-      s = nullptr;
-      for (const auto& x : corr)
-        if (x.prn == prn) c = &x;
-      for (const auto& x : now)
-        if (x.prn == prn) s = &x;
+      c = find_prn(corr, prn);
+      s = find_prn(now, prn);
       return c && s && c->data_wiped && c->cn0_dbhz >= opt_.coast_cn0_dbhz &&
              std::abs(c->integration_time_s - T_) < 1e-9;
     };
@@ -308,12 +313,8 @@ class UltraTightCore final : public UltraTightCoreBase {
     const StateMatrix<17>& P = filter_.P();
     for (const ReplicaCommand& command : replicas) {
       if (command.aided_only) continue;
-      const ChannelCorrelation* c = nullptr;
-      const SatelliteObservable* s = nullptr;
-      for (const auto& x : corr)
-        if (x.prn == command.prn) c = &x;
-      for (const auto& x : now_)
-        if (x.prn == command.prn) s = &x;
+      const ChannelCorrelation* c = find_prn(corr, command.prn);
+      const SatelliteObservable* s = find_prn(now_, command.prn);
       if (!c || !s || !c->has_carrier_rate || !(c->cn0_dbhz >= opt_.coast_cn0_dbhz) ||
           !(c->carrier_rate_window_s > 0.0))
         continue;
@@ -343,16 +344,8 @@ class UltraTightCore final : public UltraTightCoreBase {
     if (rows.empty()) return;
     ++counters.rate_updates;
     counters.rate_rows += static_cast<long long>(rows.size());
-    period_dx_.setZero();
-    // update() counts into the I&Q counters: take the carrier-rate update out of them again.
-    const bool ok = update(CarrierRateMeasurement(nominal_, rows, opt_.lever_arm_b, imu_steps_.w_ib_b, common_var));
-    --counters.updates;
-    if (ok) {
-      --counters.accepted;
+    if (apply(CarrierRateMeasurement(nominal_, rows, opt_.lever_arm_b, imu_steps_.w_ib_b, common_var)).accepted)
       ++counters.rate_accepted;
-    } else {
-      --counters.rejected;
-    }
   }
 
   NominalState nominal() const override { return nominal_; }
@@ -448,22 +441,26 @@ class UltraTightCore final : public UltraTightCoreBase {
     imu_steps_.clear();
   }
 
+  // One filter update; when accepted, its correction goes into the nominal and the INS (closed loop).
   template <class M>
-  bool update(const M& m) {
-    ++counters.updates;
+  UpdateResult apply(const M& m) {
     const UpdateResult r = filter_.update(m);
-    last_result_ = r;
-    if (!r.accepted) {
-      ++counters.rejected;
-      return false;
-    }
-    ++counters.accepted;
+    if (!r.accepted) return r;
     last_dx_ = filter_.x();
     period_dx_ += last_dx_;
     nominal_ = corrected<17>(nominal_, filter_.x());
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<17>::Zero());
-    return true;
+    return r;
+  }
+
+  // A satellite's I&Q or discriminator update, counted (counters.updates, accepted, rejected).
+  template <class M>
+  bool update(const M& m) {
+    ++counters.updates;
+    last_result_ = apply(m);
+    ++(last_result_.accepted ? counters.accepted : counters.rejected);
+    return last_result_.accepted;
   }
 
   void fill_output() {

@@ -60,6 +60,25 @@ std::array<double, 3> ned(double lat_deg, double lon_deg, const std::array<doubl
           -cl * co * d[0] - cl * so * d[1] - sl * d[2]};
 }
 
+// A simulation's truth.csv, interpolated linearly in time (t_s, seconds since the first sample).
+struct TruthTrack {
+  NamedCsv csv;
+  std::vector<double> t;
+  explicit TruthTrack(const std::filesystem::path& file) : csv(read_named_csv(file)) {
+    if (csv.rows.size() < 2) throw io::InputError(csv.file, "fewer than two rows");
+    const std::size_t t_col = csv.column("t_s");
+    for (std::size_t r = 0; r < csv.rows.size(); ++r) t.push_back(csv.number(r, t_col));
+  }
+  bool covers(double time) const { return time >= t.front() && time <= t.back(); }
+  // Column `c` at `time`, on the line through the two rows around it (the first or last two outside the span).
+  double at(std::size_t c, double time) const {
+    const std::size_t i = std::clamp<std::size_t>(
+        static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), time) - t.begin()), 1, t.size() - 1);
+    const double w = (time - t[i - 1]) / (t[i] - t[i - 1]);
+    return csv.number(i - 1, c) + w * (csv.number(i, c) - csv.number(i - 1, c));
+  }
+};
+
 }  // namespace
 
 std::vector<LockOutcome> lock_outcomes(const std::vector<int>& prns, const std::filesystem::path& tracking_csv,
@@ -116,11 +135,11 @@ std::vector<LockOutcome> read_lock_outcomes_csv(const std::filesystem::path& fil
 
 std::vector<NavZ> nav_z_scores(const std::filesystem::path& nav_csv, const std::filesystem::path& truth_csv,
                                const std::vector<double>& times_s) {
-  const NamedCsv nav = read_named_csv(nav_csv), truth = read_named_csv(truth_csv);
-  if (truth.rows.size() < 2) throw io::InputError(truth.file, "fewer than two rows");
-  std::vector<double> tt, rt;
-  const std::size_t truth_t = truth.column("t_s"), nav_t = nav.column("t_s");
-  for (std::size_t r = 0; r < truth.rows.size(); ++r) tt.push_back(truth.number(r, truth_t));
+  const NamedCsv nav = read_named_csv(nav_csv);
+  const TruthTrack track(truth_csv);
+  const NamedCsv& truth = track.csv;
+  std::vector<double> rt;
+  const std::size_t nav_t = nav.column("t_s");
   for (std::size_t r = 0; r < nav.rows.size(); ++r) rt.push_back(nav.number(r, nav_t));
   const std::array<std::size_t, 6> truth_cols{truth.column("ecef_x_m"),  truth.column("ecef_y_m"),
                                               truth.column("ecef_z_m"),  truth.column("vel_n_mps"),
@@ -136,12 +155,7 @@ std::vector<NavZ> nav_z_scores(const std::filesystem::path& nav_csv, const std::
     if (after == rt.begin()) continue;
     const std::size_t j = static_cast<std::size_t>(after - rt.begin()) - 1;
     const double tr = rt[j];
-    const std::size_t i = std::clamp<std::size_t>(
-        static_cast<std::size_t>(std::lower_bound(tt.begin(), tt.end(), tr) - tt.begin()), 1, tt.size() - 1);
-    const double w = (tr - tt[i - 1]) / (tt[i] - tt[i - 1]);
-    const auto lin = [&](std::size_t c) {
-      return truth.number(i - 1, c) + w * (truth.number(i, c) - truth.number(i - 1, c));
-    };
+    const auto lin = [&](std::size_t c) { return track.at(c, tr); };
     const double lat_deg = nav.number(j, lat), lon_deg = nav.number(j, lon);
     const std::array<double, 3> q = ecef(lat_deg, lon_deg, nav.number(j, height));
     const std::array<double, 3> ep =
@@ -163,22 +177,14 @@ std::vector<NavZ> nav_z_scores(const std::filesystem::path& nav_csv, const std::
 
 WeakPartPositions weak_part_positions(const std::filesystem::path& solution_csv, const std::filesystem::path& nav_csv,
                                       const std::filesystem::path& truth_csv, double from_s) {
-  const NamedCsv truth = read_named_csv(truth_csv);
-  if (truth.rows.size() < 2) throw io::InputError(truth.file, "fewer than two rows");
-  const std::size_t truth_t = truth.column("t_s"), truth_tow = truth.column("tow_s");
-  const std::array<std::size_t, 3> truth_r{truth.column("ecef_x_m"), truth.column("ecef_y_m"),
-                                           truth.column("ecef_z_m")};
-  std::vector<double> tt;
-  for (std::size_t r = 0; r < truth.rows.size(); ++r) tt.push_back(truth.number(r, truth_t));
-  const double tow0 = truth.number(0, truth_tow) - tt.front();
+  const TruthTrack track(truth_csv);
+  const std::array<std::size_t, 3> truth_r{track.csv.column("ecef_x_m"), track.csv.column("ecef_y_m"),
+                                           track.csv.column("ecef_z_m")};
+  const double tow0 = track.csv.number(0, track.csv.column("tow_s")) - track.t.front();
   // The truth position at t seconds since the first sample; false outside the truth's span.
   const auto truth_at = [&](double t, std::array<double, 3>& p) {
-    if (!(t >= tt.front() && t <= tt.back())) return false;
-    const std::size_t i = std::clamp<std::size_t>(
-        static_cast<std::size_t>(std::lower_bound(tt.begin(), tt.end(), t) - tt.begin()), 1, tt.size() - 1);
-    const double w = (t - tt[i - 1]) / (tt[i] - tt[i - 1]);
-    for (int k = 0; k < 3; ++k)
-      p[k] = truth.number(i - 1, truth_r[k]) + w * (truth.number(i, truth_r[k]) - truth.number(i - 1, truth_r[k]));
+    if (!track.covers(t)) return false;
+    for (int k = 0; k < 3; ++k) p[k] = track.at(truth_r[k], t);
     return true;
   };
   const auto accumulate = [](double e2, double& sum, double& worst, int& n) {
