@@ -280,6 +280,11 @@ fs::path resolve(const CampaignFile& c, const std::string& path) {
   return path.empty() ? fs::path() : (c.base_dir / path).lexically_normal();
 }
 
+// The scenario template of a run: [simulate] scenario with the run's parameters filled in.
+fs::path scenario_path(const CampaignFile& c, const pipelines::CampaignRun& run) {
+  return resolve(c, substitute(c, c.scenario_spec, run, c.source.string() + ": [simulate] scenario"));
+}
+
 }  // namespace
 
 CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
@@ -326,12 +331,24 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
   }
   if (simulate) {
     Table table{file, "simulate", *simulate, {}};
-    const std::string scenario = table.text("scenario", "");
-    if (scenario.empty()) throw io::InputError(file, "key 'simulate.scenario' is required", line_of(*simulate));
-    c.scenario_template = resolve(c, scenario);
+    c.scenario_spec = table.text("scenario", "");
+    if (c.scenario_spec.empty()) throw io::InputError(file, "key 'simulate.scenario' is required", line_of(*simulate));
+    if (const toml::node* n = table.get("set")) {
+      const toml::table* set = n->as_table();
+      if (!set) table.fail(*n, "set", "must be a table of dotted keys: { \"signal.cn0_dbhz\" = \"{cn0_dbhz}\" }");
+      Table entries{file, "simulate.set", *set, {}};
+      for (auto&& [key, value] : *set) {
+        const std::string k(key.str());
+        try {
+          (void)parse_toml_override(k + "=x");
+        } catch (const std::invalid_argument& e) {
+          table.fail(value, "set", e.what());
+        }
+        c.scenario_set.emplace_back(k, value_text(value, entries, k));
+      }
+    }
     c.keep_samples = table.boolean("keep_samples", false);
     table.check_done();
-    c.scenario_text = read_text(c.scenario_template, file);
   }
   for (const toml::table* s : steps) {
     Table table{file, fmt::format("step[{}]", c.steps.size()), *s, {}};
@@ -451,8 +468,18 @@ CampaignFile read_campaign(const fs::path& path, const fs::path& base_dir) {
   }
   // Every run's templates must fill in: a misspelt {name} fails here, before any run.
   const std::vector<pipelines::CampaignRun> runs = pipelines::expand_campaign(c.axes);
+  if (simulate)  // each scenario template the runs name, read once
+    for (const pipelines::CampaignRun& run : runs) {
+      const fs::path path = scenario_path(c, run);
+      if (!c.scenario_texts.contains(path)) c.scenario_texts[path] = read_text(path, file);
+    }
   if (!runs.empty()) {
-    if (simulate) (void)substitute(c, c.scenario_text, runs.front(), c.scenario_template.string());
+    if (simulate) {
+      const fs::path path = scenario_path(c, runs.front());
+      (void)substitute(c, c.scenario_texts.at(path), runs.front(), path.string());
+      for (const auto& [key, value] : c.scenario_set)
+        (void)substitute(c, value, runs.front(), file + ": [simulate] set");
+    }
     for (const auto& args : c.steps)
       for (const std::string& arg : args) (void)fill_in(c, arg, runs.front(), file + ": [[step]]");
     for (const CampaignTemplateFile& f : c.files) (void)fill_in(c, f.text, runs.front(), f.source.string());
@@ -530,8 +557,12 @@ pipelines::CampaignJob campaign_job(const CampaignFile& c, const pipelines::Camp
   }
   if (!c.steps.empty()) throw std::logic_error("a [[step]] campaign's runs are tools::run_campaign_steps's");
   if (!c.recordings) {
-    const std::string text = substitute(c, c.scenario_text, run, c.scenario_template.string());
-    job.scenario = parse_scenario(text, c.scenario_template);
+    const fs::path path = scenario_path(c, run);
+    const std::string text = substitute(c, c.scenario_texts.at(path), run, path.string());
+    std::vector<TomlOverride> overrides;
+    for (const auto& [key, value] : c.scenario_set)
+      overrides.push_back({key, substitute(c, value, run, file + ": [simulate] set")});
+    job.scenario = parse_scenario(text, path, overrides);
     job.scenario_echo = to_toml(*job.scenario);
   } else {
     const auto param = [&](const char* name) { return run.find(name) ? *run.find(name) : std::string(); };

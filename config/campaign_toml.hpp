@@ -10,7 +10,10 @@
 //                further keys are zipped columns, one value per axis value: seed = [100, 101, 102, 103]
 //                or linear in the axis position: seed = { start = 100, step = 1 }
 //                The first axis varies slowest; a run's parameters are each axis value, then its columns in key order.
-//   [simulate]   scenario = "threshold.scenario.toml"   a scenario file whose text names parameters as {name}
+//   [simulate]   scenario = "threshold.scenario.toml"   a scenario file whose text names parameters as {name}; the
+//                path may name them too ("../scenarios/ultratight_{trajectory}.toml": one file per value)
+//                set = { "signal.cn0_dbhz" = "{cn0_dbhz}" }   keys changed before the scenario is read
+//                (config/toml_override.hpp; values may name parameters)
 //                keep_samples = false                   (the IF sample file is deleted after the receive)
 //   [[recording]] instead of [simulate]: name = "a"  input = "a.bin"  format = "i8"  sample_rate_hz = 4e6
 //                if_hz = 0.0  imu = "imu.csv"  truth = "truth.csv"; the recordings are the first axis, "recording"
@@ -41,6 +44,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,8 +88,9 @@ struct CampaignFile {
   std::filesystem::path base_dir;  // relative paths resolve here
   std::string name, description;
   std::vector<pipelines::CampaignAxis> axes;
-  std::filesystem::path scenario_template;  // empty for recordings
-  std::string scenario_text;
+  std::string scenario_spec;  // [simulate] scenario as written (may name parameters); empty for recordings
+  std::map<std::filesystem::path, std::string> scenario_texts;    // every template the runs name, read once
+  std::vector<std::pair<std::string, std::string>> scenario_set;  // [simulate] set: dotted key, templated value
   bool keep_samples = false;
   bool recordings = false;
   std::vector<std::vector<std::string>> steps;  // [[step]] args, templated

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "ins/imu_datasheet.hpp"
@@ -621,13 +622,19 @@ void check_given_keys(const std::string& file, const GivenKeys& given, const Sce
 
 }  // namespace
 
-Scenario parse_scenario(std::string_view text, const std::filesystem::path& source) {
+Scenario parse_scenario(std::string_view text, const std::filesystem::path& source,
+                        const std::vector<TomlOverride>& overrides) {
   const std::string file = source.string();
   toml::table root;
   try {
     root = toml::parse(text, file);
   } catch (const toml::parse_error& e) {
     throw InputError(file, std::string(e.description()), static_cast<int>(e.source().begin.line));
+  }
+  try {
+    apply_toml_overrides(root, overrides);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(file, e.what());
   }
   const Reader r(file);
   Scenario s;
@@ -643,12 +650,12 @@ Scenario parse_scenario(std::string_view text, const std::filesystem::path& sour
   return s;
 }
 
-Scenario read_scenario(const std::filesystem::path& path) {
+Scenario read_scenario(const std::filesystem::path& path, const std::vector<TomlOverride>& overrides) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string(), "cannot open the scenario file: " + io::open_failure_reason());
   std::stringstream ss;
   ss << in.rdbuf();
-  return parse_scenario(ss.str(), path);
+  return parse_scenario(ss.str(), path, overrides);
 }
 
 }  // namespace ultratrack::config

@@ -63,15 +63,19 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "config/toml_override.hpp"
 #include "sim/scenario.hpp"
 
 namespace ultratrack::config {
 
-// Parses scenario text; `source` names it in errors and anchors relative paths. Throws InputError.
-sim::Scenario parse_scenario(std::string_view text, const std::filesystem::path& source);
+// Parses scenario text; `source` names it in errors and anchors relative paths. `overrides` change keys before
+// the scenario is read (config/toml_override.hpp; a bad one is an InputError naming it). Throws InputError.
+sim::Scenario parse_scenario(std::string_view text, const std::filesystem::path& source,
+                             const std::vector<TomlOverride>& overrides = {});
 // Reads and parses a scenario file. Throws InputError (missing file, syntax, unknown key, wrong type, range).
-sim::Scenario read_scenario(const std::filesystem::path& path);
+sim::Scenario read_scenario(const std::filesystem::path& path, const std::vector<TomlOverride>& overrides = {});
 
 // The scenario as TOML with every key written (defaults filled in, paths made absolute): reading it back
 // gives the same scenario.

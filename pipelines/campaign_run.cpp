@@ -88,9 +88,19 @@ std::optional<std::map<std::string, std::string>> run(const CampaignJob& job, co
   if (prns.empty())
     for (int prn = 1; prn <= 32; ++prn) prns.push_back(prn);
 
-  if (job.metrics.lock_outcomes)
-    write_lock_outcomes_csv(run_dir / "lock_outcomes.csv", lock_outcomes(prns, run_dir / "rx" / "tracking.csv",
-                                                                         duration_s, *job.metrics.lock_outcomes));
+  if (job.metrics.lock_outcomes) {
+    const std::vector<LockOutcome> outcomes =
+        lock_outcomes(prns, run_dir / "rx" / "tracking.csv", duration_s, *job.metrics.lock_outcomes);
+    write_lock_outcomes_csv(run_dir / "lock_outcomes.csv", outcomes);
+    // Per run, for `stats` reports (the lock_threshold report reads the per-satellite file).
+    int kept = 0, lost = 0;
+    for (const LockOutcome& o : outcomes) {
+      if (o.outcome == "kept") ++kept;
+      if (o.outcome == "lost") ++lost;
+    }
+    scalars["satellites_kept"] = std::to_string(kept);
+    scalars["satellites_lost"] = std::to_string(lost);
+  }
   // The common rule beside the receiver's own (pipelines/truth_lock_rule.hpp), where the simulation wrote its truth.
   const fs::path satellite_truth = run_dir / "sim" / "satellite_truth.csv";
   if (job.metrics.lock_outcomes && job.scenario && fs::exists(satellite_truth) &&

@@ -8,10 +8,12 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "config/scenario_toml.hpp"
 #include "interrupt_guard.hpp"
+#include "io/input_error.hpp"
 #include "simulation_run.hpp"
 
 namespace ultratrack::tools {
@@ -21,11 +23,24 @@ void add_simulate_command(CLI::App& app) {
   auto scenario_path = std::make_shared<std::string>();
   auto out_dir = std::make_shared<std::string>();
   auto quiet = std::make_shared<bool>(false);
+  auto settings = std::make_shared<std::vector<std::string>>();
   cmd->add_option("--scenario", *scenario_path, "Scenario file (TOML)")->required();
+  cmd->add_option("--set", *settings,
+                  "Change a scenario key before it is read: KEY=VALUE, the key dotted (signal.cn0_dbhz=35), the value "
+                  "as TOML or a bare string; repeatable")
+      ->allow_extra_args(false);
   cmd->add_option("--out", *out_dir, "Output folder (created when missing)")->required();
   cmd->add_flag("--quiet", *quiet, "No progress lines");
-  cmd->callback([scenario_path, out_dir, quiet] {
-    const sim::Scenario scenario = config::read_scenario(*scenario_path);
+  cmd->callback([scenario_path, out_dir, quiet, settings] {
+    std::vector<config::TomlOverride> overrides;
+    for (const std::string& s : *settings) {
+      try {
+        overrides.push_back(config::parse_toml_override(s));
+      } catch (const std::invalid_argument& e) {
+        throw io::InputError("--set", e.what());
+      }
+    }
+    const sim::Scenario scenario = config::read_scenario(*scenario_path, overrides);
     const InterruptGuard interrupt;
     const auto r = run_simulation(scenario, *out_dir, *quiet ? nullptr : stderr, interrupt.token());
     const std::string inertial =

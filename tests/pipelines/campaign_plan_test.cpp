@@ -111,12 +111,64 @@ TEST(CampaignToml, ReadsAxesColumnsAndSections) {
   EXPECT_EQ(c.slurm.runs_per_task, 2);
   ASSERT_EQ(c.slurm.extra.size(), 1u);
   ASSERT_EQ(c.reductions.size(), 1u);
-  EXPECT_EQ(c.scenario_template, dir / "s.toml");
+  ASSERT_EQ(c.scenario_texts.size(), 1u);
+  EXPECT_EQ(c.scenario_texts.begin()->first, dir / "s.toml");
   // The job of a run is its scenario with the parameters filled in.
   const auto job = ultratrack::config::campaign_job(c, runs[5]);
   ASSERT_TRUE(job.scenario);
   EXPECT_EQ(job.scenario->seed, 104u);
   EXPECT_EQ(job.scenario->cn0_dbhz, 26.5);
+}
+
+// A scenario path that names a parameter picks a file per run; [simulate] set changes keys of whichever it is.
+TEST(CampaignToml, ScenarioPathAndSetNameParameters) {
+  const auto dir = ultratrack::test::scratch_dir();
+  std::ofstream(dir / "ut_a.toml") << "[signal]\nseed = 7\nduration_s = 60.0\n";
+  std::ofstream(dir / "ut_b.toml") << "[signal]\nseed = 8\nduration_s = 60.0\ncn0_dbhz = 50.0\n";
+  std::ofstream(dir / "c.toml") << R"(
+[[axis]]
+name = "which"
+values = ["a", "b"]
+[[axis]]
+name = "cn0_dbhz"
+values = [35.0, 40.0]
+[simulate]
+scenario = "ut_{which}.toml"
+set = { "signal.cn0_dbhz" = "{cn0_dbhz}", "signal.duration_s" = 36.0 }
+)";
+  const auto c = ultratrack::config::read_campaign(dir / "c.toml");
+  EXPECT_EQ(c.scenario_texts.size(), 2u);  // each file read once
+  const auto runs = expand_campaign(c.axes);
+  ASSERT_EQ(runs.size(), 4u);
+  const auto job = ultratrack::config::campaign_job(c, runs[3]);  // which = b, 40 dB-Hz
+  ASSERT_TRUE(job.scenario);
+  EXPECT_EQ(job.scenario->seed, 8u);
+  EXPECT_EQ(job.scenario->cn0_dbhz, 40.0);
+  EXPECT_EQ(job.scenario->duration_s, 36.0);
+  EXPECT_EQ(job.scenario->source, dir / "ut_b.toml");
+  EXPECT_EQ(ultratrack::config::campaign_job(c, runs[0]).scenario->seed, 7u);
+
+  // A value of the axis with no file: the campaign fails when read, naming the file, before any run.
+  std::ofstream(dir / "c2.toml") << R"(
+[[axis]]
+name = "which"
+values = ["a", "c"]
+[simulate]
+scenario = "ut_{which}.toml"
+)";
+  try {
+    (void)ultratrack::config::read_campaign(dir / "c2.toml");
+    FAIL() << "no error";
+  } catch (const ultratrack::io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("ut_c.toml"), std::string::npos) << e.what();
+  }
+  // A key of set that is not dotted, or a parameter that does not exist.
+  std::ofstream(dir / "c3.toml") << "[[axis]]\nname = \"which\"\nvalues = [\"a\"]\n[simulate]\n"
+                                    "scenario = \"ut_{which}.toml\"\nset = { cn0_dbhz = 35.0 }\n";
+  EXPECT_THROW((void)ultratrack::config::read_campaign(dir / "c3.toml"), ultratrack::io::InputError);
+  std::ofstream(dir / "c4.toml") << "[[axis]]\nname = \"which\"\nvalues = [\"a\"]\n[simulate]\n"
+                                    "scenario = \"ut_{which}.toml\"\nset = { \"signal.cn0_dbhz\" = \"{level}\" }\n";
+  EXPECT_THROW((void)ultratrack::config::read_campaign(dir / "c4.toml"), ultratrack::io::InputError);
 }
 
 // The InputError of a campaign file, or "no InputError".
