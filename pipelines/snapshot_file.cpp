@@ -56,12 +56,19 @@ SnapshotFileResult snapshot_file(const SnapshotFileJob& job) {
     m.ephemeris = *eph;
     measurements.push_back(m);
   }
-  if (measurements.size() < 5)
+  if (measurements.size() < 5) {
+    // The nav file's time span beside the time asked for: a nav file of another day is the usual cause.
+    const auto seconds = [](const signals::Ephemeris& e) { return e.week * 604800.0 + e.toe_s; };
+    const auto [first, last] = std::minmax_element(
+        job.nav.ephemerides.begin(), job.nav.ephemerides.end(),
+        [&](const signals::Ephemeris& a, const signals::Ephemeris& b) { return seconds(a) < seconds(b); });
     result.solution.failure = fmt::format(
-        "{} satellites detected, {} with a healthy ephemeris at the time: at least 5 "
-        "are needed",
-        result.detections.size(), measurements.size());
-  else
+        "{} satellites detected, {} with a healthy ephemeris at the time: at least 5 are needed (the time asked "
+        "for: week {} TOW {:.0f}; the nav file's ephemerides: week {} TOW {:.0f} to week {} TOW {:.0f}, each valid "
+        "about 2 h around its time)",
+        result.detections.size(), measurements.size(), job.approximate_time.week, job.approximate_time.tow_s,
+        first->week, first->toe_s, last->week, last->toe_s);
+  } else
     result.solution =
         receiver::solve_snapshot(measurements, job.approximate_time, job.approximate_position_e_m, options);
   return result;

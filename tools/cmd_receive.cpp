@@ -108,9 +108,13 @@ void run_receive(const ReceiveArgs& args) {
     throw CommandExit(3, fmt::format("{}: no fused solution ({}); outputs up to the end are in {}", args.input,
                                      summary.navigation_not_started, args.out));
   if (summary.fixes == 0 && !(fused && summary.navigation_started))
-    throw CommandExit(3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} "
-                                     "ephemerides decoded; --nav gives a hot start); outputs up to the end are in {}",
-                                     args.input, t, summary.satellites_tracked, summary.ephemerides_decoded, args.out));
+    throw CommandExit(
+        3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} ephemerides decoded; a "
+                       "fix needs {}; for a shorter recording use `snapshot`); outputs up to the end are in {}",
+                       args.input, t, summary.satellites_tracked, summary.ephemerides_decoded,
+                       args.nav.empty() ? "about 30 s of signal to decode the ephemerides, or 6-10 s with --nav"
+                                        : "6-10 s of signal with --nav (the time of week from the signal)",
+                       args.out));
   if (summary.fixes == 0) return;  // a fused solution without any PVT fix (tight coupling)
   fmt::print("receive: first fix after {:.2f} s; mean position {:.7f} deg, {:.7f} deg, {:.2f} m; outputs in {}\n",
              summary.ttff_s, summary.mean_lat_deg, summary.mean_lon_deg, summary.mean_height_m, args.out);

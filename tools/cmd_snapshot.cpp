@@ -103,7 +103,7 @@ void run_snapshot(const SnapshotArgs& args) {
   const InterruptGuard writing;
   pipelines::write_snapshot_outputs(args.out, job, result, args.format.format, wall_s);
   const receiver::SnapshotSolution& solution = result.solution;
-  if (!solution.valid) throw CommandExit(3, "ultratrack snapshot: no fix: " + solution.failure);
+  if (!solution.valid) throw CommandExit(3, "snapshot: no fix: " + solution.failure);
   if (args.quiet) return;
   fmt::print("{} satellites detected, {} used; ", result.detections.size(), solution.used);
   fmt::print("fix {:.7f} {:.7f} {:.1f} m, time correction {:+.3f} s, quality {} (residual rms {:.1f} m)\n",
