@@ -34,6 +34,7 @@ bool NisReleaseOptions::IsValid(std::string* why) const {
   if (!(gate_probability > 0.0 && gate_probability < 1.0))
     return fail("NIS release: the gate probability must lie in (0, 1)");
   if (min_filter_channels < 1) return fail("NIS release: min_filter_channels must be >= 1");
+  if (filter_persistence < 1) return fail("NIS release: filter_persistence must be >= 1");
   return true;
 }
 
@@ -85,6 +86,8 @@ NisVerdict NisReleaseMonitor::evaluate() {
     }
     if (pool > pool_limit_) {
       if (filter_out_) return v;  // logged already: no channel is blamed while the pool stays out
+      if (++pool_out_evaluations_ < opt_.filter_persistence) return v;  // not yet persistent: nobody blamed
+      pool_out_evaluations_ = 0;
       filter_out_ = true;
       v.filter = true;
       v.reasons.push_back(fmt::format("pooled NIS {:.0f} of {} channels over {} updates each (limit {:.0f})", pool,
@@ -93,6 +96,7 @@ NisVerdict NisReleaseMonitor::evaluate() {
       return v;
     }
     filter_out_ = false;
+    pool_out_evaluations_ = 0;
   }
   for (int prn : out) {
     const WindowedNis& w = windows_[static_cast<std::size_t>(prn)];
@@ -113,6 +117,7 @@ void NisReleaseMonitor::forget(int prn) {
 void NisReleaseMonitor::reset() {
   for (auto& w : windows_) w.reset();
   touched_.fill(false);
+  pool_out_evaluations_ = 0;
 }
 
 void ReleaseLog::add(double t_s, int prn, const std::string& reason, const std::string& detail) {

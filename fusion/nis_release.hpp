@@ -7,8 +7,9 @@
 // (the sum of every full window's NIS against margin x the quantile of their summed dof, at least
 // min_filter_channels windows). One contradicted channel cannot pass that alone (it adds at most W x the cap below
 // to a pool of n - 1 clean windows); when most channels rise together the pool passes first (its quantile is the
-// tighter, relative to its dof): the filter, not the channels, is wrong: one filter event (the loop re-opens or
-// resets the filter) and no channel is blamed while the pool stays outside; another filter event only after the pool
+// tighter, relative to its dof): the filter, not the channels, is wrong: one filter event once the pool has stayed
+// outside filter_persistence evaluations in a row (the loop re-opens or resets the filter), and no channel is blamed
+// while the pool stays outside; another filter event only after the pool
 // has come back inside its band (re-opening cures a wrong state, not a wrong noise model: a filter whose NIS stays
 // high after it is logged once). ReleaseLog records every release of a loop with its time, PRN and reason and counts
 // them per reason (summary.json).
@@ -40,6 +41,10 @@ struct NisReleaseOptions {
   double margin = 3.0;               // the band is margin x the chi-square quantile, >= 1
   double gate_probability = 0.9999;  // an update's NIS counts at most the gate threshold of its dof at this, (0, 1)
   int min_filter_channels = 3;       // the pooled test needs at least this many full windows, >= 1
+  // The pool must stay out of its band this many evaluations in a row (50: 1 s of the loop's epochs) before the
+  // filter event: a wrong state stays wrong, while a C/N0 step (the channels' C/N0 estimates, hence the I&Q noise
+  // model, lag the signal for a second or so) passes. Meanwhile no channel is blamed. >= 1.
+  int filter_persistence = 50;
   bool IsValid(std::string* why = nullptr) const;
 };
 
@@ -79,6 +84,7 @@ class NisReleaseMonitor final {
   mutable int pool_dof_ = -1;                  // the last pooled limit's dof, and the limit
   mutable double pool_limit_ = 0.0;
   bool filter_out_ = false;
+  int pool_out_evaluations_ = 0;  // consecutive evaluations with the pool out of its band
 };
 
 // The releases of one loop: every release with its time, PRN (0: the whole filter) and reason, and the count per
