@@ -6,22 +6,12 @@
 #   satellites, the geometry the seed's targets name), the banked 500 km/h circle (attitude_moving.toml) and the
 #   static receiver's cycle slips and 5 s blockage (attitude_faults.toml).
 #   benchmarks/validation/attitude_table.sh [--out DIR] [--ultratrack build/tools/ultratrack] [--keep]
-# Cost: about 4 CPU-min and 1.6 GB of scratch at a time (sample files are deleted after their receive unless --keep).
+# Cost: about 1 CPU-min and 1.6 GB of scratch at a time (sample files are deleted after their receive unless --keep).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-out=/tmp/ultratrack_attitude_table; ultratrack=$root/build/tools/ultratrack; keep=0
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --out) out=$2; shift 2 ;;
-    --ultratrack) ultratrack=$2; shift 2 ;;
-    --keep) keep=1; shift ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
-    *) echo "attitude_table.sh: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
-[ -x "$ultratrack" ] || { echo "attitude_table.sh: $ultratrack not built" >&2; exit 2; }
-mkdir -p "$out"; out=$(realpath "$out")
+name=attitude_table.sh; out=/tmp/ultratrack_attitude_table
+source "$here/table_options.sh"
 nav=$root/tests/data/brdc3540_0000-0200.14n
 antennas=$root/scenarios/attitude_antennas.toml
 

@@ -10,18 +10,8 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-out=/tmp/ultratrack_gnss_ins_if_table; ultratrack=$root/build/tools/ultratrack; keep=0
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --out) out=$2; shift 2 ;;
-    --ultratrack) ultratrack=$2; shift 2 ;;
-    --keep) keep=1; shift ;;
-    -h|--help) sed -n '2,8p' "$0"; exit 0 ;;
-    *) echo "gnss_ins_if_table.sh: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
-[ -x "$ultratrack" ] || { echo "gnss_ins_if_table.sh: $ultratrack not built" >&2; exit 2; }
-mkdir -p "$out"; out=$(realpath "$out")
+name=gnss_ins_if_table.sh; out=/tmp/ultratrack_gnss_ins_if_table
+source "$here/table_options.sh"
 sim=$out/sim
 "$ultratrack" simulate --scenario "$root/scenarios/circle_100m_30kmh_imu.toml" --out "$sim" --quiet > "$out/sim.log"
 runs=("scalar scalar ekf" "loose-ekf loose ekf" "loose-ukf loose ukf" "tight-ekf tight ekf" "tight-ukf tight ukf")

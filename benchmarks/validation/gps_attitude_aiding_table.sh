@@ -10,18 +10,8 @@
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-out=/tmp/ultratrack_gps_attitude_aiding; ultratrack=$root/build/tools/ultratrack; keep=0
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --out) out=$2; shift 2 ;;
-    --ultratrack) ultratrack=$2; shift 2 ;;
-    --keep) keep=1; shift ;;
-    -h|--help) sed -n '2,9p' "$0"; exit 0 ;;
-    *) echo "gps_attitude_aiding_table.sh: unknown argument $1" >&2; exit 2 ;;
-  esac
-done
-[ -x "$ultratrack" ] || { echo "gps_attitude_aiding_table.sh: $ultratrack not built" >&2; exit 2; }
-mkdir -p "$out"; out=$(realpath "$out")
+name=gps_attitude_aiding_table.sh; out=/tmp/ultratrack_gps_attitude_aiding
+source "$here/table_options.sh"
 sim=$out/sim
 u() { "$ultratrack" "$@" --quiet > /dev/null; }
 u simulate --scenario "$root/scenarios/attitude_moving.toml" --out "$sim"
