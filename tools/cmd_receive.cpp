@@ -101,7 +101,7 @@ void run_receive(const ReceiveArgs& args) {
   const double t = summary.processed_s;
   fmt::print("receive: {:.1f} s of signal in {:.2f} s ({:.1f}x real time, {} threads){}\n", t, wall_s,
              wall_s > 0 ? t / wall_s : 0.0, summary.threads, summary.interrupted ? ", interrupted" : "");
-  fmt::print("receive: satellites tracked {}, used {}; fixes {}; ephemerides decoded {}\n", summary.satellites_tracked,
+  fmt::print("receive: satellites locked {}, used {}; fixes {}; ephemerides decoded {}\n", summary.satellites_tracked,
              summary.satellites_used, summary.fixes, summary.ephemerides_decoded);
   for (const std::string& line : summary.report) fmt::print("{}\n", line);
   if (fused && !summary.navigation_started)
@@ -109,7 +109,7 @@ void run_receive(const ReceiveArgs& args) {
                                      summary.navigation_not_started, args.out));
   if (summary.fixes == 0 && !(fused && summary.navigation_started))
     throw CommandExit(
-        3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites tracked, {} ephemerides decoded; a "
+        3, fmt::format("{}: no position fix in {:.1f} s of signal ({} satellites locked, {} ephemerides decoded; a "
                        "fix needs {}; for a shorter recording use `snapshot`); outputs up to the end are in {}",
                        args.input, t, summary.satellites_tracked, summary.ephemerides_decoded,
                        args.nav.empty() ? "about 30 s of signal to decode the ephemerides, or 6-10 s with --nav"
