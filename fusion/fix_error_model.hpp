@@ -43,7 +43,7 @@ inline Eigen::Vector3d propagate_fix_error(const Eigen::Vector3d& b_ned_m, doubl
 // The white 1-sigma of a fix whose total 1-sigma is sigma_fix (per axis; see the file comment).
 Eigen::Vector3d fix_white_sigma(const Eigen::Vector3d& sigma_fix_ned_m, const FixErrorOptions& o);
 
-// A process model of NB states (a LinearProcessModel: InsErrorModel<15>, OdometerAugmentedModel) with the three
+// A process model of NB states (a LinearProcessModel: InsErrorModel<15>, OdometerAugmentedModel<15>) with the three
 // fix-error states appended at [NB, NB + 3). Satisfies LinearProcessModel<NB + 3>.
 template <class Base, int NB>
 class FixErrorAugmentedModel {

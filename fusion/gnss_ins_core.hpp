@@ -43,14 +43,17 @@ struct CoreBase {
 };
 
 // The filter's states: the INS errors (15; 17 with the receiver clock in tight mode), then what is appended.
-// Tight with height aiding: + the terrain height [17] (height_aiding.hpp). Loose with odometer aiding: + VMS delay,
-// misalignment, scale factor [15, 19) (odometer_error_model.hpp). Loose with Gauss-Markov fix errors: + three NED
-// fix-error states after all the others (fix_error_model.hpp).
+// Tight with height aiding: + the terrain height [17] (height_aiding.hpp). Odometer aiding: + VMS delay,
+// misalignment, scale factor at [kNav, kNav + 4) (odometer_error_model.hpp; [15, 19) loose, [17, 21) tight). Loose
+// with Gauss-Markov fix errors: + three NED fix-error states after all the others (fix_error_model.hpp).
 template <bool Tight, bool Terrain, bool Odometer, bool FixError>
 struct Layout {
+  static_assert(!(Terrain && Odometer), "height aiding and odometer aiding are not combined");
+  static_assert(!(Tight && FixError), "fix-error states are for fixes (loose)");
   static constexpr bool kHasClock = Tight, kHasTerrain = Terrain, kHasOdometer = Odometer, kHasFixError = FixError;
   static constexpr int kNav = Tight ? 17 : 15;                                 // INS (and clock) error states
   static constexpr int kBase = kNav + (Terrain ? 1 : 0) + (Odometer ? 4 : 0);  // before the fix-error states
+  static constexpr int kOdo = kNav;                                            // first odometer state
   static constexpr int kFix = kBase;                                           // first fix-error state
   static constexpr int N = kBase + (FixError ? 3 : 0);
 };
@@ -61,6 +64,7 @@ using OdometerLayout = Layout<false, false, true, false>;
 using OdometerFixErrorLayout = Layout<false, false, true, true>;
 using TightLayout = Layout<true, false, false, false>;
 using TightTerrainLayout = Layout<true, true, false, false>;
+using TightOdometerLayout = Layout<true, false, true, false>;
 
 // The filter of layout L (EKF or UKF as the options say), started at `initial`.
 template <class L>
@@ -74,5 +78,7 @@ extern template std::unique_ptr<CoreBase> make_core<OdometerFixErrorLayout>(cons
 extern template std::unique_ptr<CoreBase> make_core<TightLayout>(const ins::NavState&, const IntegrationOptions&);
 extern template std::unique_ptr<CoreBase> make_core<TightTerrainLayout>(const ins::NavState&,
                                                                         const IntegrationOptions&);
+extern template std::unique_ptr<CoreBase> make_core<TightOdometerLayout>(const ins::NavState&,
+                                                                         const IntegrationOptions&);
 
 }  // namespace ultratrack::fusion::gnss_ins_detail

@@ -45,7 +45,7 @@ inline bool finite(const Pending& p) {
 template <class L>
 using BaseModelFor =
     std::conditional_t<L::kHasTerrain, TerrainAugmentedModel,
-                       std::conditional_t<L::kHasOdometer, OdometerAugmentedModel, InsErrorModel<L::kNav>>>;
+                       std::conditional_t<L::kHasOdometer, OdometerAugmentedModel<L::kNav>, InsErrorModel<L::kNav>>>;
 template <class L>
 using ProcessModelFor =
     std::conditional_t<L::kHasFixError, FixErrorAugmentedModel<BaseModelFor<L>, L::kBase>, BaseModelFor<L>>;
@@ -191,7 +191,8 @@ class Core final : public CoreBase {
     // fix error), reset.
     nominal_ = corrected<kNav>(nominal_, filter_.x().template head<kNav>());
     if constexpr (L::kHasTerrain) terrain_m_ -= filter_.x()(ix::kTerrain);
-    if constexpr (L::kHasOdometer) odometer_ = corrected(odometer_, StateVector<19>(filter_.x().template head<19>()));
+    if constexpr (L::kHasOdometer)
+      odometer_ = corrected(odometer_, Eigen::Vector4d(filter_.x().template segment<4>(L::kOdo)));
     if constexpr (L::kHasFixError) fix_error_n_ -= filter_.x().template segment<3>(L::kFix);
     ins_.set_state(nominal_.nav);
     filter_.set_x(StateVector<N>::Zero());
@@ -316,7 +317,7 @@ class Core final : public CoreBase {
     }
     if constexpr (L::kHasOdometer) {
       o.odometer.value = odometer_;
-      o.odometer.sigma = {sd(ix::kOdoDelay), sd(ix::kOdoPitch), sd(ix::kOdoYaw), sd(ix::kOdoScale)};
+      o.odometer.sigma = {sd(L::kOdo), sd(L::kOdo + 1), sd(L::kOdo + 2), sd(L::kOdo + 3)};
     }
     if constexpr (L::kHasFixError) {
       o.fix_error_ned_m = fix_error_n_;
@@ -334,7 +335,7 @@ class Core final : public CoreBase {
     if constexpr (L::kHasTerrain)
       return TerrainAugmentedModel(o.model, o.height_aiding);
     else if constexpr (L::kHasOdometer)
-      return OdometerAugmentedModel(o.model, o.odometer);
+      return OdometerAugmentedModel<kNav>(o.model, o.odometer);
     else
       return InsErrorModel<kNav>(o.model);
   }
@@ -388,7 +389,7 @@ class Core final : public CoreBase {
     }
   }
 
-  // Odometer aiding (19 states): the INS heading and velocity after each IMU step over the last windows.
+  // Odometer aiding: the INS heading and velocity after each IMU step over the last windows.
   struct HistoryPoint {
     double t_s, yaw_rad;
     Eigen::Vector3d v_n;
@@ -419,10 +420,13 @@ class Core final : public CoreBase {
       const Eigen::Vector3d a_n =
           span > 0.0 ? Eigen::Vector3d((nominal_.nav.v_n - it->v_n) / span) : Eigen::Vector3d::Zero();
       const Eigen::Vector3d a_b = nominal_.nav.q_nb.conjugate() * a_n;
-      ++(update(for_filter<L, 19>(VmsMeasurement(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer)),
-                -4)
-             ? counters.odometer_accepted
-             : counters.odometer_rejected);
+      VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer);
+      bool accepted;
+      if constexpr (L::kOdo == ix::kOdoDelay)
+        accepted = update(for_filter<L, 19>(std::move(m)), -4);
+      else
+        accepted = update(OdometerStatesAt<VmsMeasurement, L::kOdo, N>(std::move(m)), -4);
+      ++(accepted ? counters.odometer_accepted : counters.odometer_rejected);
     }
   }
 
@@ -457,7 +461,7 @@ std::unique_ptr<CoreBase> make_core(const ins::NavState& initial, const Integrat
     P_base = TerrainAugmentedModel(mo, o.height_aiding)
                  .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else if constexpr (L::kHasOdometer)
-    P_base = OdometerAugmentedModel(mo, o.odometer)
+    P_base = OdometerAugmentedModel<L::kNav>(mo, o.odometer)
                  .initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);
   else
     P_base = InsErrorModel<L::kNav>(mo).initial_covariance(o.sigma_pos_ned_m, o.sigma_vel_n_mps, o.sigma_att_rad);

@@ -40,8 +40,8 @@ bool IntegrationOptions::IsValid(std::string* why) const {
     return fail("integration: Gauss-Markov fix-error states are for the loose coupling (fixes) only");
   if (o.fix_error.enabled && o.fix_error_correlation_s > 0.0)
     return fail("integration: fix errors either as Gauss-Markov states or by an inflated variance, not both");
-  if (o.odometer.enabled && o.coupling != Coupling::kLoose)
-    return fail("integration: odometer aiding is implemented for the loose coupling only");
+  if (o.coupling == Coupling::kTight && o.odometer.enabled && o.height_aiding.enabled)
+    return fail("integration: odometer aiding and height aiding are not combined (the odometer bounds the height)");
   if (o.land.nhc &&
       (!(o.land.nhc_sigma_mps > 0.0) || !(o.land.nhc_interval_s >= 0.0) || !o.land.lever_arm_b.allFinite()))
     return fail("integration: non-holonomic constraints need a positive sigma and interval >= 0");
@@ -71,7 +71,9 @@ GnssInsIntegration::GnssInsIntegration(const ins::NavState& initial, const Integ
   if (std::string why; !options.IsValid(&why)) throw std::invalid_argument(why);
   impl_->options = options;
   const bool odometer = options.odometer.enabled, fix_error = options.fix_error.enabled;
-  if (options.coupling == Coupling::kTight)
+  if (options.coupling == Coupling::kTight && odometer)
+    impl_->core = make_core<Layout<true, false, true, false>>(initial, options);
+  else if (options.coupling == Coupling::kTight)
     impl_->core = options.height_aiding.enabled ? make_core<Layout<true, true, false, false>>(initial, options)
                                                 : make_core<Layout<true, false, false, false>>(initial, options);
   else if (odometer && fix_error)

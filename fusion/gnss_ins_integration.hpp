@@ -14,8 +14,8 @@
 // later fix rejected.
 // Tight mode, optionally: height aiding (fusion/height_aiding.hpp) in epochs with fewer than 4 satellites.
 // Loose: 15 states, GnssFix. Tight: 17 states, ObservationEpoch + ephemerides; with height aiding 18 (+ the
-// terrain height). Loose with odometer aiding: 19 (+ VMS delay, misalignment, scale factor; [KimVMS]), odometer
-// speeds through add_odometer, gated by fusion/vms_measurement.hpp's rule. Loose with Gauss-Markov fix errors:
+// terrain height). With odometer aiding: 19 loose, 21 tight (+ VMS delay, misalignment, scale factor; [KimVMS]),
+// odometer speeds through add_odometer, gated by fusion/vms_measurement.hpp's rule. Loose with Gauss-Markov fix errors:
 // + 3 NED fix-error states after all others (18, or 22 with the odometer; fusion/fix_error_model.hpp). EKF or UKF.
 #pragma once
 
@@ -85,7 +85,7 @@ struct IntegrationOptions {
   FixErrorOptions fix_error;
   // Land vehicles: non-holonomic constraints (fusion/nhc_measurement.hpp), off by default.
   LandVehicleOptions land;
-  // Land vehicles: odometer (VMS) aiding, [KimVMS] (loose coupling only; off by default).
+  // Land vehicles: odometer (VMS) aiding, [KimVMS] (loose or tight; not with height aiding; off by default).
   OdometerAidingOptions odometer;
   UkfParameters ukf;
   Discretisation discretisation = Discretisation::SecondOrderSeries;

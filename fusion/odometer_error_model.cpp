@@ -26,50 +26,64 @@ bool OdometerAidingOptions::IsValid(std::string* why) const {
   return true;
 }
 
-OdometerNominal corrected(const OdometerNominal& n, const StateVector<19>& dx) {
+OdometerNominal corrected(const OdometerNominal& n, const Eigen::Vector4d& dx) {
   OdometerNominal out = n;
-  out.delay_s -= dx(ix::kOdoDelay);
-  out.pitch_rad -= dx(ix::kOdoPitch);
-  out.yaw_rad -= dx(ix::kOdoYaw);
-  out.scale_factor -= dx(ix::kOdoScale);
+  out.delay_s -= dx(0);
+  out.pitch_rad -= dx(1);
+  out.yaw_rad -= dx(2);
+  out.scale_factor -= dx(3);
   return out;
 }
 
-OdometerAugmentedModel::OdometerAugmentedModel(const InsErrorModelOptions& options,
-                                               const OdometerAidingOptions& odometer)
+OdometerNominal corrected(const OdometerNominal& n, const StateVector<19>& dx) {
+  static_assert(ix::kOdoPitch == ix::kOdoDelay + 1 && ix::kOdoYaw == ix::kOdoDelay + 2 &&
+                ix::kOdoScale == ix::kOdoDelay + 3);
+  return corrected(n, Eigen::Vector4d(dx.segment<4>(ix::kOdoDelay)));
+}
+
+template <int NB>
+OdometerAugmentedModel<NB>::OdometerAugmentedModel(const InsErrorModelOptions& options,
+                                                   const OdometerAidingOptions& odometer)
     : ins_(options), odo_(odometer) {
   if (std::string why; !odometer.IsValid(&why)) throw std::invalid_argument(why);
   set_linearisation(InsLinearisation{});
 }
 
-void OdometerAugmentedModel::set_linearisation(const InsLinearisation& lin) {
+template <int NB>
+void OdometerAugmentedModel<NB>::set_linearisation(const InsLinearisation& lin) {
   ins_.set_linearisation(lin);
   F_.setZero();
-  F_.topLeftCorner<15, 15>() = ins_.F(StateVector<15>::Zero());
+  F_.template topLeftCorner<NB, NB>() = ins_.F(StateVector<NB>::Zero());
   cached_dt_ = -1.0;
 }
 
-const StateMatrix<19>& OdometerAugmentedModel::transition(double dt) const {
+template <int NB>
+auto OdometerAugmentedModel<NB>::transition(double dt) const -> const StateMatrix<N>& {
   if (dt != cached_dt_) {
     cached_phi_.setIdentity();
-    cached_phi_.topLeftCorner<15, 15>() = ins_.transition(dt);  // the odometer states are constant
+    cached_phi_.template topLeftCorner<NB, NB>() = ins_.transition(dt);  // the odometer states are constant
     cached_dt_ = dt;
   }
   return cached_phi_;
 }
 
-StateVector<19> OdometerAugmentedModel::f(const StateVector<19>& x, double dt) const { return transition(dt) * x; }
+template <int NB>
+auto OdometerAugmentedModel<NB>::f(const StateVector<N>& x, double dt) const -> StateVector<N> {
+  return transition(dt) * x;
+}
 
-auto OdometerAugmentedModel::G(const StateVector<19>&) const -> Eigen::Matrix<double, 19, kNoiseSize> {
-  Eigen::Matrix<double, 19, kNoiseSize> g = Eigen::Matrix<double, 19, kNoiseSize>::Zero();
-  g.topLeftCorner<15, kNoiseSize - 4>() = ins_.G(StateVector<15>::Zero());
-  g.bottomRightCorner<4, 4>().setIdentity();
+template <int NB>
+auto OdometerAugmentedModel<NB>::G(const StateVector<N>&) const -> Eigen::Matrix<double, N, kNoiseSize> {
+  Eigen::Matrix<double, N, kNoiseSize> g = Eigen::Matrix<double, N, kNoiseSize>::Zero();
+  g.template topLeftCorner<NB, kNoiseSize - 4>() = ins_.G(StateVector<NB>::Zero());
+  g.template bottomRightCorner<4, 4>().setIdentity();
   return g;
 }
 
-auto OdometerAugmentedModel::Qc() const -> Eigen::Matrix<double, kNoiseSize, kNoiseSize> {
+template <int NB>
+auto OdometerAugmentedModel<NB>::Qc() const -> Eigen::Matrix<double, kNoiseSize, kNoiseSize> {
   Eigen::Matrix<double, kNoiseSize, kNoiseSize> q = Eigen::Matrix<double, kNoiseSize, kNoiseSize>::Zero();
-  q.topLeftCorner<kNoiseSize - 4, kNoiseSize - 4>() = ins_.Qc();
+  q.template topLeftCorner<kNoiseSize - 4, kNoiseSize - 4>() = ins_.Qc();
   const int o = kNoiseSize - 4;
   q(o + 0, o + 0) = odo_.delay_psd;
   q(o + 1, o + 1) = odo_.misalignment_psd;
@@ -78,15 +92,18 @@ auto OdometerAugmentedModel::Qc() const -> Eigen::Matrix<double, kNoiseSize, kNo
   return q;
 }
 
-StateMatrix<19> OdometerAugmentedModel::initial_covariance(const Eigen::Vector3d& sp, const Eigen::Vector3d& sv,
-                                                           const Eigen::Vector3d& sa) const {
-  StateMatrix<19> P = StateMatrix<19>::Zero();
-  P.topLeftCorner<15, 15>() = ins_.initial_covariance(sp, sv, sa);
-  P(ix::kOdoDelay, ix::kOdoDelay) = odo_.sigma_delay_s * odo_.sigma_delay_s;
-  P(ix::kOdoPitch, ix::kOdoPitch) = odo_.sigma_misalignment_rad * odo_.sigma_misalignment_rad;
-  P(ix::kOdoYaw, ix::kOdoYaw) = odo_.sigma_misalignment_rad * odo_.sigma_misalignment_rad;
-  P(ix::kOdoScale, ix::kOdoScale) = odo_.sigma_scale_factor * odo_.sigma_scale_factor;
+template <int NB>
+auto OdometerAugmentedModel<NB>::initial_covariance(const Eigen::Vector3d& sp, const Eigen::Vector3d& sv,
+                                                    const Eigen::Vector3d& sa) const -> StateMatrix<N> {
+  StateMatrix<N> P = StateMatrix<N>::Zero();
+  P.template topLeftCorner<NB, NB>() = ins_.initial_covariance(sp, sv, sa);
+  const Eigen::Vector4d sigma(odo_.sigma_delay_s, odo_.sigma_misalignment_rad, odo_.sigma_misalignment_rad,
+                              odo_.sigma_scale_factor);
+  P.template bottomRightCorner<4, 4>() = sigma.cwiseAbs2().asDiagonal();
   return P;
 }
+
+template class OdometerAugmentedModel<15>;
+template class OdometerAugmentedModel<17>;
 
 }  // namespace ultratrack::fusion

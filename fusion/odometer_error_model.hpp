@@ -3,14 +3,18 @@
 // fusion/ins_error_state.hpp plus four odometer (VMS) states, each estimate minus truth:
 //   [15] VMS time delay error, s         [16] mounting misalignment pitch error, rad (about the vehicle's y)
 //   [17] mounting misalignment yaw error, rad (about z)          [18] VMS scale-factor error, ratio
+// The tight coupling keeps its clock states at [15, 17) and appends the same four at [17, 21): the model is a
+// template on the base size NB (15, or 17 with the clock) and the odometer states sit at [NB, NB + 4) in that order.
+// The ix::kOdo* indices below are those of the 19-state order, in which fusion/vms_measurement.hpp is written.
 // The odometer states are random constants with an optional random walk (tyre wear, load). The options hold
 // the odometer aiding's settings too: the gating rule of eqs. 16-17 (fusion/vms_measurement.hpp), its rate,
 // the lever arm to the wheels' non-holonomic point and the measurement sigmas.
-// Satisfies ProcessModel<19> (filter_types.hpp): the EKF and the UKF take it as they take the 15-state model.
+// Satisfies ProcessModel<NB + 4> (filter_types.hpp): the EKF and the UKF take it as they take the 15-state model.
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 
 #include "fusion/filter_types.hpp"
 #include "fusion/ins_error_model.hpp"
@@ -67,31 +71,68 @@ struct OdometerEstimate {
   OdometerNominal sigma;
 };
 
-// The nominal with the error state's odometer part removed (truth = nominal - dx).
+// The nominal with the error state's odometer part removed (truth = nominal - dx); dx_odometer holds the four
+// odometer states in the order delay, pitch, yaw, scale factor.
+OdometerNominal corrected(const OdometerNominal& nominal, const Eigen::Vector4d& dx_odometer);
+// The same from a 19-state vector (odometer states at ix::kOdo*).
 OdometerNominal corrected(const OdometerNominal& nominal, const StateVector<19>& dx);
 
+// NB = 15: the INS errors (loose); NB = 17: the INS and receiver clock errors (tight). N = NB + 4.
+template <int NB>
 class OdometerAugmentedModel {
  public:
-  static constexpr int kNoiseSize = InsErrorModel<15>::kNoiseSize + 4;
+  static constexpr int N = NB + 4;
+  static constexpr int kIndex = NB;  // first odometer state (the delay)
+  static constexpr int kNoiseSize = InsErrorModel<NB>::kNoiseSize + 4;
 
   OdometerAugmentedModel(const InsErrorModelOptions& options, const OdometerAidingOptions& odometer);
 
   void set_linearisation(const InsLinearisation& lin);
-  StateVector<19> f(const StateVector<19>& x, double dt) const;
-  const StateMatrix<19>& transition(double dt) const;
-  StateMatrix<19> F(const StateVector<19>& /*x*/) const { return F_; }
-  Eigen::Matrix<double, 19, kNoiseSize> G(const StateVector<19>& x) const;
+  StateVector<N> f(const StateVector<N>& x, double dt) const;
+  const StateMatrix<N>& transition(double dt) const;
+  StateMatrix<N> F(const StateVector<N>& /*x*/) const { return F_; }
+  Eigen::Matrix<double, N, kNoiseSize> G(const StateVector<N>& x) const;
   Eigen::Matrix<double, kNoiseSize, kNoiseSize> Qc() const;
-  // The 15-state covariance and the odometer sigmas, uncorrelated.
-  StateMatrix<19> initial_covariance(const Eigen::Vector3d& sigma_pos_ned_m, const Eigen::Vector3d& sigma_vel_n_mps,
-                                     const Eigen::Vector3d& sigma_att_rad) const;
+  // The base model's covariance and the odometer sigmas, uncorrelated.
+  StateMatrix<N> initial_covariance(const Eigen::Vector3d& sigma_pos_ned_m, const Eigen::Vector3d& sigma_vel_n_mps,
+                                    const Eigen::Vector3d& sigma_att_rad) const;
 
  private:
-  InsErrorModel<15> ins_;
+  InsErrorModel<NB> ins_;
   OdometerAidingOptions odo_;
-  StateMatrix<19> F_ = StateMatrix<19>::Zero();
+  StateMatrix<N> F_ = StateMatrix<N>::Zero();
   mutable double cached_dt_ = -1.0;
-  mutable StateMatrix<19> cached_phi_ = StateMatrix<19>::Identity();
+  mutable StateMatrix<N> cached_phi_ = StateMatrix<N>::Identity();
+};
+
+extern template class OdometerAugmentedModel<15>;
+extern template class OdometerAugmentedModel<17>;
+
+// A measurement written for the 19-state order (INS errors, then the odometer's four: VmsMeasurement) as a filter
+// of N states takes it whose odometer states start at Offset (the other states do not enter it).
+template <class M, int Offset, int N>
+class OdometerStatesAt {
+ public:
+  static constexpr int kMeasurementSize = measurement_size_v<M>;
+  explicit OdometerStatesAt(M m) : m_(std::move(m)) {}
+  Eigen::VectorXd z() const { return m_.z(); }
+  Eigen::VectorXd h(const StateVector<N>& dx) const { return m_.h(gather(dx)); }
+  MeasurementJacobian<N> H(const StateVector<N>& dx) const {
+    const MeasurementJacobian<19> h19 = m_.H(gather(dx));
+    MeasurementJacobian<N> out = MeasurementJacobian<N>::Zero(h19.rows(), N);
+    out.leftCols(15) = h19.leftCols(15);
+    out.middleCols(Offset, 4) = h19.rightCols(4);
+    return out;
+  }
+  Eigen::MatrixXd R() const { return m_.R(); }
+
+ private:
+  static StateVector<19> gather(const StateVector<N>& dx) {
+    StateVector<19> x;
+    x << dx.template head<15>(), dx.template segment<4>(Offset);
+    return x;
+  }
+  M m_;
 };
 
 }  // namespace ultratrack::fusion

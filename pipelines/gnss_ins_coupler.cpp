@@ -373,6 +373,7 @@ struct GnssInsCoupler::Impl {
       } else {
         if (eph.size() < 4) ++epochs_below_4;
         integration->add_observations(e, eph, iono());
+        if (odometer_use && !e.observations.empty()) odometer_use->gnss_last_used_s = t;
         ++used;
       }
     } else if (f) {

@@ -4,7 +4,7 @@
 // fusion::GnssInsIntegration: loose: each PVT fix (position and Doppler velocity with the PVT's a-priori
 // covariance) -> GnssFix; tight: each observation epoch (raw pseudoranges and Doppler; ephemerides from the
 // navigation file and the decoded ones; the PVT's elevation mask, atmosphere switches and elevation/C/N0 sigma
-// model) -> pseudorange and rate updates, also with fewer than four satellites. Loose with odometer rows
+// model) -> pseudorange and rate updates, also with fewer than four satellites. Loose or tight with odometer rows
 // (ReceiveOptions::odometer): their speed windows as `fuse --odometer`'s VMS/NHC updates (pipelines/fuse.hpp), which
 // bridge signal blockages; summary.json's fusion object then has fuse's "odometer" object. The INS starts after the
 // alignment (static: levelling + gyrocompassing over the first seconds; motion: from the fixes' velocities; config: the

@@ -33,8 +33,8 @@ struct ReceiveOptions {
   FuseConfig navigation;                // `fuse`'s configuration keys
   ImuTimeOrigin imu_time_origin;
   std::string imu_name = "IMU data";  // names the IMU data in errors and summary.json (the file's path)
-  // kLoose: odometer rows (empty: no odometer aiding; `fuse --odometer`'s VMS/NHC updates, [odometer] keys) and the
-  // name of their file for errors and summary.json.
+  // kLoose, kTight: odometer rows (empty: no odometer aiding; `fuse --odometer`'s VMS/NHC updates, [odometer] keys) and
+  // the name of their file for errors and summary.json.
   std::vector<ins::OdometerSample> odometer;
   std::string odometer_name = "odometer data";
 

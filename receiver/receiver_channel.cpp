@@ -311,7 +311,10 @@ KnownBits ReceiverChannel::known_bits(const CorrelationEpoch& e, int wanted) {
 
 std::optional<ChannelMeasurement> ReceiverChannel::measure() {
   if (!synchronised() || !(week_trusted_ || nav_.decoder().week_known())) return std::nullopt;
-  if (loop_.coasting()) {  // no signal: nothing measured; the track resumes as a new one (loss of lock)
+  // No signal (coasting, or a sudden fade of a channel no vector loop holds: receiver/fade_detector.hpp; a vector
+  // loop's channels have its presence test and coasting instead): nothing measured; the track resumes as a new one
+  // (loss of lock).
+  if (loop_.coasting() || (!vector_.vector && loop_.signal_faded())) {
     reported_ = false;
     return std::nullopt;
   }

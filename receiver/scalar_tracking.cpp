@@ -190,6 +190,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
     if (long_.enabled()) long_.add_cn0(*c, state_ == TrackingState::kBitSynced);
   }
   r.cn0_dbhz = cn0_dbhz_;
+  fade_.add(taps.prompt, taps.noise, cn0_dbhz_, t);
   r.phase_locked = r.pli >= opt_.pli_lock_threshold;
   // Filter-driven: the presence test on every 20 ms epoch (long sums included: energy, not phase); while
   // coasting it looks for the signal's return.

@@ -4,8 +4,9 @@
 // (2nd/3rd order); carrier-aided DLL (normalised early-minus-late envelope);
 // 1 ms epochs, then 20 ms coherent after bit sync; C/N0, phase-lock and C/N0 lock detectors; loss of lock is
 // a state (kLost), never silently tracked noise. Units: Hz, chips, cycles, seconds; C/N0 in dB-Hz at the edge.
-// The class composes its stages: PullIn (pull_in.hpp), LongCoherentIntegration (long_coherent.hpp) and
-// LossOfLockTest (loss_of_lock.hpp); its options are in scalar_tracking_options.hpp.
+// The class composes its stages: PullIn (pull_in.hpp), LongCoherentIntegration (long_coherent.hpp),
+// LossOfLockTest (loss_of_lock.hpp) and FadeDetector (fade_detector.hpp: a blockage seen within an epoch, so that
+// the channel's measurements stop before the loss test ends its lock); its options are in scalar_tracking_options.hpp.
 #pragma once
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include "receiver/carrier_control.hpp"
 #include "receiver/correlation_epoch.hpp"
 #include "receiver/discriminators.hpp"
+#include "receiver/fade_detector.hpp"
 #include "receiver/lock_detectors.hpp"
 #include "receiver/long_coherent.hpp"
 #include "receiver/loop_filters.hpp"
@@ -131,6 +133,10 @@ class ScalarTracking final {
   // The absent windows a filter-driven channel's loss needs at its current level (PresenceMonitor).
   int presence_required_windows() const { return loss_.presence_required_windows(); }
   bool relocking() const { return relocking_; }
+  // A sudden fade of a strong signal (receiver/fade_detector.hpp: a blockage) is in progress: the loops run on, but
+  // what they measure is noise-driven until it ends.
+  bool signal_faded() const { return fade_.faded(); }
+  long long signal_fades() const { return fade_.fades(); }
   std::optional<double> cn0_dbhz() const { return cn0_dbhz_; }
   double pli() const { return pli_.value(); }
   // Bit sync result (valid once state is kBitSynced or bit_synchronised()).
@@ -173,6 +179,7 @@ class ScalarTracking final {
   PullIn pull_in_;
   LongCoherentIntegration long_;
   LossOfLockTest loss_;
+  FadeDetector fade_;
   CrossDot relock_fll_{};
   double relock_s_ = 0.0;
   double pll_bw_now_hz_ = 0.0;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Odometer aiding (fusion/vms_measurement.hpp, fusion/odometer_error_model.hpp): the VMS/NHC Jacobian against
 // central differences of h, h against the closed form for known errors, the gating rule of [KimVMS] eqs.
-// 16-17, and a short drive where the 19-state filter recovers a simulated scale factor.
+// 16-17, a short drive where the 19-state filter recovers a simulated scale factor, and the tight layout (clock at
+// [15, 17), odometer at [17, 21)): the measurement moved there by OdometerStatesAt, the model's blocks.
 #include "fusion/vms_measurement.hpp"
 
 #include <gtest/gtest.h>
@@ -96,7 +97,7 @@ TEST(OdometerAugmentedModel, KeepsTheOdometerStatesConstantAndRunsInBothFilters)
   InsErrorModelOptions mo;
   mo.accel.bias_sigma = 1e-3;
   mo.gyro.bias_sigma = 1e-5;
-  OdometerAugmentedModel model(mo, oo);
+  OdometerAugmentedModel<15> model(mo, oo);
   InsLinearisation lin;
   lin.nav = moving_nominal().nav;
   lin.f_b = Eigen::Vector3d(0.0, 0.0, -9.8);
@@ -120,6 +121,50 @@ TEST(OdometerAugmentedModel, KeepsTheOdometerStatesConstantAndRunsInBothFilters)
   // Estimate minus truth with truth = nominal (0) - dx: dx < 0 means an estimated scale factor > 0.
   EXPECT_LT(ekf.x()(ix::kOdoScale), -0.002);
   EXPECT_NEAR(ukf.x()(ix::kOdoScale), ekf.x()(ix::kOdoScale), 1e-3);
+}
+
+// The tight layout's measurement: h and H on 21 states equal the 19-state ones with the clock states inert and the
+// odometer block moved to [17, 21) (a copy of the state vector made here, not by the adapter).
+TEST(OdometerStatesAt, MovesTheOdometerBlockBehindTheClock) {
+  const VmsMeasurement m(moving_nominal(), some_odometer(), Eigen::Vector3d(0.01, -0.02, 0.05),
+                         Eigen::Vector3d(0.8, 0.3, -0.1), {100.0, 22.3, 1.0}, OdometerAidingOptions{});
+  const OdometerStatesAt<VmsMeasurement, 17, 21> moved(m);
+  StateVector<19> x19;
+  x19 << 0.3, -0.2, 0.5, 0.01, -0.02, 0.03, 1e-4, -2e-4, 3e-4, 1e-3, 2e-3, -1e-3, 1e-5, 2e-5, -3e-5, 0.01, 1e-3, -2e-3,
+      0.004;
+  StateVector<21> x21;
+  x21 << x19.head<15>(), 7.0, -3.0, x19.tail<4>();  // clock bias and drift errors: no effect on the odometer
+  EXPECT_TRUE(moved.h(x21).isApprox(m.h(x19), 1e-12));
+  const MeasurementJacobian<19> H19 = m.H(x19);
+  const MeasurementJacobian<21> H21 = moved.H(x21);
+  EXPECT_TRUE(H21.leftCols<15>().isApprox(H19.leftCols<15>()));
+  EXPECT_TRUE(H21.middleCols<2>(15).isZero());
+  EXPECT_TRUE(H21.rightCols<4>().isApprox(H19.rightCols<4>()));
+}
+
+// The 21-state model: the INS-and-clock block is InsErrorModel<17>'s, the odometer states are constant, the initial
+// covariance holds the odometer sigmas at [17, 21).
+TEST(OdometerAugmentedModel, TightLayoutKeepsTheClockModelAndTheOdometerStatesConstant) {
+  OdometerAidingOptions oo;
+  InsErrorModelOptions mo;
+  mo.accel.bias_sigma = 1e-3;
+  mo.gyro.bias_sigma = 1e-5;
+  OdometerAugmentedModel<17> model(mo, oo);
+  InsErrorModel<17> base(mo);
+  InsLinearisation lin;
+  lin.nav = moving_nominal().nav;
+  lin.f_b = Eigen::Vector3d(0.0, 0.0, -9.8);
+  model.set_linearisation(lin);
+  base.set_linearisation(lin);
+  const StateMatrix<21> phi = model.transition(0.5);
+  EXPECT_TRUE((phi.topLeftCorner<17, 17>().isApprox(base.transition(0.5))));
+  EXPECT_TRUE((phi.bottomRightCorner<4, 4>().isIdentity()));
+  EXPECT_TRUE((phi.topRightCorner<17, 4>().isZero()));
+  const StateMatrix<21> P0 = model.initial_covariance(Eigen::Vector3d::Constant(1.0), Eigen::Vector3d::Constant(0.1),
+                                                      Eigen::Vector3d::Constant(1e-3));
+  EXPECT_DOUBLE_EQ(P0(17, 17), oo.sigma_delay_s * oo.sigma_delay_s);
+  EXPECT_DOUBLE_EQ(P0(20, 20), oo.sigma_scale_factor * oo.sigma_scale_factor);
+  EXPECT_GT(P0(ix::kClockBias, ix::kClockBias), 0.0);
 }
 
 }  // namespace
