@@ -4,11 +4,11 @@
 # aiding on land"): simulates scenarios/odometer_tunnel.toml (a car at 20 m/s, HG1700AE, a 10 Hz odometer with
 # scale factor, delay and mounting errors, every satellite blocked from 30 s to 90 s) and runs
 # `receive --imu imu.csv --coupling C` on it without and with `--odometer odometer.csv` for each coupling C (loose,
-# tight: the odometer states ride in either filter). Prints, for each run, the horizontal error against truth.csv at
-# the tunnel's entry (30 s) and exit (90 s) and its RMS over the blockage (benchmarks/nav_error_stats.py), and the
-# odometer object's estimates.
+# tight, ultra-tight: the odometer states ride in every filter). Prints, for each run, the horizontal error against
+# truth.csv at the tunnel's entry (30 s) and exit (90 s) and its RMS over the blockage (benchmarks/nav_error_stats.py),
+# and the odometer object's estimates.
 # CPU: ~10 s simulate + ~1-3 s per receive on one core; 400 MB of samples in --out (deleted unless --keep).
-# Usage: benchmarks/odometer_tunnel.sh [--build DIR] [--out DIR] [--couplings "loose tight"]
+# Usage: benchmarks/odometer_tunnel.sh [--build DIR] [--out DIR] [--couplings "loose tight ultra-tight"]
 #          [--brdc RINEX --week W --tow-shift S] [--keep]
 #   --brdc (or --nav): the scenario's broadcast ephemerides (default the shipped tests/data file;
 #   benchmarks/ephemeris_option.sh)
@@ -16,7 +16,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 root=$here
 source "$here/benchmarks/ephemeris_option.sh"
-build="$here/build"; out="${TMPDIR:-/tmp}/odometer_tunnel"; keep=0; couplings="loose tight"
+build="$here/build"; out="${TMPDIR:-/tmp}/odometer_tunnel"; keep=0; couplings="loose tight ultra-tight"
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build="$2"; shift 2 ;; --out) out="$2"; shift 2 ;; --keep) keep=1; shift ;;

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <cmath>
-#include <deque>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -14,6 +13,7 @@
 #include <variant>
 
 #include "fusion/gnss_ins_core.hpp"
+#include "fusion/odometer_history.hpp"
 #include "ins/attitude.hpp"
 #include "signals/gps_constants.hpp"
 
@@ -166,7 +166,7 @@ class Core final : public CoreBase {
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
     if constexpr (L::kHasFixError)
       fix_error_n_ = propagate_fix_error(fix_error_n_, dt, opt_.fix_error.correlation_time_s);
-    if constexpr (L::kHasOdometer) record_history();
+    if constexpr (L::kHasOdometer) history_.record(nominal_.nav, 1.0 / opt_.odometer.update_rate_hz + 1.0);
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
 
@@ -389,38 +389,18 @@ class Core final : public CoreBase {
     }
   }
 
-  // Odometer aiding: the INS heading and velocity after each IMU step over the last windows.
-  struct HistoryPoint {
-    double t_s, yaw_rad;
-    Eigen::Vector3d v_n;
-  };
-  void record_history() {
-    const double yaw = ins::euler_from_quaternion(nominal_.nav.q_nb).yaw_rad;
-    history_.push_back({nominal_.nav.t_s, yaw, nominal_.nav.v_n});
-    const double keep_s = 1.0 / opt_.odometer.update_rate_hz + 1.0;
-    while (history_.size() > 2 && history_[1].t_s < nominal_.nav.t_s - keep_s) history_.pop_front();
-  }
-
   // One odometer window ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
   void apply_odometer(const OdometerSpeed& speed) {
     if constexpr (L::kHasOdometer) {
-      const double t0 = nominal_.nav.t_s - speed.window_s;
-      if (history_.empty() || history_.front().t_s > t0 + 1e-6) {
+      const auto w = history_.window(nominal_.nav, speed, opt_.odometer);
+      if (!w) {
         ++counters.odometer_unusable;
         return;
       }
-      auto it = history_.begin();  // the last point at or before the window's start
-      while (std::next(it) != history_.end() && std::next(it)->t_s <= t0 + 1e-9) ++it;
-      const double yaw_now = ins::euler_from_quaternion(nominal_.nav.q_nb).yaw_rad;
-      const OdometerGate gate = odometer_gate(opt_.odometer, yaw_now - it->yaw_rad, speed.window_s, speed.speed_mps);
-      if (!gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
-      if (!gate.speed_ok) ++counters.odometer_gated_speed;
-      if (!gate.update()) return;
-      const double span = nominal_.nav.t_s - it->t_s;
-      const Eigen::Vector3d a_n =
-          span > 0.0 ? Eigen::Vector3d((nominal_.nav.v_n - it->v_n) / span) : Eigen::Vector3d::Zero();
-      const Eigen::Vector3d a_b = nominal_.nav.q_nb.conjugate() * a_n;
-      VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, a_b, speed, opt_.odometer);
+      if (!w->gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
+      if (!w->gate.speed_ok) ++counters.odometer_gated_speed;
+      if (!w->gate.update()) return;
+      VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, w->a_b, speed, opt_.odometer);
       bool accepted;
       if constexpr (L::kOdo == ix::kOdoDelay)
         accepted = update(for_filter<L, 19>(std::move(m)), -4);
@@ -446,7 +426,7 @@ class Core final : public CoreBase {
   double last_fix_t_s_ = -1e300;
   OdometerNominal odometer_;
   Eigen::Vector3d fix_error_n_ = Eigen::Vector3d::Zero();  // Gauss-Markov fix error estimate, NED [m]
-  std::deque<HistoryPoint> history_;
+  OdometerHistory history_;  // odometer aiding: the INS heading and velocity over the last windows
 };
 
 template <class L>

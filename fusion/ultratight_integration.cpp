@@ -8,8 +8,10 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <type_traits>
 
 #include "fusion/carrier_rate_measurement.hpp"
+#include "fusion/odometer_history.hpp"
 #include "fusion/ultratight_measurement_models.hpp"
 #include "ins/earth_model.hpp"
 #include "signals/gps_constants.hpp"
@@ -46,6 +48,7 @@ bool UltraTightOptions::IsValid(std::string* why) const {
     return fail("ultra-tight: gate probability must lie in (0, 1)");
   if (!std::isfinite(o.coast_cn0_dbhz)) return fail("ultra-tight: coasting threshold not finite");
   if (std::isnan(o.measurement_mask_rad)) return fail("ultra-tight: measurement mask is NaN");
+  if (std::string inner; o.odometer.enabled && !o.odometer.IsValid(&inner)) return fail("ultra-tight: " + inner);
   return true;
 }
 
@@ -58,6 +61,7 @@ struct UltraTightCoreBase {
   virtual NominalState nominal() const = 0;
   virtual Eigen::MatrixXd covariance() const = 0;
   virtual void set_covariance(const Eigen::MatrixXd& P) = 0;
+  virtual void add_odometer(const OdometerSpeed& speed) = 0;
   std::vector<ReplicaCommand> replicas;
   std::vector<UltraTightSatelliteUpdate> last_updates;
   IntegrationOutput output;
@@ -76,17 +80,25 @@ struct ChannelState {
   double end_phase_rad = 0.0, end_phase_var_rad2 = 0.0, end_phase_t_s = 0.0;
 };
 
+// N = 17 (INS and clock errors) or 21 (+ the odometer's four at [17, 21): UltraTightOptions::odometer). The I&Q,
+// discriminator and carrier-rate models are written for the first 17 and padded.
 template <class Filter>
 class UltraTightCore final : public UltraTightCoreBase {
+  static constexpr int N = Filter::kStateSize;
+  static constexpr bool kOdometer = N == 21;
+  static_assert(N == 17 || N == 21);
+  using Model = std::conditional_t<kOdometer, OdometerAugmentedModel<17>, InsErrorModel<17>>;
+
  public:
   UltraTightCore(const ins::NavState& initial, std::vector<signals::Ephemeris> eph, const UltraTightOptions& o,
                  Filter filter)
-      : opt_(o), eph_(std::move(eph)), ins_(initial, o.strapdown), model_(o.model), filter_(std::move(filter)) {
+      : opt_(o), eph_(std::move(eph)), ins_(initial, o.strapdown), model_(make_model(o)), filter_(std::move(filter)) {
     nominal_.nav = ins_.state();
     nominal_.clock_bias_m = o.initial_clock_bias_m;
     nominal_.clock_drift_mps = o.initial_clock_drift_mps;
     nominal_.accel_bias_b = o.initial_accel_bias_b;
     nominal_.gyro_bias_b = o.initial_gyro_bias_b;
+    odometer_ = o.initial_odometer;
     InsLinearisation lin;
     lin.nav = nominal_.nav;
     lin.f_b = nominal_.nav.q_nb.conjugate() * Eigen::Vector3d(0.0, 0.0, -9.80665);
@@ -104,7 +116,34 @@ class UltraTightCore final : public UltraTightCoreBase {
     nominal_.nav = ins_.state();
     nominal_.clock_bias_m += nominal_.clock_drift_mps * dt;
     imu_steps_.add(q0, nominal_.nav.q_nb, dth, dv, dt);
+    if constexpr (kOdometer) history_.record(nominal_.nav, 1.0 / opt_.odometer.update_rate_hz + 1.0);
     fill_output();
+  }
+
+  // One odometer window ending now ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
+  void add_odometer(const OdometerSpeed& speed) override {
+    if constexpr (kOdometer) {
+      if (!std::isfinite(speed.speed_mps) || !(speed.window_s > 0.0) || !std::isfinite(speed.window_s)) {
+        ++counters.odometer_unusable;
+        return;
+      }
+      const auto w = history_.window(nominal_.nav, speed, opt_.odometer);
+      if (!w) {
+        ++counters.odometer_unusable;
+        return;
+      }
+      if (!w->gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
+      if (!w->gate.speed_ok) ++counters.odometer_gated_speed;
+      if (!w->gate.update()) return;
+      propagate();
+      const VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, w->a_b, speed, opt_.odometer);
+      ++(apply(OdometerStatesAt<VmsMeasurement, 17, N>(m)).accepted ? counters.odometer_accepted
+                                                                    : counters.odometer_rejected);
+      fill_output();
+    } else {
+      (void)speed;
+      throw std::logic_error("ultra-tight: odometer aiding is not enabled");
+    }
   }
 
   void add_ephemerides(const std::vector<signals::Ephemeris>& eph) override {
@@ -179,18 +218,19 @@ class UltraTightCore final : public UltraTightCoreBase {
     // -0.91: the frequency the taps see is nearly the drift at the period's start); for the white FM (S_b) the
     // mean phase's rate equivalent (2 / T^2) int (T - s) db(s) has covariance S_b with the bias increment.
     const double common_var = usable_count > 0 ? clock_rate_noise_var(T_) : 0.0;
-    StateMatrix<17> P_prime;
-    StateVector<17> cov_xe = StateVector<17>::Zero();
+    StateMatrix<N> P_prime;
+    StateVector<N> cov_xe = StateVector<N>::Zero();
     if (common_var > 0.0) {
       cov_xe(ix::kClockBias) = opt_.model.clock.bias_psd_m2_per_s;
       cov_xe(ix::kClockDrift) = -2.0 * opt_.model.clock.drift_psd_m2_per_s3 * T_ / 3.0;
       P_prime = filter_.P();
-      StateVector<17> u = StateVector<17>::Zero();
+      StateVector<N> u = StateVector<N>::Zero();
       u(ix::kClockDrift) = 1.0;
       P_prime += common_var * u * u.transpose() + u * cov_xe.transpose() + cov_xe * u.transpose();
       filter_.set_P(P_prime);
     }
     period_dx_.setZero();
+    period_odometer_dx_.setZero();
     struct EndPhase {
       ChannelState* ch;
       ReplicaErrors17 rep;  // at the nominal of the satellite's update
@@ -260,17 +300,18 @@ class UltraTightCore final : public UltraTightCoreBase {
         IqPeriodOptions period;
         period.offset = offset;
         period.span_s = span;
-        period.prior_code_sigma_chips = prior_code_sigma_chips(rep, filter_.P(), span);
+        period.prior_code_sigma_chips = prior_code_sigma_chips(rep, P17(), span);
         period.clock_rate_var_m2ps2 = clock_rate_var;
         period.start_phase_rad = start_phase;
         period.start_phase_var_rad2 = start_phase_var;
-        ok = update(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, c->taps, period));
+        ok =
+            update(padded(PeriodIqMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, is, c->taps, period)));
       } else {
         // The frequency discriminator reads the mean phase, start phase + pi T f(T / 3): the start phase comes off.
-        ok = update(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset, span,
-                                                   period_discriminator_errors(c->taps, is, start_phase),
-                                                   discriminator_noise(is), clock_rate_var,
-                                                   start_phase_rate_variance(start_phase_var, T_)));
+        ok = update(padded(PeriodDiscriminatorMeasurement(nominal_, *s, opt_.lever_arm_b, imu_steps_.w_ib_b, offset,
+                                                          span, period_discriminator_errors(c->taps, is, start_phase),
+                                                          discriminator_noise(is), clock_rate_var,
+                                                          start_phase_rate_variance(start_phase_var, T_))));
       }
       if (c->continuous_carrier) {
         // This epoch's end phase (after the period's last update, below): its measured mean phase (data wiped:
@@ -310,7 +351,7 @@ class UltraTightCore final : public UltraTightCoreBase {
     const Eigen::Vector3d r_ant = antenna_position_e(nominal_.nav, opt_.lever_arm_b);
     const Eigen::Vector3d v_ant = ins::C_en(nominal_.nav.lat_rad, nominal_.nav.lon_rad) *
                                   antenna_velocity_n(nominal_.nav, imu_steps_.w_ib_b, opt_.lever_arm_b);
-    const StateMatrix<17>& P = filter_.P();
+    const StateMatrix<17> P = P17();
     for (const ReplicaCommand& command : replicas) {
       if (command.aided_only) continue;
       const ChannelCorrelation* c = find_prn(corr, command.prn);
@@ -344,18 +385,39 @@ class UltraTightCore final : public UltraTightCoreBase {
     if (rows.empty()) return;
     ++counters.rate_updates;
     counters.rate_rows += static_cast<long long>(rows.size());
-    if (apply(CarrierRateMeasurement(nominal_, rows, opt_.lever_arm_b, imu_steps_.w_ib_b, common_var)).accepted)
+    if (apply(padded(CarrierRateMeasurement(nominal_, rows, opt_.lever_arm_b, imu_steps_.w_ib_b, common_var))).accepted)
       ++counters.rate_accepted;
   }
 
   NominalState nominal() const override { return nominal_; }
-  Eigen::MatrixXd covariance() const override { return filter_.P(); }
+  Eigen::MatrixXd covariance() const override { return P17(); }
+  // The INS-and-clock block; with the odometer states theirs is kept and the cross terms dropped (a block-diagonal
+  // of two covariances is one).
   void set_covariance(const Eigen::MatrixXd& P) override {
-    filter_.set_P(StateMatrix<17>(P));
+    StateMatrix<N> full = StateMatrix<N>::Zero();
+    full.template topLeftCorner<17, 17>() = P;
+    if constexpr (kOdometer) full.template bottomRightCorner<4, 4>() = filter_.P().template bottomRightCorner<4, 4>();
+    filter_.set_P(full);
     fill_output();
   }
 
  private:
+  static Model make_model(const UltraTightOptions& o) {
+    if constexpr (kOdometer)
+      return Model(o.model, o.odometer);
+    else
+      return Model(o.model);
+  }
+  StateMatrix<17> P17() const { return filter_.P().template topLeftCorner<17, 17>(); }
+  // A model written for the 17 INS-and-clock states, as the filter of N states takes it.
+  template <class M>
+  static auto padded(M m) {
+    if constexpr (N == 17)
+      return m;
+    else
+      return PaddedMeasurement<M, 17, N>(std::move(m));
+  }
+
   // Satellites above the mask predicted from the current nominal (antenna position, clock): two passes of
   // the transmit-time iteration through prepare_satellites, the pseudorange and rate then being predictions.
   void predict_satellites(std::vector<SatelliteObservable>& out) const {
@@ -417,19 +479,20 @@ class UltraTightCore final : public UltraTightCoreBase {
   // posterior x' (mean delta = the period's corrections, covariance P'_post): mean m = w' delta, variance
   // v - g' w + w' P'_post w, Cov(x', e) = P'_post w. The state is x = x' - u e: the nominal's drift loses m,
   // P = P'_post - c u' - u c' + var u u' (c = P'_post w). With no update this returns P exactly.
-  void end_common_clock(const StateMatrix<17>& P_prime, double v, const StateVector<17>& c0) {
-    StateVector<17> u = StateVector<17>::Zero();
+  void end_common_clock(const StateMatrix<N>& P_prime, double v, const StateVector<N>& c0) {
+    StateVector<N> u = StateVector<N>::Zero();
     u(ix::kClockDrift) = 1.0;
-    const StateVector<17> g = c0 + v * u;
-    const StateVector<17> w = P_prime.ldlt().solve(g);
-    const StateMatrix<17> P_post = filter_.P();
-    const double m = w.dot(period_dx_);
+    const StateVector<N> g = c0 + v * u;
+    const StateVector<N> w = P_prime.ldlt().solve(g);
+    const StateMatrix<N> P_post = filter_.P();
+    double m = w.template head<17>().dot(period_dx_);
+    if constexpr (kOdometer) m += w.template tail<4>().dot(period_odometer_dx_);
     const double var = std::max(0.0, v - g.dot(w) + w.dot(P_post * w));
-    const StateVector<17> c = P_post * w;
-    StateMatrix<17> P = P_post - c * u.transpose() - u * c.transpose() + var * u * u.transpose();
+    const StateVector<N> c = P_post * w;
+    StateMatrix<N> P = P_post - c * u.transpose() - u * c.transpose() + var * u * u.transpose();
     filter_.set_P(0.5 * (P + P.transpose()));
     if (m != 0.0) {
-      nominal_ = corrected<17>(nominal_, StateVector<17>(-m * u));
+      nominal_ = corrected<17>(nominal_, StateVector<17>(-m * u.template head<17>()));
       ins_.set_state(nominal_.nav);
     }
   }
@@ -446,11 +509,16 @@ class UltraTightCore final : public UltraTightCoreBase {
   UpdateResult apply(const M& m) {
     const UpdateResult r = filter_.update(m);
     if (!r.accepted) return r;
-    last_dx_ = filter_.x();
+    last_dx_ = filter_.x().template head<17>();
     period_dx_ += last_dx_;
-    nominal_ = corrected<17>(nominal_, filter_.x());
+    nominal_ = corrected<17>(nominal_, last_dx_);
+    if constexpr (kOdometer) {
+      const Eigen::Vector4d dx_odometer = filter_.x().template tail<4>();
+      period_odometer_dx_ += dx_odometer;
+      odometer_ = corrected(odometer_, dx_odometer);
+    }
     ins_.set_state(nominal_.nav);
-    filter_.set_x(StateVector<17>::Zero());
+    filter_.set_x(StateVector<N>::Zero());
     return r;
   }
 
@@ -466,24 +534,28 @@ class UltraTightCore final : public UltraTightCoreBase {
   void fill_output() {
     IntegrationOutput& o = output;
     o.nav = nominal_.nav;
-    const StateVector<17> sd = filter_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
-    o.sigma_pos_ned_m = sd.segment<3>(ix::kPos);
-    o.sigma_vel_n_mps = sd.segment<3>(ix::kVel);
-    o.sigma_att_rad = sd.segment<3>(ix::kAtt);
+    const StateVector<N> sd = filter_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
+    o.sigma_pos_ned_m = sd.template segment<3>(ix::kPos);
+    o.sigma_vel_n_mps = sd.template segment<3>(ix::kVel);
+    o.sigma_att_rad = sd.template segment<3>(ix::kAtt);
     o.accel_bias_b = nominal_.accel_bias_b;
     o.gyro_bias_b = nominal_.gyro_bias_b;
-    o.sigma_accel_bias_b = sd.segment<3>(ix::kAccelBias);
-    o.sigma_gyro_bias_b = sd.segment<3>(ix::kGyroBias);
+    o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
+    o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
     o.clock_bias_m = nominal_.clock_bias_m;
     o.clock_drift_mps = nominal_.clock_drift_mps;
     o.sigma_clock_bias_m = sd(ix::kClockBias);
     o.sigma_clock_drift_mps = sd(ix::kClockDrift);
+    if constexpr (kOdometer) {
+      o.odometer.value = odometer_;
+      o.odometer.sigma = {sd(17), sd(18), sd(19), sd(20)};
+    }
   }
 
   UltraTightOptions opt_;
   std::vector<signals::Ephemeris> eph_;
   ins::Strapdown ins_;
-  InsErrorModel<17> model_;
+  Model model_;
   Filter filter_;
   NominalState nominal_;
   std::vector<SatelliteObservable> sats_start_;
@@ -494,8 +566,11 @@ class UltraTightCore final : public UltraTightCoreBase {
   double T_ = 0.020;
   ImuStepAccumulator imu_steps_;
   UpdateResult last_result_;
-  StateVector<17> last_dx_ = StateVector<17>::Zero();    // the correction of the latest accepted update
-  StateVector<17> period_dx_ = StateVector<17>::Zero();  // the corrections of this period's updates, summed
+  StateVector<17> last_dx_ = StateVector<17>::Zero();             // the correction of the latest accepted update
+  StateVector<17> period_dx_ = StateVector<17>::Zero();           // the corrections of this period's updates, summed
+  Eigen::Vector4d period_odometer_dx_ = Eigen::Vector4d::Zero();  // ... of the odometer states
+  OdometerNominal odometer_;                                      // odometer aiding (21 states)
+  OdometerHistory history_;
 };
 
 }  // namespace
@@ -513,17 +588,33 @@ UltraTightIntegration::UltraTightIntegration(const ins::NavState& initial, std::
   InsErrorModelOptions mo = options.model;
   mo.discretisation = options.discretisation;
   impl_->options.model = mo;
-  const InsErrorModel<17> model(mo);
-  const StateMatrix<17> P0 =
-      model.initial_covariance(options.sigma_pos_ned_m, options.sigma_vel_n_mps, options.sigma_att_rad);
-  const StateVector<17> x0 = StateVector<17>::Zero();
-  if (options.filter == FilterKind::Ekf)
-    impl_->core = std::make_unique<UltraTightCore<Ekf<17>>>(
-        initial, std::move(eph), impl_->options, Ekf<17>(x0, P0, EkfOptions{mo.discretisation, options.gate}));
-  else
-    impl_->core = std::make_unique<UltraTightCore<Ukf<17>>>(
+  const StateMatrix<17> P17 =
+      InsErrorModel<17>(mo).initial_covariance(options.sigma_pos_ned_m, options.sigma_vel_n_mps, options.sigma_att_rad);
+  auto make = [&]<int N>(const StateMatrix<N>& P0) -> std::unique_ptr<UltraTightCoreBase> {
+    const StateVector<N> x0 = StateVector<N>::Zero();
+    if (options.filter == FilterKind::Ekf)
+      return std::make_unique<UltraTightCore<Ekf<N>>>(initial, std::move(eph), impl_->options,
+                                                      Ekf<N>(x0, P0, EkfOptions{mo.discretisation, options.gate}));
+    return std::make_unique<UltraTightCore<Ukf<N>>>(
         initial, std::move(eph), impl_->options,
-        Ukf<17>(x0, P0, UkfOptions{options.ukf, mo.discretisation, options.gate}));
+        Ukf<N>(x0, P0, UkfOptions{options.ukf, mo.discretisation, options.gate}));
+  };
+  if (options.odometer.enabled) {
+    // The odometer's states after the clock's: their initial sigmas (the given ones, else the options' own),
+    // uncorrelated with the rest.
+    const OdometerAidingOptions& oo = options.odometer;
+    const OdometerNominal& given = options.sigma_initial_odometer;
+    const auto pick = [](double g, double fallback) { return g > 0.0 ? g : fallback; };
+    const Eigen::Vector4d sigma(pick(given.delay_s, oo.sigma_delay_s), pick(given.pitch_rad, oo.sigma_misalignment_rad),
+                                pick(given.yaw_rad, oo.sigma_misalignment_rad),
+                                pick(given.scale_factor, oo.sigma_scale_factor));
+    StateMatrix<21> P0 = StateMatrix<21>::Zero();
+    P0.topLeftCorner<17, 17>() = P17;
+    P0.bottomRightCorner<4, 4>() = sigma.cwiseAbs2().asDiagonal();
+    impl_->core = make(P0);
+  } else {
+    impl_->core = make(P17);
+  }
 }
 
 UltraTightIntegration::~UltraTightIntegration() = default;
@@ -551,6 +642,7 @@ void UltraTightIntegration::set_covariance(const Eigen::MatrixXd& P) {
     throw std::invalid_argument("ultra-tight: a covariance must be positive definite");
   impl_->core->set_covariance(P);
 }
+void UltraTightIntegration::add_odometer(const OdometerSpeed& speed) { impl_->core->add_odometer(speed); }
 const UltraTightCounters& UltraTightIntegration::counters() const { return impl_->core->counters; }
 const std::vector<UltraTightSatelliteUpdate>& UltraTightIntegration::last_updates() const {
   return impl_->core->last_updates;

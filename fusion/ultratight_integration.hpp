@@ -25,6 +25,8 @@
 
 #include "fusion/gnss_ins_integration.hpp"
 #include "fusion/iq_measurements.hpp"
+#include "fusion/odometer_error_model.hpp"
+#include "fusion/vms_measurement.hpp"
 #include "receiver/nco_command.hpp"
 #include "signals/ephemeris.hpp"
 
@@ -70,6 +72,12 @@ struct UltraTightOptions {
   // states are errors of these.
   Eigen::Vector3d initial_accel_bias_b = Eigen::Vector3d::Zero();
   Eigen::Vector3d initial_gyro_bias_b = Eigen::Vector3d::Zero();
+  // Land vehicles: odometer (VMS) aiding ([KimVMS], fusion/vms_measurement.hpp; off by default): the odometer's four
+  // states after the clock's (21 states), speeds through add_odometer. Their nominal at the start (e.g. the tight
+  // filter's estimates at the hand-over) and 1-sigma (a field <= 0: the options' initial sigma).
+  OdometerAidingOptions odometer;
+  OdometerNominal initial_odometer;
+  OdometerNominal sigma_initial_odometer;
 
   // Sigmas positive, tap offset in (0, 0.5] chip, gate probability in (0, 1), thresholds not NaN; why says which.
   bool IsValid(std::string* why) const;
@@ -141,6 +149,10 @@ struct UltraTightCounters {
   // Carrier-phase rates (fusion/carrier_rate_measurement.hpp): updates (one per window, all satellites), their
   // accepted ones, the rows used and the rows screened out (carrier_rate_screen_sigma).
   long long rate_updates = 0, rate_accepted = 0, rate_rows = 0, rate_screened = 0;
+  // Odometer windows (add_odometer): VMS/NHC updates accepted and refused by the gate, windows gated out by the
+  // heading rate and by the speed (both may hold for one window), and windows the INS history does not cover.
+  long long odometer_accepted = 0, odometer_rejected = 0, odometer_gated_yaw_rate = 0, odometer_gated_speed = 0;
+  long long odometer_unusable = 0;
 };
 
 class UltraTightIntegration {
@@ -168,11 +180,14 @@ class UltraTightIntegration {
   const std::vector<ReplicaCommand>& replicas() const;
   const IntegrationOutput& output() const;
   NominalState nominal() const;
-  Eigen::MatrixXd covariance() const;  // 17 x 17
+  Eigen::MatrixXd covariance() const;  // 17 x 17 (the INS and clock states; with the odometer's, their block)
   // Replaces the error covariance (17 x 17, symmetric positive definite; std::invalid_argument otherwise): a loop
   // re-opening a filter its measurements contradict (fusion/lockout_recovery.hpp's inflate_for_recovery). The
   // state and the replicas of the open period are kept.
   void set_covariance(const Eigen::MatrixXd& P);
+  // One odometer window ending at the current INS time (options.odometer enabled; std::logic_error otherwise): the
+  // gate of [KimVMS] eqs. 16-17, then the VMS/NHC update. Non-finite speeds count as unusable.
+  void add_odometer(const OdometerSpeed& speed);
   const UltraTightCounters& counters() const;
   // The updates of the latest finish_period (satellites with a usable measurement), in replica order.
   const std::vector<UltraTightSatelliteUpdate>& last_updates() const;

@@ -95,7 +95,22 @@ struct GnssInsCoupler::Impl {
   // Odometer aiding (loose, settings.odometer given): the speed windows and the next one to hand over.
   std::vector<fusion::OdometerSpeed> odometer;
   std::size_t next_odometer = 0;
+  long long tight_odometer_windows = 0;  // windows the tight integration took before any hand-over
   std::optional<OdometerUse> odometer_use;
+  // The ultra-tight driver's odometer counters after the hand-over (take_odometer_windows).
+  fusion::UltraTightCounters handed_over_counters;
+
+  // The odometer counters of both filters (the tight one's, then the ultra-tight driver's).
+  fusion::IntegrationCounters odometer_counters() const {
+    fusion::IntegrationCounters k = integration->counters();
+    const fusion::UltraTightCounters& u = handed_over_counters;
+    k.odometer_accepted += u.odometer_accepted;
+    k.odometer_rejected += u.odometer_rejected;
+    k.odometer_gated_yaw_rate += u.odometer_gated_yaw_rate;
+    k.odometer_gated_speed += u.odometer_gated_speed;
+    k.odometer_unusable += u.odometer_unusable;
+    return k;
+  }
 
   // Counts.
   long long epochs_seen = 0, fixes_seen = 0, before_start = 0, used = 0, nav_rows = 0;
@@ -202,7 +217,7 @@ struct GnssInsCoupler::Impl {
       }
       for (; next_odometer < odometer.size() && odometer[next_odometer].t_s <= inc.t_s; ++next_odometer) {
         integration->add_odometer(odometer[next_odometer]);
-        ++odometer_use->windows;
+        tight_odometer_windows = ++odometer_use->windows;
       }
       integration->add_imu(inc);
       emit();
@@ -484,6 +499,24 @@ std::optional<std::pair<std::int64_t, double>> GnssInsCoupler::last_epoch_time()
   return std::make_pair(impl_->last_epoch_sample, impl_->last_epoch_t_s);
 }
 void GnssInsCoupler::hand_over() { impl_->handed_over = true; }
+
+std::vector<fusion::OdometerSpeed> GnssInsCoupler::take_odometer_windows() {
+  Impl& m = *impl_;
+  std::vector<fusion::OdometerSpeed> rest(m.odometer.begin() + static_cast<std::ptrdiff_t>(m.next_odometer),
+                                          m.odometer.end());
+  m.next_odometer = m.odometer.size();
+  return rest;
+}
+
+void GnssInsCoupler::record_handed_over_odometer(long long windows, const fusion::UltraTightCounters& counters,
+                                                 const fusion::OdometerEstimate& estimate, double gnss_last_used_s) {
+  Impl& m = *impl_;
+  if (!m.odometer_use) return;
+  m.handed_over_counters = counters;
+  m.odometer_use->estimate = estimate;
+  m.odometer_use->windows = m.tight_odometer_windows + windows;
+  m.odometer_use->gnss_last_used_s = std::max(m.odometer_use->gnss_last_used_s, gnss_last_used_s);
+}
 bool GnssInsCoupler::handed_over() const { return impl_->handed_over; }
 void GnssInsCoupler::write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
                                const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad) {
@@ -535,8 +568,8 @@ std::string GnssInsCoupler::summary_json() const {
   j += fmt::format(", \"lockout_recoveries\": {}, \"recovery_events\": {}", k.recoveries,
                    recovery_events_json(m.integration->recovery_events()));
   if (m.odometer_use)
-    j += ", \"odometer\": " +
-         odometer_json(*m.odometer_use, k, m.settings.navigation.odometer, m.settings.odometer_name);
+    j += ", \"odometer\": " + odometer_json(*m.odometer_use, m.odometer_counters(), m.settings.navigation.odometer,
+                                            m.settings.odometer_name);
   if (m.is_tight())
     j += fmt::format(
         ", \"clock_oscillator\": {{\"preset\": \"{}\", \"h0\": {:.3g}, \"h_minus2\": {:.3g}}}, "
@@ -565,12 +598,14 @@ std::string GnssInsCoupler::report() const {
       to_string(m.settings.coupling), m.settings.filter == fusion::FilterKind::Ekf ? "EKF" : "UKF", m.alignment_note,
       m.start_s, m.used, m.before_start, k.accepted, k.rejected, m.final_sigma.position_ned_m.head<2>().norm(),
       m.final_sigma.position_ned_m.z(), m.nav_rows);
-  if (m.odometer_use)
+  if (m.odometer_use) {
+    const fusion::IntegrationCounters o = m.odometer_counters();
     r += fmt::format(
         "\nreceive: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading "
         "rate {}, by speed {}",
-        m.odometer_use->windows, k.odometer_accepted, k.odometer_rejected, k.odometer_gated_yaw_rate,
-        k.odometer_gated_speed);
+        m.odometer_use->windows, o.odometer_accepted, o.odometer_rejected, o.odometer_gated_yaw_rate,
+        o.odometer_gated_speed);
+  }
   return r;
 }
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "fusion/gnss_ins_integration.hpp"
+#include "fusion/ultratight_integration.hpp"
 #include "ins/nav_state.hpp"
 #include "pipelines/receive_options.hpp"
 #include "pipelines/receive_sinks.hpp"
@@ -72,6 +73,13 @@ class GnssInsCoupler final : public receiver::ReceiverObserver {
   std::optional<std::pair<std::int64_t, double>> last_epoch_time() const;
   void hand_over();
   bool handed_over() const;
+  // Odometer aiding after the hand-over (the ultra-tight driver takes the speeds): the windows not yet handed to the
+  // tight integration (each once; empty without --odometer), then, as the driver runs, what it made of them (its
+  // odometer counters and estimate, the last time its satellite updates were accepted): summary.json's odometer
+  // object covers both filters.
+  std::vector<fusion::OdometerSpeed> take_odometer_windows();
+  void record_handed_over_odometer(long long windows, const fusion::UltraTightCounters& counters,
+                                   const fusion::OdometerEstimate& estimate, double gnss_last_used_s);
   void write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
                  const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad);
 

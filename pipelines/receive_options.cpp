@@ -21,11 +21,7 @@ bool ReceiveOptions::IsValid(std::string* error) const {
   const auto& names = ins::imu_preset_names();
   if (std::find(names.begin(), names.end(), navigation.imu_preset) == names.end())
     return fail("unknown IMU preset '" + navigation.imu_preset + "'");
-  if (!odometer.empty() && coupling == Coupling::kUltraTight)
-    return fail(
-        "--odometer works with --coupling loose or tight (the ultra-tight filter does not carry the odometer "
-        "states yet)");
-  if (!odometer.empty() && coupling == Coupling::kTight && navigation.height_aiding.enabled)
+  if (!odometer.empty() && coupling != Coupling::kLoose && navigation.height_aiding.enabled)
     return fail("--odometer and [height_aiding] mode = \"auto\" are not combined (the odometer bounds the height)");
   if (align == AlignMode::Attitude) return fail("--align attitude is `fuse`'s (GPS attitude rows)");
   if (align == AlignMode::Config && !navigation.attitude_deg)

@@ -71,12 +71,27 @@ void UltraTightLoop::feed_imu_to(double t) {
                                        t, imu.front().t_s, imu.back().t_s));
     const ins::ImuIncrement& a = imu[next_imu_ - 1];
     const ins::ImuIncrement& b = imu[next_imu_];
-    const double end = std::min(b.t_s, t);
+    double end = std::min(b.t_s, t);
+    // An odometer window ending inside: the row is split there, the window taken at its time.
+    while (next_odometer_ < odometer_.size() && odometer_[next_odometer_].t_s <= t_ins_ + 1e-9) ++next_odometer_;
+    const bool window_ends = next_odometer_ < odometer_.size() && odometer_[next_odometer_].t_s <= end + 1e-9;
+    if (window_ends) end = odometer_[next_odometer_].t_s;
     const double share = (end - t_ins_) / (b.t_s - a.t_s);
     driver_->add_imu({end, b.dtheta_b * share, b.dv_b * share});
     t_ins_ = end;
+    if (window_ends) {
+      driver_->add_odometer(odometer_[next_odometer_++]);
+      ++odometer_windows_;
+      record_odometer();
+    }
     if (end >= b.t_s - 1e-9) emit_nav();
   }
+}
+
+void UltraTightLoop::record_odometer() {
+  if (driver_ && driver_->options().odometer.enabled)
+    fusion_.record_handed_over_odometer(odometer_windows_, driver_->counters(), driver_->output().odometer,
+                                        gnss_last_used_s_);
 }
 
 void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) {
@@ -114,6 +129,14 @@ void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) 
   o.gps_time_origin = origin_;
   o.initial_accel_bias_b = out.accel_bias_b;
   o.initial_gyro_bias_b = out.gyro_bias_b;
+  if (!s.odometer.empty()) {  // the odometer states go on from the tight filter's estimates
+    o.odometer = c.odometer;
+    o.odometer.enabled = true;
+    o.initial_odometer = out.odometer.value;
+    o.sigma_initial_odometer = out.odometer.sigma;
+    odometer_ = fusion_.take_odometer_windows();
+    next_odometer_ = 0;
+  }
   // The bias that makes this epoch's receive time (on the clock as it reads now) the tight filter's GPS time of it:
   // pseudoranges c (t_rx - t_tx) then equal range + bias, as the driver predicts them.
   corrections_at_start_s_ = epoch.clock_corrections_s;
@@ -128,6 +151,8 @@ void UltraTightLoop::start(const receiver::VectorEpochInput& epoch, double t_k) 
   ephemerides_ = eph;
   ephemerides_seen_ = epoch.ephemerides->size();
   driver_.emplace(out.nav, std::move(eph), o);
+  gnss_last_used_s_ = out.nav.t_s;
+  accepted_before_ = 0;
   t_ins_ = out.nav.t_s;
   next_imu_ = 0;
   handover_t_s_ = t_k;
@@ -481,6 +506,8 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
   if (period_open_) {
     driver_->finish_period(correlations(epoch, t_k));
     nis_tests(static_cast<double>(epoch.sample) / epoch.fs_hz);
+    if (driver_->counters().accepted > accepted_before_) gnss_last_used_s_ = t_ins_;
+    accepted_before_ = driver_->counters().accepted;
   }
   // Sets decoded since the hand-over (the engine appends them): a satellite without one at the hand-over, or a new
   // IODE, is predicted from them from this period on (each from the set valid at its transmit time).
@@ -533,6 +560,7 @@ void UltraTightLoop::finish(std::int64_t end_sample) {
     const double t_end = last_t_s_ + static_cast<double>(end_sample - *last_sample_) / options_.fs_hz;
     feed_imu_to(std::min(t_end, fusion_.imu().back().t_s));
   }
+  record_odometer();
 }
 
 std::string UltraTightLoop::summary_json() const {

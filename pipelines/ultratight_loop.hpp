@@ -14,9 +14,10 @@
 // released to its scalar loops and left out of the filter until it loses synchronisation; the channels' pooled
 // windows outside their band re-open the filter's covariance instead. Every release is logged (summary.json). Every
 // vector epoch after the hand-over goes to the sink (UltraTightEpochLog: ultratight.csv), the navigation rows through
-// the coupler's sink (nav.csv). Time: the driver's t_s is IMU time (GPS time minus the IMU time origin); its clock bias
-// is against the receiver clock with the engine's clock jumps since the hand-over taken out. Units: s, m, m/s, Hz,
-// chips.
+// the coupler's sink (nav.csv). With --odometer the driver carries the odometer states (fusion::UltraTightOptions::
+// odometer) and takes the windows the tight integration left at their times, IMU rows split there. Time: the driver's
+// t_s is IMU time (GPS time minus the IMU time origin); its clock bias is against the receiver clock with the engine's
+// clock jumps since the hand-over taken out. Units: s, m, m/s, Hz, chips.
 #pragma once
 
 #include <algorithm>
@@ -165,6 +166,14 @@ class UltraTightLoop final : public receiver::VectorLoop {
   fusion::NisReleaseMonitor nis_;
   fusion::ReleaseLog release_log_;
   long long filter_reopens_ = 0;
+  // Odometer aiding (--odometer): the windows the tight integration left, the next to hand to the driver, how many
+  // it took, and the last time the driver's satellite updates were accepted (the odometer object's GNSS end).
+  std::vector<fusion::OdometerSpeed> odometer_;
+  std::size_t next_odometer_ = 0;
+  long long odometer_windows_ = 0;
+  long long accepted_before_ = 0;
+  double gnss_last_used_s_ = 0.0;
+  void record_odometer();
 };
 
 }  // namespace ultratrack::pipelines

@@ -31,11 +31,10 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
                   "with --coupling: static, motion (default), config or file:ALIGNMENT.json (`ultratrack align`)");
   cmd->add_option("--fusion-config", a.config,
                   "with --coupling: TOML with `fuse`'s keys ([imu] [initial] [alignment] [gnss] [filter] [output])");
-  cmd->add_option(
-      "--odometer", a.odometer,
-      "with --coupling loose or tight: odometer CSV (t_s,pulses,distance_m; t_s on the IMU's time line) as VMS "
-      "speed and non-holonomic updates ([odometer] keys in --fusion-config), as `fuse --odometer`; "
-      "bridges signal blockages");
+  cmd->add_option("--odometer", a.odometer,
+                  "with --imu: odometer CSV (t_s,pulses,distance_m; t_s on the IMU's time line) as VMS "
+                  "speed and non-holonomic updates ([odometer] keys in --fusion-config), as `fuse --odometer`; "
+                  "bridges signal blockages");
   cmd->add_option("--imu-time-origin", a.time_origin,
                   "IMU t_s = 0 at: sample0 (default: the input's first sample, as simulate writes), tow (t_s is "
                   "the GPS time of week) or a GPS time of week in seconds");
@@ -100,15 +99,11 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
     if (!a.ut_measurement.empty())
       throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
     if (!a.odometer.empty())
-      throw io::InputError("command line", "--odometer needs --coupling loose or tight and --imu");
+      throw io::InputError("command line", "--odometer needs --coupling loose, tight or ultra-tight and --imu");
     if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
     if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
     return;
   }
-  if (!a.odometer.empty() && s.coupling == Coupling::kUltraTight)
-    throw io::InputError("command line",
-                         "--odometer works with --coupling loose or tight (the ultra-tight filter does not carry the "
-                         "odometer states yet)");
   if (!a.ut_measurement.empty() && s.coupling != Coupling::kUltraTight)
     throw io::InputError("command line", "--ut-measurement needs --coupling ultra-tight");
   if (a.ut_serial && s.coupling != Coupling::kUltraTight)

@@ -74,7 +74,8 @@ const Sim& simulated() {
   return s;
 }
 
-// The receive of the scenario's file into rx in the given coupling, with the odometer when asked.
+// The receive of the scenario's file into rx in the given coupling (ultra-tight: EKF, I&Q), with the odometer when
+// asked.
 void receive(const fs::path& rx, bool odometer, pipelines::Coupling coupling) {
   const auto& s = simulated();
   pipelines::ReceiveFileJob job;
@@ -185,17 +186,21 @@ TEST(ReceiveOdometer, TightCouplingWithTheOdometerBridgesATunnel) {
   check_tunnel(pipelines::Coupling::kTight, "tight");
 }
 
-// The ultra-tight filter carries no odometer states: the options say so, naming what works. Tight with height
-// aiding is refused too (one filter carries either the terrain state or the odometer's).
-TEST(ReceiveOdometer, UltraTightCouplingWithAnOdometerIsRejectedNamingLooseOrTight) {
+// The ultra-tight driver takes the odometer states over from the tight filter at the hand-over ([17, 21) after
+// its clock) and the windows from then on.
+TEST(ReceiveOdometer, UltraTightCouplingWithTheOdometerBridgesATunnel) {
+  check_tunnel(pipelines::Coupling::kUltraTight, "ultra-tight");
+}
+
+// Every coupling with an IMU takes the odometer; with height aiding the tight and ultra-tight ones refuse it (one
+// filter carries either the terrain state or the odometer's), naming the key.
+TEST(ReceiveOdometer, HeightAidingWithAnOdometerIsRejectedNamingIt) {
   pipelines::ReceiveOptions o;
   o.receiver.fs_hz = 2.0e6;
   o.odometer = {{1.0, 10, 1.0}, {2.0, 10, 1.0}};
-  o.coupling = pipelines::Coupling::kUltraTight;
   std::string why;
-  EXPECT_FALSE(o.IsValid(&why));
-  EXPECT_NE(why.find("--coupling loose or tight"), std::string::npos) << why;
-  for (const auto coupling : {pipelines::Coupling::kLoose, pipelines::Coupling::kTight}) {
+  for (const auto coupling :
+       {pipelines::Coupling::kLoose, pipelines::Coupling::kTight, pipelines::Coupling::kUltraTight}) {
     o.coupling = coupling;
     EXPECT_TRUE(o.IsValid(&why)) << why;
   }

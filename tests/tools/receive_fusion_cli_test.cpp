@@ -91,9 +91,8 @@ TEST(ReceiveFusionCli, BadImuInputIsOneInputErrorNamingTheFileAndLeavesNoOutputs
       io::InputError);
 }
 
-// --odometer: loose or tight (the ultra-tight filter carries no odometer states), a bad odometer file is one InputError
-// naming it, and no outputs either way.
-TEST(ReceiveFusionCli, OdometerIsLooseOrTightAndABadFileIsOneInputErrorNamingIt) {
+// --odometer: a bad odometer file is one InputError naming it, and no outputs; without --imu, an InputError too.
+TEST(ReceiveFusionCli, ABadOdometerFileIsOneInputErrorNamingIt) {
   const auto& s = simulated();
   const fs::path good = s.dir / "odometer.csv", bad = s.dir / "odometer_backwards.csv";
   std::ofstream(good) << "t_s,pulses,distance_m\n0.1,10,0.8\n0.2,10,0.8\n0.3,10,0.8\n";
@@ -111,10 +110,6 @@ TEST(ReceiveFusionCli, OdometerIsLooseOrTightAndABadFileIsOneInputErrorNamingIt)
     ADD_FAILURE() << name << ": no error";
     return io::InputError("", "");
   };
-  {
-    const io::InputError e = run("ultra-tight", "ultra-tight", good);
-    EXPECT_NE(std::string(e.what()).find("--coupling loose or tight"), std::string::npos) << e.what();
-  }
   const io::InputError e = run("backwards", "loose", bad);
   EXPECT_EQ(e.file(), bad.string()) << e.what();
   EXPECT_THROW(test_support::run_command(
