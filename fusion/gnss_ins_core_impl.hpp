@@ -392,14 +392,8 @@ class Core final : public CoreBase {
   // One odometer window ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
   void apply_odometer(const OdometerSpeed& speed) {
     if constexpr (L::kHasOdometer) {
-      const auto w = history_.window(nominal_.nav, speed, opt_.odometer);
-      if (!w) {
-        ++counters.odometer_unusable;
-        return;
-      }
-      if (!w->gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
-      if (!w->gate.speed_ok) ++counters.odometer_gated_speed;
-      if (!w->gate.update()) return;
+      const auto w = history_.gated_window(nominal_.nav, speed, opt_.odometer, counters);
+      if (!w) return;
       VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, w->a_b, speed, opt_.odometer);
       bool accepted;
       if constexpr (L::kOdo == ix::kOdoDelay)

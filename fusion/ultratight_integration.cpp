@@ -127,14 +127,8 @@ class UltraTightCore final : public UltraTightCoreBase {
         ++counters.odometer_unusable;
         return;
       }
-      const auto w = history_.window(nominal_.nav, speed, opt_.odometer);
-      if (!w) {
-        ++counters.odometer_unusable;
-        return;
-      }
-      if (!w->gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
-      if (!w->gate.speed_ok) ++counters.odometer_gated_speed;
-      if (!w->gate.update()) return;
+      const auto w = history_.gated_window(nominal_.nav, speed, opt_.odometer, counters);
+      if (!w) return;
       propagate();
       const VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, w->a_b, speed, opt_.odometer);
       ++(apply(OdometerStatesAt<VmsMeasurement, 17, N>(m)).accepted ? counters.odometer_accepted
