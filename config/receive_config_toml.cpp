@@ -128,7 +128,8 @@ const std::map<std::string, Table>& sections() {
         {"exclude_unhealthy", [](const Setter& v, O& o) { o.pvt.exclude_unhealthy = v.boolean(); }},
         {"fault_exclusion", [](const Setter& v, O& o) { o.pvt.fault_exclusion = v.boolean(); }},
         {"sigma_zenith_m", [](const Setter& v, O& o) { o.pvt.sigma_zenith_m = v.number(); }},
-        {"sigma_doppler_mps", [](const Setter& v, O& o) { o.pvt.sigma_doppler_mps = v.number(); }}}},
+        {"sigma_doppler_mps", [](const Setter& v, O& o) { o.pvt.sigma_doppler_mps = v.number(); }},
+        {"max_gdop", [](const Setter& v, O& o) { o.pvt.max_gdop = v.number(); }}}},
   };
   return s;
 }

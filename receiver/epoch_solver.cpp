@@ -122,7 +122,10 @@ void EpochSolver::solve(const ObservationEpoch& epoch, const NavigationStore& na
   pvt.ionosphere = pvt.ionosphere && navigation.klobuchar().valid;
   const Eigen::Vector3d initial = last_fix_ ? last_fix_->r_e_m : Eigen::Vector3d::Zero();
   PvtSolution fix = solve_pvt(pvt_input_, epoch.receive_time, navigation.klobuchar(), pvt, initial);
-  if (!fix.valid) return;
+  if (!fix.valid) {
+    if (fix.gdop > pvt.max_gdop) ++run_stats.fixes_rejected_gdop;
+    return;
+  }
   if (!run_stats.first_fix_sample) run_stats.first_fix_sample = epoch.sample_index;
   ++run_stats.fixes;
   run_stats.sum_r_e_m += fix.r_e_m;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include "receiver/chi_square.hpp"
 #include "signals/atmosphere.hpp"
@@ -183,6 +184,7 @@ bool PvtOptions::IsValid(std::string* why) const {
       return "false-alarm probability not in (0, 1)";
     if (!(sigma_zenith_m > 0.0) || !(sigma_doppler_mps > 0.0)) return "measurement sigmas must be positive";
     if (max_iterations < 1) return "max_iterations must be at least 1";
+    if (!(max_gdop > 0.0)) return "max_gdop must be positive";
     return {};
   }();
   if (why) *why = problem;
@@ -275,6 +277,11 @@ PvtSolution solve_pvt(const std::vector<SatelliteMeasurement>& meas, const signa
   sol.hdop = std::sqrt(Q_enu(0, 0) + Q_enu(1, 1));
   sol.vdop = std::sqrt(Q_enu(2, 2));
   sol.tdop = std::sqrt(Q(3, 3));
+  if (!(sol.gdop <= opt.max_gdop)) {
+    sol.valid = false;
+    sol.failure = "GDOP " + std::to_string(sol.gdop) + " above the limit " + std::to_string(opt.max_gdop);
+    return sol;
+  }
 
   // Velocity and clock drift: one linear solve (the range-rate model is linear in them).
   std::vector<Geometry> rate_rows = linearise(meas, receive_time, iono, opt, x, Eigen::Vector3d::Zero(), 0.0, active);

@@ -2,7 +2,8 @@
 // Position, velocity and time from one epoch of pseudoranges and Doppler: iterated weighted least squares
 // in ECEF (WGS-84) with the satellite clock, relativity, TGD, Sagnac, broadcast ionosphere and troposphere
 // corrections, an elevation mask, a chi-square residual test that excludes one faulty satellite, velocity
-// and clock drift from Doppler, and DOPs. Units: metres, m/s, seconds; angles in radians.
+// and clock drift from Doppler, and DOPs (a GDOP above PvtOptions::max_gdop: no solution). Units: metres, m/s, seconds;
+// angles in radians.
 #pragma once
 
 #include <Eigen/Core>
@@ -35,6 +36,10 @@ struct PvtOptions {
   double sigma_zenith_m = 1.0;      // pseudorange 1-sigma at zenith and 45 dB-Hz; grows with 1/sin(el), lower C/N0
   double sigma_doppler_mps = 0.05;  // range-rate 1-sigma at zenith and 45 dB-Hz
   int max_iterations = 10;
+  // A solution whose GDOP exceeds this is no solution (RTKLIB's pos2-rejgdop, default 30): with 4-5 satellites
+  // nearly on one cone the geometry turns metres of range noise into kilometres (a 24 dB-Hz file: PDOP 310, fixes
+  // 0.7-2.3 km off, docs/validation.md).
+  double max_gdop = 30.0;
 
   // Empty when valid, else the reason.
   // True when the options fit together; otherwise false and *why (when given) says which setting and why.

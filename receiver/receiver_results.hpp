@@ -50,6 +50,7 @@ struct ReceiverStats {
   std::int64_t samples_processed = 0;
   std::optional<std::int64_t> first_fix_sample;
   int fixes = 0;
+  int fixes_rejected_gdop = 0;  // epochs whose solution had a GDOP above PvtOptions::max_gdop (no fix)
   int observation_epochs = 0;
   int clock_jumps = 0;
   Eigen::Vector3d sum_r_e_m = Eigen::Vector3d::Zero();  // for the mean fix

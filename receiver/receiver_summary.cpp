@@ -52,8 +52,10 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
   const bool fix = s.fixes > 0;
   fmt::print(out, "  \"fix\": {},\n  \"ttff_s\": {},\n", fix,
              fix ? fmt::format("{:.3f}", ttff_seconds(engine)) : "null");
-  fmt::print(out, "  \"fixes\": {},\n  \"observation_epochs\": {},\n  \"clock_jumps\": {},\n", s.fixes,
-             s.observation_epochs, s.clock_jumps);
+  fmt::print(out,
+             "  \"fixes\": {},\n  \"fixes_rejected_gdop\": {},\n  \"observation_epochs\": {},\n  \"clock_jumps\": "
+             "{},\n",
+             s.fixes, s.fixes_rejected_gdop, s.observation_epochs, s.clock_jumps);
   fmt::print(out, "  \"satellites_acquired\": {},\n  \"satellites_tracked\": {},\n  \"satellites_used\": {},\n",
              prn_list(acquired), prn_list(tracked), prn_list(used));
   if (fix) {

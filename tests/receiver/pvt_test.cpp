@@ -267,3 +267,28 @@ TEST(Pvt, CovarianceLiesBetweenTheDopBoundsOfItsWeights) {
   EXPECT_LT((sol.velocity_covariance_m2ps2 - ratio2 * sol.covariance_m2).norm(),
             1e-6 * ratio2 * sol.covariance_m2.norm());
 }
+
+// RTKLIB's default GDOP limit (30): a normal sky passes it; the same epoch with the limit just below its GDOP is no
+// solution, whose failure names the GDOP; just above, the same solution as without a limit.
+TEST(Pvt, AGdopAboveTheLimitIsNoSolution) {
+  const Receiver rx = make_receiver(35.274016, 137.013759, 100.0);
+  const auto meas = visible_measurements(rx, false, 5.0);
+  receiver::PvtOptions opt;
+  opt.elevation_mask_rad = 0.0;
+  opt.ionosphere = opt.troposphere = false;
+  EXPECT_DOUBLE_EQ(opt.max_gdop, 30.0);
+  const auto sol = receiver::solve_pvt(meas, receiver_clock_time(rx), {}, opt);
+  ASSERT_TRUE(sol.valid) << sol.failure;
+  ASSERT_GT(sol.gdop, 1.0);
+  opt.max_gdop = 0.999 * sol.gdop;
+  const auto refused = receiver::solve_pvt(meas, receiver_clock_time(rx), {}, opt);
+  EXPECT_FALSE(refused.valid);
+  EXPECT_NE(refused.failure.find("GDOP"), std::string::npos) << refused.failure;
+  opt.max_gdop = 1.001 * sol.gdop;
+  const auto kept = receiver::solve_pvt(meas, receiver_clock_time(rx), {}, opt);
+  ASSERT_TRUE(kept.valid);
+  EXPECT_EQ(kept.r_e_m, sol.r_e_m);
+  opt.max_gdop = 0.0;
+  std::string why;
+  EXPECT_FALSE(opt.IsValid(&why));
+}
