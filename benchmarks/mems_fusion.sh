@@ -8,7 +8,11 @@
 #       [--scenario S.toml (default scenarios/mems_drive_adis16405.toml)] [--fuse-config C.toml (default
 #       scenarios/mems_datasheet_fuse.toml)] [--from-s 60]
 #       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--velocity-sigma 0.05] [--correlation S] [--interval S]
-#       [--told-correlation S] [--told-sigma "N E D"] [--outage "START DURATION"] [--clean]
+#       [--told-correlation S] [--told-sigma "N E D"] [--outage "START DURATION"] [--accel-bias-mg MG]
+#       [--gyro-bias-dph DPH] [--clean]
+# --accel-bias-mg, --gyro-bias-dph: the unit's turn-on biases (1 sigma) in the simulation and in the filter's
+# datasheet model alike (accel_bias_mg, gyro_bias_dph in the scenario's and the fuse configuration's [imu]; e.g. 5 mg
+# and 1080 deg/h against the ADIS16405's 50 and 10800).
 # --velocity-sigma: the fixes' white velocity noise per axis (gnsssim), told to the filter as [gnss]
 # velocity_sigma_mps (the fix file carries the position sigmas only). --correlation: the fixes' errors first-order
 # Gauss-Markov with that time (gnsssim); --interval: the filter's decorrelating interval between fixes used ([gnss]
@@ -22,6 +26,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="$here/build"; seeds="1 2 3 4 5"; out="${TMPDIR:-/tmp}/mems_fusion"; fixes=vel; filter=ekf; nhc=on
 sigma="0.5 0.5 1.0"; velocity_sigma=0.05; correlation=0; interval=0; told=0; told_sigma=""; outage=""; clean=0
+accel_bias_mg=""; gyro_bias_dph=""
 scenario="$here/scenarios/mems_drive_adis16405.toml"; fuse_config="$here/scenarios/mems_datasheet_fuse.toml"; from_s=60
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -29,6 +34,7 @@ while [ $# -gt 0 ]; do
     --fixes) fixes="$2"; shift 2 ;; --filter) filter="$2"; shift 2 ;; --nhc) nhc="$2"; shift 2 ;;
     --sigma) sigma="$2"; shift 2 ;; --velocity-sigma) velocity_sigma="$2"; shift 2 ;;
     --correlation) correlation="$2"; shift 2 ;; --interval) interval="$2"; shift 2 ;;
+    --accel-bias-mg) accel_bias_mg="$2"; shift 2 ;; --gyro-bias-dph) gyro_bias_dph="$2"; shift 2 ;;
     --told-correlation) told="$2"; shift 2 ;; --told-sigma) told_sigma="$2"; shift 2 ;;
     --outage) outage="$2"; shift 2 ;; --clean) clean=1; shift ;;
     --scenario) scenario="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
@@ -43,6 +49,10 @@ segments=$(sed -n 's/^file = "\(.*\)"/\1/p' "$scenario")
 [ -n "$segments" ] && cp "$(dirname "$scenario")/$segments" "$out/"
 config="$out/fuse.toml"
 grep -v '^nhc = ' "$fuse_config" > "$config"
+set_biases=(-e "")
+[ -n "$accel_bias_mg" ] && set_biases+=(-e "s/^accel_bias_mg = .*/accel_bias_mg = $accel_bias_mg/")
+[ -n "$gyro_bias_dph" ] && set_biases+=(-e "s/^gyro_bias_dph = .*/gyro_bias_dph = $gyro_bias_dph/")
+sed -i "${set_biases[@]}" "$config"
 if [ "$nhc" = on ]; then
   if grep -q '^\[vehicle\]' "$config"; then sed -i 's/^\[vehicle\]/[vehicle]\nnhc = true/' "$config"
   else printf '\n[vehicle]\nnhc = true\n' >> "$config"; fi
@@ -59,7 +69,7 @@ echo "fixes $fixes ($sigma m, velocity $velocity_sigma m/s, correlation ${correl
     "filter told ${told} s${told_sigma:+ as states of $told_sigma m}), filter $filter, nhc $nhc${outage:+, outage $outage}"
 for seed in $seeds; do
   run="$out/seed$seed"
-  sed "s/^seed = .*/seed = $seed/" "$scenario" > "$out/scenario_$seed.toml"
+  sed -e "s/^seed = .*/seed = $seed/" "${set_biases[@]}" "$scenario" > "$out/scenario_$seed.toml"
   "$U" simulate --scenario "$out/scenario_$seed.toml" --out "$run/sim" --quiet >/dev/null
   # shellcheck disable=SC2086
   "$U" gnsssim --truth "$run/sim/truth.csv" --rate 5 --first 0.137 --sigma $sigma --velocity-sigma "$velocity_sigma" \
