@@ -170,12 +170,7 @@ class Core final : public CoreBase {
     if (imu_steps_.dt_s >= opt_.propagation_interval_s) propagate();
   }
 
-  void propagate() {
-    if (imu_steps_.dt_s <= 0.0) return;
-    model_.set_linearisation(imu_steps_.linearisation(nominal_.nav));
-    filter_.predict(model_, imu_steps_.dt_s);
-    imu_steps_.clear();
-  }
+  void propagate() { imu_steps_.predict(filter_, model_, nominal_.nav); }
 
   template <class M>
   bool update(const M& m, int prn) {
@@ -302,15 +297,8 @@ class Core final : public CoreBase {
 
   void fill_output() {
     IntegrationOutput& o = output;
-    o.nav = nominal_.nav;
     const StateVector<N> sd = filter_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
-    o.sigma_pos_ned_m = sd.template segment<3>(ix::kPos);
-    o.sigma_vel_n_mps = sd.template segment<3>(ix::kVel);
-    o.sigma_att_rad = sd.template segment<3>(ix::kAtt);
-    o.accel_bias_b = nominal_.accel_bias_b;
-    o.gyro_bias_b = nominal_.gyro_bias_b;
-    o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
-    o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
+    set_ins_output<N>(o, nominal_, sd);
     if constexpr (L::kHasTerrain) {
       o.terrain_height_m = terrain_m_;
       o.sigma_terrain_height_m = sd(ix::kTerrain);

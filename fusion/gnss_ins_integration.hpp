@@ -127,6 +127,20 @@ struct IntegrationOutput {
   Eigen::Vector3d fix_error_ned_m = Eigen::Vector3d::Zero(), sigma_fix_error_ned_m = Eigen::Vector3d::Zero();
 };
 
+// The INS part of an output (navigation state, bias estimates, the sigmas of the 15 INS error states) from a filter's
+// nominal and the square roots of its covariance diagonal (any state count N >= 15, INS states first).
+template <int N>
+void set_ins_output(IntegrationOutput& o, const NominalState& nominal, const StateVector<N>& sd) {
+  o.nav = nominal.nav;
+  o.sigma_pos_ned_m = sd.template segment<3>(ix::kPos);
+  o.sigma_vel_n_mps = sd.template segment<3>(ix::kVel);
+  o.sigma_att_rad = sd.template segment<3>(ix::kAtt);
+  o.accel_bias_b = nominal.accel_bias_b;
+  o.gyro_bias_b = nominal.gyro_bias_b;
+  o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
+  o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
+}
+
 struct IntegrationCounters {
   long long imu_steps = 0;
   long long epochs = 0;    // GNSS fixes / observation epochs applied

@@ -86,6 +86,15 @@ struct ImuStepAccumulator {
     dt_s = 0.0;
     dv_n.setZero();
   }
+  // The filter predicted with the model linearised over the accumulated steps ending at nav, then cleared (nothing
+  // when no step has accumulated).
+  template <class Filter, class Model>
+  void predict(Filter& filter, Model& model, const ins::NavState& nav) {
+    if (dt_s <= 0.0) return;
+    model.set_linearisation(linearisation(nav));
+    filter.predict(model, dt_s);
+    clear();
+  }
 };
 
 template <int N>

@@ -473,12 +473,7 @@ class UltraTightCore final : public UltraTightCoreBase {
     }
   }
 
-  void propagate() {
-    if (imu_steps_.dt_s <= 0.0) return;
-    model_.set_linearisation(imu_steps_.linearisation(nominal_.nav));
-    filter_.predict(model_, imu_steps_.dt_s);
-    imu_steps_.clear();
-  }
+  void propagate() { imu_steps_.predict(filter_, model_, nominal_.nav); }
 
   // One filter update; when accepted, its correction goes into the nominal and the INS (closed loop).
   template <class M>
@@ -509,15 +504,8 @@ class UltraTightCore final : public UltraTightCoreBase {
 
   void fill_output() {
     IntegrationOutput& o = output;
-    o.nav = nominal_.nav;
     const StateVector<N> sd = filter_.P().diagonal().cwiseMax(0.0).cwiseSqrt();
-    o.sigma_pos_ned_m = sd.template segment<3>(ix::kPos);
-    o.sigma_vel_n_mps = sd.template segment<3>(ix::kVel);
-    o.sigma_att_rad = sd.template segment<3>(ix::kAtt);
-    o.accel_bias_b = nominal_.accel_bias_b;
-    o.gyro_bias_b = nominal_.gyro_bias_b;
-    o.sigma_accel_bias_b = sd.template segment<3>(ix::kAccelBias);
-    o.sigma_gyro_bias_b = sd.template segment<3>(ix::kGyroBias);
+    set_ins_output<N>(o, nominal_, sd);
     o.clock_bias_m = nominal_.clock_bias_m;
     o.clock_drift_mps = nominal_.clock_drift_mps;
     o.sigma_clock_bias_m = sd(ix::kClockBias);
