@@ -95,7 +95,7 @@ struct GnssInsCoupler::Impl {
   // Odometer aiding (loose, settings.odometer given): the speed windows and the next one to hand over.
   std::vector<fusion::OdometerSpeed> odometer;
   std::size_t next_odometer = 0;
-  long long tight_odometer_windows = 0;  // windows the tight integration took before any hand-over
+  long long tight_odometer_windows = 0;  // windows the tight integration took before the hand-over
   std::optional<OdometerUse> odometer_use;
   // The ultra-tight driver's odometer counters after the hand-over (take_odometer_windows).
   fusion::UltraTightCounters handed_over_counters;
@@ -217,7 +217,7 @@ struct GnssInsCoupler::Impl {
       }
       for (; next_odometer < odometer.size() && odometer[next_odometer].t_s <= inc.t_s; ++next_odometer) {
         integration->add_odometer(odometer[next_odometer]);
-        tight_odometer_windows = ++odometer_use->windows;
+        ++odometer_use->windows;
       }
       integration->add_imu(inc);
       emit();
@@ -502,6 +502,7 @@ void GnssInsCoupler::hand_over() { impl_->handed_over = true; }
 
 std::vector<fusion::OdometerSpeed> GnssInsCoupler::take_odometer_windows() {
   Impl& m = *impl_;
+  if (m.odometer_use) m.tight_odometer_windows = m.odometer_use->windows;
   std::vector<fusion::OdometerSpeed> rest(m.odometer.begin() + static_cast<std::ptrdiff_t>(m.next_odometer),
                                           m.odometer.end());
   m.next_odometer = m.odometer.size();
