@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <variant>
 
+#include "fusion/bias_frame_reset.hpp"
 #include "fusion/gnss_ins_core.hpp"
 #include "fusion/odometer_history.hpp"
 #include "ins/attitude.hpp"
@@ -184,7 +185,9 @@ class Core final : public CoreBase {
     ++counters.accepted;
     // Closed loop: fold the estimated errors into the nominal (INS, IMU compensation, clock, terrain, odometer,
     // fix error), reset.
+    const Eigen::Quaterniond q_before = nominal_.nav.q_nb;
     nominal_ = corrected<kNav>(nominal_, filter_.x().template head<kNav>());
+    filter_.set_P(reset_bias_frame<N>(filter_.P(), q_before, nominal_.nav.q_nb));
     if constexpr (L::kHasTerrain) terrain_m_ -= filter_.x()(ix::kTerrain);
     if constexpr (L::kHasOdometer)
       odometer_ = corrected(odometer_, Eigen::Vector4d(filter_.x().template segment<4>(L::kOdo)));

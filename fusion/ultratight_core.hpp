@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "fusion/bias_frame_reset.hpp"
 #include "fusion/carrier_rate_measurement.hpp"
 #include "fusion/odometer_history.hpp"
 #include "fusion/ultratight_integration.hpp"
@@ -482,7 +483,9 @@ class UltraTightCore final : public UltraTightCoreBase {
     if (!r.accepted) return r;
     last_dx_ = filter_.x().template head<17>();
     period_dx_ += last_dx_;
+    const Eigen::Quaterniond q_before = nominal_.nav.q_nb;
     nominal_ = corrected<17>(nominal_, last_dx_);
+    filter_.set_P(reset_bias_frame<N>(filter_.P(), q_before, nominal_.nav.q_nb));
     if constexpr (kOdometer) {
       const Eigen::Vector4d dx_odometer = filter_.x().template tail<4>();
       period_odometer_dx_ += dx_odometer;

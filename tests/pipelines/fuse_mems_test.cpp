@@ -13,15 +13,11 @@
 #include <numbers>
 
 #include "config/fuse_config_toml.hpp"
-#include "config/scenario_toml.hpp"
 #include "ins/attitude.hpp"
 #include "ins/earth_model.hpp"
-#include "ins/imu_csv.hpp"
 #include "pipelines/fuse.hpp"
-#include "pipelines/gnss_fix_simulation.hpp"
 #include "sim/scenario_models.hpp"
-#include "sim/simulation_files.hpp"
-#include "sim/truth_csv.hpp"
+#include "support/mems_drive_unit.hpp"
 #include "support/test_data.hpp"
 
 namespace ultratrack::pipelines {
@@ -39,20 +35,9 @@ struct Errors {
 double wrapped_deg(double a_rad) { return std::remainder(a_rad, 2.0 * std::numbers::pi) / kDeg; }
 
 Errors run_fuse(bool nhc) {
-  const auto dir = test::scratch_dir();
-  const auto scenario_file = test::scenarios_dir() / "mems_drive_adis16405.toml";
-  const sim::Scenario scenario = config::read_scenario(scenario_file);
-  const sim::SimulationResult simulated =
-      sim::simulate_to_folder(scenario, dir / "sim", test::read_text_file(scenario_file));
-  const auto imu = ins::read_imu_csv(dir / "sim" / "imu.csv");
-  const ins::TruthInterpolator truth(truth_samples_from_nav(sim::read_truth_csv(dir / "sim" / "truth.csv")));
-  GnssFixSimulationOptions fixes;
-  fixes.rate_hz = 5.0;
-  fixes.first_time_s = 0.137;
-  fixes.sigma_ned_m = Eigen::Vector3d(0.5, 0.5, 1.0);
-  fixes.with_velocity = false;
-  fixes.seed = 1;
-  const std::vector<GnssFixRow> gnss = simulate_gnss_fixes(truth, fixes);
+  const test_support::MemsDriveUnit unit = test_support::simulate_mems_drive_unit(test::scratch_dir(), 1, false);
+  const ins::TruthInterpolator& truth = unit.truth;
+  const std::vector<GnssFixRow>& gnss = unit.fixes;
 
   FuseSettings s;
   s.config = config::read_fuse_config(test::scenarios_dir() / "mems_datasheet_fuse.toml");
@@ -60,7 +45,7 @@ Errors run_fuse(bool nhc) {
   s.align = AlignMode::Motion;
   double h2 = 0, v2 = 0, r2 = 0, p2 = 0, y2 = 0;
   int n = 0;
-  const FuseResult result = fuse(imu, gnss, {}, s, [&](const ins::NavState& nav, const NavSigma&) {
+  const FuseResult result = fuse(unit.imu, gnss, {}, s, [&](const ins::NavState& nav, const NavSigma&) {
     if (nav.t_s < 60.0 || nav.t_s > truth.end_s()) return;
     const ins::EcefMotion m = truth.antenna(nav.t_s, Eigen::Vector3d::Zero());
     const Eigen::Vector3d d = ins::C_en(nav.lat_rad, nav.lon_rad).transpose() *
@@ -75,7 +60,7 @@ Errors run_fuse(bool nhc) {
     ++n;
   });
   EXPECT_GT(n, 1000);
-  const ins::ImuErrorSpec spec = sim::imu_error_spec(scenario);
+  const ins::ImuErrorSpec spec = sim::imu_error_spec(unit.scenario);
   auto worst_z = [](const Eigen::Vector3d& estimate, const Eigen::Vector3d& truth, const Eigen::Vector3d& sigma,
                     double in_run) {
     return ((estimate - truth).array() / (sigma.array().square() + in_run * in_run).sqrt()).abs().maxCoeff();
@@ -85,9 +70,9 @@ Errors run_fuse(bool nhc) {
           std::sqrt(r2 / n),
           std::sqrt(p2 / n),
           std::sqrt(y2 / n),
-          worst_z(result.gyro_bias_b, simulated.imu_turn_on.gyro.bias, result.sigma_gyro_bias_b,
+          worst_z(result.gyro_bias_b, unit.simulated.imu_turn_on.gyro.bias, result.sigma_gyro_bias_b,
                   spec.gyro.bias_instability_sigma),
-          worst_z(result.accel_bias_b, simulated.imu_turn_on.accel.bias, result.sigma_accel_bias_b,
+          worst_z(result.accel_bias_b, unit.simulated.imu_turn_on.accel.bias, result.sigma_accel_bias_b,
                   spec.accel.bias_instability_sigma)};
 }
 
