@@ -10,9 +10,11 @@ two-sided 95 % band is [chi2(0.025, 3M) / M, chi2(0.975, 3M) / M]. Prints one JS
 averaged over runs and times, the band, the share of times whose run average lies inside the band, and each axis's
 mean squared normalised error (1 when consistent). With --window-s W, also "windows": per window [t, t + W) of the
 common times, each axis's mean squared normalised error, RMS error and RMS 1-sigma (which side is off, and when;
-position m, velocity m/s, attitude deg), and each axis's mean normalised error (a bias shared by the runs).
+position m, velocity m/s, attitude deg), and each axis's mean normalised error (a bias shared by the runs). With
+--per-run, also "per_run": each run's NEES of the three blocks averaged over its times (which runs carry the mean),
+and their medians. --to-s ends the span (default: the end).
 
-    benchmarks/nav_nees.py [--from-s 60] [--window-s 20] NAV1.csv TRUTH1.csv [NAV2.csv TRUTH2.csv ...]
+    benchmarks/nav_nees.py [--from-s 60] [--to-s T] [--window-s 20] [--per-run] NAV1.csv TRUTH1.csv [...]
 """
 import argparse
 import json
@@ -43,7 +45,7 @@ def psi(est, tru):
     return [0.5 * (m[1][2] - m[2][1]), 0.5 * (m[2][0] - m[0][2]), 0.5 * (m[0][1] - m[1][0])]
 
 
-def run_nees(nav_path, truth_path, from_s):
+def run_nees(nav_path, truth_path, from_s, to_s):
     truth = {round(r["t_s"] * 1e6): r for r in rows(truth_path)}
     out = {}
     with open(nav_path, newline="") as f:
@@ -53,7 +55,7 @@ def run_nees(nav_path, truth_path, from_s):
             t = float(values[0])
             key = round(t * 1e6)
             tr = truth.get(key)
-            if t < from_s or tr is None:
+            if t < from_s or t > to_s or tr is None:
                 continue
             r = {k: float(v) for k, v in zip(names, values) if v}
             dp = ned_error(r, tr)
@@ -119,12 +121,14 @@ def chi2_quantile(p, k):
 def main():
     p = argparse.ArgumentParser()
     p.add_argument("--from-s", type=float, default=60.0)
+    p.add_argument("--to-s", type=float, default=math.inf)
     p.add_argument("--window-s", type=float, default=0.0)
+    p.add_argument("--per-run", action="store_true")
     p.add_argument("files", nargs="+")
     a = p.parse_args()
     if len(a.files) % 2:
         sys.exit("nav_nees: give NAV.csv TRUTH.csv pairs")
-    runs = [run_nees(a.files[i], a.files[i + 1], a.from_s) for i in range(0, len(a.files), 2)]
+    runs = [run_nees(a.files[i], a.files[i + 1], a.from_s, a.to_s) for i in range(0, len(a.files), 2)]
     errors = runs
     runs = [{t: [(e / s) ** 2 for e, s in v] for t, v in r.items()} for r in errors]
     common = set(runs[0])
@@ -145,6 +149,12 @@ def main():
                         "per_axis_ned": axes}
     if a.window_s > 0.0:
         result["windows"] = windows(errors, common, a.window_s)
+    if a.per_run:
+        blocks = ("position", "velocity", "attitude")
+        per_run = [dict({"nav": a.files[2 * i]}, **{name: round(sum(sum(r[t][3 * b:3 * b + 3]) for t in common) / len(common), 3)
+                                                    for b, name in enumerate(blocks)}) for i, r in enumerate(runs)]
+        result["per_run"] = per_run
+        result["per_run_median"] = {name: sorted(x[name] for x in per_run)[m // 2] for name in blocks}
     print(json.dumps(result))
 
 
