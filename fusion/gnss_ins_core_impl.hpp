@@ -383,7 +383,7 @@ class Core final : public CoreBase {
   // One odometer window ([KimVMS] eqs. 11-17): the gate of eqs. 16-17, then the VMS/NHC update.
   void apply_odometer(const OdometerSpeed& speed) {
     if constexpr (L::kHasOdometer) {
-      const auto w = history_.gated_window(nominal_.nav, speed, opt_.odometer, counters);
+      const auto w = history_.gated_window(nominal_.nav, speed, opt_.odometer, counters.odometer);
       if (!w) return;
       VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, w->a_b, speed, opt_.odometer);
       bool accepted;
@@ -391,7 +391,7 @@ class Core final : public CoreBase {
         accepted = update(for_filter<L, 19>(std::move(m)), -4);
       else
         accepted = update(OdometerStatesAt<VmsMeasurement, L::kOdo, N>(std::move(m)), -4);
-      ++(accepted ? counters.odometer_accepted : counters.odometer_rejected);
+      ++(accepted ? counters.odometer.accepted : counters.odometer.rejected);
     }
   }
 

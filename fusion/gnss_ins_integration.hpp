@@ -165,10 +165,7 @@ struct IntegrationCounters {
   long long recoveries = 0;                      // lock-out recoveries (recovery_events() says when and why)
   long long nhc_accepted = 0, nhc_rejected = 0;  // non-holonomic constraint updates
   long long fixes_skipped = 0;                   // loose: within fix_min_interval_s of the last fix used
-  // Odometer windows: updates accepted / refused by the innovation gate; gated out by the heading-rate rule and
-  // by the speed rule (a window failing both counts in both); unusable (no INS history over the window yet).
-  long long odometer_accepted = 0, odometer_rejected = 0;
-  long long odometer_gated_yaw_rate = 0, odometer_gated_speed = 0, odometer_unusable = 0;
+  OdometerCounters odometer;                     // odometer windows (fusion/vms_measurement.hpp)
 };
 
 // Per-update diagnostics (for NIS / consistency logs).

@@ -26,18 +26,16 @@ class OdometerHistory {
   // The window (now.t_s - speed.window_s, now.t_s]: nothing when the history does not reach back to its start.
   std::optional<Window> window(const ins::NavState& now, const OdometerSpeed& speed,
                                const OdometerAidingOptions& options) const;
-  // The window if it passes the gate, else nothing; counted in the filter's counters (fields odometer_unusable,
-  // odometer_gated_yaw_rate, odometer_gated_speed: IntegrationCounters, UltraTightCounters).
-  template <class Counters>
+  // The window if it passes the gate, else nothing; counted (unusable, gated_yaw_rate, gated_speed).
   std::optional<Window> gated_window(const ins::NavState& now, const OdometerSpeed& speed,
-                                     const OdometerAidingOptions& options, Counters& counters) const {
+                                     const OdometerAidingOptions& options, OdometerCounters& counters) const {
     const auto w = window(now, speed, options);
     if (!w) {
-      ++counters.odometer_unusable;
+      ++counters.unusable;
       return std::nullopt;
     }
-    if (!w->gate.yaw_rate_ok) ++counters.odometer_gated_yaw_rate;
-    if (!w->gate.speed_ok) ++counters.odometer_gated_speed;
+    if (!w->gate.yaw_rate_ok) ++counters.gated_yaw_rate;
+    if (!w->gate.speed_ok) ++counters.gated_speed;
     if (!w->gate.update()) return std::nullopt;
     return w;
   }

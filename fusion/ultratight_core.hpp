@@ -107,15 +107,15 @@ class UltraTightCore final : public UltraTightCoreBase {
   void add_odometer(const OdometerSpeed& speed) override {
     if constexpr (kOdometer) {
       if (!std::isfinite(speed.speed_mps) || !(speed.window_s > 0.0) || !std::isfinite(speed.window_s)) {
-        ++counters.odometer_unusable;
+        ++counters.odometer.unusable;
         return;
       }
-      const auto w = history_.gated_window(nominal_.nav, speed, opt_.odometer, counters);
+      const auto w = history_.gated_window(nominal_.nav, speed, opt_.odometer, counters.odometer);
       if (!w) return;
       propagate();
       const VmsMeasurement m(nominal_, odometer_, imu_steps_.w_ib_b, w->a_b, speed, opt_.odometer);
-      ++(apply(OdometerStatesAt<VmsMeasurement, 17, N>(m)).accepted ? counters.odometer_accepted
-                                                                    : counters.odometer_rejected);
+      ++(apply(OdometerStatesAt<VmsMeasurement, 17, N>(m)).accepted ? counters.odometer.accepted
+                                                                    : counters.odometer.rejected);
       fill_output();
     } else {
       (void)speed;

@@ -149,10 +149,7 @@ struct UltraTightCounters {
   // Carrier-phase rates (fusion/carrier_rate_measurement.hpp): updates (one per window, all satellites), their
   // accepted ones, the rows used and the rows screened out (carrier_rate_screen_sigma).
   long long rate_updates = 0, rate_accepted = 0, rate_rows = 0, rate_screened = 0;
-  // Odometer windows (add_odometer): VMS/NHC updates accepted and refused by the gate, windows gated out by the
-  // heading rate and by the speed (both may hold for one window), and windows the INS history does not cover.
-  long long odometer_accepted = 0, odometer_rejected = 0, odometer_gated_yaw_rate = 0, odometer_gated_speed = 0;
-  long long odometer_unusable = 0;
+  OdometerCounters odometer;  // odometer windows (add_odometer; fusion/vms_measurement.hpp)
 };
 
 class UltraTightIntegration {

@@ -57,6 +57,21 @@ struct OdometerGate {
   bool update() const { return yaw_rate_ok && speed_ok; }
 };
 
+// What became of a filter's odometer windows: updates accepted / refused by the innovation gate; gated out by the
+// heading-rate rule and by the speed rule (a window failing both counts in both); unusable (no INS history over the
+// window yet, or a non-finite speed). Summed over the filters of one run (tight, then ultra-tight).
+struct OdometerCounters {
+  long long accepted = 0, rejected = 0, gated_yaw_rate = 0, gated_speed = 0, unusable = 0;
+  OdometerCounters& operator+=(const OdometerCounters& o) {
+    accepted += o.accepted;
+    rejected += o.rejected;
+    gated_yaw_rate += o.gated_yaw_rate;
+    gated_speed += o.gated_speed;
+    unusable += o.unusable;
+    return *this;
+  }
+};
+
 // heading_change_rad: INS heading at the window's end minus at its start (wrapped inside).
 OdometerGate odometer_gate(const OdometerAidingOptions& options, double heading_change_rad, double window_s,
                            double vms_speed_mps);

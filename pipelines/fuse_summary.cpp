@@ -11,7 +11,7 @@
 
 namespace ultratrack::pipelines {
 
-std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounters& n,
+std::string odometer_json(const OdometerUse& u, const fusion::OdometerCounters& n,
                           const fusion::OdometerAidingOptions& o, const std::string& file) {
   const fusion::OdometerNominal &v = u.estimate.value, &sd = u.estimate.sigma;
   auto opt = [](const std::optional<double>& x) { return x ? fmt::format("{:.6g}", *x) : std::string("null"); };
@@ -24,8 +24,8 @@ std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounter
       "\"update_rate_hz\": {:.6g}, \"windows\": {}, \"updates_accepted\": {}, \"updates_rejected\": {}, "
       "\"gated_yaw_rate\": {}, \"gated_speed\": {}, \"unusable\": {}, ",
       io::json_escape(file), o.mode == fusion::OdometerMode::kGated ? "gated" : "always",
-      o.yaw_rate_threshold_rad_s / io::kRadPerDeg, o.min_speed_mps, o.update_rate_hz, u.windows, n.odometer_accepted,
-      n.odometer_rejected, n.odometer_gated_yaw_rate, n.odometer_gated_speed, n.odometer_unusable);
+      o.yaw_rate_threshold_rad_s / io::kRadPerDeg, o.min_speed_mps, o.update_rate_hz, u.windows, n.accepted, n.rejected,
+      n.gated_yaw_rate, n.gated_speed, n.unusable);
   j += fmt::format(
       "\"scale_factor\": {:.6g}, \"sigma_scale_factor\": {:.6g}, \"misalignment_pitch_deg\": {:.6g}, "
       "\"sigma_misalignment_pitch_deg\": {:.6g}, \"misalignment_yaw_deg\": {:.6g}, \"sigma_misalignment_yaw_deg\": "
@@ -95,7 +95,8 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
     j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,
                      r.fixes_after_gnss_until);
   if (r.odometer)
-    j += "  \"odometer\": " + odometer_json(*r.odometer, r.counters, s.config.odometer, s.odometer_file) + ",\n";
+    j += "  \"odometer\": " + odometer_json(*r.odometer, r.counters.odometer, s.config.odometer, s.odometer_file) +
+         ",\n";
   if (s.config.land.nhc)
     j += fmt::format("  \"nhc_updates_accepted\": {},\n  \"nhc_updates_rejected\": {},\n", r.counters.nhc_accepted,
                      r.counters.nhc_rejected);

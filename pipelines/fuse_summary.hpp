@@ -15,7 +15,7 @@ std::string recovery_events_json(const std::vector<fusion::RecoveryEvent>& event
 // The "odometer" object: settings, update counts by rule, the odometer estimates with their 1-sigma and, against
 // truth, [KimVMS]'s errors as % of the distance travelled since GNSS was last used (DT; null without truth).
 // file names the odometer data. `fuse` and `receive` (pipelines/gnss_ins_coupler.hpp) write it.
-std::string odometer_json(const OdometerUse& u, const fusion::IntegrationCounters& counters,
+std::string odometer_json(const OdometerUse& u, const fusion::OdometerCounters& counters,
                           const fusion::OdometerAidingOptions& options, const std::string& file);
 
 std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const std::string& imu_file,

@@ -98,17 +98,12 @@ struct GnssInsCoupler::Impl {
   long long tight_odometer_windows = 0;  // windows the tight integration took before the hand-over
   std::optional<OdometerUse> odometer_use;
   // The ultra-tight driver's odometer counters after the hand-over (take_odometer_windows).
-  fusion::UltraTightCounters handed_over_counters;
+  fusion::OdometerCounters handed_over_odometer;
 
   // The odometer counters of both filters (the tight one's, then the ultra-tight driver's).
-  fusion::IntegrationCounters odometer_counters() const {
-    fusion::IntegrationCounters k = integration->counters();
-    const fusion::UltraTightCounters& u = handed_over_counters;
-    k.odometer_accepted += u.odometer_accepted;
-    k.odometer_rejected += u.odometer_rejected;
-    k.odometer_gated_yaw_rate += u.odometer_gated_yaw_rate;
-    k.odometer_gated_speed += u.odometer_gated_speed;
-    k.odometer_unusable += u.odometer_unusable;
+  fusion::OdometerCounters odometer_counters() const {
+    fusion::OdometerCounters k = integration->counters().odometer;
+    k += handed_over_odometer;
     return k;
   }
 
@@ -509,11 +504,11 @@ std::vector<fusion::OdometerSpeed> GnssInsCoupler::take_odometer_windows() {
   return rest;
 }
 
-void GnssInsCoupler::record_handed_over_odometer(long long windows, const fusion::UltraTightCounters& counters,
+void GnssInsCoupler::record_handed_over_odometer(long long windows, const fusion::OdometerCounters& counters,
                                                  const fusion::OdometerEstimate& estimate, double gnss_last_used_s) {
   Impl& m = *impl_;
   if (!m.odometer_use) return;
-  m.handed_over_counters = counters;
+  m.handed_over_odometer = counters;
   m.odometer_use->estimate = estimate;
   m.odometer_use->windows = m.tight_odometer_windows + windows;
   m.odometer_use->gnss_last_used_s = std::max(m.odometer_use->gnss_last_used_s, gnss_last_used_s);
@@ -600,12 +595,11 @@ std::string GnssInsCoupler::report() const {
       m.start_s, m.used, m.before_start, k.accepted, k.rejected, m.final_sigma.position_ned_m.head<2>().norm(),
       m.final_sigma.position_ned_m.z(), m.nav_rows);
   if (m.odometer_use) {
-    const fusion::IntegrationCounters o = m.odometer_counters();
+    const fusion::OdometerCounters o = m.odometer_counters();
     r += fmt::format(
         "\nreceive: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading "
         "rate {}, by speed {}",
-        m.odometer_use->windows, o.odometer_accepted, o.odometer_rejected, o.odometer_gated_yaw_rate,
-        o.odometer_gated_speed);
+        m.odometer_use->windows, o.accepted, o.rejected, o.gated_yaw_rate, o.gated_speed);
   }
   return r;
 }

@@ -22,7 +22,6 @@
 #include <vector>
 
 #include "fusion/gnss_ins_integration.hpp"
-#include "fusion/ultratight_integration.hpp"
 #include "ins/nav_state.hpp"
 #include "pipelines/receive_options.hpp"
 #include "pipelines/receive_sinks.hpp"
@@ -78,7 +77,7 @@ class GnssInsCoupler final : public receiver::ReceiverObserver {
   // odometer counters and estimate, the last time its satellite updates were accepted): summary.json's odometer
   // object covers both filters.
   std::vector<fusion::OdometerSpeed> take_odometer_windows();
-  void record_handed_over_odometer(long long windows, const fusion::UltraTightCounters& counters,
+  void record_handed_over_odometer(long long windows, const fusion::OdometerCounters& counters,
                                    const fusion::OdometerEstimate& estimate, double gnss_last_used_s);
   void write_nav(const ins::NavState& nav, const Eigen::Vector3d& sigma_pos_ned_m,
                  const Eigen::Vector3d& sigma_vel_n_mps, const Eigen::Vector3d& sigma_att_rad);

@@ -90,7 +90,7 @@ void UltraTightLoop::feed_imu_to(double t) {
 
 void UltraTightLoop::record_odometer() {
   if (driver_ && driver_->options().odometer.enabled)
-    fusion_.record_handed_over_odometer(odometer_windows_, driver_->counters(), driver_->output().odometer,
+    fusion_.record_handed_over_odometer(odometer_windows_, driver_->counters().odometer, driver_->output().odometer,
                                         gnss_last_used_s_);
 }
 

@@ -163,12 +163,12 @@ void run_fuse_command(const FuseCommandOptions& o) {
         r.attitude.rows, r.attitude.fixed_rows, r.attitude.unfixed_skipped, r.counters.attitude_accepted,
         r.counters.attitude_rejected, r.counters.attitude_unusable, r.counters.fixes_without_attitude);
   if (const auto& u = r.odometer) {
-    const auto& n = r.counters;
+    const auto& n = r.counters.odometer;
     fmt::print(
         "fuse: odometer: {} windows, updates accepted {}, rejected {} (gate); gated out by heading rate {}, by "
         "speed {}; scale factor {:.5f} +- {:.5f}, misalignment pitch {:.3f} yaw {:.3f} deg, delay {:.3f} s\n",
-        u->windows, n.odometer_accepted, n.odometer_rejected, n.odometer_gated_yaw_rate, n.odometer_gated_speed,
-        u->estimate.value.scale_factor, u->estimate.sigma.scale_factor, u->estimate.value.pitch_rad / io::kRadPerDeg,
+        u->windows, n.accepted, n.rejected, n.gated_yaw_rate, n.gated_speed, u->estimate.value.scale_factor,
+        u->estimate.sigma.scale_factor, u->estimate.value.pitch_rad / io::kRadPerDeg,
         u->estimate.value.yaw_rad / io::kRadPerDeg, u->estimate.value.delay_s);
     if (u->distance_travelled_m)
       fmt::print(

@@ -89,15 +89,15 @@ TEST(FuseOdometer, EstimatesTheOdometerErrorsAndBoundsTheDrift) {
   ASSERT_TRUE(u.distance_travelled_m && u.horizontal_error_max_m);
   EXPECT_GT(*u.distance_travelled_m, 3000.0);
   EXPECT_LT(100.0 * *u.horizontal_error_max_m / *u.distance_travelled_m, 0.16);
-  EXPECT_GT(r.counters.odometer_gated_yaw_rate, 10);  // the turns
-  EXPECT_GT(r.counters.odometer_gated_speed, 5);      // the stop (and the parked start)
-  EXPECT_GE(r.counters.odometer_rejected, 1);         // the locked wheel at 300 s
-  EXPECT_GT(r.counters.odometer_accepted, 150);
+  EXPECT_GT(r.counters.odometer.gated_yaw_rate, 10);  // the turns
+  EXPECT_GT(r.counters.odometer.gated_speed, 5);      // the stop (and the parked start)
+  EXPECT_GE(r.counters.odometer.rejected, 1);         // the locked wheel at 300 s
+  EXPECT_GT(r.counters.odometer.accepted, 150);
   EXPECT_GT(r.fixes_after_gnss_until, 200);
 
   const FuseResult always = run(true, fusion::OdometerMode::kAlways);
-  EXPECT_EQ(always.counters.odometer_gated_yaw_rate + always.counters.odometer_gated_speed, 0);
-  EXPECT_GT(always.counters.odometer_accepted, r.counters.odometer_accepted);
+  EXPECT_EQ(always.counters.odometer.gated_yaw_rate + always.counters.odometer.gated_speed, 0);
+  EXPECT_GT(always.counters.odometer.accepted, r.counters.odometer.accepted);
 
   // Without the odometer the same drive after the GNSS is pure inertial: its error at the end is larger.
   const FuseResult inertial = run(false);
