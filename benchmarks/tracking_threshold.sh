@@ -23,12 +23,16 @@
 # re-acquired (it has failed the run; re-acquisition searches would only cost time). The receiver's other
 # settings are its defaults: --config-extra FILE appends [tracking] (or [pvt]) settings to the receive's
 # configuration, --receive-args passes more flags (e.g. a later issue's tracking modes) to every receive.
+# The loops are told the simulated front end's oscillator class (`receive --oscillator`), as a user who knows
+# their front end sets it: the scenario's `[receiver] oscillator` (tcxo, ocxo), else ideal (the static files and
+# scenarios without one have a perfect clock); --oscillator NAME tells them another (e.g. ideal on a TCXO file:
+# the loops assuming a perfect clock).
 #
 #   benchmarks/tracking_threshold.sh [--levels "24 26 28 30 32"] [--files 4] [--duration 60] [--fs 2.6e6]
 #       [--seed0 100] [--out DIR] [--ultratrack build/tools/ultratrack] [--receive-args "..."]
 #       [--config-extra FILE] [--lock-deadline 5] [--nav FILE] [--keep] [--coupling scalar|vector]
 #       [--strong-s T0 [--strong-cn0 45]] [--couplings "scalar vector ultra-tight"] [--filter ekf|ukf]
-#       [--scenario FILE] [--reuse] [--week W --tow-shift S]
+#       [--scenario FILE] [--reuse] [--week W --tow-shift S] [--oscillator tcxo|ocxo|ideal]
 # The ephemeris: benchmarks/ephemeris_option.sh (--nav or --brdc FILE; the shipped file by default; the files start
 # at tow 530400 + 90 k). Needs python3 (the report). CPU: about 15 s per file at
 # 2.6 MHz on one core. Files are deleted after their receive unless --keep. --reuse: a file kept by an earlier
@@ -65,7 +69,7 @@ source "$root/benchmarks/ephemeris_option.sh"
 levels="24 26 28 30 32"; files=4; duration=60; fs=2.6e6; seed0=100; out=/tmp/ultratrack_threshold
 ultratrack=$root/build/tools/ultratrack; receive_args=""; keep=0; nav=$brdc
 lock_deadline_s=5; extra_config=""; report_only=0; reuse=0
-strong_s=0; strong_cn0=45; couplings=""; scenario=""; filter=ekf
+strong_s=0; strong_cn0=45; couplings=""; scenario=""; filter=ekf; oscillator=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --levels) levels=$2; shift 2 ;;
@@ -87,10 +91,11 @@ while [ $# -gt 0 ]; do
     --couplings) couplings=$2; shift 2 ;;
     --filter) filter=$2; shift 2 ;;  # the GNSS/INS couplings' filter
     --scenario) scenario=$(realpath "$2"); shift 2 ;;
+    --oscillator) oscillator=$2; shift 2 ;;
     --keep) keep=1; shift ;;
     --reuse) reuse=1; keep=1; shift ;;
     --report-only) report_only=1; out=$2; shift 2 ;;
-    -h|--help) sed -n '2,53p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,64p' "$0"; exit 0 ;;
     *) echo "tracking_threshold.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -103,6 +108,26 @@ command -v python3 >/dev/null || { echo "tracking_threshold.sh: python3 is neede
 [ "$report_only" = 1 ] || nav=$(realpath "$nav")
 mkdir -p "$out"
 out=$(realpath "$out")
+
+# The simulated front end's oscillator class (see above) unless --oscillator says otherwise.
+if [ -z "$oscillator" ]; then
+  oscillator=ideal
+  if [ -n "$scenario" ]; then
+    oscillator=$(python3 - "$scenario" <<'PY'
+import re, sys
+section, found = "", "ideal"
+for line in open(sys.argv[1]):
+    m = re.match(r"\s*\[+([a-z_0-9]+)\]+", line)
+    if m:
+        section = m.group(1)
+    v = re.match(r'\s*oscillator\s*=\s*"([a-z]+)"', line)
+    if section == "receiver" and v:
+        found = v.group(1)
+print(found)
+PY
+)
+  fi
+fi
 
 acq_config=$out/acquisition.toml
 cat > "$acq_config" <<'TOML'
@@ -229,7 +254,7 @@ PY
       rc=0
       # shellcheck disable=SC2086
       nice -n 5 "$ultratrack" receive --input "$sim/antenna0.i8.bin" --format i8 --fs "$sim_fs" --nav "$nav" \
-        --prn "$prns" --out "$rx" --quiet "${config_args[@]}" $receive_args "${coupling_args[@]}" > "$rx.log" 2>&1 || rc=$?
+        --prn "$prns" --out "$rx" --quiet --oscillator "$oscillator" "${config_args[@]}" $receive_args "${coupling_args[@]}" > "$rx.log" 2>&1 || rc=$?
       if [ "$rc" != 0 ] && [ ! -f "$rx/tracking.csv" ] && grep -q -- "--coupling\|coupling" "$rx.log"; then
         echo "tracking_threshold: receive rejects --coupling $coupling ($(tail -n 1 "$rx.log")): skipped" >&2
         skipped="$skipped$coupling "; continue

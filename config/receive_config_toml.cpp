@@ -9,7 +9,6 @@
 
 #include "io/units.hpp"
 #include "signals/input_error.hpp"
-#include "signals/oscillator_allan.hpp"
 
 namespace ultratrack::config {
 namespace {
@@ -102,17 +101,9 @@ const std::map<std::string, Table>& sections() {
         {"coherent_max_bn_t", [](const Setter& v, O& o) { o.tracking.coherent_max_bn_t = v.number(); }},
         {"oscillator", [](const Setter& v, O& o) {
            // The front end's oscillator class as a tracking loop sees it (signals/oscillator_allan.hpp).
-           const std::string name = v.node.value<std::string>().value_or("");
-           if (name == "none") {
-             o.tracking.oscillator_h0 = o.tracking.oscillator_h_minus2 = 0.0;
-             return;
-           }
-           const auto allan = signals::oscillator_signal_preset(name);
-           if (!allan)
-             throw signals::InputError(v.file, "key '" + v.key + "' must be \"tcxo\", \"ocxo\" or \"none\"",
+           if (!receiver::set_tracking_oscillator(o.tracking, v.node.value<std::string>().value_or("")))
+             throw signals::InputError(v.file, "key '" + v.key + "' must be \"tcxo\", \"ocxo\" or \"ideal\"",
                                        static_cast<int>(v.node.source().begin.line));
-           o.tracking.oscillator_h0 = allan->h0;
-           o.tracking.oscillator_h_minus2 = allan->h_minus2;
          }},
         {"oscillator_h0", [](const Setter& v, O& o) { o.tracking.oscillator_h0 = v.number(); }},
         {"oscillator_h_minus2", [](const Setter& v, O& o) { o.tracking.oscillator_h_minus2 = v.number(); }},

@@ -76,6 +76,9 @@ void write_summary_json(const std::filesystem::path& path, const ReceiverEngine&
                ionosphere_source_name(iono[i].source),
                ionosphere_change_seconds(iono[i], s.first_sample, engine.options().fs_hz));
   fmt::print(out, "]}},\n");
+  fmt::print(out, "  \"tracking_oscillator\": {{\"class\": \"{}\", \"h0\": {:.4g}, \"h_minus2\": {:.4g}}},\n",
+             tracking_oscillator_name(engine.options().tracking), engine.options().tracking.oscillator_h0,
+             engine.options().tracking.oscillator_h_minus2);
   // One line, so that a comparison across the change that added it can leave it out.
   fmt::print(out, "  \"nav_bits\": {{\"mode\": \"{}\", \"per_satellite\": [", to_string(engine.options().nav_bits));
   bool first_bits = true;

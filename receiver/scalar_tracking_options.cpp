@@ -107,6 +107,27 @@ bool ScalarTrackingOptions::IsValid(std::string* why) const {
   return problem.empty();
 }
 
+bool set_tracking_oscillator(ScalarTrackingOptions& o, const std::string& name) {
+  if (name == "ideal" || name == "none") {
+    o.oscillator_h0 = o.oscillator_h_minus2 = 0.0;
+    return true;
+  }
+  const auto allan = signals::oscillator_signal_preset(name);
+  if (!allan) return false;
+  o.oscillator_h0 = allan->h0;
+  o.oscillator_h_minus2 = allan->h_minus2;
+  return true;
+}
+
+std::string tracking_oscillator_name(const ScalarTrackingOptions& o) {
+  if (o.oscillator_h0 == 0.0 && o.oscillator_h_minus2 == 0.0) return "ideal";
+  for (const std::string& name : signals::oscillator_preset_names()) {
+    const auto allan = signals::oscillator_signal_preset(name);
+    if (o.oscillator_h0 == allan->h0 && o.oscillator_h_minus2 == allan->h_minus2) return name;
+  }
+  return "custom";
+}
+
 ChannelConfig channel_config(const ScalarTrackingOptions& o, int prn, double sample_rate_hz, int num_antennas) {
   ChannelConfig c;
   c.prn = prn;

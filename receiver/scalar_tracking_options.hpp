@@ -9,6 +9,7 @@
 #include "receiver/bit_sync.hpp"
 #include "receiver/lock_detectors.hpp"
 #include "receiver/tracking_channel.hpp"
+#include "signals/oscillator_allan.hpp"
 
 namespace ultratrack::receiver {
 
@@ -98,11 +99,15 @@ struct ScalarTrackingOptions {
   // noise passes a PLL as jitter that grows as the bandwidth narrows (receiver/long_coherent.hpp), so with it the
   // choice of N minimises the total jitter, thermal and oscillator: a TCXO's random-walk frequency (Brown & Hwang,
   // h-2 2e-20) puts 48 deg into the 2 Hz loop of 100 ms integration and 12 deg into the 5 Hz one of 20 ms.
-  double oscillator_h0 = 0.0;           // white frequency, s; [0, 1e-17]
-  double oscillator_h_minus2 = 0.0;     // random-walk frequency, 1/s; [0, 1e-17]
-  double coherent_jitter_deg = 4.0;     // (0, 30]
-  double coherent_hysteresis_db = 2.0;  // [0, 10]
-  double coherent_max_bn_t = 0.2;       // (0, 0.25]
+  // Default: a TCXO (oscillator_signal_preset("tcxo")), the clock of real front ends (RTL-SDR, MAX2769 and
+  // HackRF boards, bladeRF). Assuming a perfect clock on a TCXO's signal picks 100 ms below 30.2 dB-Hz and loses
+  // every satellite there; assuming a TCXO on a perfect clock's signal costs ~2 dB of threshold
+  // (docs/validation.md, section 6). set_tracking_oscillator() names the class.
+  double oscillator_h0 = signals::oscillator_signal_preset("tcxo")->h0;              // white frequency, s; [0, 1e-17]
+  double oscillator_h_minus2 = signals::oscillator_signal_preset("tcxo")->h_minus2;  // random walk, 1/s; [0, 1e-17]
+  double coherent_jitter_deg = 4.0;                                                  // (0, 30]
+  double coherent_hysteresis_db = 2.0;                                               // [0, 10]
+  double coherent_max_bn_t = 0.2;                                                    // (0, 0.25]
   // Lock test of a channel whose replica a filter drives (ultra-tight: set_filter_driven): the scalar loss test
   // above (0.2 s C/N0 below cn0_loss_threshold_dbhz or PLI below pli_loss_threshold for loss_of_lock_time_s)
   // is replaced by receiver/presence_test.hpp on the 20 ms epochs: prompt power over the noise tap's over
@@ -130,7 +135,12 @@ struct ScalarTrackingOptions {
   bool IsValid(std::string* why) const;
 };
 
-// Empty when the options are valid, else a message naming the first bad field, its value and its range.
+// The front end's oscillator class for the loops: "tcxo" or "ocxo" (signals::oscillator_signal_preset), or
+// "ideal" (also "none": a perfect clock, for simulated files without clock noise). False for another name
+// (nothing changes).
+bool set_tracking_oscillator(ScalarTrackingOptions& options, const std::string& name);
+// The class name the coefficients match ("tcxo", "ocxo", "ideal"), or "custom".
+std::string tracking_oscillator_name(const ScalarTrackingOptions& options);
 
 // The channel configuration these options need (correlator layout with the noise tap when kNoiseTap).
 ChannelConfig channel_config(const ScalarTrackingOptions& options, int prn, double sample_rate_hz,

@@ -37,7 +37,7 @@ namespace ultratrack::tools {
 namespace {
 
 struct ReceiveArgs {
-  std::string input, fs, if_hz = "0", config, nav, nav_bits, out;
+  std::string input, fs, if_hz = "0", config, nav, nav_bits, oscillator, out;
   std::string elevation_mask, troposphere, ionosphere, channels, prns, duration, skip, reference_week, threads;
   FormatArgs format;
   ReceiveFusionArgs fusion;
@@ -72,6 +72,9 @@ void run_receive(const ReceiveArgs& args) {
   if (!args.threads.empty()) options.threads = parse_int_option("--threads", args.threads);
   if (!args.nav_bits.empty())
     options.nav_bits = receiver::parse_nav_bit_source("command line: --nav-bits", args.nav_bits);
+  if (!args.oscillator.empty() && !receiver::set_tracking_oscillator(options.tracking, args.oscillator))
+    throw signals::InputError("command line",
+                              "--oscillator: must be tcxo, ocxo or ideal, not '" + args.oscillator + "'");
   if (!args.prns.empty()) options.prns = parse_prn_list_option("--prn", args.prns);
   if (!args.nav.empty()) job.navigation = signals::read_rinex_nav(args.nav);
   if (!args.reference_week.empty()) {
@@ -135,6 +138,9 @@ void add_receive_command(CLI::App& app) {
   cmd->add_option("--nav-bits", args->nav_bits,
                   "decoded|oracle: bits for data wipe-off (default decoded: from the signal; oracle: --nav re-encoded "
                   "as `simulate` does, for simulation studies)");
+  cmd->add_option("--oscillator", args->oscillator,
+                  "tcxo|ocxo|ideal: the front end's oscillator class for the tracking loops (default tcxo; ideal: a "
+                  "perfect clock, e.g. a simulated file without clock noise)");
   cmd->add_option("--elevation-mask-deg", args->elevation_mask, "PVT elevation mask, degrees (default 10)");
   cmd->add_option("--troposphere", args->troposphere, "on|off (default on)");
   cmd->add_option(

@@ -107,6 +107,10 @@ TEST(ReceiveVector, HotStartKeepsEverySatelliteInVectorModeAndPositionsAsWellAsS
       std::string::npos);
   EXPECT_NE(ultratrack::test::read_text_file(scalar / "summary.json").find("\"coupling\": \"scalar\""),
             std::string::npos);
+  // The tracking loops' oscillator as summary.json echoes it: the default, a TCXO.
+  EXPECT_NE(ultratrack::test::read_text_file(scalar / "summary.json")
+                .find("\"tracking_oscillator\": {\"class\": \"tcxo\", \"h0\": 9.356e-23, \"h_minus2\": 2e-20}"),
+            std::string::npos);
 
   // Every satellite of the file acquired once and never lost, in both runs.
   std::vector<int> prns;
@@ -368,11 +372,12 @@ TEST(ReceiveVector, ChannelsCoastThroughFadesAndReLockWithoutAcquisition) {
 // lost every vector channel within ~0.5 s of a step to <= 25 dB-Hz, gives way to the presence test (a 60 s run at
 // 22 dB-Hz is falsely lost with probability 4e-11: docs/validation.md), their PLLs integrate 100 ms with the
 // known bits wiped (--nav-bits oracle: every bit of the simulated file; with the default decoded bits, none of
-// subframes 1-3 repeat within 25 s and 2 of 10 channels coasted), and their discriminators keep updating the filter
-// with C/N0-weighted noise. So every channel handed over must stay in vector mode and locked (bit-synced, never
-// coasting or lost) to the end. Against the simulator's truth: the filter's position RMS over the weak part within 5 m
-// (the threshold runs at 22-24 dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code loop is slow and its
-// sigma optimistic).
+// subframes 1-3 repeat within 25 s and 2 of 10 channels coasted; the receiver told the file's perfect clock: a
+// TCXO, the default, keeps them on 20 ms, where 22 dB-Hz is below the aided PLL's threshold), and their discriminators
+// keep updating the filter with C/N0-weighted noise. So every channel handed over must stay in vector mode and locked
+// (bit-synced, never coasting or lost) to the end. Against the simulator's truth: the filter's position RMS over the
+// weak part within 5 m (the threshold runs at 22-24 dB-Hz: 1-5 m; the discriminator's gain there is ~0.5, so the code
+// loop is slow and its sigma optimistic).
 TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
   const std::filesystem::path brdc = ultratrack::test::shipped_nav_file();
   constexpr double kStep = 15.0, kEnd = 25.0, kWeak = 22.0;
@@ -393,7 +398,8 @@ TEST(ReceiveVector, FilterDrivenChannelsKeepLockAfterAStepToAWeakSignal) {
                                        .out = vector,
                                        .coupling = ultratrack::pipelines::Coupling::kVector,
                                        .troposphere = false,
-                                       .nav_bits = ultratrack::receiver::NavBitSource::kOracle});
+                                       .nav_bits = ultratrack::receiver::NavBitSource::kOracle,
+                                       .oscillator = "ideal"});
   fs::remove(sim / "antenna0.i8.bin");
 
   // vector.csv: the PRNs commanded at the step, and any of them not commanded (or coasting) afterwards; the

@@ -107,7 +107,8 @@ double rms(const std::vector<double>& v) {
 }  // namespace
 
 TEST(LongCoherent, KeepsLockAt20DbHzWithKnownBitsAndLosesItAt20Ms) {
-  ScalarTrackingOptions opt;  // defaults: up to 100 ms, adaptive
+  ScalarTrackingOptions opt;              // defaults: up to 100 ms, adaptive
+  set_tracking_oscillator(opt, "ideal");  // the test signal's clock is perfect
   const Outcome longer = run(opt, true, 20.0, 3.0, 14.0);
   EXPECT_FALSE(longer.lost) << "lost at " << longer.lost_at_s << " s";
   EXPECT_EQ(longer.max_loop_ms, 100);
@@ -136,7 +137,8 @@ TEST(LongCoherent, KeepsLockAt20DbHzWithKnownBitsAndLosesItAt20Ms) {
 // excursions of 40-65 deg, RMS 14-21 deg against the truth, and 5 of 30 satellite-runs lost at 30 dB-Hz in the
 // issue-7 threshold runs while every one was kept at 26-28 dB-Hz.
 TEST(LongCoherent, SwitchingTheCoherentTimeOnADopplerRampKeepsThePhase) {
-  ScalarTrackingOptions opt;  // defaults: adaptive, up to 100 ms
+  ScalarTrackingOptions opt;              // defaults: adaptive, up to 100 ms
+  set_tracking_oscillator(opt, "ideal");  // the test signal's clock is perfect
   const Outcome o = run(opt, true, 30.0, 3.0, 20.0, 100, 4.0);
   EXPECT_FALSE(o.lost) << "lost at " << o.lost_at_s << " s";
   EXPECT_GE(o.switches, 6) << "the test needs switches between the integration times";
@@ -159,7 +161,8 @@ TEST(LongCoherent, StrongSignalStaysOn20Ms) {
 }
 
 TEST(LongCoherent, ChoiceFollowsTheJitterThresholdsWithHysteresis) {
-  ScalarTrackingOptions o;  // 5 Hz at 20 ms, Bn T <= 0.2, 4 deg, 2 dB, up to 100 ms
+  ScalarTrackingOptions o;              // 5 Hz at 20 ms, Bn T <= 0.2, 4 deg, 2 dB, up to 100 ms
+  set_tracking_oscillator(o, "ideal");  // thermal jitter only
   // Kaplan's thermal jitter sqrt(Bn / c (1 + 1 / (2 T c))) reaches 4 deg at 30.21 dB-Hz (20 ms, 5 Hz), 30.16
   // (40 ms, 5 Hz), 26.18 (100 ms, 2 Hz), 23.17 (200 ms, 1 Hz) and 20.16 (400 ms, 0.5 Hz).
   EXPECT_NEAR(pll_thermal_jitter_rad(5.0, 0.02, 30.21) * 180 / M_PI, 4.0, 0.01);
@@ -225,16 +228,25 @@ TEST(LongCoherent, OscillatorJitterMatchesTheLoopsErrorResponse) {
 // clock jitter (12 deg at 5 Hz, 48 deg at 2 Hz) growing faster than the thermal falls as the loop narrows (40 ms at
 // 5 Hz gains < 5 %: not worth its bits); an OCXO (2.3 deg at 2 Hz) leaves the thermal choice.
 TEST(LongCoherent, ChoiceWithAnOscillatorMinimisesTheTotalJitter) {
-  ScalarTrackingOptions o;
-  o.oscillator_h0 = 9.4e-23;
-  o.oscillator_h_minus2 = 2e-20;
+  ScalarTrackingOptions o;  // the default: a TCXO (oscillator_signal_preset)
+  EXPECT_EQ(tracking_oscillator_name(o), "tcxo");
+  EXPECT_NEAR(o.oscillator_h0, 9.36e-23, 0.01e-23);
+  EXPECT_DOUBLE_EQ(o.oscillator_h_minus2, 2e-20);
   EXPECT_EQ(choose_coherent_epochs(o, 45.0, 1), 1);
   EXPECT_EQ(choose_coherent_epochs(o, 29.0, 1), 1);
   EXPECT_EQ(choose_coherent_epochs(o, 20.0, 1), 1);
   EXPECT_EQ(choose_coherent_epochs(o, 29.0, 5), 1);
-  o.oscillator_h0 = 2e-23;
-  o.oscillator_h_minus2 = 4e-23;  // OCXO
+  EXPECT_TRUE(set_tracking_oscillator(o, "ocxo"));
+  EXPECT_EQ(tracking_oscillator_name(o), "ocxo");
+  EXPECT_NEAR(o.oscillator_h0, 2.0e-23, 0.01e-23);
+  EXPECT_DOUBLE_EQ(o.oscillator_h_minus2, 4e-23);
   EXPECT_EQ(choose_coherent_epochs(o, 29.0, 1), 5);
+  EXPECT_TRUE(set_tracking_oscillator(o, "none"));  // a perfect clock, as "ideal"
+  EXPECT_EQ(tracking_oscillator_name(o), "ideal");
+  EXPECT_FALSE(set_tracking_oscillator(o, "rubidium"));
+  EXPECT_EQ(tracking_oscillator_name(o), "ideal");  // unchanged
+  o.oscillator_h0 = 1e-22;
+  EXPECT_EQ(tracking_oscillator_name(o), "custom");
   o.oscillator_h_minus2 = 1e-16;
   EXPECT_NE(io::why_invalid(o), "");
 }
@@ -244,6 +256,8 @@ TEST(LongCoherent, ChoiceWithAnOscillatorMinimisesTheTotalJitter) {
 // Run with --gtest_also_run_disabled_tests --gtest_filter=LongCoherent.DISABLED_FadeSweep (minutes of CPU).
 TEST(LongCoherent, DISABLED_FadeSweep) {
   ScalarTrackingOptions on, off;
+  set_tracking_oscillator(on, "ideal");  // the test signal's clock is perfect
+  set_tracking_oscillator(off, "ideal");
   off.max_coherent_ms = 20;
   for (const double level : {14.0, 16.0, 18.0, 20.0, 22.0, 24.0, 26.0}) {
     int kept_on = 0, kept_off = 0;

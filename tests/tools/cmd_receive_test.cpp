@@ -88,6 +88,9 @@ TEST(ReceiveCommand, BadInputIsAnInputErrorAndLeavesNoOutputs) {
   EXPECT_THROW(
       run({"--input", noise, "--format", "i8", "--fs", "2.6e6", "--troposphere", "maybe", "--out", out.string()}),
       InputError);
+  EXPECT_THROW(
+      run({"--input", noise, "--format", "i8", "--fs", "2.6e6", "--oscillator", "rubidium", "--out", out.string()}),
+      InputError);
   EXPECT_EQ(files_in(out), 0);
   // White noise (or a wrong rate): no satellite in the searched PRNs -> InputError, and no outputs.
   try {
@@ -129,7 +132,13 @@ TEST(ReceiveConfig, UnknownKeysAndBadTypesNameTheFileAndKey) {
   const auto bad_section = dir / "bad_section.toml";
   std::ofstream(bad_section) << "[receivr]\nchannels = 4\n";
   EXPECT_THROW(ultratrack::config::apply_receive_config(bad_section, o), InputError);
-  // The front end's oscillator for the tracking loops: a named class or explicit coefficients.
+  // The front end's oscillator for the tracking loops: a named class or explicit coefficients; "ideal" (or the
+  // older "none") a perfect clock.
+  const auto ideal = dir / "ideal.toml";
+  std::ofstream(ideal) << "[tracking]\noscillator = \"ideal\"\n";
+  ultratrack::config::apply_receive_config(ideal, o);
+  EXPECT_EQ(o.tracking.oscillator_h0, 0.0);
+  EXPECT_EQ(o.tracking.oscillator_h_minus2, 0.0);
   const auto tcxo = dir / "tcxo.toml";
   std::ofstream(tcxo) << "[tracking]\noscillator = \"tcxo\"\n";
   ultratrack::config::apply_receive_config(tcxo, o);
@@ -141,7 +150,7 @@ TEST(ReceiveConfig, UnknownKeysAndBadTypesNameTheFileAndKey) {
     ultratrack::config::apply_receive_config(bad_oscillator, o);
     FAIL() << "unknown oscillator accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("\"tcxo\", \"ocxo\" or \"none\""), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("\"tcxo\", \"ocxo\" or \"ideal\""), std::string::npos) << e.what();
   }
 }
 
