@@ -101,8 +101,8 @@ struct ScalarTrackingOptions {
   // h-2 2e-20) puts 48 deg into the 2 Hz loop of 100 ms integration and 12 deg into the 5 Hz one of 20 ms.
   // Default: a TCXO (oscillator_signal_preset("tcxo")), the clock of real front ends (RTL-SDR, MAX2769 and
   // HackRF boards, bladeRF). Assuming a perfect clock on a TCXO's signal picks 100 ms below 30.2 dB-Hz and loses
-  // every satellite there; assuming a TCXO on a perfect clock's signal costs ~2 dB of threshold
-  // (docs/validation.md, section 6). set_tracking_oscillator() names the class.
+  // every satellite there; assuming a TCXO on a perfect clock's signal costs ~1 dB of threshold (29.0 against
+  // 27.9 dB-Hz: docs/validation.md, section 16). set_tracking_oscillator() names the class.
   double oscillator_h0 = signals::oscillator_signal_preset("tcxo")->h0;              // white frequency, s; [0, 1e-17]
   double oscillator_h_minus2 = signals::oscillator_signal_preset("tcxo")->h_minus2;  // random walk, 1/s; [0, 1e-17]
   double coherent_jitter_deg = 4.0;                                                  // (0, 30]
