@@ -254,7 +254,8 @@ PY
       rc=0
       # shellcheck disable=SC2086
       nice -n 5 "$ultratrack" receive --input "$sim/antenna0.i8.bin" --format i8 --fs "$sim_fs" --nav "$nav" \
-        --prn "$prns" --out "$rx" --quiet --oscillator "$oscillator" "${config_args[@]}" $receive_args "${coupling_args[@]}" > "$rx.log" 2>&1 || rc=$?
+        --prn "$prns" --out "$rx" --quiet --oscillator "$oscillator" "${config_args[@]}" $receive_args \
+        "${coupling_args[@]}" > "$rx.log" 2>&1 || rc=$?
       if [ "$rc" != 0 ] && [ ! -f "$rx/tracking.csv" ] && grep -q -- "--coupling\|coupling" "$rx.log"; then
         echo "tracking_threshold: receive rejects --coupling $coupling ($(tail -n 1 "$rx.log")): skipped" >&2
         skipped="$skipped$coupling "; continue

@@ -34,9 +34,9 @@ struct SimulatedReceive {
   int threads = 0;  // all cores
   receiver::NavBitSource nav_bits = receiver::NavBitSource::kDecoded;
   fusion::VectorCarrier vector_carrier = fusion::VectorCarrier::kAidedPll;  // kVector
-  // The tracking loops' oscillator class (receiver::set_tracking_oscillator); the default is a TCXO, the
-  // simulator's default clock is perfect ("ideal").
-  const char* oscillator = "tcxo";
+  // The tracking loops' oscillator class (receiver::set_tracking_oscillator); nullptr: the receiver's default (a
+  // TCXO). The simulator's default clock is perfect ("ideal").
+  const char* oscillator = nullptr;
 };
 
 inline pipelines::ReceiveSummary receive_simulated(const SimulatedReceive& r) {
@@ -49,7 +49,7 @@ inline pipelines::ReceiveSummary receive_simulated(const SimulatedReceive& r) {
   job.options.receiver.threads = r.threads;
   job.options.receiver.nav_bits = r.nav_bits;
   job.options.vector_carrier = r.vector_carrier;
-  if (!receiver::set_tracking_oscillator(job.options.receiver.tracking, r.oscillator))
+  if (r.oscillator && !receiver::set_tracking_oscillator(job.options.receiver.tracking, r.oscillator))
     throw std::invalid_argument(std::string("unknown oscillator ") + r.oscillator);
   if (r.nav) job.navigation = signals::read_rinex_nav(*r.nav);
   pipelines::date_recording(job.options.receiver, job.navigation, 0);
