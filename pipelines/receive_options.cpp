@@ -17,6 +17,8 @@ bool ReceiveOptions::IsValid(std::string* error) const {
   if (coupling != Coupling::kVector && vector_carrier != fusion::VectorCarrier::kAidedPll)
     return fail("--vector-carrier needs --coupling vector");
   if (std::string why; !nis_release.IsValid(&why)) return fail(why);
+  if (!(ut_clock_loop_bw_hz >= 0.0 && ut_clock_loop_bw_hz <= 12.5))
+    return fail("--ut-clock-loop-bw must be 0 (off) or in (0, 12.5] Hz (Bn T <= 0.25 at 20 ms)");
   if (!uses_imu(coupling)) return true;
   const auto& names = ins::imu_preset_names();
   if (std::find(names.begin(), names.end(), navigation.imu_preset) == names.end())

@@ -44,6 +44,9 @@ struct ReceiveOptions {
   // between blocks, its commands at the epoch that produced them (slower with 2 or more threads).
   fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;
   bool ut_pipelined = true;
+  // kUltraTight: the common clock loop's noise bandwidth (receiver/common_clock_loop.hpp; --ut-clock-loop-bw), Hz,
+  // in (0, 12.5]; 0: off (each channel's PLL follows the receiver oscillator alone).
+  double ut_clock_loop_bw_hz = 5.0;
   // kVector, kUltraTight: the windowed NIS test that releases channels (and re-opens or resets the filter):
   // --nis-window, --nis-probability (fusion/nis_release.hpp).
   fusion::NisReleaseOptions nis_release;

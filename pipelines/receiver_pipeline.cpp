@@ -47,6 +47,7 @@ struct Receiver::Impl {
     if (o.coupling == Coupling::kUltraTight) {
       UltraTightLoopOptions ut;
       ut.nis = o.nis_release;
+      ut.common_clock_bw_hz = o.ut_clock_loop_bw_hz;
       ultratight.emplace(*fusion, sink, ut).attach(engine);
     }
   }

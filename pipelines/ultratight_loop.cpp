@@ -29,7 +29,10 @@ constexpr double kEpochChips = 20.0 * 1023.0;  // a 20 ms channel epoch of C/A c
 }  // namespace
 
 UltraTightLoop::UltraTightLoop(GnssInsCoupler& fusion, ReceiveSink& sink, UltraTightLoopOptions ut)
-    : fusion_(fusion), sink_(sink), options_(fusion.options().receiver), ut_(ut), nis_(ut.nis) {}
+    : fusion_(fusion), sink_(sink), options_(fusion.options().receiver), ut_(ut), nis_(ut.nis) {
+  if (ut_.common_clock_bw_hz > 0.0)
+    clock_loop_.emplace(receiver::CommonClockLoopOptions{ut_.common_clock_bw_hz, ut_.period_s});
+}
 
 UltraTightLoop::ChannelState& UltraTightLoop::channel(int prn) {
   auto [it, made] = channels_.try_emplace(prn);
@@ -164,6 +167,7 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
                                                                      double t_k) {
   std::vector<fusion::ChannelCorrelation> out;
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
+  const double common_offset_hz = common_carrier_offset_hz(epoch, t_k);
   for (const auto& in : epoch.channels) {
     if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
     if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
@@ -175,7 +179,7 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     // Hz off the signal; the I&Q (and discriminator) model takes that replica carrier as given and reads the
     // difference as the filter's Doppler error (16-34 Hz innovations were accepted: docs/validation.md), so its
     // correlations are left out until it is back.
-    if (runaway_check(in, t_start_s + half_s)) {
+    if (runaway_check(in, t_start_s + half_s, common_offset_hz)) {
       ++runaway_left_out_;
       channel(in.prn).rate_anchored = false;
       continue;
@@ -275,11 +279,31 @@ double UltraTightLoop::predicted_doppler_at(int prn, double t_s) const {
   return f1 + (f1 - f0) / (t1 - t0) * (t_s - t1);
 }
 
+double UltraTightLoop::common_carrier_offset_hz(const receiver::VectorEpochInput& epoch, double t_k) const {
+  std::vector<double> offsets;
+  for (const auto& in : epoch.channels) {
+    const auto it = channels_.find(in.prn);
+    if (it == channels_.end() || !it->second.commanded || in.coasting || !in.synchronised || !in.has_measurement)
+      continue;
+    if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;
+    const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
+    const double t_mid_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz + half_s;
+    const double offset = in.replica_carrier_frequency_hz - predicted_doppler_at(in.prn, t_mid_s);
+    if (std::isfinite(offset)) offsets.push_back(offset);
+  }
+  if (offsets.size() < 4) return NAN;
+  const auto middle = offsets.begin() + static_cast<std::ptrdiff_t>(offsets.size() / 2);
+  std::nth_element(offsets.begin(), middle, offsets.end());
+  if (offsets.size() % 2 == 1) return *middle;
+  return 0.5 * (*middle + *std::max_element(offsets.begin(), middle));
+}
+
 // Carrier runaway of one channel with a 20 ms measurement (t_mid_s: its middle, IMU time); returns whether the
 // channel is judged off its signal (its correlations are then not used). Only a commanded, not coasting channel
-// below runaway_below_dbhz is checked; anything else starts the monitor afresh. A 1 s mean beyond runaway_hz sets
-// the aiding step (sent with the next command) and keeps the channel off until a later 1 s mean is within it.
-bool UltraTightLoop::runaway_check(const receiver::VectorChannelInput& in, double t_mid_s) {
+// below runaway_below_dbhz is checked; anything else starts the monitor afresh. A 1 s mean of its offset from the
+// common one (common_offset_hz) beyond runaway_relative_hz, or without a common one of its offset beyond runaway_hz,
+// sets the aiding step (sent with the next command) and keeps the channel off until a later 1 s mean is within it.
+bool UltraTightLoop::runaway_check(const receiver::VectorChannelInput& in, double t_mid_s, double common_offset_hz) {
   ChannelState& st = channel(in.prn);
   st.last_offset_hz = in.replica_carrier_frequency_hz - predicted_doppler_at(in.prn, t_mid_s);
   if (!st.commanded || in.coasting || !(in.cn0_dbhz < ut_.runaway_below_dbhz)) {
@@ -289,9 +313,12 @@ bool UltraTightLoop::runaway_check(const receiver::VectorChannelInput& in, doubl
     st.pending_step_hz = 0.0;
     return false;
   }
-  if (st.runaway.add(st.last_offset_hz, ut_.period_s)) {
+  // Against the common offset when there is one (the channel's own error), else the offset itself.
+  const bool relative = std::isfinite(common_offset_hz);
+  const double own_offset_hz = relative ? st.last_offset_hz - common_offset_hz : st.last_offset_hz;
+  if (st.runaway.add(own_offset_hz, ut_.period_s)) {
     const double mean = st.runaway.mean_hz();
-    const bool off = std::abs(mean) > ut_.runaway_hz;
+    const bool off = std::abs(mean) > (relative ? ut_.runaway_relative_hz : ut_.runaway_hz);
     st.runaway_repeats = off && st.runaway_off ? st.runaway_repeats + 1 : 0;
     st.runaway_off = off;
     if (st.runaway_repeats >= ut_.runaway_max_recentres) {
@@ -339,7 +366,7 @@ std::map<int, double> UltraTightLoop::propagated_doppler_change() {
 
 void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k,
                              std::span<receiver::VectorChannelCommand> commands,
-                             const std::map<int, double>& aid_change) {
+                             const std::map<int, double>& aid_change, double clock_change_hz) {
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
   std::map<int, const fusion::UltraTightSatelliteUpdate*> updates;
   for (const auto& u : driver_->last_updates()) updates[u.prn] = &u;
@@ -396,6 +423,7 @@ void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k
       if (vector) {
         commands[i].vector = true;
         commands[i].filter_driven = true;
+        commands[i].clock_steered = clock_loop_.has_value();
         commands[i].code_rate_chips_per_s = r.nco.code_rate_chips_per_s;
         commands[i].code_phase_jump_chips = jump;
         st.sent_code_rate_chips_per_s = r.nco.code_rate_chips_per_s;
@@ -404,7 +432,7 @@ void UltraTightLoop::command(const receiver::VectorEpochInput& epoch, double t_k
         if (!st.commanded || !std::isfinite(st.aid_hz) || change == aid_change.end())
           st.aid_hz = r.nco.carrier_frequency_hz;  // joins (the channel only uses changes of it)
         else
-          st.aid_hz += change->second;
+          st.aid_hz += change->second + clock_change_hz;
         // Carrier runaway: the aiding steps once by minus the offset of the last 5 epochs, which the channel adds to
         // its PLL's frequency (ScalarTracking::aid_frequency), putting it back on the prediction; the phase is flagged
         // while the channel is judged off (its phase is not the signal's, and the step starts a new arc).
@@ -518,6 +546,7 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
     driver_->add_ephemerides(fresh);
     ephemerides_.insert(ephemerides_.end(), fresh.begin(), fresh.end());
   }
+  const double clock_change_hz = common_clock_update(epoch);
   driver_->start_period(ut_.period_s);
   period_open_ = true;
   for (const auto& in : epoch.channels) {
@@ -529,7 +558,28 @@ void UltraTightLoop::update(const receiver::VectorEpochInput& epoch,
   }
   last_sample_ = epoch.sample;
   last_t_s_ = t_k;
-  command(epoch, t_k, commands, aid_change);
+  command(epoch, t_k, commands, aid_change, clock_change_hz);
+}
+
+double UltraTightLoop::common_clock_update(const receiver::VectorEpochInput& epoch) {
+  if (!clock_loop_) return 0.0;
+  std::vector<receiver::ChannelPrompt> prompts;
+  for (const auto& in : epoch.channels) {
+    const auto it = channels_.find(in.prn);
+    if (it == channels_.end()) continue;
+    const ChannelState& st = it->second;
+    if (!st.commanded || st.runaway_off || st.nis_released) continue;
+    // A channel re-locking after a coast (a tunnel's exit) pulls its own phase in for its first second: its prompt
+    // says nothing yet about the common clock (with it the loop was pushed 3 Hz off at a tunnel's exit).
+    if (st.since_relock_s < ut_.nis_settle_s) continue;
+    if (!in.synchronised || in.coasting || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
+    if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4 || !(in.iq_scale > 0.0)) continue;
+    // The bit by the in-phase sign even where it is known: a channel that re-locked half a cycle off (a Costas
+    // PLL may) has every known bit inverted, and its prompt would pull every channel by pi (seen at a tunnel's exit).
+    prompts.push_back({in.iq_i[1], in.iq_q[1], 0, in.cn0_dbhz});
+  }
+  const double before = clock_loop_->frequency_hz();
+  return clock_loop_->update(prompts) - before;
 }
 
 void UltraTightLoop::nis_tests(double t_s) {
@@ -588,6 +638,11 @@ std::string UltraTightLoop::summary_json() const {
   j += fmt::format(
       ", \"carrier_rate\": {{\"window_s\": {:g}, \"updates\": {}, \"accepted\": {}, \"rows\": {}, \"screened\": {}}}",
       ut_.carrier_rate_window_s, k.rate_updates, k.rate_accepted, k.rate_rows, k.rate_screened);
+  if (clock_loop_)
+    j += fmt::format(", \"common_clock\": {{\"bandwidth_hz\": {:g}, \"updates\": {}, \"frequency_hz\": {:.4f}}}",
+                     ut_.common_clock_bw_hz, clock_loop_->updates(), clock_loop_->frequency_hz());
+  else
+    j += ", \"common_clock\": null";
   j += fmt::format(", \"nis_window\": {}, \"nis_probability\": {:g}, \"filter_reopens\": {}, {}", ut_.nis.window,
                    ut_.nis.probability, filter_reopens_, release_log_.json_members());
   j += fmt::format(

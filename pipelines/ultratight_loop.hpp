@@ -6,7 +6,9 @@
 // 20 ms, (1) runs the INS to the vector epoch, (2) updates from each synchronised channel's latest correlation
 // epoch (E/P/L I&Q normalised to unit noise, data bit removed by the prompt's sign, the replica that actually ran
 // given explicitly), (3) predicts every satellite's replica and commands each channel's code (rate and phase jump)
-// and carrier aiding (predicted Doppler; the channel's Costas PLL stays closed, so carrier phase stays continuous).
+// and carrier aiding (predicted Doppler, plus the common clock loop's frequency: receiver/common_clock_loop.hpp, which
+// tracks the receiver oscillator on all channels' prompts at once; the channel's Costas PLL stays closed, so carrier
+// phase stays continuous).
 // A channel that loses lock coasts on the prediction and re-locks without acquisition. A weak channel whose PLL
 // runs away from the predicted Doppler (fusion/false_lock_monitor.hpp) is left out of the filter, stepped back onto the
 // prediction and its carrier phase flagged as slipped; one that keeps running away is released. A channel whose
@@ -35,6 +37,7 @@
 #include "pipelines/gnss_ins_coupler.hpp"
 #include "pipelines/prompt_power_average.hpp"
 #include "pipelines/receive_sinks.hpp"
+#include "receiver/common_clock_loop.hpp"
 #include "receiver/receiver_engine.hpp"
 #include "receiver/vector_loop.hpp"
 
@@ -59,6 +62,11 @@ struct UltraTightLoopOptions {
   double runaway_below_dbhz = 30.0;
   double runaway_average_s = 1.0;
   double runaway_hz = 5.0;
+  // The same test on the offset from the channels' common one (the median over at least 4 commanded channels: the
+  // filter's clock error, which every replica shares and the common clock loop has taken out of them but not out
+  // of the prediction). With a TCXO at 20 dB-Hz a locked channel's 1 s mean lies within 0.7 Hz of the median and
+  // a slipping one 2-7 Hz off, for tens of seconds, all under runaway_hz (docs/validation.md, section 16).
+  double runaway_relative_hz = 2.0;
   // A channel still beyond runaway_hz in the 1 s after each of this many re-centrings in a row is not locked (its
   // PLL cannot hold the signal): the loop releases it (scalar, then lost) instead of keeping it "bit-synced".
   int runaway_max_recentres = 3;
@@ -77,6 +85,10 @@ struct UltraTightLoopOptions {
   // channel's replica phase change over the window since its previous one updates the filter's range rates (and so
   // the common clock drift, which a TCXO moves by ~1 Hz / sqrt(s): docs/validation.md). 0: off.
   double carrier_rate_window_s = 0.2;
+  // The common clock loop (receiver/common_clock_loop.hpp): the receiver oscillator's phase tracked once on all the
+  // commanded channels' prompts (noise bandwidth, Hz) and added to every one's carrier aid, so that each PLL integrates
+  // on thermal jitter alone. 0: off (each PLL follows the oscillator itself).
+  double common_clock_bw_hz = 5.0;
 };
 
 class UltraTightLoop final : public receiver::VectorLoop {
@@ -130,11 +142,16 @@ class UltraTightLoop final : public receiver::VectorLoop {
   std::vector<fusion::ChannelCorrelation> correlations(const receiver::VectorEpochInput& epoch, double t_k);
   std::map<int, double> propagated_doppler_change();
   double predicted_doppler_at(int prn, double t_s) const;
-  bool runaway_check(const receiver::VectorChannelInput& in, double t_mid_s);
+  bool runaway_check(const receiver::VectorChannelInput& in, double t_mid_s, double common_offset_hz);
+  // The median of the commanded channels' carrier offsets (replica minus predicted Doppler) at this epoch; NaN with
+  // fewer than 4.
+  double common_carrier_offset_hz(const receiver::VectorEpochInput& epoch, double t_k) const;
   void carrier_rate(const receiver::VectorChannelInput& in, double t_mid_s, double phase_var_rad2, ChannelState& st,
                     fusion::ChannelCorrelation& c) const;
   void command(const receiver::VectorEpochInput& epoch, double t_k, std::span<receiver::VectorChannelCommand> out,
-               const std::map<int, double>& aid_change);
+               const std::map<int, double>& aid_change, double clock_change_hz = 0.0);
+  // The common clock loop's update from the commanded channels' latest prompts: the change of its frequency (Hz).
+  double common_clock_update(const receiver::VectorEpochInput& epoch);
   // The windowed NIS tests after a period's updates (t_s: receiver time for the log).
   void nis_tests(double t_s);
 
@@ -164,6 +181,7 @@ class UltraTightLoop final : public receiver::VectorLoop {
   long long measurements_ = 0, known_bits_ = 0, not_wiped_ = 0;
   long long runaway_recentres_ = 0, runaway_left_out_ = 0, runaway_releases_ = 0;
   fusion::NisReleaseMonitor nis_;
+  std::optional<receiver::CommonClockLoop> clock_loop_;  // UltraTightLoopOptions::common_clock_bw_hz > 0
   fusion::ReleaseLog release_log_;
   long long filter_reopens_ = 0;
   // Odometer aiding (--odometer): the windows the tight integration left, the next to hand to the driver, how many

@@ -30,11 +30,13 @@ void apply_fusion_options(py::dict& o, pipelines::ReceiveOptions& s) {
   std::string filter, align, fusion_config, ut_measurement, vector_carrier;
   py::object time_origin = py::none();
   bool ut_pipelined = true;
+  double ut_clock_loop_bw_hz = s.ut_clock_loop_bw_hz;
   const bool has_filter = take_option(o, "filter", filter), has_align = take_option(o, "align", align);
   const bool has_config = take_option(o, "fusion_config", fusion_config);
   const bool has_origin = take_option(o, "imu_time_origin", time_origin);
   const bool has_form = take_option(o, "ut_measurement", ut_measurement);
   const bool has_pipelined = take_option(o, "ut_pipelined", ut_pipelined);
+  const bool has_clock_loop = take_option(o, "ut_clock_loop_bw_hz", ut_clock_loop_bw_hz);
   if (take_option(o, "vector_carrier", vector_carrier)) {
     if (s.coupling != Coupling::kVector) throw io::InputError("python", "vector_carrier needs coupling='vector'");
     s.vector_carrier =
@@ -47,13 +49,17 @@ void apply_fusion_options(py::dict& o, pipelines::ReceiveOptions& s) {
       throw io::InputError("python",
                            "imu, filter, align, fusion_config and imu_time_origin need coupling "
                            "'loose', 'tight' or 'ultra-tight'");
-    if (has_form || has_pipelined)
-      throw io::InputError("python", "ut_measurement and ut_pipelined need coupling 'ultra-tight'");
+    if (has_form || has_pipelined || has_clock_loop)
+      throw io::InputError("python",
+                           "ut_measurement, ut_pipelined and ut_clock_loop_bw_hz need coupling 'ultra-tight'");
     return;
   }
-  if ((has_form || has_pipelined) && s.coupling != Coupling::kUltraTight)
-    throw io::InputError("python", "ut_measurement and ut_pipelined need coupling 'ultra-tight'");
+  if ((has_form || has_pipelined || has_clock_loop) && s.coupling != Coupling::kUltraTight)
+    throw io::InputError("python", "ut_measurement, ut_pipelined and ut_clock_loop_bw_hz need coupling 'ultra-tight'");
   s.ut_pipelined = ut_pipelined;
+  if (!(ut_clock_loop_bw_hz >= 0.0 && ut_clock_loop_bw_hz <= 12.5))
+    throw io::InputError("python", "ut_clock_loop_bw_hz must be 0 (off) or in (0, 12.5] Hz");
+  s.ut_clock_loop_bw_hz = ut_clock_loop_bw_hz;
   if (has_form)
     s.ut_form = enum_from_name(
         "ut_measurement", ut_measurement, {fusion::UltraTightForm::Iq, fusion::UltraTightForm::Discriminator},

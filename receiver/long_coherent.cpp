@@ -51,12 +51,13 @@ double long_coherent_pll_bw_hz(const ScalarTrackingOptions& o, int epochs) {
   return std::min(o.pll_bw_coherent_hz, o.coherent_max_bn_t / (epochs * kBitPeriod_s));
 }
 
-int choose_coherent_epochs(const ScalarTrackingOptions& o, double cn0_dbhz, int current) {
+int choose_coherent_epochs(const ScalarTrackingOptions& o, double cn0_dbhz, int current, bool oscillator_tracked) {
   const int max_epochs = std::max(1, o.max_coherent_ms / 20);
   const auto jitter_rad = [&](int n, double cn0) {
     const double bn = long_coherent_pll_bw_hz(o, n);
     const double thermal = pll_thermal_jitter_rad(bn, n * kBitPeriod_s, cn0);
-    const double clock = pll_oscillator_jitter_rad(bn, o.pll_order, o.oscillator_h0, o.oscillator_h_minus2);
+    const double clock =
+        oscillator_tracked ? 0.0 : pll_oscillator_jitter_rad(bn, o.pll_order, o.oscillator_h0, o.oscillator_h_minus2);
     return std::sqrt(thermal * thermal + clock * clock);
   };
   const auto shortest = [&](double cn0) {
@@ -69,7 +70,7 @@ int choose_coherent_epochs(const ScalarTrackingOptions& o, double cn0_dbhz, int 
     }
     // None within the bound. Without an oscillator the longest (thermal jitter falls with T); with one the
     // shortest within 5 % of the least total jitter (a longer block that gains less is not worth its bits).
-    if (!(o.oscillator_h0 > 0.0 || o.oscillator_h_minus2 > 0.0)) return jitters.back().first;
+    if (oscillator_tracked || !(o.oscillator_h0 > 0.0 || o.oscillator_h_minus2 > 0.0)) return jitters.back().first;
     double least = jitters.front().second;
     for (const auto& [n, j] : jitters) least = std::min(least, j);
     for (const auto& [n, j] : jitters)
@@ -87,15 +88,16 @@ int LongCoherentIntegration::known_bits_wanted() const {
   return target_epochs_ > 1 || block_count_ > 0 ? std::max(target_epochs_, block_epochs_) : 0;
 }
 
-void LongCoherentIntegration::add_cn0(double cn0_dbhz, bool bit_synced) {
+void LongCoherentIntegration::add_cn0(double cn0_dbhz, bool bit_synced, bool oscillator_tracked) {
   // The choice follows each estimate (the hysteresis absorbs its ~1 dB spread; a fade must reach the longer
   // integration before the 20 ms loop fails); the loss test in long mode reads the slow one (in dB: it
   // follows a loss of signal, whose estimates read 0 dB-Hz, within about a second).
+  oscillator_tracked_ = oscillator_tracked;
   cn0_slow_dbhz_ = have_slow_cn0_
                        ? cn0_slow_dbhz_ + std::min(1.0, opt_.cn0_window_s / kCn0Slow_s) * (cn0_dbhz - cn0_slow_dbhz_)
                        : cn0_dbhz;
   have_slow_cn0_ = true;
-  if (bit_synced) target_epochs_ = choose_coherent_epochs(opt_, cn0_dbhz, target_epochs_);
+  if (bit_synced) target_epochs_ = choose_coherent_epochs(opt_, cn0_dbhz, target_epochs_, oscillator_tracked);
 }
 
 bool LongCoherentIntegration::slow_cn0_below(double threshold_dbhz) const {
@@ -107,18 +109,23 @@ bool LongCoherentIntegration::bridging(bool bit_synced, double time_s) const {
 }
 
 // The PLI restarts (its sums' scale changes with the length) with a time constant of at least 3 updates, and
-// keeps that of the chosen length while 20 ms updates bridge unknown bits.
+// keeps that of the chosen length while 20 ms updates bridge unknown bits. A channel whose oscillator another loop
+// tracks runs its 20 ms updates (bits unknown) at the bandwidth of the chosen length too: with the clock and the
+// dynamics taken out (common clock loop, INS aiding) only thermal noise is left to its loop, and the 5 Hz one
+// slips on it below ~22 dB-Hz (a 20 ms Costas loop at 2 Hz has 9 deg of thermal jitter at 20 dB-Hz, 14 at 5 Hz).
 void LongCoherentIntegration::set_loop_epochs(int epochs, bool bridging, CarrierLoopFilter& carrier,
                                               PhaseLockIndicator& pli) {
   const int pli_epochs = epochs > 1 || bridging ? std::max(epochs, target_epochs_) : 1;
   const double tau = pli_epochs == 1 ? opt_.pli_time_constant_s
                                      : std::max(opt_.pli_time_constant_s, kPliUpdates * pli_epochs * kBitPeriod_s);
   rereference_carrier_state(epochs, carrier);  // also when a block of another length was dropped before its update
-  if (epochs == loop_epochs_ && tau == pli_tau_s_) return;
-  if (epochs != loop_epochs_) {
-    carrier.set_bandwidths(epochs == 1 ? opt_.pll_bw_coherent_hz : long_coherent_pll_bw_hz(opt_, epochs), 0.0);
-    pli.reset();
-  }
+  const double bn_hz = epochs > 1                                  ? long_coherent_pll_bw_hz(opt_, epochs)
+                       : oscillator_tracked_ && target_epochs_ > 1 ? long_coherent_pll_bw_hz(opt_, target_epochs_)
+                                                                   : opt_.pll_bw_coherent_hz;
+  if (epochs == loop_epochs_ && tau == pli_tau_s_ && bn_hz == loop_bw_hz_) return;
+  if (bn_hz != loop_bw_hz_) carrier.set_bandwidths(bn_hz, 0.0);
+  if (epochs != loop_epochs_) pli.reset();
+  loop_bw_hz_ = bn_hz;
   loop_epochs_ = epochs;
   pli_tau_s_ = tau;
   pli.set_time_constant(tau);
@@ -138,6 +145,7 @@ void LongCoherentIntegration::rereference_carrier_state(int epochs, CarrierLoopF
 
 void LongCoherentIntegration::restart_20ms_loops() {
   loop_epochs_ = 1;
+  loop_bw_hz_ = opt_.pll_bw_coherent_hz;
   state_epochs_ = 1;
   pli_tau_s_ = opt_.pli_time_constant_s;
 }

@@ -29,8 +29,10 @@ double pll_oscillator_jitter_rad(double bn_hz, int pll_order, double h0, double 
 double long_coherent_pll_bw_hz(const ScalarTrackingOptions& options, int epochs);
 // The number of 20 ms epochs (1, 2, 5, 10, 20) to integrate coherently at cn0_dbhz, with hysteresis around the
 // current number (see ScalarTrackingOptions): the shortest whose jitter (thermal and the configured oscillator's)
-// is within coherent_jitter_deg, else the one with the least jitter.
-int choose_coherent_epochs(const ScalarTrackingOptions& options, double cn0_dbhz, int current_epochs);
+// is within coherent_jitter_deg, else the one with the least jitter. oscillator_tracked: another loop takes the
+// oscillator's phase noise (receiver/common_clock_loop.hpp), so thermal jitter alone decides.
+int choose_coherent_epochs(const ScalarTrackingOptions& options, double cn0_dbhz, int current_epochs,
+                           bool oscillator_tracked = false);
 
 // The sums of one completed block: its length in epochs and seconds and the sign-corrected E, P, L taps.
 struct CoherentBlockSums {
@@ -50,8 +52,9 @@ class LongCoherentIntegration final {
   void set_target_epochs(int epochs) { target_epochs_ = epochs; }
   // The bits ahead a bit-synced channel's next update wants known (0: none wanted).
   int known_bits_wanted() const;
-  // A C/N0 estimate (dB-Hz): low-passed over 1 s for the loss test; N re-chosen when bit_synced.
-  void add_cn0(double cn0_dbhz, bool bit_synced);
+  // A C/N0 estimate (dB-Hz): low-passed over 1 s for the loss test; N re-chosen when bit_synced (on thermal
+  // jitter alone when oscillator_tracked: choose_coherent_epochs).
+  void add_cn0(double cn0_dbhz, bool bit_synced, bool oscillator_tracked = false);
   // The 1 s C/N0 is below threshold_dbhz (false before the first estimate).
   bool slow_cn0_below(double threshold_dbhz) const;
   // 20 ms updates bridging unknown bits between long updates of a weak bit-synced channel (at most 10 s after
@@ -84,8 +87,10 @@ class LongCoherentIntegration final {
 
  private:
   ScalarTrackingOptions opt_;
-  int target_epochs_ = 1;       // chosen from the C/N0
-  int loop_epochs_ = 1;         // of the loops' settings in effect
+  int target_epochs_ = 1;                        // chosen from the C/N0
+  int loop_epochs_ = 1;                          // of the loops' settings in effect
+  double loop_bw_hz_ = opt_.pll_bw_coherent_hz;  // the carrier loop's bandwidth set by set_loop_epochs
+  bool oscillator_tracked_ = false;              // add_cn0's: another loop tracks the oscillator
   int state_epochs_ = 1;        // the update length (x 20 ms) the carrier loop's frequency state is referenced to
   double pli_tau_s_ = 0.0;      // PLI time constant set by set_loop_epochs (0: the option's)
   double cn0_slow_dbhz_ = 0.0;  // C/N0 estimates low-passed over 1 s

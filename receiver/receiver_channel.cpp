@@ -58,6 +58,7 @@ void ReceiverChannel::set_vector_command(const VectorChannelCommand& command) {
   ScalarTrackingControl control;
   control.coasting_allowed = vector_.vector;
   control.filter_driven = vector_.vector && vector_.filter_driven;
+  control.clock_steered = vector_.vector && vector_.clock_steered && vector_.carrier == CarrierControl::kAided;
   // Vector FLL: the loop's frequency is the NCO's; the channel's own carrier loop stands still.
   const bool fll =
       vector_.vector && vector_.carrier != CarrierControl::kAided && std::isfinite(vector_.carrier_frequency_hz);

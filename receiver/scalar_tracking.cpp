@@ -67,6 +67,7 @@ ScalarTracking::ScalarTracking(const ScalarTrackingOptions& options, const NcoCo
 void ScalarTracking::apply(const ScalarTrackingControl& c) {
   allow_coasting(c.coasting_allowed);
   set_filter_driven(c.filter_driven);
+  clock_steered_ = c.clock_steered;
   const bool commanded = c.carrier != CarrierControl::kAided;
   set_carrier_commanded(commanded, c.carrier == CarrierControl::kFrequencyAndPhase);
   if (commanded) {
@@ -82,6 +83,7 @@ ScalarTrackingControl ScalarTracking::control() const {
   ScalarTrackingControl c;
   c.coasting_allowed = coasting_allowed_;
   c.filter_driven = filter_driven_;
+  c.clock_steered = clock_steered_;
   c.carrier = !carrier_commanded_     ? CarrierControl::kAided
               : carrier_phase_locked_ ? CarrierControl::kFrequencyAndPhase
                                       : CarrierControl::kFrequency;
@@ -187,7 +189,7 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
   r.pli = long_path ? pli_.value() : pli_.update(taps.prompt, noise_power_, t);
   if (auto c = cn0_.add(taps.prompt, taps.noise, t)) {
     cn0_dbhz_ = *c;
-    if (long_.enabled()) long_.add_cn0(*c, state_ == TrackingState::kBitSynced);
+    if (long_.enabled()) long_.add_cn0(*c, state_ == TrackingState::kBitSynced, clock_steered_);
   }
   r.cn0_dbhz = cn0_dbhz_;
   fade_.add(taps.prompt, taps.noise, cn0_dbhz_, t);

@@ -105,6 +105,10 @@ struct ScalarTrackingControl {
   // ignored otherwise. aid_delta_hz (kShift) not finite: ignored.
   CarrierAid aid = CarrierAid::kNone;
   double aid_delta_hz = 0.0;
+  // The external loop also tracks the receiver oscillator for this channel (receiver/common_clock_loop.hpp: its
+  // frequency reaches the NCO through the aid): the PLL sees the oscillator's residual only, so long coherent
+  // integration chooses its length on thermal jitter (choose_coherent_epochs without the oscillator).
+  bool clock_steered = false;
 };
 
 class ScalarTracking final {
@@ -174,6 +178,7 @@ class ScalarTracking final {
   bool ever_locked_ = false;
   bool coasting_allowed_ = false, relocking_ = false;
   bool filter_driven_ = false;
+  bool clock_steered_ = false;  // ScalarTrackingControl::clock_steered
   bool carrier_commanded_ = false;
   bool carrier_phase_locked_ = false;
   PullIn pull_in_;

@@ -120,6 +120,10 @@ struct VectorChannelCommand {
   // (pure PLL; with a commanded carrier there is no PLL, and the known bits wipe the frequency discriminator's
   // epochs instead), and its epochs are handed over without the per-epoch fade gate (with their known bit_sign).
   bool filter_driven = false;
+  // The loop adds a common clock loop's frequency (receiver/common_clock_loop.hpp) to this channel's carrier aid
+  // (kAided): the channel's PLL chooses its coherent time as if its oscillator were perfect
+  // (ScalarTrackingControl::clock_steered).
+  bool clock_steered = false;
 };
 
 class VectorLoop {

@@ -51,6 +51,11 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
       cmd->add_flag("--ut-pipelined", a.ut_pipelined,
                     "with --coupling ultra-tight: the pipelined loop, which is the default (kept for older command "
                     "lines; --ut-pipelined=false is --ut-serial)");
+  a.ut_clock_loop_bw_option = cmd->add_option(
+      "--ut-clock-loop-bw", a.ut_clock_loop_bw_hz,
+      "with --coupling ultra-tight: noise bandwidth (Hz, default 5; 0: off) of the common clock loop, which tracks "
+      "the receiver oscillator's phase on all channels' prompts at once and steers every channel's carrier with it, "
+      "so that each PLL narrows to its thermal optimum (a TCXO otherwise holds them at 5 Hz, 20 ms)");
   cmd->add_option("--vector-carrier", a.vector_carrier,
                   "with --coupling vector: aided-pll (default: each channel's PLL, aided), fll (the filter "
                   "commands the carrier NCOs: vector FLL) or pll (the filter commands the carrier NCOs' frequency "
@@ -68,6 +73,7 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
 
 void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveOptions& s) {
   const bool pipelined_given = a.ut_pipelined_option && a.ut_pipelined_option->count() > 0;
+  const bool clock_loop_given = a.ut_clock_loop_bw_option && a.ut_clock_loop_bw_option->count() > 0;
   const auto coupling = pipelines::coupling_from_string(a.coupling);
   if (!coupling)
     throw io::InputError("command line",
@@ -102,6 +108,7 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
       throw io::InputError("command line", "--odometer needs --coupling loose, tight or ultra-tight and --imu");
     if (a.ut_serial) throw io::InputError("command line", "--ut-serial needs --coupling ultra-tight");
     if (pipelined_given) throw io::InputError("command line", "--ut-pipelined needs --coupling ultra-tight");
+    if (clock_loop_given) throw io::InputError("command line", "--ut-clock-loop-bw needs --coupling ultra-tight");
     return;
   }
   if (!a.ut_measurement.empty() && s.coupling != Coupling::kUltraTight)
@@ -113,6 +120,12 @@ void apply_receive_coupling_args(const ReceiveFusionArgs& a, pipelines::ReceiveO
   if (a.ut_serial && pipelined_given && a.ut_pipelined)
     throw io::InputError("command line", "--ut-serial and --ut-pipelined exclude each other");
   s.ut_pipelined = a.ut_pipelined && !a.ut_serial;
+  if (clock_loop_given && s.coupling != Coupling::kUltraTight)
+    throw io::InputError("command line", "--ut-clock-loop-bw needs --coupling ultra-tight");
+  if (!(a.ut_clock_loop_bw_hz >= 0.0 && a.ut_clock_loop_bw_hz <= 12.5))
+    throw io::InputError("command line", "--ut-clock-loop-bw must be 0 (off) or in (0, 12.5] Hz, got " +
+                                             std::to_string(a.ut_clock_loop_bw_hz));
+  s.ut_clock_loop_bw_hz = a.ut_clock_loop_bw_hz;
   if (a.ut_measurement.empty() || a.ut_measurement == "iq") {
     s.ut_form = fusion::UltraTightForm::Iq;
   } else if (a.ut_measurement == "discriminator") {

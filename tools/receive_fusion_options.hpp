@@ -29,6 +29,8 @@ struct ReceiveFusionArgs {
   double nis_probability = 0.0;
   const CLI::Option* nis_window_option = nullptr;
   const CLI::Option* nis_probability_option = nullptr;
+  double ut_clock_loop_bw_hz = 5.0;  // --ut-clock-loop-bw (ultra-tight)
+  const CLI::Option* ut_clock_loop_bw_option = nullptr;
 };
 void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& args);
 

@@ -70,7 +70,8 @@ def receive(input, format=None, fs=None, if_hz=0.0, coupling="scalar", imu=None,
     then implied and if_hz must be 0. Receiving the array of a file's samples gives the file's results. options: the command line's other settings by name: config, nav_bits,
     elevation_mask_deg, troposphere (bool), ionosphere (bool), channels, threads, prn (list of int), duration, skip,
     reference_week, iq_swap, q_negate, two_bit_coding, two_bit_order; with coupling loose, tight or ultra-tight:
-    filter, align, fusion_config, imu_time_origin ("sample0", "tow" or seconds), ut_measurement, ut_pipelined;
+    filter, align, fusion_config, imu_time_origin ("sample0", "tow" or seconds), ut_measurement, ut_pipelined,
+    ut_clock_loop_bw_hz (the common clock loop's bandwidth, 0: off);
     with coupling vector: vector_carrier."""
     if fs is None:
         raise TypeError("receive: fs (the sample rate, Hz) is required")

@@ -101,6 +101,14 @@ TEST(ReceiveUltraTightCli, BadOptionsAreOneInputError) {
   expect_error("bad_form",
                {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-measurement", "phase"},
                "--ut-measurement must be iq or discriminator");
+  expect_error("clock_loop_scalar", {"--ut-clock-loop-bw", "5"}, "--ut-clock-loop-bw needs --coupling ultra-tight");
+  expect_error("clock_loop_tight",
+               {"--imu", (s.sim / "imu.csv").string(), "--coupling", "tight", "--ut-clock-loop-bw", "5"},
+               "--ut-clock-loop-bw needs --coupling ultra-tight");
+  for (const char* bw : {"-1", "13", "nan"})
+    expect_error(std::string("clock_loop_bw_") + bw,
+                 {"--imu", (s.sim / "imu.csv").string(), "--coupling", "ultra-tight", "--ut-clock-loop-bw", bw},
+                 "--ut-clock-loop-bw must be 0 (off) or in (0, 12.5] Hz");
   expect_error("bad_coupling", {"--coupling", "ultratight"}, "ultra-tight");
   expect_error("missing_imu_file", {"--imu", (s.dir / "none.csv").string(), "--coupling", "ultra-tight"}, "not found");
   expect_error("nis_scalar", {"--nis-window", "20"}, "--nis-window and --nis-probability need --coupling vector");
