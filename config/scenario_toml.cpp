@@ -10,6 +10,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "ins/trajectory.hpp"
 #include "io/input_error.hpp"
 #include "io/open_failure.hpp"
+#include "io/units.hpp"
 #include "signals/gps_constants.hpp"
 #include "signals/oscillator_allan.hpp"
 
@@ -236,6 +238,40 @@ void read_blockages(const Reader& r, const toml::node& section_node, Scenario& s
     ev.duration_s = r.number(*d, "blockage.duration_s");
     r.check(*d, "blockage.duration_s", ev.duration_s > 0 && ev.duration_s <= 86400, "must be within (0, 86400] s");
     s.blockages.push_back(ev);
+  }
+}
+
+// [[vibration]]: frequency_hz (required), accel_amplitude_mps2 = [north, east, down] (peak, m/s^2) and
+// angle_amplitude_deg = [roll, pitch, yaw] (peak), phase_deg; at least one amplitude not zero.
+void read_vibrations(const Reader& r, const toml::node& section_node, Scenario& s) {
+  for (const auto& e : tables_of(r, section_node, "vibration", "expected [[vibration]] tables")) {
+    const EventTable t(r, e, "vibration", {"frequency_hz", "accel_amplitude_mps2", "angle_amplitude_deg", "phase_deg"});
+    ins::Vibration v;
+    const toml::node* f = t.get("frequency_hz", true);
+    v.frequency_hz = r.number(*f, "vibration.frequency_hz");
+    r.check(*f, "vibration.frequency_hz", v.frequency_hz > 0 && v.frequency_hz <= 500, "must be within (0, 500] Hz");
+    bool moves = false;
+    if (const toml::node* a = t.get("accel_amplitude_mps2", false)) {
+      v.accel_amplitude_n_mps2 = r.triple(*a, "vibration.accel_amplitude_mps2");
+      for (const double x : v.accel_amplitude_n_mps2) {
+        r.check(*a, "vibration.accel_amplitude_mps2", std::abs(x) <= 100, "each must be within +-100 m/s^2");
+        moves = moves || x != 0.0;
+      }
+    }
+    if (const toml::node* a = t.get("angle_amplitude_deg", false)) {
+      const auto deg = r.triple(*a, "vibration.angle_amplitude_deg");
+      for (int i = 0; i < 3; ++i) {
+        r.check(*a, "vibration.angle_amplitude_deg", std::abs(deg[i]) <= 10, "each must be within +-10 deg");
+        v.angle_amplitude_rad[static_cast<std::size_t>(i)] = deg[i] * io::kRadPerDeg;
+        moves = moves || deg[i] != 0.0;
+      }
+    }
+    if (!moves) r.fail(e, "vibration", "needs accel_amplitude_mps2 or angle_amplitude_deg not zero");
+    if (const toml::node* p = t.get("phase_deg", false)) {
+      v.phase_rad = r.number(*p, "vibration.phase_deg") * io::kRadPerDeg;
+      r.check(*p, "vibration.phase_deg", std::abs(v.phase_rad) <= 2.0 * std::numbers::pi, "must be within +-360 deg");
+    }
+    s.vibrations.push_back(v);
   }
 }
 
@@ -574,7 +610,7 @@ void read_table_key(const Reader& r, const std::string& section, const toml::nod
   } else {
     r.fail(section_node, section,
            "unknown section (signal, time, navigation, receiver, atmosphere, output, trajectory, imu, "
-           "[[antenna]], [[cycle_slip]], [[blockage]], [[cn0_step]], [[odometer_slip]])");
+           "[[antenna]], [[cycle_slip]], [[blockage]], [[cn0_step]], [[odometer_slip]], [[vibration]])");
   }
 }
 
@@ -591,6 +627,8 @@ void read_section(const Reader& r, const std::string& section, const toml::node&
     read_blockages(r, section_node, s);
   } else if (section == "odometer_slip") {
     read_odometer_slips(r, section_node, s);
+  } else if (section == "vibration") {
+    read_vibrations(r, section_node, s);
   } else {
     const auto* tbl = section_node.as_table();
     if (!tbl) r.fail(section_node, section, "expected a table [" + section + "]");
@@ -603,6 +641,7 @@ void check_given_keys(const std::string& file, const GivenKeys& given, const Sce
   const auto fail = [&](const std::string& problem) { throw InputError(file, problem); };
   if (!given.trajectory) {
     if (given.antennas) fail("[[antenna]] needs a [trajectory] section (static receivers: antenna_offsets_enu_m)");
+    if (!s.vibrations.empty()) fail("[[vibration]] needs a [trajectory] section (the platform that vibrates)");
     if (given.attitude) fail("key receiver.attitude_deg: needs [trajectory] profile = \"static\"");
     return;
   }

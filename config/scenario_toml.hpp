@@ -37,6 +37,9 @@
 //                 lateral acceleration, breaking the non-holonomic constraints in turns as real tyres do)
 //   [[odometer_slip]] start_s = 100.0  duration_s = 2.0  ratio = -1.0   (wheel slip / skid: pulses scaled by
 //                 1 + ratio over the event; -1 a locked wheel, > 0 a spinning one)
+//   [[vibration]] frequency_hz = 12.0 (0..500)  accel_amplitude_mps2 = [n, e, d] (peak, +-100)  angle_amplitude_deg
+//                 = [roll, pitch, yaw] (peak, +-10)  phase_deg = 0.0   (a tone the whole platform carries, IMU and
+//                 antennas: ins::Vibration; at least one amplitude not zero; needs [trajectory])
 //                 The start position is [receiver] llh_deg_m; t = 0 of the trajectory is the [time] start.
 //   [imu]         preset = "ideal" (ideal, hg1700ae, dmu6x, navigation, mems, adis16405, adis16465, bmi088,
 //                 stim300)  seed = 1

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <filesystem>
+#include <numbers>
 #include <string>
 
 #include "config/scenario_toml.hpp"
@@ -149,6 +150,15 @@ std::string events_toml(const Scenario& s) {
   for (const auto& o : s.odometer_slips)
     out += fmt::format("\n[[odometer_slip]]\nstart_s = {}\nduration_s = {}\nratio = {}\n", toml_float(o.start_s),
                        toml_float(o.duration_s), toml_float(o.ratio));
+  constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+  for (const auto& v : s.vibrations)
+    out += fmt::format(
+        "\n[[vibration]]\nfrequency_hz = {}\naccel_amplitude_mps2 = [{}, {}, {}]\nangle_amplitude_deg = [{}, {}, {}]\n"
+        "phase_deg = {}\n",
+        toml_float(v.frequency_hz), toml_float(v.accel_amplitude_n_mps2[0]), toml_float(v.accel_amplitude_n_mps2[1]),
+        toml_float(v.accel_amplitude_n_mps2[2]), toml_float(v.angle_amplitude_rad[0] * kDegPerRad),
+        toml_float(v.angle_amplitude_rad[1] * kDegPerRad), toml_float(v.angle_amplitude_rad[2] * kDegPerRad),
+        toml_float(v.phase_rad * kDegPerRad));
   for (const auto& b : s.blockages)
     out += fmt::format("\n[[blockage]]\nantenna = {}\nstart_s = {}\nduration_s = {}\n", b.antenna,
                        toml_float(b.start_s), toml_float(b.duration_s));

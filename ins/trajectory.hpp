@@ -5,6 +5,7 @@
 // Units: SI (rad, m, s); headings from north towards east.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -20,6 +21,18 @@ struct Segment {
   double grade_rad = 0.0;       // road slope: vertical speed speed * tan(grade), pitch = grade
 };
 
+// A platform vibration tone (engine, road, rotor) the whole body carries, IMU and antennas alike: the position moves
+// by d_n(t) = -(a / w^2) sin(w t + phase), w = 2 pi frequency_hz, in the local level frame (north, east, down: a the
+// peak linear accelerations), so that velocity and specific force carry its exact derivatives; roll, pitch and yaw
+// gain angle_amplitude sin(w t + phase). The ideal IMU, the truth and the antennas' motion carry it consistently
+// (ins/trajectory_simulator.hpp). The path length (odometer) does not.
+struct Vibration {
+  double frequency_hz = 0.0;
+  std::array<double, 3> accel_amplitude_n_mps2{};  // peak, north east down
+  std::array<double, 3> angle_amplitude_rad{};     // peak, roll pitch yaw
+  double phase_rad = 0.0;
+};
+
 struct TrajectorySpec {
   double lat0_rad = 0.0;
   double lon0_rad = 0.0;
@@ -31,6 +44,7 @@ struct TrajectorySpec {
   double roll0_rad = 0.0;          // constant roll and pitch added to the attitude (a vehicle parked on a
   double pitch0_rad = 0.0;         // slope, an IMU mounted tilted); |pitch| well below 90 deg
   std::vector<Segment> segments;
+  std::vector<Vibration> vibrations;  // none: a smooth ride
 
   double duration_s() const;
 };

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include "ins/attitude.hpp"
@@ -23,7 +24,15 @@ TrajectoryGenerator::TrajectoryGenerator(TrajectorySpec spec, double imu_rate_hz
   if (!(imu_rate_hz > 0.0) || !std::isfinite(imu_rate_hz)) throw std::invalid_argument("IMU rate must be positive");
   if (spec_.segments.empty()) throw std::invalid_argument("trajectory has no segments");
   dt_ = 1.0 / imu_rate_hz;
-  substeps_ = std::max(1, static_cast<int>(std::ceil(dt_ / 0.0025 - 1e-9)));
+  // Sub-steps of at most 2.5 ms, and 40 per period of the fastest vibration (RK4 and the increments' quadrature
+  // then resolve it to ~1e-6 of its amplitude).
+  double h_max = 0.0025;
+  for (const auto& v : spec_.vibrations) {
+    if (!(v.frequency_hz > 0.0) || !std::isfinite(v.frequency_hz))
+      throw std::invalid_argument("vibration frequency must be positive");
+    h_max = std::min(h_max, 1.0 / (40.0 * v.frequency_hz));
+  }
+  substeps_ = std::max(1, static_cast<int>(std::ceil(dt_ / h_max - 1e-9)));
   n_steps_ = static_cast<long long>(std::llround(spec_.duration_s() * imu_rate_hz));
   double t = 0.0;
   for (const auto& s : spec_.segments) {
@@ -98,6 +107,23 @@ Kinematics kinematics(double s, double psi, double a, double r, double c, double
   return k;
 }
 
+// The vibration tones at t added to the smooth kinematics: displacement -(a / w^2) sin, velocity -(a / w) cos,
+// acceleration a sin (local level), angles and their rates.
+void add_vibrations(const std::vector<Vibration>& tones, double t, Kinematics& k) {
+  for (const Vibration& v : tones) {
+    const double w = 2.0 * std::numbers::pi * v.frequency_hz;
+    const double s = std::sin(w * t + v.phase_rad), c = std::cos(w * t + v.phase_rad);
+    const Eigen::Vector3d a(v.accel_amplitude_n_mps2[0], v.accel_amplitude_n_mps2[1], v.accel_amplitude_n_mps2[2]);
+    const Eigen::Vector3d theta(v.angle_amplitude_rad[0], v.angle_amplitude_rad[1], v.angle_amplitude_rad[2]);
+    k.v_n += -(c / w) * a;
+    k.dv_n += s * a;
+    k.e.roll_rad += s * theta.x();
+    k.e.pitch_rad += s * theta.y();
+    k.e.yaw_rad += s * theta.z();
+    k.euler_rate += (w * c) * theta;
+  }
+}
+
 Eigen::Vector3d w_nb_b(const EulerAngles& e, const Eigen::Vector3d& rate) {
   const double sf = std::sin(e.roll_rad), cf = std::cos(e.roll_rad);
   const double st = std::sin(e.pitch_rad), ct = std::cos(e.pitch_rad);
@@ -108,7 +134,9 @@ Eigen::Vector3d w_nb_b(const EulerAngles& e, const Eigen::Vector3d& rate) {
 
 TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State& y) const {
   const Commands u = commands(t);
-  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
+  Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
+  const double path_rate = k.v_n.norm();  // the smooth ride's: an odometer does not count the vibration
+  add_vibrations(spec_.vibrations, t, k);
   const double lat = y[2], h = y[4];
   const Eigen::Vector3d pos_rate = geodetic_rates(lat, h, k.v_n);
   const Eigen::Vector3d w_ie = earth_rate_n(lat);
@@ -123,7 +151,7 @@ TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State
   d[2] = pos_rate.x();
   d[3] = pos_rate.y();
   d[4] = pos_rate.z();
-  d[5] = k.v_n.norm();
+  d[5] = path_rate;
   for (int i = 0; i < 3; ++i) {
     d[6 + i] = w_ib[i];
     d[9 + i] = f_b[i];
@@ -133,7 +161,8 @@ TrajectoryGenerator::State TrajectoryGenerator::derivative(double t, const State
 
 void TrajectoryGenerator::fill_truth(double t, const State& y, TruthSample& out) const {
   const Commands u = commands(t);
-  const Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
+  Kinematics k = kinematics(y[0], y[1], u.a, u.r, u.climb, u.grade, u.dr, u.dclimb, u.dgrade, spec_);
+  add_vibrations(spec_.vibrations, t, k);
   out.t_s = t;
   out.lat_rad = y[2];
   out.lon_rad = y[3];

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Truth and exact IMU increments for a TrajectorySpec. The vehicle kinematics (speed, heading, height,
-// Euler attitude) are smooth analytic functions of the commands; position is integrated with RK4 on fine
-// sub-steps, and delta-theta / delta-v are the integrals of w_ib_b and f_b over each IMU interval on the same
-// sub-steps, so an ideal IMU run through Strapdown reproduces the truth. Units SI; frames as nav_state.hpp.
+// Euler attitude) are smooth analytic functions of the commands, plus the vibration tones' sinusoids
+// (TrajectorySpec::vibrations); position is integrated with RK4 on fine sub-steps (at most 2.5 ms, 40 per period of
+// the fastest tone), and delta-theta / delta-v are the integrals of w_ib_b and f_b over each IMU interval on the same
+// sub-steps, so an ideal IMU run through Strapdown reproduces the truth (with vibration, to the mechanisation's coning
+// and sculling truncation). Units SI; frames as nav_state.hpp.
 #pragma once
 
 #include <Eigen/Core>

@@ -89,6 +89,8 @@ struct Scenario {
   double odometer_misalignment_pitch_deg = 0.0;   // IMU mounting relative to the vehicle: the IMU data and the
   double odometer_misalignment_yaw_deg = 0.0;     // truth attitude are the trajectory's rotated by C_bv
   std::vector<ins::OdometerSlip> odometer_slips;  // [[odometer_slip]]
+  // [[vibration]] (with [trajectory]): tones the whole platform carries, IMU and antennas (ins::Vibration).
+  std::vector<ins::Vibration> vibrations;
   double sideslip_deg_per_mps2 = 0.0;  // the vehicle yaws from its track by this times the lateral acceleration
 
   // IMU errors: a preset (ins/imu_error_model.hpp) with optional datasheet overrides.

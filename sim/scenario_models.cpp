@@ -51,6 +51,7 @@ ins::TrajectorySpec trajectory_spec(const Scenario& s) {
       throw InputError(s.source.string(), "key trajectory.file: no such segment file " + file.string());
     spec = ins::read_segments_csv(file, start);  // errors in the file name it and the line
   }
+  spec.vibrations = s.vibrations;
   return spec;
 }
 

@@ -3,10 +3,12 @@
 // keys are InputErrors naming the file, the key and the line; the echo (to_toml) reads back the same.
 #include <gtest/gtest.h>
 
+#include <numbers>
 #include <string>
 
 #include "config/scenario_toml.hpp"
 #include "signals/input_error.hpp"
+#include "sim/scenario_models.hpp"
 
 namespace ultratrack::tools {
 using namespace ultratrack::config;
@@ -233,6 +235,46 @@ TEST(Scenario, EventsOnMissingAntennasOrWithUnknownKeysAreErrors) {
   EXPECT_NE(
       error_of(text + "[[blockage]]\nantenna = 0\nstart_s = 1.0\nduration_s = 1.0\nprn = 4\n").find("blockage.prn"),
       std::string::npos);
+}
+
+// [[vibration]]: tones parse (degrees to radians), echo back, reach the trajectory spec, and bad ones are errors.
+TEST(Scenario, VibrationTonesParseEchoAndAreChecked) {
+  const std::string base =
+      "[signal]\nduration_s = 30.0\n[receiver]\nllh_deg_m = [35.0, 137.0, 100.0]\n"
+      "[trajectory]\nprofile = \"static\"\nduration_s = 30.0\n";
+  const std::string tones =
+      "[[vibration]]\nfrequency_hz = 12.0\naccel_amplitude_mps2 = [0.5, 0.0, 1.5]\nangle_amplitude_deg = [0.1, 0.0, "
+      "0.0]\n[[vibration]]\nfrequency_hz = 30.0\nangle_amplitude_deg = [0.0, 0.02, 0.0]\nphase_deg = 90.0\n";
+  const Scenario s = parse_scenario(base + tones, "/data/v.toml");
+  ASSERT_EQ(s.vibrations.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.vibrations[0].frequency_hz, 12.0);
+  EXPECT_DOUBLE_EQ(s.vibrations[0].accel_amplitude_n_mps2[2], 1.5);
+  EXPECT_NEAR(s.vibrations[0].angle_amplitude_rad[0], 0.1 * std::numbers::pi / 180.0, 1e-15);
+  EXPECT_NEAR(s.vibrations[1].phase_rad, std::numbers::pi / 2.0, 1e-15);
+  const Scenario back = parse_scenario(to_toml(s), "/data/v.toml");
+  ASSERT_EQ(back.vibrations.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_DOUBLE_EQ(back.vibrations[i].frequency_hz, s.vibrations[i].frequency_hz);
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_NEAR(back.vibrations[i].accel_amplitude_n_mps2[k], s.vibrations[i].accel_amplitude_n_mps2[k], 1e-15);
+      EXPECT_NEAR(back.vibrations[i].angle_amplitude_rad[k], s.vibrations[i].angle_amplitude_rad[k], 1e-15);
+    }
+    EXPECT_NEAR(back.vibrations[i].phase_rad, s.vibrations[i].phase_rad, 1e-15);
+  }
+  EXPECT_EQ(sim::trajectory_spec(s).vibrations.size(), 2u);
+  EXPECT_EQ(to_toml(parse_scenario(base, "/data/v.toml")).find("vibration"), std::string::npos);
+  auto e = error_of(base + "[[vibration]]\naccel_amplitude_mps2 = [0.0, 0.0, 1.0]\n");
+  EXPECT_NE(e.find("vibration.frequency_hz"), std::string::npos) << e;
+  e = error_of(base + "[[vibration]]\nfrequency_hz = 0.0\naccel_amplitude_mps2 = [0.0, 0.0, 1.0]\n");
+  EXPECT_NE(e.find("(0, 500] Hz"), std::string::npos) << e;
+  e = error_of(base + "[[vibration]]\nfrequency_hz = 10.0\n");
+  EXPECT_NE(e.find("needs accel_amplitude_mps2 or angle_amplitude_deg"), std::string::npos) << e;
+  e = error_of(base + "[[vibration]]\nfrequency_hz = 10.0\nangle_amplitude_deg = [20.0, 0.0, 0.0]\n");
+  EXPECT_NE(e.find("+-10 deg"), std::string::npos) << e;
+  e = error_of(base + "[[vibration]]\nfrequency_hz = 10.0\namplitude = 1.0\n");
+  EXPECT_NE(e.find("vibration.amplitude"), std::string::npos) << e;
+  e = error_of("[signal]\nduration_s = 30.0\n[[vibration]]\nfrequency_hz = 10.0\naccel_amplitude_mps2 = [0, 0, 1.0]\n");
+  EXPECT_NE(e.find("needs a [trajectory]"), std::string::npos) << e;
 }
 
 }  // namespace
