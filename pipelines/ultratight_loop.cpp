@@ -26,6 +26,21 @@ constexpr double kLambda_m = signals::kL1Wavelength_m;
 constexpr double kChip_m = kC / signals::kCaChipRate_hz;
 constexpr double kEpochChips = 20.0 * 1023.0;  // a 20 ms channel epoch of C/A code
 
+// A channel's latest correlation epoch is new, of one loop period (20 ms), and has a transmit-time tag.
+bool fresh_epoch(const receiver::VectorChannelInput& in, double period_s) {
+  return in.synchronised && in.has_measurement && std::abs(in.integration_time_s - period_s) <= 1e-4;
+}
+
+// The start and the middle of a channel's latest correlation epoch on the driver's time line (t_k at epoch.sample).
+struct EpochTimes {
+  double start_s, half_s;
+  double mid_s() const { return start_s + half_s; }
+};
+EpochTimes epoch_times(const receiver::VectorEpochInput& epoch, const receiver::VectorChannelInput& in, double t_k) {
+  return {t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz,
+          static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz};
+}
+
 }  // namespace
 
 UltraTightLoop::UltraTightLoop(GnssInsCoupler& fusion, ReceiveSink& sink, UltraTightLoopOptions ut)
@@ -169,17 +184,16 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
   const double common_offset_hz = common_carrier_offset_hz(epoch, t_k);
   for (const auto& in : epoch.channels) {
-    if (!in.synchronised || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
-    if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;  // not a 20 ms epoch
-    if (!(in.iq_scale > 0.0)) continue;                                   // no noise estimate
+    if (!fresh_epoch(in, ut_.period_s) || !std::isfinite(in.cn0_dbhz)) continue;
+    if (!(in.iq_scale > 0.0)) continue;          // no noise estimate
     if (channel(in.prn).nis_released) continue;  // its correlations contradict the filter: not used
-    const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
-    const double t_start_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz;
+    const EpochTimes times = epoch_times(epoch, in, t_k);
+    const double half_s = times.half_s, t_start_s = times.start_s;
     // A channel whose PLL ran away from the prediction correlates mostly noise against a replica carrier tens of
     // Hz off the signal; the I&Q (and discriminator) model takes that replica carrier as given and reads the
     // difference as the filter's Doppler error (16-34 Hz innovations were accepted: docs/validation.md), so its
     // correlations are left out until it is back.
-    if (runaway_check(in, t_start_s + half_s, common_offset_hz)) {
+    if (runaway_check(in, times.mid_s(), common_offset_hz)) {
       ++runaway_left_out_;
       channel(in.prn).rate_anchored = false;
       continue;
@@ -230,7 +244,7 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     c.replica_range_rate_mps = -kLambda_m * in.replica_carrier_frequency_hz;
     c.replica_t_start_s = t_start_s;
     c.replica_pseudorange_m = in.replica_pseudorange_mid_m + shift_m - c.replica_range_rate_mps * half_s;
-    carrier_rate(in, t_start_s + half_s, c.start_phase_var_rad2, st, c);
+    carrier_rate(in, times.mid_s(), c.start_phase_var_rad2, st, c);
     out.push_back(c);
   }
   return out;
@@ -283,12 +297,9 @@ double UltraTightLoop::common_carrier_offset_hz(const receiver::VectorEpochInput
   std::vector<double> offsets;
   for (const auto& in : epoch.channels) {
     const auto it = channels_.find(in.prn);
-    if (it == channels_.end() || !it->second.commanded || in.coasting || !in.synchronised || !in.has_measurement)
-      continue;
-    if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4) continue;
-    const double half_s = static_cast<double>(in.measurement_sample - in.measurement_first_sample) / epoch.fs_hz;
-    const double t_mid_s = t_k - static_cast<double>(epoch.sample - in.measurement_first_sample) / epoch.fs_hz + half_s;
-    const double offset = in.replica_carrier_frequency_hz - predicted_doppler_at(in.prn, t_mid_s);
+    if (it == channels_.end() || !it->second.commanded || in.coasting || !fresh_epoch(in, ut_.period_s)) continue;
+    const double offset =
+        in.replica_carrier_frequency_hz - predicted_doppler_at(in.prn, epoch_times(epoch, in, t_k).mid_s());
     if (std::isfinite(offset)) offsets.push_back(offset);
   }
   if (offsets.size() < 4) return NAN;
@@ -572,8 +583,7 @@ double UltraTightLoop::common_clock_update(const receiver::VectorEpochInput& epo
     // A channel re-locking after a coast (a tunnel's exit) pulls its own phase in for its first second: its prompt
     // says nothing yet about the common clock (with it the loop was pushed 3 Hz off at a tunnel's exit).
     if (st.since_relock_s < ut_.nis_settle_s) continue;
-    if (!in.synchronised || in.coasting || !in.has_measurement || !std::isfinite(in.cn0_dbhz)) continue;
-    if (std::abs(in.integration_time_s - ut_.period_s) > 1e-4 || !(in.iq_scale > 0.0)) continue;
+    if (in.coasting || !fresh_epoch(in, ut_.period_s) || !std::isfinite(in.cn0_dbhz) || !(in.iq_scale > 0.0)) continue;
     // The bit by the in-phase sign even where it is known: a channel that re-locked half a cycle off (a Costas
     // PLL may) has every known bit inverted, and its prompt would pull every channel by pi (seen at a tunnel's exit).
     prompts.push_back({in.iq_i[1], in.iq_q[1], 0, in.cn0_dbhz});
