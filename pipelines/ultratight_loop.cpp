@@ -583,7 +583,16 @@ double UltraTightLoop::common_clock_update(const receiver::VectorEpochInput& epo
     // A channel re-locking after a coast (a tunnel's exit) pulls its own phase in for its first second: its prompt
     // says nothing yet about the common clock (with it the loop was pushed 3 Hz off at a tunnel's exit).
     if (st.since_relock_s < ut_.nis_settle_s) continue;
-    if (in.coasting || !fresh_epoch(in, ut_.period_s) || !std::isfinite(in.cn0_dbhz) || !(in.iq_scale > 0.0)) continue;
+    if (in.coasting || !in.synchronised || !in.has_prompt || !std::isfinite(in.cn0_dbhz) || !(in.iq_scale > 0.0) ||
+        std::abs(in.prompt_integration_time_s - ut_.period_s) > 1e-4)
+      continue;
+    // An epoch the fade gate dropped still counts once the channel's C/N0 estimate (0.2 s) reads below 30 dB-Hz:
+    // after a step down to ~20 dB-Hz the gate drops most epochs until the 1 s presence window follows, and the loop,
+    // short of channels, held while the TCXO moved (steered 2 Hz PLLs slipped 0.7-0.9 s after the step). Above
+    // 30 dB-Hz the estimate still reads the signal of before a fade, and would weight its noise as that signal's.
+    // The loop's own signal test (common_clock_loop.hpp) holds it when the prompts are noise.
+    constexpr double kUngatedBelowDbHz = 30.0;
+    if (!in.prompt_gate_passed && !(in.cn0_dbhz < kUngatedBelowDbHz)) continue;
     // The bit by the in-phase sign even where it is known: a channel that re-locked half a cycle off (a Costas
     // PLL may) has every known bit inverted, and its prompt would pull every channel by pi (seen at a tunnel's exit).
     prompts.push_back({in.iq_i[1], in.iq_q[1], 0, in.cn0_dbhz});
@@ -649,8 +658,10 @@ std::string UltraTightLoop::summary_json() const {
       ", \"carrier_rate\": {{\"window_s\": {:g}, \"updates\": {}, \"accepted\": {}, \"rows\": {}, \"screened\": {}}}",
       ut_.carrier_rate_window_s, k.rate_updates, k.rate_accepted, k.rate_rows, k.rate_screened);
   if (clock_loop_)
-    j += fmt::format(", \"common_clock\": {{\"bandwidth_hz\": {:g}, \"updates\": {}, \"frequency_hz\": {:.4f}}}",
-                     ut_.common_clock_bw_hz, clock_loop_->updates(), clock_loop_->frequency_hz());
+    j += fmt::format(
+        ", \"common_clock\": {{\"bandwidth_hz\": {:g}, \"updates\": {}, \"held_no_signal\": {}, \"frequency_hz\": "
+        "{:.4f}}}",
+        ut_.common_clock_bw_hz, clock_loop_->updates(), clock_loop_->held_no_signal(), clock_loop_->frequency_hz());
   else
     j += ", \"common_clock\": null";
   j += fmt::format(", \"nis_window\": {}, \"nis_probability\": {:g}, \"filter_reopens\": {}, {}", ut_.nis.window,

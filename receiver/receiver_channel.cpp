@@ -127,13 +127,26 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   // probability ~1e-3 and sees a tunnel at once, where the 1 s presence window takes 1-2 s.
   constexpr double kGateFromDbHz = 30.0;
   const bool present = e.signal_present || (vector_.filter_driven && loop_.presence_cn0_dbhz() < kGateFromDbHz);
-  if (!fresh || !e.valid || !e.bit_synced || !present || e.num_code_periods < 2) return in;
+  if (!fresh || !e.valid || !e.bit_synced || e.num_code_periods < 2) return in;
+  if (e.noise_power > 0.0) {
+    const double scale = 1.0 / std::sqrt(0.5 * e.noise_power);  // noise tap: variance 2 sigma^2 (I and Q)
+    in.iq_scale = scale;
+    const std::array<std::complex<float>, 3> taps{e.early, e.prompt, e.late};
+    for (int k = 0; k < 3; ++k) {
+      in.iq_i[k] = taps[k].real() * scale;
+      in.iq_q[k] = taps[k].imag() * scale;
+    }
+  }
+  in.has_prompt = true;
+  in.prompt_gate_passed = present;
+  in.prompt_integration_time_s = e.num_samples / fs_hz_;
+  if (!present) return in;
+  in.integration_time_s = in.prompt_integration_time_s;
   in.bit_sign = vector_.filter_driven ? e.bit_sign : 0;
   in.pll_coherent_epochs = std::max(1, loop_.coherent_epochs());
   const int half = e.num_samples / 2;
   in.has_measurement = true;
   in.measurement_sample = e.first_sample + half;
-  in.integration_time_s = e.num_samples / fs_hz_;
   in.code_error_chips = e.code_error_chips;
   in.replica_pseudorange_mid_m = pseudorange(in.measurement_sample, e.first_code_period,
                                              e.code_phase_start_chips + e.code_rate_chips_per_s * half / fs_hz_);
@@ -147,15 +160,6 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
   in.replica_carrier_phase_next_cycles =
       replica.carrier_phase_cycles +
       in.carrier_frequency_hz * static_cast<double>(in.next_epoch_sample - replica.sample_index) / fs_hz_;
-  if (e.noise_power > 0.0) {
-    const double scale = 1.0 / std::sqrt(0.5 * e.noise_power);  // noise tap: variance 2 sigma^2 (I and Q)
-    in.iq_scale = scale;
-    const std::array<std::complex<float>, 3> taps{e.early, e.prompt, e.late};
-    for (int k = 0; k < 3; ++k) {
-      in.iq_i[k] = taps[k].real() * scale;
-      in.iq_q[k] = taps[k].imag() * scale;
-    }
-  }
   const EpochSummary& p = previous_epoch_;
   if (p.valid && p.bit_synced && p.num_code_periods == e.num_code_periods &&
       p.first_sample + p.num_samples == e.first_sample) {

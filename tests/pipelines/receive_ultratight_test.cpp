@@ -409,7 +409,9 @@ TEST(ReceiveUltraTight, AChannelWhoseEphemerisContradictsItsSignalIsReleasedAndT
   for (const auto& [p, rows] : log) {
     if (rows.empty() || !rows.front().ultratight) continue;
     for (const Row& r : rows) {
-      if (p != prn) EXPECT_TRUE(r.ultratight) << "PRN " << p << " at " << r.t;
+      if (p != prn) {
+        EXPECT_TRUE(r.ultratight) << "PRN " << p << " at " << r.t;
+      }
       if (p == prn && r.t > released_s + 0.05) {
         EXPECT_FALSE(r.ultratight) << "PRN " << p << " commanded again at " << r.t;
         EXPECT_FALSE(r.updated) << "PRN " << p << " updates the filter again at " << r.t;
