@@ -8,7 +8,10 @@ Per oscillator, trajectory, mode and C/N0 level, over the campaign's files: sate
 receiver's own loss rule (lock_outcomes.csv: kept of kept + lost; not locked at the step and not acquired left out)
 and by the common rule from the simulator's truth (truth_lock_outcomes.csv: kept of tracked), and the 3-D RMS of
 solution.csv after the step per file (weak_rms_3d_m; '-' where a file had no fix after it). Reads only complete
-runs; prints a markdown table. The campaign's own `campaign report` gives the same counts with intervals.
+runs; prints a markdown table, then per oscillator, trajectory and mode the 90 % threshold of the pooled fractions by
+each rule, found as `campaign report` finds it (the lowest level above which every level keeps >= 90 %, interpolated
+linearly from the level below): over several campaigns' folders (weak_signal_told and _more) it pools what one
+campaign's report cannot. The campaign's own `campaign report` gives the same counts with intervals.
 """
 import csv
 import os
@@ -19,6 +22,17 @@ from collections import defaultdict
 def rows(path):
     with open(path) as f:
         return list(csv.DictReader(f))
+
+
+def crossing(points):
+    """The lowest level above which the kept fraction stays >= 0.9 (points: sorted (level, fraction))."""
+    for i in range(len(points)):
+        if all(v >= 0.9 for _, v in points[i:]):
+            if i == 0:
+                return f"<= {points[0][0]:.1f}"
+            (l0, v0), (l1, v1) = points[i - 1], points[i]
+            return f"{l0 + (0.9 - v0) * (l1 - l0) / (v1 - v0):.2f}"
+    return "none"
 
 
 def main(outs):
@@ -51,6 +65,16 @@ def main(outs):
         rms = " ".join(v if v is not None else "-" for _, v in sorted(t["rms"]))
         print(f"| {key[0]} | {key[1]} | {key[2]} | {key[3]:g} | {t['own'][0]}/{t['own'][1]} | "
               f"{t['common'][0]}/{t['common'][1]} | {rms} |")
+    print()
+    print("90 % threshold of the pooled fractions, dB-Hz: own rule / common rule")
+    groups = sorted({key[:3] for key in table})
+    for g in groups:
+        curves = []
+        for rule in ("own", "common"):
+            pts = [(key[3], table[key][rule][0] / table[key][rule][1])
+                   for key in sorted(table) if key[:3] == g and table[key][rule][1] > 0]
+            curves.append(crossing(pts) if pts else "-")
+        print(f"  {' '.join(x for x in g if x)}: {curves[0]} / {curves[1]}")
 
 
 if __name__ == "__main__":
