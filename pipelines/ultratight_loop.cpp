@@ -590,7 +590,8 @@ double UltraTightLoop::common_clock_update(const receiver::VectorEpochInput& epo
     // after a step down to ~20 dB-Hz the gate drops most epochs until the 1 s presence window follows, and the loop,
     // short of channels, held while the TCXO moved (steered 2 Hz PLLs slipped 0.7-0.9 s after the step). Above
     // 30 dB-Hz the estimate still reads the signal of before a fade, and would weight its noise as that signal's.
-    // The loop's own signal test (common_clock_loop.hpp) holds it when the prompts are noise.
+    // (A signal test on the prompts' excess energy, to hold the loop on noise, was tried and dropped: on oracle-bit
+    // files of campaigns/weak_signal.toml it came with whole files lost to a loop that ran off with every channel.)
     constexpr double kUngatedBelowDbHz = 30.0;
     if (!in.prompt_gate_passed && !(in.cn0_dbhz < kUngatedBelowDbHz)) continue;
     // The bit by the in-phase sign even where it is known: a channel that re-locked half a cycle off (a Costas
@@ -658,10 +659,8 @@ std::string UltraTightLoop::summary_json() const {
       ", \"carrier_rate\": {{\"window_s\": {:g}, \"updates\": {}, \"accepted\": {}, \"rows\": {}, \"screened\": {}}}",
       ut_.carrier_rate_window_s, k.rate_updates, k.rate_accepted, k.rate_rows, k.rate_screened);
   if (clock_loop_)
-    j += fmt::format(
-        ", \"common_clock\": {{\"bandwidth_hz\": {:g}, \"updates\": {}, \"held_no_signal\": {}, \"frequency_hz\": "
-        "{:.4f}}}",
-        ut_.common_clock_bw_hz, clock_loop_->updates(), clock_loop_->held_no_signal(), clock_loop_->frequency_hz());
+    j += fmt::format(", \"common_clock\": {{\"bandwidth_hz\": {:g}, \"updates\": {}, \"frequency_hz\": {:.4f}}}",
+                     ut_.common_clock_bw_hz, clock_loop_->updates(), clock_loop_->frequency_hz());
   else
     j += ", \"common_clock\": null";
   j += fmt::format(", \"nis_window\": {}, \"nis_probability\": {:g}, \"filter_reopens\": {}, {}", ut_.nis.window,

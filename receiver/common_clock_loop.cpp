@@ -13,13 +13,11 @@ CommonClockLoop::CommonClockLoop(const CommonClockLoopOptions& options) : opt_(o
   if (!(opt_.period_s > 0.0) || !(opt_.bandwidth_hz > 0.0) || !(opt_.bandwidth_hz * opt_.period_s <= 0.25))
     throw std::invalid_argument("common clock loop: bandwidth_hz must be in (0, 0.25 / period_s], period_s > 0");
   if (opt_.min_channels < 1) throw std::invalid_argument("common clock loop: min_channels must be at least 1");
-  if (opt_.detection_epochs < 0 || !(opt_.detection_sigma >= 0.0))
-    throw std::invalid_argument("common clock loop: detection_epochs and detection_sigma must not be negative");
   w0_rad_s_ = opt_.bandwidth_hz / kSecondOrderBnPerW0;
 }
 
 double CommonClockLoop::update(std::span<const ChannelPrompt> prompts) {
-  double sum_i = 0.0, sum_q = 0.0, sum_a2 = 0.0, excess = 0.0, sum_a4 = 0.0;
+  double sum_i = 0.0, sum_q = 0.0, sum_a2 = 0.0;
   int used = 0;
   for (const ChannelPrompt& p : prompts) {
     if (!std::isfinite(p.i) || !std::isfinite(p.q) || !std::isfinite(p.cn0_dbhz)) continue;
@@ -29,28 +27,10 @@ double CommonClockLoop::update(std::span<const ChannelPrompt> prompts) {
     sum_i += a * bit * p.i;
     sum_q += a * bit * p.q;
     sum_a2 += a2;
-    excess += a2 * (p.i * p.i + p.q * p.q - 2.0);
-    sum_a4 += a2 * a2;
     ++used;
   }
   channels_used_ = used;
-  if (used < opt_.min_channels || !(sum_a2 > 0.0)) {
-    window_.clear();  // another set of channels: the test starts afresh
-    return frequency_hz_;
-  }
-  if (opt_.detection_epochs > 0) {
-    window_.push_back({excess, 4.0 * sum_a4});
-    if (static_cast<int>(window_.size()) > opt_.detection_epochs) window_.pop_front();
-    double d = 0.0, v = 0.0;
-    for (const Energy& e : window_) {
-      d += e.excess;
-      v += e.noise_variance;
-    }
-    if (!(d > opt_.detection_sigma * std::sqrt(v))) {
-      ++held_no_signal_;
-      return frequency_hz_;
-    }
-  }
+  if (used < opt_.min_channels || !(sum_a2 > 0.0)) return frequency_hz_;
   mean_phase_rad_ = std::atan2(sum_q, sum_i);
   mean_phase_sigma_rad_ = std::sqrt(1.0 / sum_a2);
   constexpr double kZeta = std::numbers::sqrt2 / 2.0;

@@ -21,27 +21,16 @@
 // 45-60 deg error reads 38-42 deg against 32 (averaged arctangents lagged one such excursion by a cycle and a half on
 // a foreign-convention file). Weights: the prompt's expected amplitude A = sqrt(2 c T) in unit-noise units,
 // c = 10^(C/N0 / 10). Units: Hz, rad, seconds; C/N0 in dB-Hz.
-// Signal test: the loop updates only while its prompts hold signal, so that noise (a tunnel, a blockage, channels
-// fed through a fade gate) cannot walk its frequency off (a 5 Hz loop on noise alone walks ~0.5 Hz per update).
-// Statistic: the weighted excess energy D = sum A^2 (|P|^2 - 2), phase-free (the loop may be off in phase when it
-// matters most); noise alone: mean 0, variance 4 sum A^4 (|P|^2 of unit-variance arms: exponential, mean 2,
-// variance 4); signal: mean sum A^2 A_true^2. Summed over the latest detection_epochs updates with at least
-// min_channels (fewer: the window restarts) and compared with detection_sigma of its noise spread. With 3 sigma and
-// 5 epochs (a simulation of this statistic): 5 channels at 20 dB-Hz (A^2 = 4) pass 99.98 % of updates, 4 at 18 dB-Hz
-// 93 %; noise alone passes 0.4 % (the sum's tail is heavier than a Gaussian's).
 #pragma once
 
-#include <deque>
 #include <span>
 
 namespace ultratrack::receiver {
 
 struct CommonClockLoopOptions {
-  double bandwidth_hz = 5.0;     // noise bandwidth; (0, 0.25 / period_s]
-  double period_s = 0.020;       // update interval (the vector epoch)
-  int min_channels = 4;          // fewer contributing phases: no update (the loop holds its frequency)
-  int detection_epochs = 5;      // the signal test's window (updates); 0: no test
-  double detection_sigma = 3.0;  // its threshold in noise standard deviations
+  double bandwidth_hz = 5.0;  // noise bandwidth; (0, 0.25 / period_s]
+  double period_s = 0.020;    // update interval (the vector epoch)
+  int min_channels = 4;       // fewer contributing phases: no update (the loop holds its frequency)
 };
 
 // One channel's latest 20 ms prompt against its replica, normalised to unit noise variance per arm, the data bit
@@ -58,7 +47,7 @@ class CommonClockLoop {
   // Throws std::invalid_argument for a bandwidth or period outside its range or min_channels < 1.
   explicit CommonClockLoop(const CommonClockLoopOptions& options = {});
   // One update from the channels' latest prompts (non-finite entries ignored); returns the loop's frequency (Hz),
-  // unchanged when fewer than min_channels contribute or the signal test fails.
+  // unchanged when fewer than min_channels contribute.
   double update(std::span<const ChannelPrompt> prompts);
   // The frequency the loop adds to every steered channel's NCO (Hz; 0 at the start).
   double frequency_hz() const { return frequency_hz_; }
@@ -68,8 +57,6 @@ class CommonClockLoop {
   double mean_phase_sigma_rad() const { return mean_phase_sigma_rad_; }
   int channels_used() const { return channels_used_; }
   long long updates() const { return updates_; }
-  // Calls with min_channels or more prompts whose signal test failed (the loop held).
-  long long held_no_signal() const { return held_no_signal_; }
   const CommonClockLoopOptions& options() const { return opt_; }
 
  private:
@@ -79,11 +66,7 @@ class CommonClockLoop {
   double frequency_hz_ = 0.0;
   double mean_phase_rad_ = 0.0, mean_phase_sigma_rad_ = 0.0;
   int channels_used_ = 0;
-  long long updates_ = 0, held_no_signal_ = 0;
-  struct Energy {
-    double excess, noise_variance;
-  };
-  std::deque<Energy> window_;  // the signal test's latest updates
+  long long updates_ = 0;
 };
 
 }  // namespace ultratrack::receiver

@@ -3,8 +3,7 @@
 // frequency step with no standing phase error; combining N channels' prompts divides the noise variance by N (the
 // loop's output spread by sqrt(N)); prompts combine by their amplitudes (maximal-ratio: the combined phasor of
 // two groups is their A^2-weighted sum); the data bit, known or decided by the in-phase sign, does not turn the
-// sum; too few channels hold the loop; its signal test holds it on noise and passes weak signals at the rates its
-// header states; and a steered channel chooses its coherent time on thermal jitter alone.
+// sum; too few channels hold the loop; and a steered channel chooses its coherent time on thermal jitter alone.
 #include "receiver/common_clock_loop.hpp"
 
 #include <gtest/gtest.h>
@@ -123,67 +122,12 @@ TEST(CommonClockLoop, HoldsWithTooFewChannelsAndIgnoresNonFiniteEntries) {
   EXPECT_EQ(loop.updates(), 1);
 }
 
-// Prompts of n channels at cn0_dbhz (weights) carrying signal_cn0_dbhz (NaN: noise alone) on a perfect clock, the
-// loop closed on them; returns the loop after `calls` calls and the RMS of its frequency over them.
-struct NoiseRun {
-  CommonClockLoop loop;
-  double rms_hz = 0.0;
-};
-NoiseRun run_on(CommonClockLoopOptions options, int n, double cn0_dbhz, double signal_cn0_dbhz, int calls,
-                std::uint64_t seed) {
-  NoiseRun run{CommonClockLoop(options)};
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  std::vector<ChannelPrompt> prompts(static_cast<std::size_t>(n));
-  double replica_rad = 0.0, sum2 = 0.0;
-  for (int k = 0; k < calls; ++k) {
-    for (auto& p : prompts) {
-      p = std::isnan(signal_cn0_dbhz) ? ChannelPrompt{0.0, 0.0, 0, cn0_dbhz} : prompt(-replica_rad, signal_cn0_dbhz);
-      p.cn0_dbhz = cn0_dbhz;
-      p.i += noise(rng);
-      p.q += noise(rng);
-    }
-    const double f = run.loop.update(prompts);
-    replica_rad += 2.0 * std::numbers::pi * f * run.loop.options().period_s;
-    sum2 += f * f;
-  }
-  run.rms_hz = std::sqrt(sum2 / calls);
-  return run;
-}
-
-// Noise alone (a tunnel): the header's rate is 0.4 % of updates (a simulation of the statistic); 1 % bounds it with
-// the window's correlation (5 updates) taken into account (binomial spread of 20 +- 10 in 5,000). Without the test
-// the loop walks: ~0.5 Hz per update, tens of Hz RMS over 5,000; with it the few updates leave a fraction of that.
-TEST(CommonClockLoop, SignalTestHoldsTheLoopOnNoise) {
-  constexpr int kCalls = 5000;
-  const NoiseRun tested = run_on({}, 8, 20.0, NAN, kCalls, 11);
-  EXPECT_LE(tested.loop.updates(), kCalls / 100);
-  EXPECT_EQ(tested.loop.updates() + tested.loop.held_no_signal(), kCalls);
-  CommonClockLoopOptions off;
-  off.detection_epochs = 0;
-  const NoiseRun untested = run_on(off, 8, 20.0, NAN, kCalls, 11);
-  EXPECT_EQ(untested.loop.updates(), kCalls);
-  EXPECT_LT(tested.rms_hz, 0.3 * untested.rms_hz);
-}
-
-// Weak signals pass: 5 channels at 20 dB-Hz, 99.98 % of updates by the header's simulation; at least 99.5 % here
-// (25 holds in 5,000 would be 12 times the expected 1).
-TEST(CommonClockLoop, SignalTestPassesFiveChannelsAt20DbHz) {
-  constexpr int kCalls = 5000;
-  const NoiseRun run = run_on({}, 5, 20.0, 20.0, kCalls, 12);
-  EXPECT_LE(run.loop.held_no_signal(), kCalls / 200);
-  EXPECT_EQ(run.loop.updates() + run.loop.held_no_signal(), kCalls);
-}
-
 TEST(CommonClockLoop, RejectsBadOptions) {
   EXPECT_THROW(CommonClockLoop({0.0, 0.02, 4}), std::invalid_argument);
   EXPECT_THROW(CommonClockLoop({15.0, 0.02, 4}), std::invalid_argument);  // Bn T = 0.3
   EXPECT_THROW(CommonClockLoop({5.0, 0.0, 4}), std::invalid_argument);
   EXPECT_THROW(CommonClockLoop({5.0, 0.02, 0}), std::invalid_argument);
   EXPECT_THROW(CommonClockLoop({NAN, 0.02, 4}), std::invalid_argument);
-  EXPECT_THROW(CommonClockLoop({5.0, 0.02, 4, -1}), std::invalid_argument);
-  EXPECT_THROW(CommonClockLoop({5.0, 0.02, 4, 5, -1.0}), std::invalid_argument);
-  EXPECT_THROW(CommonClockLoop({5.0, 0.02, 4, 5, NAN}), std::invalid_argument);
 }
 
 // A steered channel (its oscillator tracked by the common loop) chooses as if its clock were perfect: with the TCXO
