@@ -31,6 +31,11 @@ bool fresh_epoch(const receiver::VectorChannelInput& in, double period_s) {
   return in.synchronised && in.has_measurement && std::abs(in.integration_time_s - period_s) <= 1e-4;
 }
 
+// The same for its prompt alone: also an epoch the fade gate kept from being a measurement (has_prompt).
+bool fresh_prompt(const receiver::VectorChannelInput& in, double period_s) {
+  return in.synchronised && in.has_prompt && std::abs(in.prompt_integration_time_s - period_s) <= 1e-4;
+}
+
 // The start and the middle of a channel's latest correlation epoch on the driver's time line (t_k at epoch.sample).
 struct EpochTimes {
   double start_s, half_s;
@@ -583,9 +588,7 @@ double UltraTightLoop::common_clock_update(const receiver::VectorEpochInput& epo
     // A channel re-locking after a coast (a tunnel's exit) pulls its own phase in for its first second: its prompt
     // says nothing yet about the common clock (with it the loop was pushed 3 Hz off at a tunnel's exit).
     if (st.since_relock_s < ut_.nis_settle_s) continue;
-    if (in.coasting || !in.synchronised || !in.has_prompt || !std::isfinite(in.cn0_dbhz) || !(in.iq_scale > 0.0) ||
-        std::abs(in.prompt_integration_time_s - ut_.period_s) > 1e-4)
-      continue;
+    if (in.coasting || !fresh_prompt(in, ut_.period_s) || !std::isfinite(in.cn0_dbhz) || !(in.iq_scale > 0.0)) continue;
     // An epoch the fade gate dropped still counts once the channel's C/N0 estimate (0.2 s) reads below 30 dB-Hz:
     // after a step down to ~20 dB-Hz the gate drops most epochs until the 1 s presence window follows, and the loop,
     // short of channels, held while the TCXO moved (steered 2 Hz PLLs slipped 0.7-0.9 s after the step). Above
@@ -593,7 +596,7 @@ double UltraTightLoop::common_clock_update(const receiver::VectorEpochInput& epo
     // (A signal test on the prompts' excess energy, to hold the loop on noise, was tried and dropped: on oracle-bit
     // files of campaigns/weak_signal.toml it came with whole files lost to a loop that ran off with every channel.)
     constexpr double kUngatedBelowDbHz = 30.0;
-    if (!in.prompt_gate_passed && !(in.cn0_dbhz < kUngatedBelowDbHz)) continue;
+    if (!in.has_measurement && !(in.cn0_dbhz < kUngatedBelowDbHz)) continue;
     // The bit by the in-phase sign even where it is known: a channel that re-locked half a cycle off (a Costas
     // PLL may) has every known bit inverted, and its prompt would pull every channel by pi (seen at a tunnel's exit).
     prompts.push_back({in.iq_i[1], in.iq_q[1], 0, in.cn0_dbhz});

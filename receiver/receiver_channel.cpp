@@ -138,7 +138,6 @@ VectorChannelInput ReceiverChannel::vector_input(const ReceiverClock& clock, int
     }
   }
   in.has_prompt = true;
-  in.prompt_gate_passed = present;
   in.prompt_integration_time_s = e.num_samples / fs_hz_;
   if (!present) return in;
   in.integration_time_s = in.prompt_integration_time_s;

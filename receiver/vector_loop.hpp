@@ -65,12 +65,11 @@ struct VectorChannelInput {
   double replica_carrier_frequency_hz = 0.0;
   std::array<double, 3> iq_i{}, iq_q{};  // early, prompt, late
   // The taps above (and iq_scale) are also filled for a new, valid, bit-synced 20 ms-class epoch that the fade gate
-  // kept from has_measurement (has_prompt true, prompt_gate_passed false): after a step down to ~20 dB-Hz the gate
+  // kept from being a measurement (has_prompt true, has_measurement false): after a step down to ~20 dB-Hz the gate
   // drops most epochs until the channel's presence window reads the new level (up to 1 s), while a loop that
   // combines many channels' prompts (receiver/common_clock_loop.hpp) still needs them. has_measurement implies
-  // has_prompt and prompt_gate_passed.
+  // has_prompt.
   bool has_prompt = false;
-  bool prompt_gate_passed = false;       // the per-epoch fade gate's verdict (receiver_channel.cpp)
   double prompt_integration_time_s = 0;  // that epoch's length (integration_time_s is set with has_measurement only)
   // The replica carrier's accumulated phase (cycles, the NCO's: +Doppler, jumps included) at measurement_sample,
   // and the phase it will have at next_epoch_sample if left on its current command (no new jump): a loop that
