@@ -189,6 +189,15 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
   const double shift_m = kC * (epoch.clock_corrections_s - corrections_at_start_s_);
   const double common_offset_hz = common_carrier_offset_hz(epoch, t_k);
   for (const auto& in : epoch.channels) {
+    // An epoch the fade gate dropped still moves the I&Q model's amplitude (PromptPowerAverage, below): after a step
+    // from 45 to 20 dB-Hz the gate drops ~1 s of epochs, and an average that skipped them met the first kept epoch
+    // with the amplitude of 45 dB-Hz. The I&Q model then reads the missing amplitude as code and frequency error
+    // (I_P innovations of -30 sigma; the few accepted ones pushed the common clock drift 1.7 Hz off and every
+    // channel followed it away: weak_signal_told_tuning, seed 203).
+    if (!fresh_epoch(in, ut_.period_s) && fresh_prompt(in, ut_.period_s) && in.iq_scale > 0.0) {
+      const double scale2 = in.iq_scale * in.iq_scale;
+      channel(in.prn).prompt_power.update((in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2, scale2);
+    }
     if (!fresh_epoch(in, ut_.period_s) || !std::isfinite(in.cn0_dbhz)) continue;
     if (!(in.iq_scale > 0.0)) continue;          // no noise estimate
     if (channel(in.prn).nis_released) continue;  // its correlations contradict the filter: not used

@@ -291,6 +291,8 @@ TrackingReport ScalarTracking::update(const CorrelationEpoch& e, KnownBits known
     f = pull_in_.step(pullin_stage, e, time_s_, carrier_, &r.frequency_error_hz);
   } else if (coherent && carrier_commanded_) {
     f = command_.carrier_frequency_hz;  // the vector FLL's (command_carrier)
+  } else if (aided_hold()) {
+    f = carrier_.frequency_hz();  // faded: the aiding alone moves the carrier
   } else {
     f = carrier_.update(r.phase_error_cycles, 0.0, t);
   }
@@ -369,7 +371,7 @@ TrackingReport ScalarTracking::long_coherent_epoch(const CorrelationEpoch& e, Tr
   const bool low_pli = r.pli < opt_.pli_loss_threshold;
   if (loss_.long_update_lost(low_cn0 || low_pli, filter_driven_, t, long_.pli_time_constant_s()))
     return lose_long_coherent_lock(e, r, false);
-  const double f = carrier_.update(r.phase_error_cycles, 0.0, t);
+  const double f = aided_hold() ? carrier_.frequency_hz() : carrier_.update(r.phase_error_cycles, 0.0, t);
   const double dll_bw = std::min(opt_.dll_bw_coherent_hz, opt_.coherent_max_bn_t / t);
   command_.carrier_frequency_hz = f;
   command_.code_rate_chips_per_s = signals::kCaChipRate_hz * (1.0 + f / signals::kL1Frequency_hz) +

@@ -107,7 +107,8 @@ struct ScalarTrackingControl {
   double aid_delta_hz = 0.0;
   // The external loop also tracks the receiver oscillator for this channel (receiver/common_clock_loop.hpp: its
   // frequency reaches the NCO through the aid): the PLL sees the oscillator's residual only, so long coherent
-  // integration chooses its length on thermal jitter (choose_coherent_epochs without the oscillator).
+  // integration chooses its length on thermal jitter (choose_coherent_epochs without the oscillator). With
+  // filter_driven, the PLL also holds on the aiding through the first tenths of a second of a sudden fade (below).
   bool clock_steered = false;
 };
 
@@ -179,6 +180,19 @@ class ScalarTracking final {
   bool coasting_allowed_ = false, relocking_ = false;
   bool filter_driven_ = false;
   bool clock_steered_ = false;  // ScalarTrackingControl::clock_steered
+  // A filter-driven channel whose oscillator an external loop steers holds its PLL while the fade detector says its
+  // prompt fell 10 dB in one epoch and the C/N0 estimate (0.2 s) still reads the signal of before (30 dB-Hz or
+  // more): the carrier then moves by the aiding alone (the filter's Doppler and the common clock loop). At a step
+  // from 45 to 20 dB-Hz the PLL otherwise ran on noise with the strong signal's bandwidth and coherent time until
+  // the estimate followed (0.2-0.3 s), and left single channels 2-5 Hz off (campaigns/weak_signal_told_tuning.toml:
+  // 6 of 8 satellites lost within 1 s of the step). Once the estimate reads the new level the loop runs again, on
+  // the weak signal's settings, fade or not: at 20 dB-Hz the fade's own end (a presence test at 20 dB-Hz) may take
+  // seconds, and a PLL held that long drifted with the aiding (5 of 10 channels 2-4 Hz off on one file).
+  bool aided_hold() const {
+    constexpr double kHoldWhileAboveDbHz = 30.0;
+    return filter_driven_ && clock_steered_ && state_ == TrackingState::kBitSynced && fade_.faded() && cn0_dbhz_ &&
+           *cn0_dbhz_ >= kHoldWhileAboveDbHz;
+  }
   bool carrier_commanded_ = false;
   bool carrier_phase_locked_ = false;
   PullIn pull_in_;

@@ -220,7 +220,6 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
   for (const auto& [prn, rows] : log)
     if (!rows.empty() && rows.front().ultratight) handed.insert(prn);
   EXPECT_GE(handed.size(), 6u);
-  EXPECT_GE(json_number(summary, "relocks"), static_cast<double>(handed.size()));
   // Below the PVT's 10 deg mask a channel is commanded but "aided only": its correlations never update the filter
   // (UltraTightOptions::measurement_mask_rad). Elevations from the simulation (at its start; they move < 0.2 deg
   // in the file's 21 s), none within 0.5 deg of the mask.
@@ -247,6 +246,7 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
     }
   }
   int late_losses = 0;  // channels whose loss the presence test declared a window late (below)
+  int undeclared = 0;   // channels whose loss it did not declare within the gap (below)
   for (int prn : handed) {
     const bool measured = elevation_deg[prn] >= 10.0;
     const auto& rows = log.at(prn);
@@ -267,16 +267,27 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
     EXPECT_EQ(outside_gap, 0) << "PRN " << prn;
     // The presence test (1 s windows of 20 ms epochs, 12 dB-Hz): no window holding 45 dB-Hz epochs fails, so the
     // loss comes at the end of the first window wholly inside the gap, 1-2 s after its start, or a window later
-    // when noise passes (probability 0.085 each): before the return (3 windows) with 1 - 0.085^3.
-    EXPECT_GE(loss_s, 1.0) << "PRN " << prn;
-    EXPECT_LE(loss_s, kGapEnd_s - kGapStart_s) << "PRN " << prn;
+    // when noise passes (probability 0.085 each). But a noise window that reads 15 dB-Hz or more also sets the
+    // monitor's level (PresenceMonitorOptions: a step down counts at once), and at ~13 dB-Hz a loss needs 3 or more
+    // absent windows, which the 4 s gap may not hold: then the loss comes after the return, i.e. never. That is a
+    // fraction of a per cent of channel-gaps, but over 12 channels about one file in ten: the same tunnel file
+    // simulated with seeds 1-11 (`receive --coupling ultra-tight --filter ekf`) left one channel's loss undeclared in
+    // 1 file of 11 at 8a375b1 (seed 1) and in 1 of 11 with the aided hold (receiver/scalar_tracking.hpp; seed 4, this
+    // file), a different draw of the same windows (12 and 13 late losses in all). So at most one channel per file.
+    const bool declared = loss_s >= 1.0 && loss_s <= kGapEnd_s - kGapStart_s;
+    if (!declared) {
+      ++undeclared;
+      std::printf("PRN %d: loss not declared within the gap (%.2f s)\n", prn, loss_s);
+    } else {
+      EXPECT_GE(loss_s, 1.0) << "PRN " << prn;
+    }
     // The carrier-runaway check (C/N0 below 30 dB-Hz, 1 s means of the replica's offset from the prediction) never
     // flags a channel while its 45 dB-Hz signal is there. In the gap a channel coasts, and the monitor restarts,
     // before it has a whole 1 s mean of faded epochs (the C/N0 estimate falls below 30 dB-Hz ~0.1 s in; the loss
     // comes 1-2 s in) unless the presence test declares the loss a window late (2-3 s in): then the PLL on noise may
     // be judged a runaway in the gap before it coasts, and stays flagged until it re-locks (seen on the shipped
     // file's sky: PRN 9 lost 2.14 s in, flagged from 2.06 s in to its re-lock).
-    const bool late = loss_s > 2.0;
+    const bool late = !declared || loss_s > 2.0;
     late_losses += late;
     for (const Row& r : rows) {
       const bool in_fade = r.t >= kGapStart_s && r.t <= kGapEnd_s + relock_s;
@@ -295,6 +306,8 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
     EXPECT_GE(after_ok, 0.75 * after) << "PRN " << prn;
     EXPECT_GE(before, 100) << "PRN " << prn;
   }
+  EXPECT_LE(undeclared, 1);
+  EXPECT_GE(json_number(summary, "relocks"), static_cast<double>(handed.size()) - undeclared);
   // No aiding step and no correlation left out unless a late-declared loss let the check act in the gap (at most one
   // re-centring per such channel).
   if (late_losses == 0) {
