@@ -188,7 +188,9 @@ pipelines::ReceiveSummary receive(const fs::path& rx, const Receive& o) {
 // of 0.1 s (0.8 m along the track) or a wrong measurement covariance breaks it. (60 s figures: validation.md.)
 TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
   const auto rx = simulated().dir / "rx_loose";
-  receive(rx, {.coupling = pipelines::Coupling::kLoose});
+  Receive loose;
+  loose.coupling = pipelines::Coupling::kLoose;
+  receive(rx, loose);
   const Rms r = compare(rx);
   const std::string summary = test::read_text_file(rx / "summary.json");
   std::printf("loose EKF: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m, running-mean bound %.3f m\n", r.epochs,
@@ -206,7 +208,9 @@ TEST(ReceiveFusion, LooseCouplingFromIfSamplesFollowsThePvtFixes) {
 TEST(ReceiveFusion, TightCouplingFromIfSamplesBeatsThePvtFixes) {
   for (const std::string filter : {"ekf", "ukf"}) {
     const auto rx = simulated().dir / ("rx_tight_" + filter);
-    receive(rx, {.filter = filter == "ekf" ? fusion::FilterKind::Ekf : fusion::FilterKind::Ukf});
+    Receive tight;
+    tight.filter = filter == "ekf" ? fusion::FilterKind::Ekf : fusion::FilterKind::Ukf;
+    receive(rx, tight);
     const Rms r = compare(rx);
     const std::string summary = test::read_text_file(rx / "summary.json");
     std::printf("tight %s: %d epochs, fused 3-D RMS %.3f m, PVT %.3f m\n", filter.c_str(), r.epochs, r.fused_m,
@@ -232,7 +236,11 @@ TEST(ReceiveFusion, TightCouplingCarriesItsClockThroughAReceiverClockJump) {
   std::ofstream(config) << "[initial]\nattitude_deg = [0, 0, 0]\nposition_deg_m = [35.274016, 137.013759, 100.0]\n"
                            "velocity_ned_mps = [8.333333333, 0, 0]\nsigma_position_m = [3, 3, 3]\n";
   const auto rx = s.dir / "rx_jump";
-  receive(rx, {.align = pipelines::AlignMode::Config, .fusion_config = config, .receive_config = rx_config});
+  Receive jump;
+  jump.align = pipelines::AlignMode::Config;
+  jump.fusion_config = config;
+  jump.receive_config = rx_config;
+  receive(rx, jump);
   const std::string summary = test::read_text_file(rx / "summary.json");
   EXPECT_EQ(json_number(summary, "clock_jumps"), 1.0);
   EXPECT_EQ(json_number(summary, "clock_jumps_removed"), 1.0);
@@ -256,9 +264,11 @@ TEST(ReceiveFusion, TightCouplingWithThreeSatellitesStaysBoundedWhereThePvtCanno
                            "position_deg_m = [35.274016, 137.01397883, 100.0]\n"  // 20.0 m east of the start
                            "velocity_ned_mps = [8.333333333, 0, 0]\nsigma_position_m = [20, 20, 20]\n";
   const auto rx = s.dir / "rx_three";
-  receive(rx, {.align = pipelines::AlignMode::Config,
-               .fusion_config = config,
-               .prns = {s.prns_by_elevation[0], s.prns_by_elevation[1], s.prns_by_elevation[2]}});
+  Receive three;
+  three.align = pipelines::AlignMode::Config;
+  three.fusion_config = config;
+  three.prns = {s.prns_by_elevation[0], s.prns_by_elevation[1], s.prns_by_elevation[2]};
+  receive(rx, three);
   const std::string summary = test::read_text_file(rx / "summary.json");
   EXPECT_EQ(json_number(summary, "fixes"), 0.0);
   const std::string solution = test::read_text_file(rx / "solution.csv");
