@@ -36,6 +36,13 @@ bool fresh_prompt(const receiver::VectorChannelInput& in, double period_s) {
   return in.synchronised && in.has_prompt && std::abs(in.prompt_integration_time_s - period_s) <= 1e-4;
 }
 
+// One prompt (its taps on the raw scale, taps / iq_scale) into the channel's I&Q amplitude average; returns A^2 from
+// the epochs before it (PromptPowerAverage::update). in.iq_scale must be > 0.
+double update_prompt_power(PromptPowerAverage& average, const receiver::VectorChannelInput& in) {
+  const double scale2 = in.iq_scale * in.iq_scale;
+  return average.update((in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2, scale2);
+}
+
 // The start and the middle of a channel's latest correlation epoch on the driver's time line (t_k at epoch.sample).
 struct EpochTimes {
   double start_s, half_s;
@@ -194,10 +201,8 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     // with the amplitude of 45 dB-Hz. The I&Q model then reads the missing amplitude as code and frequency error
     // (I_P innovations of -30 sigma; the few accepted ones pushed the common clock drift 1.7 Hz off and every
     // channel followed it away: weak_signal_told_tuning, seed 203).
-    if (!fresh_epoch(in, ut_.period_s) && fresh_prompt(in, ut_.period_s) && in.iq_scale > 0.0) {
-      const double scale2 = in.iq_scale * in.iq_scale;
-      channel(in.prn).prompt_power.update((in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2, scale2);
-    }
+    if (!fresh_epoch(in, ut_.period_s) && fresh_prompt(in, ut_.period_s) && in.iq_scale > 0.0)
+      update_prompt_power(channel(in.prn).prompt_power, in);
     if (!fresh_epoch(in, ut_.period_s) || !std::isfinite(in.cn0_dbhz)) continue;
     if (!(in.iq_scale > 0.0)) continue;          // no noise estimate
     if (channel(in.prn).nis_released) continue;  // its correlations contradict the filter: not used
@@ -223,11 +228,9 @@ std::vector<fusion::ChannelCorrelation> UltraTightLoop::correlations(const recei
     // average of the epochs before this one: with this epoch's prompt in it (weight 0.1) the I_P innovation
     // would lose a tenth of its noise (variance 0.81).
     ChannelState& st = channel(in.prn);
-    const double scale2 = in.iq_scale * in.iq_scale;
-    const double p2 = (in.iq_i[1] * in.iq_i[1] + in.iq_q[1] * in.iq_q[1]) / scale2;
     // PromptPowerAverage: the ~1 s mean while the C/N0 holds (the 0.2 s mean's spread made the gate below,
     // coast_cn0_dbhz, pass only its upper tail at 16 dB-Hz: A^2 ~1.9 x the taps'), the 0.2 s one after a step.
-    const double a2 = st.prompt_power.update(p2, scale2);
+    const double a2 = update_prompt_power(st.prompt_power, in);
     c.cn0_dbhz = a2 > 0.0 ? 10.0 * std::log10(a2 / (2.0 * ut_.period_s)) : -100.0;
     // The channel's PLL stays closed: the period starts with its residual phase error (thermal jitter of the
     // loop at its design bandwidth for the coherent time it runs now, N x 20 ms), not the realigned phase of the

@@ -44,15 +44,22 @@ test::TestSatellite satellite(int prn, double cn0) {
   return sat;
 }
 
-// Runs the channel + scalar closure over duration_s of signal starting from an acquisition-like result.
-std::vector<EpochRecord> track(const test::TestSatellite& sat, const ScalarTrackingOptions& opt,
-                               double doppler_error_hz, double code_error_chips, double duration_s,
-                               std::uint64_t seed = 42) {
+// An acquisition-like start on `sat`: the replica code_error_chips behind the signal's code and doppler_error_hz off
+// its Doppler, at sample 0.
+ChannelStart acquisition_start(const test::TestSatellite& sat, double doppler_error_hz, double code_error_chips) {
   ChannelStart start;
   start.sample_index = 0;
   start.code_phase_chips = std::fmod(sat.code_phase_chips - code_error_chips + 1023.0, 1023.0);
   start.carrier_frequency_hz = sat.doppler_hz + doppler_error_hz;
-  TrackingChannel channel(channel_config(opt, sat.prn, kFs), start);
+  return start;
+}
+
+// Runs the channel + scalar closure over duration_s of signal starting from an acquisition-like result.
+std::vector<EpochRecord> track(const test::TestSatellite& sat, const ScalarTrackingOptions& opt,
+                               double doppler_error_hz, double code_error_chips, double duration_s,
+                               std::uint64_t seed = 42) {
+  TrackingChannel channel(channel_config(opt, sat.prn, kFs),
+                          acquisition_start(sat, doppler_error_hz, code_error_chips));
   ScalarTracking loop(opt, channel.current_command());
   std::vector<EpochRecord> out;
   const test::TestSignal sig{kFs, true, seed};
@@ -303,13 +310,10 @@ TEST(ScalarTracking, CoastsThroughAFadeAndReLocksFromTheAidedFrequency) {
   after.start_s = 4.5;
   after.stop_s = 1e30;
   ScalarTrackingOptions opt;
-  ChannelStart start;
-  start.code_phase_chips = std::fmod(before.code_phase_chips - 0.2 + 1023.0, 1023.0);
-  start.carrier_frequency_hz = before.doppler_hz + 40.0;
-  TrackingChannel channel(channel_config(opt, before.prn, kFs), start);
+  TrackingChannel channel(channel_config(opt, before.prn, kFs), acquisition_start(before, 40.0, 0.2));
   ScalarTracking loop(opt, channel.current_command());
   const test::TestSignal sig{kFs, true, 5};
-  const auto true_doppler = [&](double t) { return before.doppler_hz + before.doppler_rate_hzps * t; };
+  const auto true_doppler = [&](double t) { return test::true_doppler_hz(before, t); };
   double coast_from = -1.0, relocked_at = -1.0;
   PerfectAiding aiding{true_doppler, {}};
   aiding.control.coasting_allowed = true;
@@ -372,13 +376,10 @@ TEST(ScalarTracking, AFilterDrivenClockSteeredPllHoldsOnItsAidingThroughAStepDow
   after.start_s = kStep_s;
   after.stop_s = 1e30;
   ScalarTrackingOptions opt;
-  ChannelStart start;
-  start.code_phase_chips = std::fmod(before.code_phase_chips - 0.2 + 1023.0, 1023.0);
-  start.carrier_frequency_hz = before.doppler_hz + 40.0;
-  TrackingChannel channel(channel_config(opt, before.prn, kFs), start);
+  TrackingChannel channel(channel_config(opt, before.prn, kFs), acquisition_start(before, 40.0, 0.2));
   ScalarTracking loop(opt, channel.current_command());
   const test::TestSignal sig{kFs, true, 11};
-  const auto true_doppler = [&](double t) { return before.doppler_hz + before.doppler_rate_hzps * t; };
+  const auto true_doppler = [&](double t) { return test::true_doppler_hz(before, t); };
   double worst_hz = 0.0;
   PerfectAiding aiding{true_doppler, {}};
   aiding.control.coasting_allowed = true;
