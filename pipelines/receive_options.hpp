@@ -38,12 +38,14 @@ struct ReceiveOptions {
   std::vector<ins::OdometerSample> odometer;
   std::string odometer_name = "odometer data";
 
-  // kUltraTight. Pipelined (the default): the loop runs beside the next block's correlation
-  // (receiver::ReceiverEngine::set_vector_loop), its commands one 20 ms vector epoch later, as a real-time
-  // receiver runs its navigation filter concurrently with the correlators. false: the loop runs on the caller
-  // between blocks, its commands at the epoch that produced them (slower with 2 or more threads).
+  // kUltraTight. Serial (the default since 2026-11-29): the loop runs on the caller between blocks, its commands at
+  // the epoch that produced them. Pipelined: it runs beside the next block's correlation
+  // (receiver::ReceiverEngine::set_vector_loop), its commands one 20 ms vector epoch later, as a real-time receiver
+  // may run its navigation filter concurrently with the correlators: ~18 % faster with 2 threads, but that period
+  // of delay in the common clock loop (receiver/common_clock_loop.hpp) rings with the channels' 100 ms PLLs on a
+  // TCXO (docs/validation.md, section 16), and weak files were lost whole to it.
   fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;
-  bool ut_pipelined = true;
+  bool ut_pipelined = false;
   // kUltraTight: the common clock loop's noise bandwidth (receiver/common_clock_loop.hpp; --ut-clock-loop-bw), Hz,
   // in (0, 12.5]; 0: off (each channel's PLL follows the receiver oscillator alone).
   double ut_clock_loop_bw_hz = 5.0;

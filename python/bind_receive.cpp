@@ -29,7 +29,7 @@ using pipelines::Coupling;
 void apply_fusion_options(py::dict& o, pipelines::ReceiveOptions& s) {
   std::string filter, align, fusion_config, ut_measurement, vector_carrier;
   py::object time_origin = py::none();
-  bool ut_pipelined = true;
+  bool ut_pipelined = s.ut_pipelined;
   double ut_clock_loop_bw_hz = s.ut_clock_loop_bw_hz;
   const bool has_filter = take_option(o, "filter", filter), has_align = take_option(o, "align", align);
   const bool has_config = take_option(o, "fusion_config", fusion_config);

@@ -13,14 +13,17 @@
 // Loop: second order (a frequency step leaves no standing phase error), damping 0.707, the analogue design at
 // bandwidth_hz discretised per update (integrator += w0^2 T e, frequency = integrator + 2 zeta w0 e, e the combined
 // phase error in rad). Why these choices (benchmarks/validation/clock_loop_model.py, a discrete model independent of
-// this code, 8 channels on a TCXO): at 20 dB-Hz a channel PLL alone slips at 5 Hz / 20 ms (47 deg RMS) and at
-// 2 Hz / 100 ms (49 deg); with this loop at 5 Hz the 2 Hz PLLs hold 14-16 deg and none slips over 35 s, also with one
-// more epoch of delay (the pipelined loop's commands reach the channels a period later); at 8 Hz with that delay the
-// loop rings (24 deg, most slip). Summing the prompts before the arctangent, rather than averaging per-channel
-// arctangents, keeps the discriminator's S-curve steeper where a TCXO's 5 Hz/s excursions push it: at 20 dB-Hz a
-// 45-60 deg error reads 38-42 deg against 32 (averaged arctangents lagged one such excursion by a cycle and a half on
-// a foreign-convention file). Weights: the prompt's expected amplitude A = sqrt(2 c T) in unit-noise units,
-// c = 10^(C/N0 / 10). Units: Hz, rad, seconds; C/N0 in dB-Hz.
+// this code, 8 channels on a TCXO, the channels' loop filter as the receiver's): at 20 dB-Hz a channel PLL alone
+// slips at 5 Hz / 20 ms (45-52 deg RMS) and at 2 Hz / 100 ms (52 deg); with this loop at 5 Hz the 2 Hz PLLs hold
+// 16-17 deg and none slips when its frequency runs two epochs after the prompts it came from (the serial ultra-tight
+// loop: a prompt's epoch ends up to a period before the vector epoch, the command runs from the channel's next epoch
+// start). One epoch more (the pipelined loop, pipelines/receive_options.hpp) makes the loop and the 100 ms PLLs ring
+// (25-27 deg, most slip; in the receiver +-1.3 Hz of common frequency error at ~2.8 Hz, and whole weak files lost);
+// at 8 Hz the serial loop rings too (22-25 deg, some slip). Summing the prompts before the arctangent, rather than
+// averaging per-channel arctangents, keeps the discriminator's S-curve steeper where a TCXO's 5 Hz/s excursions push
+// it: at 20 dB-Hz a 45-60 deg error reads 38-42 deg against 32 (averaged arctangents lagged one such excursion by a
+// cycle and a half on a foreign-convention file). Weights: the prompt's expected amplitude A = sqrt(2 c T) in
+// unit-noise units, c = 10^(C/N0 / 10). Units: Hz, rad, seconds; C/N0 in dB-Hz.
 #pragma once
 
 #include <span>

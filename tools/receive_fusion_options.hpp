@@ -20,9 +20,9 @@ struct ReceiveFusionArgs {
   std::string imu, coupling = "scalar", filter, align, config, time_origin, ut_measurement, vector_carrier;
   std::string odometer;    // --odometer FILE (loose)
   std::string imu_pps;     // --imu-pps: the PPS record of the IMU's local clock
-  bool ut_serial = false;  // --ut-serial
-  // --ut-pipelined[=true|false]: names the default (older command lines); =false selects the serial loop.
-  bool ut_pipelined = true;
+  bool ut_serial = false;  // --ut-serial: names the default (older command lines)
+  // --ut-pipelined[=true|false]: the pipelined loop; =false is the serial default.
+  bool ut_pipelined = false;
   const CLI::Option* ut_pipelined_option = nullptr;  // set by add_receive_fusion_options: was it given?
   // --nis-window N, --nis-probability P (vector, ultra-tight); not given: fusion::NisReleaseOptions' defaults.
   int nis_window = 0;

@@ -1,22 +1,30 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
 """A discrete model of the common clock loop (receiver/common_clock_loop.hpp), independent of the receiver's code:
-the numbers its header and docs/validation.md (section 16) quote.
+the numbers its header, pipelines/receive_options.hpp and docs/validation.md (section 16) quote.
 
     benchmarks/validation/clock_loop_model.py scurve      # the combined phase against per-channel arctangents
     benchmarks/validation/clock_loop_model.py loops       # channel PLLs with and without the loop on a TCXO
+    benchmarks/validation/clock_loop_model.py delay       # the loop closed through its command delay, noise-free
 
 scurve: N = 8 channels whose 20 ms prompts (unit noise per arm) all carry the same phase error; the mean of the
 per-channel Costas arctangents atan(Q / I) against the phase of the prompts summed after a sign decision on I, by
 Monte Carlo (20 000 draws per point), at 18-25 dB-Hz.
 
 loops: a TCXO (h0 = 9.356e-23 s, h-2 = 2e-20 / s, Brown & Hwang's random walk; white frequency noise as the
-simulator's preset) common to N = 8 channels at one C/N0; each channel a third-order Costas PLL (the receiver's
-coefficients: b3 = 2.4, a3 = 1.1, Bn per w0 = 0.7845) updated every N x 20 ms at Bn = min(B, 0.2 / T); optionally
+simulator's preset) common to N = 8 channels at one C/N0; each channel a third-order Costas PLL with the receiver's
+loop filter (receiver/loop_filters.cpp: b3 = 2.4, a3 = 1.1, Bn per w0 = 0.7845, its proportional term a frequency
+held over the next block, the NCO phase never jumped) updated every N x 20 ms at Bn = min(B, 0.2 / T); optionally
 the common loop (second order, damping 0.707, its 20 ms updates on the summed prompts) whose frequency reaches the
-NCOs after a delay of D more epochs. Printed per case over two seeds and 35 s after a 5 s start: the median
-channel's RMS phase error (deg, wrapped to the Costas range) and the fraction of channels that slipped (a quarter
-cycle from where they started). Pure Python: a few minutes.
+NCOs d epochs after the epoch whose prompts it was computed from: a prompt's epoch ends up to a period before the
+vector epoch that reads it and the command runs from the channel's next epoch start, up to a period after it; from
+the middle of the measured epoch that is 1.5 (+-1) periods, d = 2, for the serial loop (the default) and one period
+more, d = 3, for the pipelined one (pipelines/receive_options.hpp: ut_pipelined). Printed
+per case over four seeds and 35 s after a 5 s start: the median channel's RMS phase error (deg, wrapped to the
+Costas range) and the fraction of channels that slipped (a quarter cycle from where they started: a Costas loop's;
+a PLL on known bits has half a cycle). Pure Python: about 10 s.
+
+delay: the common loop alone and noise-free, closed through d epochs: a 1 Hz frequency step and a 5 Hz/s ramp.
 """
 import cmath
 import math
@@ -63,12 +71,13 @@ def run(cn0, bn_channel, epochs, bn_common, delay, seed, duration=40.0, channels
     theta = [0.0] * channels
     f_ch = [0.0] * channels
     a_ch = [0.0] * channels
+    fi_ch = [0.0] * channels
     acc = [0j] * channels
     count = 0
     phi = w = 0.0
     wc = bn_common / 0.53 if bn_common > 0 else 0.0
     f_common = integrator = 0.0
-    pending = [0.0] * delay
+    pending = [0.0] * delay  # outputs in flight: the one computed now runs from epoch k + delay + 1
     sq = [0.0] * channels
     slipped = [False] * channels
     start = None
@@ -93,19 +102,23 @@ def run(cn0, bn_channel, epochs, bn_common, delay, seed, duration=40.0, channels
             n += 1
         if bn_common > 0:
             total = sum(x if x.real >= 0 else -x for x in z)
-            pending.append(math.atan2(total.imag, total.real))
-            m = pending.pop(0)
+            m = math.atan2(total.imag, total.real)
             integrator += wc * wc * T * m
-            f_common = integrator + 2 * 0.707 * wc * m
+            out = integrator + 2 * 0.707 * wc * m
+            pending.append(out)
+            f_common = pending.pop(0)
         for i in range(channels):
             acc[i] += z[i]
         count += 1
         if count == epochs:
             for i in range(channels):
                 e = math.atan(acc[i].imag / acc[i].real)
+                # receiver/loop_filters.cpp (in rad here): rate and frequency integrators, the proportional term a
+                # frequency held over the next block (the NCO's phase is never jumped)
+                rate0, freq0 = a_ch[i], fi_ch[i]
                 a_ch[i] += w0**3 * t_loop * e
-                f_ch[i] += a_ch[i] * t_loop + 1.1 * w0 * w0 * t_loop * e
-                theta[i] += 2.4 * w0 * t_loop * e
+                fi_ch[i] += t_loop * (0.5 * (a_ch[i] + rate0) + 1.1 * w0 * w0 * e)
+                f_ch[i] = 0.5 * (fi_ch[i] + freq0) + 2.4 * w0 * e
                 acc[i] = 0j
             count = 0
     rms = sorted(math.degrees(math.sqrt(x / n)) for x in sq)
@@ -113,21 +126,56 @@ def run(cn0, bn_channel, epochs, bn_common, delay, seed, duration=40.0, channels
 
 
 def loops():
-    cases = [  # (channel Bn, epochs, common Bn, delay, label)
-        (5.0, 1, 0.0, 0, "channel PLL 5 Hz / 20 ms alone (a TCXO's choice without the loop)"),
-        (2.0, 5, 0.0, 0, "channel PLL 2 Hz / 100 ms alone"),
-        (2.0, 5, 5.0, 0, "2 Hz / 100 ms + common loop 5 Hz"),
-        (2.0, 5, 5.0, 1, "2 Hz / 100 ms + common loop 5 Hz, one more epoch of delay"),
-        (2.0, 1, 5.0, 1, "2 Hz / 20 ms (bits unknown) + common loop 5 Hz, one more epoch of delay"),
-        (5.0, 1, 5.0, 1, "5 Hz / 20 ms + common loop 5 Hz, one more epoch of delay"),
-        (2.0, 5, 8.0, 1, "2 Hz / 100 ms + common loop 8 Hz, one more epoch of delay"),
+    cases = [  # (channel Bn, epochs, common Bn, d, label); d: the loop's output runs d epochs after its prompts
+        (5.0, 1, 0.0, 2, "channel PLL 5 Hz / 20 ms alone (a TCXO's choice without the loop)"),
+        (2.0, 5, 0.0, 2, "channel PLL 2 Hz / 100 ms alone"),
+        (2.0, 5, 5.0, 1, "2 Hz / 100 ms + common loop 5 Hz, d = 1 (no delay but the epoch's own)"),
+        (2.0, 5, 5.0, 2, "2 Hz / 100 ms + common loop 5 Hz, d = 2 (the serial loop)"),
+        (2.0, 5, 5.0, 3, "2 Hz / 100 ms + common loop 5 Hz, d = 3 (the pipelined loop)"),
+        (2.0, 5, 4.0, 3, "2 Hz / 100 ms + common loop 4 Hz, d = 3"),
+        (2.0, 1, 5.0, 2, "2 Hz / 20 ms (bits unknown) + common loop 5 Hz, d = 2"),
+        (2.0, 1, 5.0, 3, "2 Hz / 20 ms (bits unknown) + common loop 5 Hz, d = 3"),
+        (5.0, 1, 5.0, 2, "5 Hz / 20 ms + common loop 5 Hz, d = 2"),
+        (2.0, 5, 8.0, 2, "2 Hz / 100 ms + common loop 8 Hz, d = 2"),
     ]
-    print("cn0_dbhz  case  rms_phase_deg(seed 3, 4)  slipped(seed 3, 4)")
-    for cn0 in (20.0, 22.0, 25.0):
-        for bn, epochs, bc, delay, label in cases:
-            r = [run(cn0, bn, epochs, bc, delay, seed) for seed in (3, 4)]
-            print(f"{cn0:8.0f}  {label}: {r[0][0]:.1f} {r[1][0]:.1f} deg, slipped {r[0][1]:.2f} {r[1][1]:.2f}",
-                  flush=True)
+    seeds = (3, 4, 5, 6)
+    print("cn0_dbhz  case  rms_phase_deg(seeds 3-6)  slipped(seeds 3-6)")
+    for cn0 in (18.0, 20.0, 22.0, 25.0):
+        for bn, epochs, bc, d, label in cases:
+            r = [run(cn0, bn, epochs, bc, d - 1, seed) for seed in seeds]
+            print(f"{cn0:8.0f}  {label}: " + " ".join(f"{x[0]:.1f}" for x in r) + " deg, slipped " +
+                  " ".join(f"{x[1]:.2f}" for x in r), flush=True)
+
+
+def delay():
+    """The common loop alone, noise-free, closed through d epochs (its output from epoch n's mean phase runs from
+    epoch n + d on): the NCO frequency's overshoot after a 1 Hz step of the signal, its largest error 1-2 s after the step, and the phase error a 5 Hz/s ramp leaves (tests/receiver/common_clock_loop_test.cpp)."""
+    def closed(d, step_hz, ramp_hzps, bn=5.0):
+        w0 = bn / 0.53
+        integrator = 0.0  # rad/s
+        in_flight = [0.0] * d  # rad/s; in_flight[0] runs in this epoch
+        signal = replica = 0.0
+        overshoot, late, error = 0.0, 0.0, 0.0
+        for k in range(500):
+            f_signal = 2 * math.pi * (step_hz + ramp_hzps * k * T)
+            f_nco = in_flight[0]
+            error = signal - replica + 0.5 * T * (f_signal - f_nco)
+            signal += f_signal * T
+            replica += f_nco * T
+            e_hz = (f_nco - f_signal) / (2 * math.pi)
+            overshoot = max(overshoot, e_hz)
+            if 50 <= k < 100:
+                late = max(late, abs(e_hz))
+            m = error
+            integrator += w0 * w0 * T * m
+            out = integrator + 2 * 0.707 * w0 * m
+            in_flight = in_flight[1:] + [out]
+        return overshoot, late, error
+    print("d  step_overshoot_hz  error_1_to_2_s_hz  ramp_phase_error_rad")
+    for d in (1, 2, 3):
+        o, c, _ = closed(d, 1.0, 0.0)
+        _, _, r = closed(d, 0.0, 5.0)
+        print(f"{d}  {o:17.3f}  {c:17.4f}  {r:20.3f}")
 
 
 if __name__ == "__main__":
@@ -136,5 +184,7 @@ if __name__ == "__main__":
         scurve()
     elif what == "loops":
         loops()
+    elif what == "delay":
+        delay()
     else:
         sys.exit(__doc__)

@@ -8,9 +8,9 @@
 // over. Checked against the simulator's truth: every channel synchronised at the hand-over is commanded by the
 // loop to the end (none released, none re-acquired), coasts through the gap and re-locks within 1 s of the
 // signal's return; the fused position (nav.csv) against truth.csv within a bound from the noise; EKF + I&Q and
-// UKF + discriminators both with the default pipelined loop (its commands one 20 ms period later), and both again
-// with the serial loop; the same bytes with one thread and two (either loop). The command line's flags for these
-// options and its errors: tests/tools/receive_ultratight_cli_test.cpp.
+// UKF + discriminators both with the pipelined loop (`--ut-pipelined`: its commands one 20 ms period later), and both
+// again with the serial loop (the default); the same bytes with one thread and two (either loop). The command line's
+// flags for these options and its errors: tests/tools/receive_ultratight_cli_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -360,8 +360,8 @@ void check_run(fusion::FilterKind filter_kind, fusion::UltraTightForm form_kind,
 
 }  // namespace
 
-// The default loop is pipelined: job 0 of the next block's correlation, its commands one 20 ms vector epoch later.
-// The lock, coasting, re-lock, NIS and accuracy checks hold with that latency.
+// The pipelined loop (`--ut-pipelined`): job 0 of the next block's correlation, its commands one 20 ms vector epoch
+// later. The lock, coasting, re-lock, NIS and accuracy checks hold with that latency.
 TEST(ReceiveUltraTight, EkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
   check_run(fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq);
 }
@@ -370,7 +370,7 @@ TEST(ReceiveUltraTight, UkfOnDiscriminatorsKeepsEveryChannelThroughAShortTunnelA
   check_run(fusion::FilterKind::Ukf, fusion::UltraTightForm::Discriminator);
 }
 
-// The serial loop (on the caller between blocks, its commands at once) passes the same checks.
+// The serial loop (the default: on the caller between blocks, its commands at once) passes the same checks.
 TEST(ReceiveUltraTight, SerialEkfOnIqKeepsEveryChannelThroughAShortTunnelAndFollowsTruth) {
   check_run(fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq, true);
 }
@@ -452,7 +452,7 @@ std::array<std::array<std::string, 2>, 2> outputs_by_thread_count(const std::str
 
 }  // namespace
 
-// Pipelined (the default): every thread count runs the same jobs on the same inputs (--threads 1 runs the loop's
+// Pipelined: every thread count runs the same jobs on the same inputs (--threads 1 runs the loop's
 // job in turn): the same bytes.
 TEST(ReceiveUltraTight, OneThreadAndTwoGiveTheSameBytes) {
   const auto text = outputs_by_thread_count("rx_threads", false);
@@ -468,7 +468,7 @@ TEST(ReceiveUltraTight, SerialOneThreadAndTwoGiveTheSameBytesAndDifferFromPipeli
   EXPECT_GT(text[0][0].size(), 10000u);
   EXPECT_TRUE(text[0][0] == text[1][0]) << "ultratight.csv differs";
   EXPECT_TRUE(text[0][1] == text[1][1]) << "nav.csv differs";
-  const auto rx = tunnel().dir / "rx_pipelined_default";
+  const auto rx = tunnel().dir / "rx_pipelined_two_threads";
   receive(rx, fusion::FilterKind::Ekf, fusion::UltraTightForm::Iq, false, 2);
   EXPECT_FALSE(test::read_text_file(rx / "ultratight.csv") == text[0][0]);
 }

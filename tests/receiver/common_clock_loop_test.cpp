@@ -2,7 +2,8 @@
 // The common clock loop (receiver/common_clock_loop.hpp) against closed forms: a second-order loop follows a
 // frequency step with no standing phase error; combining N channels' prompts divides the noise variance by N (the
 // loop's output spread by sqrt(N)); prompts combine by their amplitudes (maximal-ratio: the combined phasor of
-// two groups is their A^2-weighted sum); the data bit, known or decided by the in-phase sign, does not turn the
+// two groups is their A^2-weighted sum); a frequency step through the serial loop's delay settles and rings through
+// the pipelined one's; the data bit, known or decided by the in-phase sign, does not turn the
 // sum; too few channels hold the loop; and a steered channel chooses its coherent time on thermal jitter alone.
 #include "receiver/common_clock_loop.hpp"
 
@@ -12,6 +13,7 @@
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "receiver/long_coherent.hpp"
@@ -72,6 +74,48 @@ TEST(CommonClockLoop, FollowsAFrequencyStepWithNoStandingPhaseError) {
   EXPECT_NEAR(loop.frequency_hz(), step_hz, 1e-3);
   EXPECT_EQ(loop.channels_used(), 6);
   EXPECT_EQ(loop.updates(), 150);
+}
+
+namespace {
+
+// The loop closed through a delay: the frequency computed from epoch n's prompts runs from epoch n + delay on, the
+// signal's frequency steps by 1 Hz at the start; noise-free prompts of 6 channels at 30 dB-Hz carry each epoch's mean
+// phase error. Returns the NCO's largest frequency overshoot beyond the step and its largest error 1-2 s after it (Hz).
+std::pair<double, double> step_through_delay(int delay) {
+  CommonClockLoop loop;
+  const double T = loop.options().period_s, step_hz = 1.0;
+  std::vector<double> in_flight(static_cast<std::size_t>(delay), 0.0);  // in_flight[0] runs in this epoch
+  double signal_rad = 0.0, replica_rad = 0.0, overshoot_hz = 0.0, late_hz = 0.0;
+  for (int k = 0; k < 150; ++k) {
+    const double nco_hz = in_flight.front();
+    const double mean_error_rad = signal_rad - replica_rad + std::numbers::pi * T * (step_hz - nco_hz);
+    signal_rad += 2.0 * std::numbers::pi * step_hz * T;
+    replica_rad += 2.0 * std::numbers::pi * nco_hz * T;
+    overshoot_hz = std::max(overshoot_hz, nco_hz - step_hz);
+    if (k >= 50 && k < 100) late_hz = std::max(late_hz, std::abs(nco_hz - step_hz));
+    const std::vector<ChannelPrompt> prompts(6, prompt(mean_error_rad, 30.0));
+    in_flight.erase(in_flight.begin());
+    in_flight.push_back(loop.update(prompts));
+  }
+  return {overshoot_hz, late_hz};
+}
+
+}  // namespace
+
+// Why the ultra-tight loop runs serially by default (pipelines/receive_options.hpp): its commands run two epochs after
+// the prompts they came from, the pipelined loop's three, and that epoch nearly undamps the 5 Hz loop. Against the
+// discrete model benchmarks/validation/clock_loop_model.py `delay` (independent of this code): a 1 Hz step overshoots
+// by 0.274, 0.520 and 0.983 Hz at delays 1, 2 and 3, and 1-2 s after it 0.0001, 0.0000 and 0.053 Hz remain.
+TEST(CommonClockLoop, AStepThroughTheSerialLoopsDelaySettlesAndThroughOneMoreEpochRings) {
+  const auto [overshoot1, late1] = step_through_delay(1);
+  const auto [overshoot2, late2] = step_through_delay(2);
+  const auto [overshoot3, late3] = step_through_delay(3);
+  EXPECT_NEAR(overshoot1, 0.274, 0.005);
+  EXPECT_NEAR(overshoot2, 0.520, 0.005);
+  EXPECT_NEAR(overshoot3, 0.983, 0.005);
+  EXPECT_LT(late1, 0.001);
+  EXPECT_LT(late2, 0.001);
+  EXPECT_NEAR(late3, 0.053, 0.002);
 }
 
 TEST(CommonClockLoop, CombiningNChannelsDividesTheSpreadBySqrtN) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // `ultratrack receive --coupling ultra-tight` on the command line: the flags that choose the loop say what the
-// library's options say (--ut-pipelined is the default, --ut-pipelined=false is --ut-serial: the same bytes), and
+// library's options say (the serial loop is the default: --ut-serial and --ut-pipelined=false give its bytes), and
 // bad option combinations are one InputError naming the flag, before anything is written. The loop's physics is
 // tested through the library: tests/pipelines/receive_ultratight_test.cpp (the same tunnel scenario).
 #include <gtest/gtest.h>
@@ -59,13 +59,13 @@ std::string ultratight_log(const std::string& name, const std::vector<std::strin
 }  // namespace
 
 TEST(ReceiveUltraTightCli, LoopFlagsSelectTheLoops) {
-  const std::string pipelined = ultratight_log("rx_default", {});
-  const std::string serial = ultratight_log("rx_serial", {"--ut-serial"});
-  EXPECT_GT(pipelined.size(), 10000u);
+  const std::string serial = ultratight_log("rx_default", {});
+  const std::string pipelined = ultratight_log("rx_pipelined", {"--ut-pipelined"});
+  EXPECT_GT(serial.size(), 10000u);
   EXPECT_NE(pipelined, serial);
-  EXPECT_EQ(ultratight_log("rx_pipelined", {"--ut-pipelined"}), pipelined) << "--ut-pipelined is not the default";
+  EXPECT_EQ(ultratight_log("rx_serial", {"--ut-serial"}), serial) << "--ut-serial is not the default";
   EXPECT_EQ(ultratight_log("rx_pipelined_false", {"--ut-pipelined=false"}), serial)
-      << "--ut-pipelined=false is not --ut-serial";
+      << "--ut-pipelined=false is not the serial default";
 }
 
 TEST(ReceiveUltraTightCli, BadOptionsAreOneInputError) {
