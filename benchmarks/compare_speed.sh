@@ -9,7 +9,7 @@
 #
 # BIN_A / BIN_B: two `ultratrack` binaries. Jobs, on the files benchmarks/output_identity.sh simulates (same scratch
 # folder, ${ULTRATRACK_IDENTITY_DIR:-/tmp/ultratrack_identity}; run that script first): sat8 (8 satellites, 60 s,
-# 2.6 MHz i8, scalar; 10 satellites on the shipped file) and ultratight (40 s of the seed-001 straight trajectory, UKF, pipelined), --threads 2.
+# 2.6 MHz i8, scalar; 10 satellites on the shipped file) and ultratight (40 s of the seed-001 straight trajectory, UKF, the default loop), --threads 2.
 set -euo pipefail
 rounds=5
 scratch=${ULTRATRACK_IDENTITY_DIR:-/tmp/ultratrack_identity}
