@@ -41,7 +41,7 @@ struct ReceiveOptions {
   // kUltraTight. Serial (the default since 2026-11-29): the loop runs on the caller between blocks, its commands at
   // the epoch that produced them. Pipelined: it runs beside the next block's correlation
   // (receiver::ReceiverEngine::set_vector_loop), its commands one 20 ms vector epoch later, as a real-time receiver
-  // may run its navigation filter concurrently with the correlators: ~18 % faster with 2 threads, but that period
+  // may run its navigation filter concurrently with the correlators: ~17 % faster with 2 threads, but that period
   // of delay in the common clock loop (receiver/common_clock_loop.hpp) rings with the channels' 100 ms PLLs on a
   // TCXO (docs/validation.md, section 16), and weak files were lost whole to it.
   fusion::UltraTightForm ut_form = fusion::UltraTightForm::Iq;

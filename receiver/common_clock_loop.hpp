@@ -18,7 +18,7 @@
 // 16-17 deg and none slips when its frequency runs two epochs after the prompts it came from (the serial ultra-tight
 // loop: a prompt's epoch ends up to a period before the vector epoch, the command runs from the channel's next epoch
 // start). One epoch more (the pipelined loop, pipelines/receive_options.hpp) makes the loop and the 100 ms PLLs ring
-// (25-27 deg, most slip; in the receiver +-1.3 Hz of common frequency error at ~2.8 Hz, and whole weak files lost);
+// (25-27 deg, most slip; in the receiver 1.3 Hz RMS of common frequency error at ~2.8 Hz, and whole weak files lost);
 // at 8 Hz the serial loop rings too (22-25 deg, some slip). Summing the prompts before the arctangent, rather than
 // averaging per-channel arctangents, keeps the discriminator's S-curve steeper where a TCXO's 5 Hz/s excursions push
 // it: at 20 dB-Hz a 45-60 deg error reads 38-42 deg against 32 (averaged arctangents lagged one such excursion by a

@@ -49,7 +49,7 @@ void add_receive_fusion_options(CLI::App* cmd, ReceiveFusionArgs& a) {
   a.ut_pipelined_option = cmd->add_flag(
       "--ut-pipelined", a.ut_pipelined,
       "with --coupling ultra-tight: run the loop beside the correlation of the next block, its commands reaching the "
-      "channels one 20 ms loop period later: ~18 % faster with 2 threads, but the common clock loop's extra period "
+      "channels one 20 ms loop period later: ~17 % faster with 2 threads, but the common clock loop's extra period "
       "of delay makes it ring with the channels' PLLs on weak signals (either way the same output for any "
       "--threads)");
   a.ut_clock_loop_bw_option = cmd->add_option(

@@ -149,7 +149,8 @@ def loops():
 
 def delay():
     """The common loop alone, noise-free, closed through d epochs (its output from epoch n's mean phase runs from
-    epoch n + d on): the NCO frequency's overshoot after a 1 Hz step of the signal, its largest error 1-2 s after the step, and the phase error a 5 Hz/s ramp leaves (tests/receiver/common_clock_loop_test.cpp)."""
+    epoch n + d on): the NCO frequency's overshoot after a 1 Hz step of the signal, its largest error 1-2 s after
+    the step, and the phase error a 5 Hz/s ramp leaves (tests/receiver/common_clock_loop_test.cpp)."""
     def closed(d, step_hz, ramp_hzps, bn=5.0):
         w0 = bn / 0.53
         integrator = 0.0  # rad/s

@@ -39,7 +39,6 @@ def main(run, t0, t1, step, ringing=False):
         prn = int(r["prn"])
         if t0 <= t <= t1 and prn in truth:
             bins[int((t - t0) / step)][prn].append(float(r["doppler_hz"]) - doppler(prn, t))
-    prns = sorted({prn for b in bins.values() for prn in b})
     if ringing:
         series = [statistics.median([statistics.mean(v) for v in bins[k].values()]) for k in sorted(bins)
                   if len(bins[k]) >= 4]
@@ -53,6 +52,7 @@ def main(run, t0, t1, step, ringing=False):
         print(f"{run}: {len(series)} epochs, common error RMS {rms:.2f} Hz, autocorrelation "
               f"{autocorrelation(round(0.1 / step)):+.2f} at 0.1 s, {autocorrelation(round(0.2 / step)):+.2f} at 0.2 s")
         return
+    prns = sorted({prn for b in bins.values() for prn in b})
     print("t_s   " + " ".join(f"{prn:6d}" for prn in prns) + "   median")
     for k in sorted(bins):
         row = [statistics.mean(bins[k][prn]) if bins[k].get(prn) else float("nan") for prn in prns]

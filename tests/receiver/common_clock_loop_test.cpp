@@ -56,28 +56,6 @@ double frequency_spread_hz(int n, int updates, std::uint64_t seed) {
   return std::sqrt(sum2 / counted - mean * mean);
 }
 
-}  // namespace
-
-TEST(CommonClockLoop, FollowsAFrequencyStepWithNoStandingPhaseError) {
-  CommonClockLoop loop;  // 5 Hz, 20 ms
-  const double step_hz = 2.0, T = loop.options().period_s;
-  double replica_rad = 0.0, worst_rad = 0.0;
-  for (int k = 0; k < 150; ++k) {  // 3 s
-    const double error_rad = 2.0 * std::numbers::pi * step_hz * k * T - replica_rad;
-    worst_rad = std::max(worst_rad, std::abs(error_rad));
-    const std::vector<ChannelPrompt> prompts(6, prompt(error_rad, 30.0));
-    replica_rad += 2.0 * std::numbers::pi * loop.update(prompts) * T;
-  }
-  // Transient peak well inside the Costas range (a 2 Hz step against w0 = 9.4 rad/s), then none left.
-  EXPECT_LT(worst_rad, 0.8);
-  EXPECT_NEAR(2.0 * std::numbers::pi * step_hz * 150 * T - replica_rad, 0.0, 1e-3);
-  EXPECT_NEAR(loop.frequency_hz(), step_hz, 1e-3);
-  EXPECT_EQ(loop.channels_used(), 6);
-  EXPECT_EQ(loop.updates(), 150);
-}
-
-namespace {
-
 // The loop closed through a delay: the frequency computed from epoch n's prompts runs from epoch n + delay on, the
 // signal's frequency steps by 1 Hz at the start; noise-free prompts of 6 channels at 30 dB-Hz carry each epoch's mean
 // phase error. Returns the NCO's largest frequency overshoot beyond the step and its largest error 1-2 s after it (Hz).
@@ -101,6 +79,24 @@ std::pair<double, double> step_through_delay(int delay) {
 }
 
 }  // namespace
+
+TEST(CommonClockLoop, FollowsAFrequencyStepWithNoStandingPhaseError) {
+  CommonClockLoop loop;  // 5 Hz, 20 ms
+  const double step_hz = 2.0, T = loop.options().period_s;
+  double replica_rad = 0.0, worst_rad = 0.0;
+  for (int k = 0; k < 150; ++k) {  // 3 s
+    const double error_rad = 2.0 * std::numbers::pi * step_hz * k * T - replica_rad;
+    worst_rad = std::max(worst_rad, std::abs(error_rad));
+    const std::vector<ChannelPrompt> prompts(6, prompt(error_rad, 30.0));
+    replica_rad += 2.0 * std::numbers::pi * loop.update(prompts) * T;
+  }
+  // Transient peak well inside the Costas range (a 2 Hz step against w0 = 9.4 rad/s), then none left.
+  EXPECT_LT(worst_rad, 0.8);
+  EXPECT_NEAR(2.0 * std::numbers::pi * step_hz * 150 * T - replica_rad, 0.0, 1e-3);
+  EXPECT_NEAR(loop.frequency_hz(), step_hz, 1e-3);
+  EXPECT_EQ(loop.channels_used(), 6);
+  EXPECT_EQ(loop.updates(), 150);
+}
 
 // Why the ultra-tight loop runs serially by default (pipelines/receive_options.hpp): its commands run two epochs after
 // the prompts they came from, the pipelined loop's three, and that epoch nearly undamps the 5 Hz loop. Against the
