@@ -10,7 +10,9 @@
 //   [initial]    attitude_deg = [roll, pitch, yaw] (needed by --align config), position_deg_m = [lat, lon, h]
 //                (else the first GNSS fix), velocity_ned_mps = [n, e, d] (else the GNSS velocity), sigma_position_m,
 //                sigma_velocity_mps, sigma_attitude_deg = [n, e, d]
-//   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2
+//   [alignment]  static_duration_s = 60, motion_min_speed_mps = 5, motion_window_s = 2, motion_heading_sigma_deg = 5
+//                (position-only fixes: the track span grows until the heading 1-sigma is at most this),
+//                standstill_gyro_bias = true (gyro biases from a standstill at the start, motion alignment)
 //   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z], update_interval_s = 0
 //                (fixes closer than this to the last one used are skipped: a decorrelating interval for fixes whose
 //                errors are correlated in time; 0: every fix), error_correlation_time_s = 0 (the fixes' position errors

@@ -100,7 +100,8 @@ std::optional<MotionAlignment> align_in_motion(std::span<const ins::ImuIncrement
     if (rows < 2) continue;
     const std::span<const ins::ImuIncrement> rows_used = imu.subspan(k_first - 1, k_last - k_first + 2);
     const GnssVelocitySample &a = gnss[i], &b = gnss[j];
-    const auto level = level_window(rows_used, a, b, {});
+    const WindowBias known{Eigen::Vector3d::Zero(), o.gyro_bias_b};
+    const auto level = level_window(rows_used, a, b, known);
     if (!level) continue;
     MotionAlignment r;
     r.t_s = b.t_s;
@@ -108,6 +109,9 @@ std::optional<MotionAlignment> align_in_motion(std::span<const ins::ImuIncrement
     r.euler = level->euler;
     r.q_nb = ins::quaternion_from_euler(r.euler);
     r.v_n = b.v_n;
+    // The heading is the end velocity's direction: a horizontal velocity error across the track turns it by
+    // sigma / speed.
+    if (b.sigma_horizontal_mps > 0.0) r.sigma_heading_rad = b.sigma_horizontal_mps / b.v_n.head<2>().norm();
     r.mean_f_b = level->f_b;
     r.f_n = level->f_n;
     // psi of the alignment made with an error d in one input, against the one without: the derivative by central
@@ -126,8 +130,8 @@ std::optional<MotionAlignment> align_in_motion(std::span<const ins::ImuIncrement
     // A bias b in the IMU: the increments measured are the true ones plus b dt, so the truth is the levelling of
     // the increments minus b dt and psi(b) = psi(level(measured), level(measured - b dt)).
     const auto with_bias = [&](bool gyro, int axis, double d) {
-      WindowBias bias;
-      (gyro ? bias.gyro_b : bias.accel_b)[axis] = d;
+      WindowBias bias = known;
+      (gyro ? bias.gyro_b : bias.accel_b)[axis] += d;
       return level_window(rows_used, a, b, bias);
     };
     r.psi_per_accel_bias = -psi_per([&](int axis, double d) { return with_bias(false, axis, d); }, 1e-3);
@@ -137,7 +141,7 @@ std::optional<MotionAlignment> align_in_motion(std::span<const ins::ImuIncrement
     const auto with_velocity_error = [&](bool end, int axis, double d) {
       GnssVelocitySample aa = a, bb = b;
       (end ? bb : aa).v_n[axis] += d;
-      return level_window(rows_used, aa, bb, {});
+      return level_window(rows_used, aa, bb, known);
     };
     r.psi_per_velocity_start = psi_per([&](int axis, double d) { return with_velocity_error(false, axis, d); }, 1e-3);
     r.psi_per_velocity_end = psi_per([&](int axis, double d) { return with_velocity_error(true, axis, d); }, 1e-3);

@@ -19,11 +19,15 @@ struct GnssVelocitySample {
   double t_s = 0.0;
   double lat_rad = 0.0, height_m = 0.0;
   Eigen::Vector3d v_n = Eigen::Vector3d::Zero();
+  double sigma_horizontal_mps = 0.0;  // 1-sigma of each horizontal component (0: not known)
 };
 
 struct MotionAlignmentOptions {
   double min_speed_mps = 5.0;  // both ends of the window at least this fast horizontally
   double window_s = 2.0;       // GNSS velocity difference span (longer: less velocity noise in the tilt)
+  // Gyro biases already known (a standstill before the motion, ins/standstill_gyro_bias.hpp), removed from the
+  // increments; the sensitivities below are then to the residual bias.
+  Eigen::Vector3d gyro_bias_b = Eigen::Vector3d::Zero();
 };
 
 struct MotionAlignment {
@@ -32,6 +36,7 @@ struct MotionAlignment {
   ins::EulerAngles euler;
   Eigen::Quaterniond q_nb = Eigen::Quaterniond::Identity();
   Eigen::Vector3d v_n = Eigen::Vector3d::Zero();
+  double sigma_heading_rad = 0.0;  // from the end velocity's sigma_horizontal_mps and speed (0: not known)
   Eigen::Vector3d mean_f_b = Eigen::Vector3d::Zero();  // measured over the window [m/s^2]
   Eigen::Vector3d f_n = Eigen::Vector3d::Zero();       // the same specific force from GNSS [m/s^2]
   // First-order sensitivities of the attitude error psi (NED, rad; C_nb_est = (I - [psi x]) C_nb_true) to an

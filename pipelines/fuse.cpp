@@ -51,18 +51,21 @@ Eigen::Vector3d ned_difference(double lat_a, double lon_a, double h_a, double la
   return ins::C_en(lat_a, lon_a).transpose() * d_e;
 }
 
-// GNSS velocities for the motion alignment: the fixes' own, else central differences of positions over at
-// least kPositionDifferenceSpan_s (at 1.5 m noise: ~0.4 m/s per axis; neighbours alone would give metres per
-// second at 5 Hz and fake motion while parked).
+// GNSS velocities for the motion alignment: the fixes' own (1-sigma velocity_sigma_mps), else central differences
+// of positions over at least span_s (at 1.5 m noise and 5 s: ~0.4 m/s per axis; neighbours alone would give metres
+// per second at 5 Hz and fake motion while parked), 1-sigma from the two fixes' horizontal sigmas. A central
+// difference over a steady turn points along the track at its middle, so long spans suit slow platforms.
 constexpr double kPositionDifferenceSpan_s = 5.0;
+constexpr double kPositionDifferenceSpans_s[] = {5.0, 10.0, 20.0, 40.0};  // tried in turn (heading sigma goal)
 
-std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFixRow>& g) {
+std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFixRow>& g, double span_s,
+                                                        double velocity_sigma_mps) {
   std::vector<fusion::GnssVelocitySample> out;
   std::size_t lo = 0, hi = 0;
   for (std::size_t i = 0; i < g.size(); ++i) {
-    fusion::GnssVelocitySample s{g[i].t_s, g[i].lat_rad, g[i].height_m, g[i].v_n};
+    fusion::GnssVelocitySample s{g[i].t_s, g[i].lat_rad, g[i].height_m, g[i].v_n, velocity_sigma_mps};
     if (!g[i].has_velocity) {
-      const double half = 0.5 * kPositionDifferenceSpan_s;
+      const double half = 0.5 * span_s;
       while (lo < i && g[lo + 1].t_s <= g[i].t_s - half) ++lo;
       if (g[lo].t_s > g[i].t_s - half + 1e-9) continue;  // not enough history yet
       hi = std::max(hi, i);
@@ -71,6 +74,8 @@ std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFi
       const auto& a = g[lo];
       const auto& b = g[hi];
       s.v_n = ned_difference(a.lat_rad, a.lon_rad, a.height_m, b.lat_rad, b.lon_rad, b.height_m) / (b.t_s - a.t_s);
+      const double sa = a.sigma_ned_m.head<2>().maxCoeff(), sb = b.sigma_ned_m.head<2>().maxCoeff();
+      s.sigma_horizontal_mps = std::hypot(sa, sb) / (b.t_s - a.t_s);
     }
     out.push_back(s);
   }
@@ -212,24 +217,41 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
           fmt::format(" (heading 1-sigma {:.0f} deg: too short or too noisy to gyrocompass: --align motion is better)",
                       start.heading_sigma_rad / io::kRadPerDeg);
   } else if (s.align == AlignMode::Motion) {
-    // Position-only fixes: smoothed velocities, a longer window and a looser initial attitude.
+    // Gyro biases from a standstill before the motion, when better than the datasheet's turn-on sigma.
+    const auto standstill = motion_standstill(imu, lat_hint, c, preset, imu.back().t_s);
+    // Position-only fixes: smoothed velocities over a span that grows until the heading's sigma meets the goal, a
+    // window at least that long and a looser tilt.
     const bool position_only =
         std::none_of(gnss.begin(), gnss.end(), [](const GnssFixRow& r) { return r.has_velocity; });
-    const double window = position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s;
-    std::vector<fusion::GnssVelocitySample> velocities = gnss_velocities(gnss);
-    if (s.gnss_until_s)  // the alignment too uses GNSS only until then
-      std::erase_if(velocities, [&](const fusion::GnssVelocitySample& v) { return v.t_s > *s.gnss_until_s; });
-    const auto a = align_moving(imu, velocities, c, window, position_only);
+    std::optional<AttitudeStart> a;
+    for (const double span : kPositionDifferenceSpans_s) {
+      std::vector<fusion::GnssVelocitySample> velocities = gnss_velocities(gnss, span, c.velocity_sigma_mps);
+      if (s.gnss_until_s)  // the alignment too uses GNSS only until then
+        std::erase_if(velocities, [&](const fusion::GnssVelocitySample& v) { return v.t_s > *s.gnss_until_s; });
+      const double window = position_only ? std::max(c.motion_window_s, span) : c.motion_window_s;
+      if (auto candidate = align_moving(imu, velocities, c, window, position_only, standstill)) {
+        a = std::move(candidate);
+        result.motion_span_s = position_only ? span : 0.0;
+        if (a->sigma_att_rad.z() <= c.motion_heading_sigma_deg * io::kRadPerDeg) break;
+      }
+      if (!position_only) break;
+    }
     if (!a) {
       double fastest = 0.0;
-      for (const auto& v : gnss_velocities(gnss)) fastest = std::max(fastest, v.v_n.head<2>().norm());
+      for (const auto& v : gnss_velocities(gnss, kPositionDifferenceSpan_s, c.velocity_sigma_mps))
+        fastest = std::max(fastest, v.v_n.head<2>().norm());
       throw AlignmentUnavailable(fmt::format(
           "no in-motion alignment: the fixes never show {} m/s for {} s within the IMU data (fastest {:.2f} m/s); "
           "for a slower platform lower [alignment] motion_min_speed_mps (the heading then comes from a shorter, "
           "noisier track), or align with --align static, config or attitude",
-          c.motion_min_speed_mps, window, fastest));
+          c.motion_min_speed_mps,
+          position_only ? std::max(c.motion_window_s, kPositionDifferenceSpan_s) : c.motion_window_s, fastest));
     }
     start = *a;
+    result.standstill = start.standstill;
+    if (result.motion_span_s > 0.0)
+      start.note += fmt::format(", heading from a {:.0f} s track ({:.1f} deg 1-sigma)", result.motion_span_s,
+                                start.sigma_att_rad.z() / io::kRadPerDeg);
   } else if (s.align == AlignMode::Attitude) {
     if (attitude.empty()) throw io::InputError("command line", "--align attitude needs --attitude FILE");
     const double from = std::max(imu_start, gnss.front().t_s);

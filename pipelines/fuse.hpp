@@ -28,6 +28,7 @@
 #include "ins/attitude.hpp"
 #include "ins/nav_state.hpp"
 #include "ins/odometer.hpp"
+#include "ins/standstill_gyro_bias.hpp"
 #include "ins/truth_interpolator.hpp"
 #include "pipelines/fuse_config.hpp"
 #include "pipelines/fuse_inputs.hpp"
@@ -92,6 +93,10 @@ struct FuseResult {
   double start_s = 0.0, end_s = 0.0;  // navigation span
   ins::EulerAngles initial_attitude;
   std::string alignment_note;
+  // Motion alignment: the gyro biases a standstill at the start measured (used when set), and the span of the
+  // position differences the heading came from (position-only fixes; 0: the fixes' velocities).
+  std::optional<ins::StandstillGyroBias> standstill;
+  double motion_span_s = 0.0;
   fusion::IntegrationCounters counters;
   std::vector<fusion::RecoveryEvent> recovery_events;  // lock-out recoveries (fusion/lockout_recovery.hpp)
   long long fixes_used = 0, fixes_before_start = 0, fixes_in_outage = 0;

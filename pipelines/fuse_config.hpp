@@ -32,6 +32,12 @@ struct FuseConfig {
   double static_duration_s = 60.0;
   double motion_min_speed_mps = 5.0;
   double motion_window_s = 2.0;
+  // Motion alignment from position-only fixes: the span of the position differences grows (5, 10, 20, 40 s) until
+  // the heading's 1-sigma is at most this (slow platforms need a longer track).
+  double motion_heading_sigma_deg = 5.0;
+  // The gyro biases measured over a standstill at the record's start (ins/standstill_gyro_bias.hpp) start the
+  // filter's bias states when better than the datasheet's turn-on sigma (motion alignment).
+  bool standstill_gyro_bias = true;
   double velocity_sigma_mps = 0.1;
   double fix_min_interval_s = 0.0;       // [gnss] update_interval_s: a decorrelating interval between fixes used
   double fix_error_correlation_s = 0.0;  // [gnss] error_correlation_time_s: fixes' errors Gauss-Markov (0: white)

@@ -75,6 +75,17 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
       "\"yaw_deg\": {:.6f}}},\n",
       io::json_escape(r.alignment_note), r.start_s, r.initial_attitude.roll_rad / io::kRadPerDeg,
       r.initial_attitude.pitch_rad / io::kRadPerDeg, r.initial_attitude.yaw_rad / io::kRadPerDeg);
+  if (r.motion_span_s > 0.0) j += fmt::format("  \"alignment_track_span_s\": {},\n", r.motion_span_s);
+  if (r.standstill) {
+    constexpr double kDegPerHourRad = 3600.0 / io::kRadPerDeg;
+    const ins::StandstillGyroBias& b = *r.standstill;
+    j += fmt::format(
+        "  \"standstill_gyro_bias\": {{\"t_start_s\": {}, \"t_end_s\": {}, \"gyro_dph\": [{:.6g}, {:.6g}, {:.6g}], "
+        "\"sigma_gyro_dph\": [{:.6g}, {:.6g}, {:.6g}]}},\n",
+        b.t_start_s, b.t_end_s, b.gyro_bias_rps.x() * kDegPerHourRad, b.gyro_bias_rps.y() * kDegPerHourRad,
+        b.gyro_bias_rps.z() * kDegPerHourRad, b.sigma_rps.x() * kDegPerHourRad, b.sigma_rps.y() * kDegPerHourRad,
+        b.sigma_rps.z() * kDegPerHourRad);
+  }
   j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
   j += fmt::format(
       "  \"imu_steps\": {},\n  \"fixes_used\": {},\n  \"fixes_before_start\": {},\n  \"fixes_in_outage\": {},\n",

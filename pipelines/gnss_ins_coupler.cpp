@@ -258,7 +258,13 @@ struct GnssInsCoupler::Impl {
       const double lat = pos_fix ? pos_fix->lat_rad : c.position_deg_m->x() * io::kRadPerDeg;
       start = align_static(std::span(imu).first(end), imu.front().t_s, lat, preset);
     } else {
-      const auto a = align_moving(imu, velocities, c, c.motion_window_s, false);
+      auto a = align_moving(imu, velocities, c, c.motion_window_s, false);
+      // Once it can align: again with the gyro biases of a standstill at the start, if there was one (looked for
+      // only now: the epochs before would each scan the record from its start).
+      if (a) {
+        if (const auto standstill = motion_standstill(imu, velocities.back().lat_rad, c, preset, t))
+          if (auto with = align_moving(imu, velocities, c, c.motion_window_s, false, standstill)) a = std::move(with);
+      }
       if (!a) {
         not_started = fmt::format("--align motion: the fixes never showed {} m/s for {} s", c.motion_min_speed_mps,
                                   c.motion_window_s);

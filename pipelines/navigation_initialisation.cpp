@@ -18,6 +18,8 @@ namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kG = 9.80665;
+// The heading from a track assumes no sideslip: a land vehicle's is of the order of a degree.
+constexpr double kSideslipAllowance_rad = 1.0 * io::kRadPerDeg;
 
 }  // namespace
 
@@ -69,17 +71,22 @@ AttitudeStart align_static(std::span<const ins::ImuIncrement> span, double t0_s,
 
 std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu,
                                           std::span<const fusion::GnssVelocitySample> velocities,
-                                          const FuseConfig& config, double window_s, bool position_only) {
-  const auto a = fusion::align_in_motion(imu, velocities, {config.motion_min_speed_mps, window_s});
+                                          const FuseConfig& config, double window_s, bool position_only,
+                                          const std::optional<ins::StandstillGyroBias>& standstill) {
+  const Eigen::Vector3d gyro_bias_b = standstill ? standstill->gyro_bias_rps : Eigen::Vector3d::Zero();
+  const auto a = fusion::align_in_motion(imu, velocities, {config.motion_min_speed_mps, window_s, gyro_bias_b});
   if (!a) return std::nullopt;
   AttitudeStart s;
+  s.standstill = standstill;
   s.t_s = a->t_s;
   s.q_nb = a->q_nb;
   s.v_n = a->v_n;
   s.sigma_vel_n_mps = Eigen::Vector3d::Constant(position_only ? 1.0 : config.velocity_sigma_mps * 2.0);
   s.attitude_per_bias << a->psi_per_accel_bias, a->psi_per_gyro_bias;
   if (position_only) {
-    s.sigma_att_rad = Eigen::Vector3d(3.0, 3.0, 5.0) * io::kRadPerDeg;
+    const double heading =
+        a->sigma_heading_rad > 0.0 ? std::max(a->sigma_heading_rad, kSideslipAllowance_rad) : 5.0 * io::kRadPerDeg;
+    s.sigma_att_rad = Eigen::Vector3d(3.0 * io::kRadPerDeg, 3.0 * io::kRadPerDeg, heading);
   } else {  // white velocity noise at both ends of the window, independent of the biases
     const double v2 = config.velocity_sigma_mps * config.velocity_sigma_mps;
     const Eigen::Matrix3d P_e = v2 * (a->psi_per_velocity_start * a->psi_per_velocity_start.transpose() +
@@ -89,6 +96,22 @@ std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu
     if (!(s.sigma_att_rad.minCoeff() > 0.0)) s.sigma_att_rad = Eigen::Vector3d(1.0, 1.0, 3.0) * io::kRadPerDeg;
   }
   s.note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
+  if (standstill) {
+    constexpr double kDph = io::kRadPerDeg / 3600.0;
+    const Eigen::Vector3d b = standstill->gyro_bias_rps / kDph;
+    s.note += fmt::format(", gyro biases from a standstill over {:.1f}-{:.1f} s: {:.0f} {:.0f} {:.0f} +- {:.0f} deg/h",
+                          standstill->t_start_s, standstill->t_end_s, b.x(), b.y(), b.z(),
+                          standstill->sigma_rps.maxCoeff() / kDph);
+  }
+  return s;
+}
+
+std::optional<ins::StandstillGyroBias> motion_standstill(std::span<const ins::ImuIncrement> imu, double lat_rad,
+                                                         const FuseConfig& config, const ins::ImuErrorSpec& preset,
+                                                         double end_by_s) {
+  if (!config.standstill_gyro_bias) return std::nullopt;
+  auto s = ins::initial_standstill_gyro_bias(imu, lat_rad, preset, end_by_s);
+  if (s && !(s->sigma_rps.array() < preset.gyro.bias_sigma).all()) s.reset();  // no better than the datasheet
   return s;
 }
 
@@ -112,6 +135,7 @@ NavigationStart initialise_navigation(const AttitudeStart& a, const GnssPosition
   s.sigma_vel_n_mps = a.sigma_vel_n_mps;
   s.sigma_att_rad = a.sigma_att_rad;
   s.attitude_per_bias = a.attitude_per_bias;
+  s.standstill = a.standstill;
   if (c.position_deg_m) {
     s.nav.lat_rad = c.position_deg_m->x() * io::kRadPerDeg;
     s.nav.lon_rad = c.position_deg_m->y() * io::kRadPerDeg;
@@ -150,6 +174,10 @@ fusion::IntegrationOptions integration_options(const NavigationStart& start, con
   if (c.initial_gyro_bias_rps) o.initial_gyro_bias_b = *c.initial_gyro_bias_rps;
   o.sigma_initial_accel_bias_b = c.sigma_accel_bias_mps2;
   o.sigma_initial_gyro_bias_b = c.sigma_gyro_bias_rps;
+  if (start.standstill && !c.initial_gyro_bias_rps) {
+    o.initial_gyro_bias_b = start.standstill->gyro_bias_rps;
+    o.sigma_initial_gyro_bias_b = start.standstill->sigma_rps;
+  }
   o.gate = c.gate;
   o.recovery = c.recovery;
   o.land = c.land;

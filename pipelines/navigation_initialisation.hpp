@@ -22,6 +22,7 @@
 #include "fusion/gnss_ins_integration.hpp"
 #include "ins/imu_error_model.hpp"
 #include "ins/nav_state.hpp"
+#include "ins/standstill_gyro_bias.hpp"
 #include "pipelines/fuse_config.hpp"
 
 namespace ultratrack::pipelines {
@@ -42,7 +43,17 @@ struct AttitudeStart {
   // Motion: the attitude error per unit of IMU bias (fusion/attitude_bias_correlation.hpp); sigma_att_rad is then
   // the part independent of the biases. Zero for the other alignments.
   fusion::AttitudePerBias attitude_per_bias = fusion::AttitudePerBias::Zero();
+  // Motion: the gyro biases a standstill at the record's start measured (motion_standstill), removed from the
+  // alignment's increments; they start the filter's gyro bias states.
+  std::optional<ins::StandstillGyroBias> standstill;
 };
+
+// Motion alignment's standstill (ins/standstill_gyro_bias.hpp): the gyro biases measured over a standstill at the
+// start of imu, ending by end_by_s, when config.standstill_gyro_bias and the estimate beats the preset's turn-on
+// sigma on every axis; nothing otherwise.
+std::optional<ins::StandstillGyroBias> motion_standstill(std::span<const ins::ImuIncrement> imu, double lat_rad,
+                                                         const FuseConfig& config, const ins::ImuErrorSpec& preset,
+                                                         double end_by_s);
 
 // Static: the number of IMU rows in the span [t0_s, t0_s + config.static_duration_s] (rows past it must exist);
 // io::InputError naming imu_name when the span holds fewer than two rows or the data end inside it.
@@ -51,15 +62,18 @@ std::size_t static_span_end(std::span<const ins::ImuIncrement> imu, double t0_s,
 // Static over span (static_span_end's rows) from t0_s at lat_rad; velocity zero, 1-sigma 0.1 m/s.
 AttitudeStart align_static(std::span<const ins::ImuIncrement> span, double t0_s, double lat_rad,
                            const ins::ImuErrorSpec& preset);
-// Motion over the GNSS velocities (window_s: the velocity difference span). The attitude's error from the IMU
+// Motion over the GNSS velocities (window_s: the velocity difference span), with a standstill's gyro biases
+// (motion_standstill) when given. The attitude's error from the IMU
 // biases goes into attitude_per_bias (the filter correlates it with its bias states); sigma_att_rad holds the rest:
 // from measured velocities, the first-order effect of their white noise (config.velocity_sigma_mps at both ends of
 // the window: tilt about sqrt(2) sigma_v / (T g), heading sigma_v / speed), velocity 2 x that sigma; position_only
-// (velocities from positions, correlated between the window's ends): attitude 3, 3, 5 deg, velocity 1 m/s. Nothing
-// when the GNSS never shows config.motion_min_speed_mps over the window.
+// (velocities from positions, correlated between the window's ends): tilt 3 deg, heading the end velocity's
+// sigma_horizontal_mps / speed (at least 1 deg: sideslip; 5 deg when not known), velocity 1 m/s. Nothing when the
+// GNSS never shows config.motion_min_speed_mps over the window.
 std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu,
                                           std::span<const fusion::GnssVelocitySample> velocities,
-                                          const FuseConfig& config, double window_s, bool position_only);
+                                          const FuseConfig& config, double window_s, bool position_only,
+                                          const std::optional<ins::StandstillGyroBias>& standstill = std::nullopt);
 // Config: config.attitude_deg (must be set) at t_s; attitude 1-sigma 1, 1, 5 deg, velocity 1 m/s.
 AttitudeStart align_from_config(double t_s, const FuseConfig& config);
 
@@ -73,6 +87,7 @@ struct NavigationStart {
   ins::NavState nav;  // at the IMU
   Eigen::Vector3d sigma_pos_ned_m, sigma_vel_n_mps, sigma_att_rad;
   fusion::AttitudePerBias attitude_per_bias = fusion::AttitudePerBias::Zero();  // the alignment's (AttitudeStart)
+  std::optional<ins::StandstillGyroBias> standstill;                            // the alignment's (AttitudeStart)
 };
 
 // The INS start: the alignment's time, attitude and velocity; the position from config.position_deg_m (with
@@ -85,7 +100,7 @@ NavigationStart initialise_navigation(const AttitudeStart& alignment, const Gnss
 // The integration's options for that start: coupling and filter, the IMU preset's error model, the lever arm, the
 // start's 1-sigmas, the configuration's gate, UKF parameters and propagation interval. (Tight callers add the
 // clock and the GPS time origin; `fuse` the GPS attitude options.) The configuration's initial biases and their
-// 1-sigma (an alignment file's) start the bias states when given.
+// 1-sigma (an alignment file's) start the bias states when given; else a standstill's gyro biases.
 fusion::IntegrationOptions integration_options(const NavigationStart& start, const FuseConfig& config,
                                                fusion::Coupling coupling, fusion::FilterKind filter);
 
