@@ -79,11 +79,16 @@ std::optional<StandstillGyroBias> initial_standstill_gyro_bias(std::span<const I
     Moments so_far = accepted;
     so_far.add(previous);
     if (so_far.n > 0) {
+      // The noise measured (an idling engine's vibration), never below the datasheet's.
       const double spread = std::sqrt(1.0 / double(m.n) + 1.0 / double(so_far.n));
-      const double tol_w = o.mean_sigmas * sigma_w * spread + 2.0 * spec.gyro.bias_instability_sigma;
-      const double tol_f = o.mean_sigmas * sigma_f * spread + 2.0 * spec.accel.bias_instability_sigma;
-      steady = ((m.mean_w() - so_far.mean_w()).array().abs() <= tol_w).all() &&
-               ((m.mean_f() - so_far.mean_f()).array().abs() <= tol_f).all();
+      const Eigen::ArrayXd noise_w = m.var_w().cwiseMax(sigma_w * sigma_w).array().sqrt();
+      const Eigen::ArrayXd noise_f = m.var_f().cwiseMax(sigma_f * sigma_f).array().sqrt();
+      steady = ((m.mean_w() - so_far.mean_w()).array().abs() <=
+                o.mean_sigmas * spread * noise_w + 2.0 * spec.gyro.bias_instability_sigma)
+                   .all() &&
+               ((m.mean_f() - so_far.mean_f()).array().abs() <=
+                o.mean_sigmas * spread * noise_f + 2.0 * spec.accel.bias_instability_sigma)
+                   .all();
     }
     if (!quiet || !steady) break;
     if (previous.n > 0) {
@@ -105,9 +110,10 @@ std::optional<StandstillGyroBias> initial_standstill_gyro_bias(std::span<const I
   const Eigen::Vector3d down_b = -r.mean_f_b.normalized();
   r.gyro_bias_rps = accepted.mean_w() + kEarthRate_rps * std::sin(lat_rad) * down_b;
   const double horizontal_earth = kEarthRate_rps * std::cos(lat_rad);
-  const double var = sigma_w * sigma_w / double(accepted.n) + horizontal_earth * horizontal_earth +
-                     spec.gyro.bias_instability_sigma * spec.gyro.bias_instability_sigma;
-  r.sigma_rps = Eigen::Vector3d::Constant(std::sqrt(var));
+  const Eigen::Vector3d noise_var = accepted.var_w().cwiseMax(sigma_w * sigma_w);  // measured, at least the datasheet's
+  r.sigma_rps = (noise_var / double(accepted.n)).array() + horizontal_earth * horizontal_earth +
+                spec.gyro.bias_instability_sigma * spec.gyro.bias_instability_sigma;
+  r.sigma_rps = r.sigma_rps.cwiseSqrt();
   return r;
 }
 

@@ -5,15 +5,18 @@
 // to the angle random walk's limit, ARW / sqrt(T).
 //
 // Standstill test, per window of `window_s` from the record's start: the angular rate's and the specific force's
-// sample variance per axis within `variance_factor` times the datasheet's white noise (vibration, driving), and
-// the window's means within `mean_sigmas` of the standstill so far (a start, a turn, a tilt; allowing the in-run
-// bias instability). The span ends at the first window that fails or at `end_by_s`; the last window that passed
-// is dropped as a margin. Motion at a constant velocity without rotation passes the test and is harmless (the
-// gyros still read bias plus earth rate); a constant rotation from the first sample on is not detected.
+// sample variance per axis within `variance_factor` times the datasheet's white noise (a parked vehicle's idling
+// engine or a robot's motors pass, driving does not), and the window's means within `mean_sigmas` of the standstill
+// so far, in sigmas of the noise measured (at least the datasheet's) plus the in-run bias instability (a start, a
+// turn, a tilt). The span ends at the first window that fails or at `end_by_s`; the last window that passed is
+// dropped as a margin. Motion at a constant velocity without rotation passes the test and is harmless (the gyros
+// still read bias plus earth rate); a constant rotation from the first sample on is not detected.
 //
 // Bias = mean rate - the earth rate's vertical part (its direction from the mean specific force). The horizontal
 // part (W cos L) is unknown without a heading and goes into the 1-sigma with the noise and the in-run instability:
-//   sigma^2 = sigma_rate^2 / N + (W cos L)^2 + sigma_instability^2   per axis.
+//   sigma^2 = s_rate^2 / N + (W cos L)^2 + sigma_instability^2   per axis,
+// s_rate the rate's sample standard deviation over the span (at least the datasheet's: real units are noisier than
+// their datasheets, and vibration averages down only as its own variance says).
 // Units: s, rad/s, m/s^2; body axes. Times are the IMU rows' (the end of each increment's interval).
 #pragma once
 
@@ -27,10 +30,10 @@
 namespace ultratrack::ins {
 
 struct StandstillOptions {
-  double window_s = 1.0;         // test window
-  double min_duration_s = 5.0;   // shorter standstills give nothing
-  double mean_sigmas = 6.0;      // a window's means against the standstill's, in sigmas of their difference
-  double variance_factor = 4.0;  // a window's sample variance against the datasheet's white noise
+  double window_s = 1.0;           // test window
+  double min_duration_s = 5.0;     // shorter standstills give nothing
+  double mean_sigmas = 6.0;        // a window's means against the standstill's, in sigmas of their difference
+  double variance_factor = 100.0;  // a window's sample variance against the datasheet's white noise
 };
 
 struct StandstillGyroBias {
