@@ -23,7 +23,7 @@ namespace {
 
 constexpr double kC = 299792458.0;
 constexpr double kMicroG = 9.80665e-6;
-constexpr double kDegPerHour = io::kRadPerDeg / 3600.0;
+constexpr double kDegPerHour = io::kRadPerSecPerDegPerHour;
 
 // Satellites above the mask seen from the antenna at GPS time t, with the observables an error-free
 // receiver on the truth would measure (so the innovation is zero).

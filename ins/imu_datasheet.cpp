@@ -10,10 +10,10 @@
 namespace ultratrack::ins {
 namespace {
 
-constexpr double kDph = io::kRadPerDeg / 3600.0;  // deg/h -> rad/s
-constexpr double kDpsh = io::kRadPerDeg / 60.0;   // deg/sqrt(h) -> rad/sqrt(s)
-constexpr double kMpspsh = 1.0 / 60.0;            // m/s/sqrt(h) -> m/s/sqrt(s)
-constexpr double kMg = 9.80665e-3;                // milli-g -> m/s^2
+constexpr double kDph = io::kRadPerSecPerDegPerHour;  // deg/h -> rad/s
+constexpr double kDpsh = io::kRadPerDeg / 60.0;       // deg/sqrt(h) -> rad/sqrt(s)
+constexpr double kMpspsh = 1.0 / 60.0;                // m/s/sqrt(h) -> m/s/sqrt(s)
+constexpr double kMg = 9.80665e-3;                    // milli-g -> m/s^2
 constexpr double kPpm = 1e-6;
 
 }  // namespace

@@ -10,8 +10,8 @@
 namespace ultratrack::ins {
 namespace {
 
-constexpr double kDegPerHour = io::kRadPerDeg / 3600.0;    // rad/s
-constexpr double kDegPerSqrtHour = io::kRadPerDeg / 60.0;  // rad/sqrt(s)
+constexpr double kDegPerHour = io::kRadPerSecPerDegPerHour;  // rad/s
+constexpr double kDegPerSqrtHour = io::kRadPerDeg / 60.0;    // rad/sqrt(s)
 constexpr double kG = 9.80665;
 constexpr double kFoot = 0.3048;
 

@@ -20,7 +20,7 @@ namespace ultratrack::pipelines {
 namespace {
 
 constexpr double kDeg = io::kRadPerDeg;
-constexpr double kDegPerHour = io::kRadPerDeg / 3600.0;
+constexpr double kDegPerHour = io::kRadPerSecPerDegPerHour;
 
 std::string vec(const Eigen::Vector3d& v, double scale) {
   return fmt::format("[{:.9g}, {:.9g}, {:.9g}]", v.x() / scale, v.y() / scale, v.z() / scale);

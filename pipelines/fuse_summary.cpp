@@ -77,14 +77,13 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
       r.initial_attitude.pitch_rad / io::kRadPerDeg, r.initial_attitude.yaw_rad / io::kRadPerDeg);
   if (r.motion_span_s > 0.0) j += fmt::format("  \"alignment_track_span_s\": {},\n", r.motion_span_s);
   if (r.standstill) {
-    constexpr double kDegPerHourRad = 3600.0 / io::kRadPerDeg;
+    constexpr double kDph = io::kRadPerSecPerDegPerHour;
     const ins::StandstillGyroBias& b = *r.standstill;
     j += fmt::format(
         "  \"standstill_gyro_bias\": {{\"t_start_s\": {}, \"t_end_s\": {}, \"gyro_dph\": [{:.6g}, {:.6g}, {:.6g}], "
         "\"sigma_gyro_dph\": [{:.6g}, {:.6g}, {:.6g}]}},\n",
-        b.t_start_s, b.t_end_s, b.gyro_bias_rps.x() * kDegPerHourRad, b.gyro_bias_rps.y() * kDegPerHourRad,
-        b.gyro_bias_rps.z() * kDegPerHourRad, b.sigma_rps.x() * kDegPerHourRad, b.sigma_rps.y() * kDegPerHourRad,
-        b.sigma_rps.z() * kDegPerHourRad);
+        b.t_start_s, b.t_end_s, b.gyro_bias_rps.x() / kDph, b.gyro_bias_rps.y() / kDph, b.gyro_bias_rps.z() / kDph,
+        b.sigma_rps.x() / kDph, b.sigma_rps.y() / kDph, b.sigma_rps.z() / kDph);
   }
   j += fmt::format("  \"start_s\": {},\n  \"end_s\": {},\n", r.start_s, r.end_s);
   j += fmt::format(
@@ -136,7 +135,7 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
       g.position_ned_m.x(), g.position_ned_m.y(), g.position_ned_m.z(), g.velocity_ned_mps.norm(),
       g.attitude_ned_rad.x() / io::kRadPerDeg, g.attitude_ned_rad.y() / io::kRadPerDeg,
       g.attitude_ned_rad.z() / io::kRadPerDeg);
-  constexpr double kMg = 9.80665e-3, kDph = io::kRadPerDeg / 3600.0;
+  constexpr double kMg = 9.80665e-3, kDph = io::kRadPerSecPerDegPerHour;
   auto triple = [](const Eigen::Vector3d& v, double unit) {
     return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v.x() / unit, v.y() / unit, v.z() / unit);
   };

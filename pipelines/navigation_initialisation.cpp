@@ -97,7 +97,7 @@ std::optional<AttitudeStart> align_moving(std::span<const ins::ImuIncrement> imu
   }
   s.note = fmt::format("in motion at {:.3f} s ({:.1f} m/s)", a->t_s, a->v_n.head<2>().norm());
   if (standstill) {
-    constexpr double kDph = io::kRadPerDeg / 3600.0;
+    constexpr double kDph = io::kRadPerSecPerDegPerHour;
     const Eigen::Vector3d b = standstill->gyro_bias_rps / kDph;
     s.note += fmt::format(", gyro biases from a standstill over {:.1f}-{:.1f} s: {:.0f} {:.0f} {:.0f} +- {:.0f} deg/h",
                           standstill->t_start_s, standstill->t_end_s, b.x(), b.y(), b.z(),
