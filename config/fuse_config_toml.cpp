@@ -114,7 +114,13 @@ const std::map<std::string, Table>& sections() {
        {{"velocity_sigma_mps", [](const Value& v, C& c) { c.velocity_sigma_mps = v.positive(); }},
         {"use_velocity", [](const Value& v, C& c) { c.use_velocity = v.boolean(); }},
         {"update_interval_s", [](const Value& v, C& c) { c.fix_min_interval_s = v.non_negative(); }},
-        {"error_correlation_time_s", [](const Value& v, C& c) { c.fix_error_correlation_s = v.non_negative(); }},
+        {"error_correlation_time_s",
+         [](const Value& v, C& c) {
+           c.fix_error_auto = v.node.is_string();
+           if (c.fix_error_auto && v.text() != "auto")
+             throw io::InputError(v.file, "key '" + v.key + "' must be a number of seconds or \"auto\"", v.line());
+           if (!c.fix_error_auto) c.fix_error_correlation_s = v.non_negative();
+         }},
         {"error_sigma_ned_m", [](const Value& v, C& c) { c.fix_error_sigma_ned_m = v.vector3(true); }},
         {"lever_arm_body_m", [](const Value& v, C& c) { c.lever_arm_b = v.vector3(); }}}},
       {"filter",

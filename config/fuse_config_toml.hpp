@@ -15,9 +15,10 @@
 //                standstill_gyro_bias = true (gyro biases from a standstill at the start, motion alignment)
 //   [gnss]       velocity_sigma_mps = 0.1, use_velocity = true, lever_arm_body_m = [x, y, z], update_interval_s = 0
 //                (fixes closer than this to the last one used are skipped: a decorrelating interval for fixes whose
-//                errors are correlated in time; 0: every fix), error_correlation_time_s = 0 (the fixes' position errors
-//                first-order Gauss-Markov with this time: their variance is inflated by 1 + 2 tau / dt; 0: white),
-//                error_sigma_ned_m = [n, e, d] (with error_correlation_time_s > 0, loose: the Gauss-Markov part's
+//                errors are correlated in time; 0: every fix), error_correlation_time_s = "auto" (fuse: measured
+//                from the fixes, fusion/fix_error_whiteness.hpp; receive: white) or seconds (the fixes' position
+//                errors first-order Gauss-Markov with this time: their variance is inflated by 1 + 2 tau / dt; 0:
+//                white), error_sigma_ned_m = [n, e, d] (with a correlation time, loose: the Gauss-Markov part's
 //                1-sigma, carried as three filter states instead of the inflation; fusion/fix_error_model.hpp)
 //   [vehicle]    nhc = false (land vehicles: zero lateral and vertical body velocity, fusion/nhc_measurement.hpp),
 //                nhc_sigma_mps = 0.3, nhc_interval_s = 0.5, nhc_lever_arm_body_m = [x, y, z] (IMU -> rear axle)

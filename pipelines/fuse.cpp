@@ -82,6 +82,21 @@ std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFi
   return out;
 }
 
+// A fix row as the loose filter takes it: its velocity only when the configuration uses velocities, at the configured
+// sigma (the fix file carries position sigmas only).
+fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c) {
+  fusion::GnssFix f;
+  f.t_s = r.t_s;
+  f.lat_rad = r.lat_rad;
+  f.lon_rad = r.lon_rad;
+  f.height_m = r.height_m;
+  f.sigma_pos_ned_m = r.sigma_ned_m;
+  f.has_velocity = r.has_velocity && c.use_velocity;
+  f.v_n_mps = r.v_n;
+  f.sigma_vel_n_mps = Eigen::Vector3d::Constant(c.velocity_sigma_mps);
+  return f;
+}
+
 bool in_outage(const FuseSettings& s, double t) {
   for (const auto& [start, duration] : s.outages)
     if (t >= start && t < start + duration) return true;
@@ -296,6 +311,22 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
 
   fusion::IntegrationOptions o = integration_options(n, c, fusion::Coupling::kLoose, s.filter);
   o.attitude = attitude_options;
+  if (c.fix_error_auto && !gnss.empty()) {  // the fixes' own errors: white at their rate, or correlated
+    std::vector<fusion::GnssFix> usable;
+    for (const GnssFixRow& r : gnss) {
+      if (in_outage(s, r.t_s) || (s.gnss_until_s && r.t_s > *s.gnss_until_s)) continue;
+      usable.push_back(loose_fix(r, c));
+    }
+    const fusion::FixErrorWhiteness& w = result.fix_whiteness.emplace(fusion::measure_fix_error_whiteness(usable));
+    if (w.correlated) {
+      o.fix_error.enabled = true;
+      o.fix_error.correlation_time_s = w.correlation_time_s;
+      o.fix_error.sigma_ned_m = c.fix_error_sigma_ned_m ? *c.fix_error_sigma_ned_m : w.sigma_ned_m;
+      o.fix_error_correlation_s = 0.0;
+    }
+  }
+  result.fix_error = o.fix_error;
+  result.fix_error_inflation_s = o.fix_error_correlation_s;
   std::vector<fusion::OdometerSpeed> odometer;
   if (!s.odometer.empty()) {
     o.odometer = c.odometer;
@@ -379,16 +410,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
         continue;
       }
       if (result.odometer) result.odometer->gnss_last_used_s = r.t_s;
-      fusion::GnssFix f;
-      f.t_s = r.t_s;
-      f.lat_rad = r.lat_rad;
-      f.lon_rad = r.lon_rad;
-      f.height_m = r.height_m;
-      f.sigma_pos_ned_m = r.sigma_ned_m;
-      f.has_velocity = r.has_velocity && c.use_velocity;
-      f.v_n_mps = r.v_n;
-      f.sigma_vel_n_mps = Eigen::Vector3d::Constant(c.velocity_sigma_mps);
-      integration.add_fix(f);
+      integration.add_fix(loose_fix(r, c));
       ++result.fixes_used;
     }
     for (; a < attitude.size() && attitude[a].t_s <= imu[k].t_s; ++a) {

@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "fusion/fix_error_whiteness.hpp"
 #include "fusion/gnss_ins_integration.hpp"
 #include "ins/attitude.hpp"
 #include "ins/nav_state.hpp"
@@ -97,6 +98,11 @@ struct FuseResult {
   // position differences the heading came from (position-only fixes; 0: the fixes' velocities).
   std::optional<ins::StandstillGyroBias> standstill;
   double motion_span_s = 0.0;
+  // The fixes' errors as the filter took them: measured (fusion/fix_error_whiteness.hpp, [gnss]
+  // error_correlation_time_s "auto") or configured; Gauss-Markov states, an inflated variance, or white.
+  std::optional<fusion::FixErrorWhiteness> fix_whiteness;
+  fusion::FixErrorOptions fix_error;   // enabled: carried as states
+  double fix_error_inflation_s = 0.0;  // > 0: the variance inflated for this correlation time
   fusion::IntegrationCounters counters;
   std::vector<fusion::RecoveryEvent> recovery_events;  // lock-out recoveries (fusion/lockout_recovery.hpp)
   long long fixes_used = 0, fixes_before_start = 0, fixes_in_outage = 0;

@@ -41,6 +41,10 @@ struct FuseConfig {
   double velocity_sigma_mps = 0.1;
   double fix_min_interval_s = 0.0;       // [gnss] update_interval_s: a decorrelating interval between fixes used
   double fix_error_correlation_s = 0.0;  // [gnss] error_correlation_time_s: fixes' errors Gauss-Markov (0: white)
+  // [gnss] error_correlation_time_s absent or "auto": `fuse` measures whether the file's fixes are white at their
+  // rate (fusion/fix_error_whiteness.hpp) and, when not, carries the measured Gauss-Markov model as states. `receive`
+  // makes its fixes as it goes and uses fix_error_correlation_s as it stands.
+  bool fix_error_auto = true;
   // [gnss] error_sigma_ned_m: with a correlation time, the Gauss-Markov part's 1-sigma, carried as filter states
   // (fusion/fix_error_model.hpp) instead of inflating the fixes' variance.
   std::optional<Eigen::Vector3d> fix_error_sigma_ned_m;

@@ -94,12 +94,32 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
   j += fmt::format("  \"fix_updates_accepted\": {},\n  \"fix_updates_rejected\": {},\n", r.counters.fix_accepted,
                    r.counters.fix_rejected);
   j += fmt::format("  \"fixes_skipped_by_interval\": {},\n", r.counters.fixes_skipped);
-  if (s.config.fix_error_correlation_s > 0.0) {
-    const auto& sg = s.config.fix_error_sigma_ned_m;
-    j += fmt::format("  \"fix_error_model\": {{\"correlation_time_s\": {}, ", s.config.fix_error_correlation_s);
-    j += sg ? fmt::format("\"kind\": \"gauss_markov_states\", \"sigma_ned_m\": [{}, {}, {}]}},\n", sg->x(), sg->y(),
-                          sg->z())
-            : std::string("\"kind\": \"inflated_variance\"},\n");
+  const bool measured = r.fix_whiteness && r.fix_whiteness->correlated;
+  const char* source = measured ? "measured" : "configuration";
+  if (r.fix_error.enabled) {
+    const auto& sg = r.fix_error.sigma_ned_m;
+    j += fmt::format(
+        "  \"fix_error_model\": {{\"kind\": \"gauss_markov_states\", \"source\": \"{}\", \"correlation_time_s\": {}, "
+        "\"sigma_ned_m\": [{}, {}, {}]}},\n",
+        source, r.fix_error.correlation_time_s, sg.x(), sg.y(), sg.z());
+  } else if (r.fix_error_inflation_s > 0.0) {
+    j += fmt::format(
+        "  \"fix_error_model\": {{\"kind\": \"inflated_variance\", \"source\": \"configuration\", "
+        "\"correlation_time_s\": {}}},\n",
+        r.fix_error_inflation_s);
+  } else {
+    j += fmt::format("  \"fix_error_model\": {{\"kind\": \"white\", \"source\": \"{}\"}},\n",
+                     r.fix_whiteness ? "measured" : "configuration");
+  }
+  if (r.fix_whiteness) {
+    const fusion::FixErrorWhiteness& w = *r.fix_whiteness;
+    j += fmt::format(
+        "  \"fix_whiteness\": {{\"measured\": {}, \"correlated\": {}, \"interval_s\": {}, \"long_lag\": {}, "
+        "\"differences\": {}, \"white_share_ned\": [{:.4f}, {:.4f}, {:.4f}], \"growth_ned\": [{:.3f}, {:.3f}, {:.3f}], "
+        "\"correlation_time_is_bound\": {}, \"note\": \"{}\"}},\n",
+        w.measured, w.correlated, w.interval_s, w.long_lag, w.differences, w.white_share.x(), w.white_share.y(),
+        w.white_share.z(), w.growth.x(), w.growth.y(), w.growth.z(), w.correlation_time_is_bound,
+        io::json_escape(w.note));
   }
   if (s.gnss_until_s)
     j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,

@@ -14,9 +14,21 @@ namespace ultratrack::pipelines {
 std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth, const GnssFixSimulationOptions& o) {
   if (!(o.rate_hz > 0.0 && o.rate_hz <= 100.0)) throw io::InputError("GNSS simulation", "rate must be in (0, 100] Hz");
   if (!(o.sigma_ned_m.minCoeff() > 0.0)) throw io::InputError("GNSS simulation", "position sigmas must be positive");
+  if (!(o.white_sigma_ned_m.minCoeff() >= 0.0) || (o.stated_sigma_ned_m && !(o.stated_sigma_ned_m->minCoeff() > 0.0)))
+    throw io::InputError("GNSS simulation", "white sigmas must not be negative, stated sigmas must be positive");
+  const bool white_part = o.white_sigma_ned_m.maxCoeff() > 0.0;
+  const Eigen::Vector3d column =
+      o.stated_sigma_ned_m.value_or((o.sigma_ned_m.cwiseAbs2() + o.white_sigma_ned_m.cwiseAbs2()).cwiseSqrt());
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   auto gauss3 = [&] { return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)); };
+  // The white part has its own generator: the other errors' draws are those of the same seed without it.
+  // (and its own distribution: a normal distribution keeps the second value of each pair it draws).
+  std::mt19937_64 rng_white(o.seed ^ 0x9e3779b97f4a7c15ULL);
+  std::normal_distribution<double> normal_white(0.0, 1.0);
+  auto gauss3_white = [&] {
+    return Eigen::Vector3d(normal_white(rng_white), normal_white(rng_white), normal_white(rng_white));
+  };
   const double dt = 1.0 / o.rate_hz;
   long long k = 0;
   while (o.first_time_s + k * dt < truth.start_s()) ++k;
@@ -35,10 +47,12 @@ std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth,
     const ins::Radii r = ins::radii_of_curvature(lat);
     GnssCsvRow f;
     f.t_s = t;
-    f.lat_rad = lat + err.x() / (r.meridian_m + h);
-    f.lon_rad = lon + err.y() / ((r.transverse_m + h) * std::cos(lat));
-    f.height_m = h - err.z();
-    f.sigma_ned_m = o.sigma_ned_m;
+    const Eigen::Vector3d e =
+        white_part ? Eigen::Vector3d(err + o.white_sigma_ned_m.cwiseProduct(gauss3_white())) : err;
+    f.lat_rad = lat + e.x() / (r.meridian_m + h);
+    f.lon_rad = lon + e.y() / ((r.transverse_m + h) * std::cos(lat));
+    f.height_m = h - e.z();
+    f.sigma_ned_m = column;
     f.has_velocity = o.with_velocity;
     if (o.with_velocity) f.v_n = ins::C_en(lat, lon).transpose() * m.v_e + o.sigma_velocity_mps * gauss3();
     fixes.push_back(f);

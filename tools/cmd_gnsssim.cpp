@@ -24,6 +24,7 @@ struct GnssSimOptions {
   double rate_hz = 1.0, first_s = 0.0, correlation_s = 0.0, velocity_sigma_mps = 0.05;
   std::vector<double> sigma_m{1.5, 1.5, 3.0};
   std::vector<double> lever_arm_m{0.0, 0.0, 0.0};
+  std::vector<double> white_sigma_m, stated_sigma_m;
   bool no_velocity = false;
   std::uint64_t seed = 1;
 };
@@ -38,6 +39,9 @@ void run_gnsssim(const GnssSimOptions& o) {
   s.first_time_s = o.first_s;
   s.sigma_ned_m = {o.sigma_m[0], o.sigma_m[1], o.sigma_m[2]};
   s.correlation_time_s = o.correlation_s;
+  if (!o.white_sigma_m.empty()) s.white_sigma_ned_m = {o.white_sigma_m[0], o.white_sigma_m[1], o.white_sigma_m[2]};
+  if (!o.stated_sigma_m.empty())
+    s.stated_sigma_ned_m = Eigen::Vector3d(o.stated_sigma_m[0], o.stated_sigma_m[1], o.stated_sigma_m[2]);
   s.with_velocity = !o.no_velocity;
   s.sigma_velocity_mps = o.velocity_sigma_mps;
   s.lever_arm_b = {o.lever_arm_m[0], o.lever_arm_m[1], o.lever_arm_m[2]};
@@ -63,6 +67,11 @@ void add_gnsssim_command(CLI::App& app) {
   cmd->add_option("--first", o->first_s, "time of the first fix (default 0)");
   cmd->add_option("--sigma", o->sigma_m, "N E D position 1-sigma in m (default 1.5 1.5 3)")->expected(3);
   cmd->add_option("--correlation", o->correlation_s, "position error correlation time in s (default 0: white)");
+  cmd->add_option("--white-sigma", o->white_sigma_m, "N E D white position 1-sigma in m on top (default none)")
+      ->expected(3);
+  cmd->add_option("--stated-sigma", o->stated_sigma_m,
+                  "N E D sigma written in the file (default the true total: a receiver that misstates its accuracy)")
+      ->expected(3);
   cmd->add_option("--velocity-sigma", o->velocity_sigma_mps, "velocity 1-sigma in m/s (default 0.05)");
   cmd->add_flag("--no-velocity", o->no_velocity, "leave the velocity columns empty");
   cmd->add_option("--lever-arm", o->lever_arm_m, "antenna in body axes from the IMU, m (x y z)")->expected(3);

@@ -80,6 +80,13 @@ TEST(FuseConfigToml, GnssErrorKeys) {
   ASSERT_TRUE(c.fix_error_sigma_ned_m);
   EXPECT_EQ(*c.fix_error_sigma_ned_m, Eigen::Vector3d(1.0, 1.5, 2.0));
   EXPECT_FALSE(read_fuse_config(write("gnss0.toml", "[gnss]\nerror_correlation_time_s = 30\n")).fix_error_sigma_ned_m);
+  // A number decides; absent or "auto", fuse measures the fixes (fusion/fix_error_whiteness.hpp).
+  EXPECT_FALSE(c.fix_error_auto);
+  EXPECT_FALSE(read_fuse_config(write("gnss1.toml", "[gnss]\nerror_correlation_time_s = 0\n")).fix_error_auto);
+  EXPECT_TRUE(read_fuse_config(write("gnss2.toml", "[gnss]\nvelocity_sigma_mps = 0.1\n")).fix_error_auto);
+  const FuseConfig a = read_fuse_config(write("gnss3.toml", "[gnss]\nerror_correlation_time_s = \"auto\"\n"));
+  EXPECT_TRUE(a.fix_error_auto);
+  EXPECT_EQ(a.fix_error_correlation_s, 0.0);
 }
 
 TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
@@ -92,6 +99,7 @@ TEST(FuseConfigToml, BadValuesNameFileLineAndKey) {
       {"[imu]\nbias_correlation_time_s = 0\n", "imu.bias_correlation_time_s", 2},
       {"[imu]\ngyro_arw_dpsh = \"2\"\n", "must be a number", 2},
       {"[imu]\npreset = \"adis99\"\n", "unknown preset 'adis99'", 2},
+      {"[gnss]\n\nerror_correlation_time_s = \"measured\"\n", "number of seconds or \"auto\"", 3},
       {"[imu]\ngyro_bias_dps = 3\n", "unknown key 'imu.gyro_bias_dps'", 2},
       {"[filter]\nrecovery_rejections = 0\n", "at least 1", 2},
       {"[filter]\nrecovery_rejections = 2.5\n", "must be an integer", 2},

@@ -166,3 +166,40 @@ TEST(FuseGnssFixSimulation, TimesAndErrorStatistics) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(sd[i] / o.sigma_ned_m[i], 1.0, 0.08) << i;
   EXPECT_NEAR(std::sqrt(vel2 / (3.0 * n)) / 0.05, 1.0, 0.05);
 }
+
+// A white part on top of 60 s Gauss-Markov errors: the fix-to-fix differences hold the white part (2 sigma_w^2 plus
+// 2 sigma^2 dt / tau of the correlated part), the columns the total unless a stated sigma is asked for, and the
+// correlated part's draws are those of the run without the white part.
+TEST(FuseGnssFixSimulation, AWhitePartOnTopAndAStatedSigma) {
+  const auto spec = ultratrack::ins::profile_spec("straight", 401.0, 36.0 * ultratrack::io::kRadPerDeg,
+                                                  127.0 * ultratrack::io::kRadPerDeg, 100.0);
+  const ultratrack::ins::TruthInterpolator truth(ultratrack::ins::simulate(spec, 20.0).truth);
+  ultratrack::pipelines::GnssFixSimulationOptions o;
+  o.rate_hz = 5.0;
+  o.sigma_ned_m = {1.0, 1.0, 2.0};
+  o.correlation_time_s = 60.0;
+  o.seed = 4;
+  const auto plain = ultratrack::pipelines::simulate_gnss_fixes(truth, o);
+  o.white_sigma_ned_m = {0.3, 0.4, 0.6};
+  const auto both = ultratrack::pipelines::simulate_gnss_fixes(truth, o);
+  o.stated_sigma_ned_m = Eigen::Vector3d(0.1, 0.1, 0.2);
+  const auto stated = ultratrack::pipelines::simulate_gnss_fixes(truth, o);
+  ASSERT_EQ(plain.size(), both.size());
+  EXPECT_TRUE(both[0].sigma_ned_m.isApprox(
+      Eigen::Vector3d(std::hypot(1.0, 0.3), std::hypot(1.0, 0.4), std::hypot(2.0, 0.6)), 1e-12));
+  EXPECT_EQ(stated[0].sigma_ned_m, Eigen::Vector3d(0.1, 0.1, 0.2));
+  EXPECT_EQ(stated[7].lat_rad, both[7].lat_rad);  // the stated sigma changes the column only
+  EXPECT_EQ(plain[0].sigma_ned_m, o.sigma_ned_m);
+  // The white part alone: both minus plain (the same Gauss-Markov draws), per axis, against its setting (2000
+  // samples: 5 sampling sigmas ~ 8 %).
+  Eigen::Vector3d sum2 = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < plain.size(); ++k) {
+    const Eigen::Vector3d d =
+        ultratrack::ins::C_en(plain[k].lat_rad, plain[k].lon_rad).transpose() *
+        (ultratrack::ins::ecef_from_geodetic(both[k].lat_rad, both[k].lon_rad, both[k].height_m) -
+         ultratrack::ins::ecef_from_geodetic(plain[k].lat_rad, plain[k].lon_rad, plain[k].height_m));
+    sum2 += d.cwiseAbs2();
+  }
+  const Eigen::Vector3d sd = (sum2 / static_cast<double>(plain.size())).cwiseSqrt();
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(sd[i] / o.white_sigma_ned_m[i], 1.0, 0.08) << i;
+}
