@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kChiSquare1Median = 0.4549364231;  // median of chi-square with one degree of freedom
 constexpr int kBlocks = 8;                          // contiguous blocks for the slope's sigma
-constexpr double kSpacingTolerance = 0.01;          // an interval within 1 % of T counts as even
+constexpr double kRegularSpacing = 0.5;             // an interval within 50 % of T keeps a run going
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -32,21 +32,31 @@ Eigen::Vector3d ned_of(const GnssFix& f, const GnssFix& ref) {
           -(f.height_m - ref.height_m)};
 }
 
-// Squared third differences at lag m over the stated variance, per axis, for every run of 3m + 1 evenly spaced fixes.
-// bad_before[i]: uneven intervals among the first i.
+// Squared third differences at lag m over their variance for the stated sigmas (scaled so that white errors give
+// 20 sigma^2, as evenly spaced fixes do), per axis, for every run of 3m + 1 regularly spaced fixes. Uneven times (a
+// receiver's or a logger's time-stamp jitter) take the divided difference's weights, which cancel a constant
+// acceleration at any spacing: c_k = 6 (mT)^3 / prod_{j != k} (t_k - t_j), (-1, 3, -3, 1) when even.
+// breaks_before[i]: irregular intervals among the first i.
 std::array<std::vector<double>, 3> normalised_third_differences(const std::vector<GnssFix>& p,
-                                                                const std::vector<int>& bad_before, int lag) {
+                                                                const std::vector<int>& breaks_before, int lag,
+                                                                double interval_s) {
   std::array<std::vector<double>, 3> out;
   const auto m = static_cast<std::size_t>(lag);
   const std::size_t span = 3 * m;
+  const double h3 = std::pow(static_cast<double>(lag) * interval_s, 3);
   for (std::size_t i = 0; i + span < p.size(); ++i) {
-    if (bad_before[i + span] != bad_before[i]) continue;
+    if (breaks_before[i + span] != breaks_before[i]) continue;
     const GnssFix& ref = p[i + m];
-    const Eigen::Vector3d d =
-        ned_of(p[i + span], ref) - 3.0 * ned_of(p[i + 2 * m], ref) - ned_of(p[i], ref);  // + 3 * ref, which is zero
-    Eigen::Vector3d var = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k <= span; k += m) var += p[i + k].sigma_pos_ned_m.cwiseAbs2();
-    var /= 4.0;
+    Eigen::Vector3d d = Eigen::Vector3d::Zero(), var = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < 4; ++k) {
+      double prod = 1.0;
+      for (std::size_t j = 0; j < 4; ++j)
+        if (j != k) prod *= p[i + k * m].t_s - p[i + j * m].t_s;
+      const double c = 6.0 * h3 / prod;
+      d += c * ned_of(p[i + k * m], ref);
+      var += c * c * p[i + k * m].sigma_pos_ned_m.cwiseAbs2();
+    }
+    var /= 20.0;
     for (int a = 0; a < 3; ++a) out[static_cast<std::size_t>(a)].push_back(d(a) * d(a) / var(a));
   }
   return out;
@@ -73,18 +83,18 @@ FixErrorWhiteness measure_fix_error_whiteness(std::span<const GnssFix> fixes, co
   for (std::size_t i = 1; i < p.size(); ++i) intervals.push_back(p[i].t_s - p[i - 1].t_s);
   const double T = median(intervals);
   w.interval_s = T;
-  std::vector<int> bad_before(p.size(), 0);
+  std::vector<int> breaks_before(p.size(), 0);
   for (std::size_t i = 1; i < p.size(); ++i)
-    bad_before[i] = bad_before[i - 1] + (std::abs(intervals[i - 1] - T) > kSpacingTolerance * T ? 1 : 0);
+    breaks_before[i] = breaks_before[i - 1] + (std::abs(intervals[i - 1] - T) > kRegularSpacing * T ? 1 : 0);
   const int M = std::clamp(static_cast<int>(std::lround(o.long_lag_s / T)), 2, 20);
   w.long_lag = M;
-  const auto d1 = normalised_third_differences(p, bad_before, 1);
-  const auto d_long = normalised_third_differences(p, bad_before, M);
+  const auto d1 = normalised_third_differences(p, breaks_before, 1, T);
+  const auto d_long = normalised_third_differences(p, breaks_before, M, T);
   w.differences = static_cast<long long>(d1[0].size());
   if (d1[0].size() < static_cast<std::size_t>(o.min_differences) ||
       d_long[0].size() < static_cast<std::size_t>(o.min_differences)) {
     w.note = fmt::format(
-        "{} evenly spaced runs of position fixes ({:.3g} s apart): too few to measure their errors' correlation "
+        "{} regularly spaced runs of position fixes ({:.3g} s apart): too few to measure their errors' correlation "
         "(at least {}), taken as white",
         std::min(d1[0].size(), d_long[0].size()), T, o.min_differences);
     return w;
@@ -97,7 +107,6 @@ FixErrorWhiteness measure_fix_error_whiteness(std::span<const GnssFix> fixes, co
     const auto& x_long = d_long[static_cast<std::size_t>(a)];
     const double v1 = robust_variance(x1, 0, x1.size()), v_long = robust_variance(x_long, 0, x_long.size());
     slope(a) = (v_long - v1) / (M - 1);
-    w.white_share(a) = std::max(0.0, (v1 - slope(a)) / 20.0);
     w.growth(a) = v1 > 0.0 ? v_long / v1 : 1.0;
     std::array<double, kBlocks> b{};
     double mean = 0.0;
@@ -113,6 +122,8 @@ FixErrorWhiteness measure_fix_error_whiteness(std::span<const GnssFix> fixes, co
     double ss = 0.0;
     for (const double v : b) ss += (v - mean) * (v - mean);
     slope_sigma(a) = std::sqrt(ss / (kBlocks - 1) / kBlocks);
+    // The intercept takes the slope off only when it is there: a slope within its noise would only add that noise.
+    w.white_share(a) = std::max(0.0, (v1 - (slope(a) > 2.0 * slope_sigma(a) ? slope(a) : 0.0)) / 20.0);
     std::vector<double> sig;
     for (const GnssFix& f : p) sig.push_back(f.sigma_pos_ned_m(a));
     median_sigma(a) = median(sig);

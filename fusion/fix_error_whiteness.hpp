@@ -7,10 +7,13 @@
 //
 // Method: third differences of the positions at a lag of m fixes (interval T),
 //   d(m) = p(t + 3mT) - 3 p(t + 2mT) + 3 p(t + mT) - p(t),
-// cancel the vehicle's motion up to a constant acceleration (the jerk's share, j (mT)^3, is millimetres at 1 s).
+// cancel the vehicle's motion up to a constant acceleration (the jerk's share, j (mT)^3, is millimetres at 1 s). Runs
+// need each interval within 50 % of the median T; uneven times (time-stamp jitter) take the divided difference's
+// weights, which cancel a constant acceleration at any spacing and are (-1, 3, -3, 1) when even.
 // For a fix error e = w + c, w white (variance s_w^2), c Gauss-Markov (s_c^2, tau), q = exp(-mT / tau):
 //   Var d(m) = 20 s_w^2 + s_c^2 (20 - 30 q + 12 q^2 - 2 q^3) = 20 s_w^2 + 12 s_c^2 mT / tau + O((mT / tau)^3).
-// Two lags, 1 and M (MT about 1 s), give the white part (the intercept) and s_c^2 / tau (the slope), each as a share
+// Two lags, 1 and M (MT about 1 s), give the white part (the intercept; the slope is taken off only when above twice
+// its 1-sigma) and s_c^2 / tau (the slope), each as a share
 // of the fixes' stated variance s^2 = s_w^2 + s_c^2, per axis. Each variance is robust (the median of d^2 / s^2 over
 // 0.4549, the median of chi-square with one degree of freedom): a jump or an outlier does not move it. The slope's
 // 1-sigma comes from eight contiguous blocks of the file.
@@ -41,11 +44,11 @@ struct FixWhitenessOptions {
 };
 
 struct FixErrorWhiteness {
-  bool measured = false;      // enough evenly spaced position fixes for a verdict
+  bool measured = false;      // enough regularly spaced position fixes for a verdict
   bool correlated = false;    // the fixes' errors are not white at their rate
   double interval_s = 0.0;    // the fixes' median interval T
   int long_lag = 0;           // M, in fixes
-  long long differences = 0;  // third differences at lag 1 (evenly spaced runs of four fixes)
+  long long differences = 0;  // third differences at lag 1 (regularly spaced runs of four fixes)
   // Per axis N, E, D: the white part's share of the stated variance (1: white at the fix rate; well above 1: the
   // stated sigma understates the noise), and Var d(M) / Var d(1) (1 for white errors, M for tau >> MT).
   Eigen::Vector3d white_share = Eigen::Vector3d::Ones();

@@ -146,7 +146,29 @@ TEST(FixErrorWhiteness, OutliersAndAGapDoNotMoveTheVerdict) {
   EXPECT_EQ(w.differences, static_cast<long long>(before - 500 - 2 * 3));  // runs of 4 on either side of the gap
 }
 
-TEST(FixErrorWhiteness, TooFewOrUnevenFixesGiveNoVerdict) {
+TEST(FixErrorWhiteness, TimeStampJitterKeepsTheVerdict) {
+  // +-10 % of the interval on each stamp (a logger's clock): the divided difference's weights take the true times.
+  for (const bool correlated : {false, true}) {
+    FixErrors e;
+    e.rate_hz = 20.0;
+    (correlated ? e.gm_sigma_m : e.white_sigma_m) = Eigen::Vector3d(0.6, 0.6, 1.2);
+    std::vector<GnssFix> fixes = draw_fixes(e);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> jitter(-0.005, 0.005);
+    for (auto& f : fixes) f.t_s += jitter(rng);  // the positions stay those of the even times: the stamps err
+    const FixErrorWhiteness w = measure_fix_error_whiteness(fixes);
+    ASSERT_TRUE(w.measured) << w.note;
+    EXPECT_EQ(w.correlated, correlated) << w.note;
+    if (correlated) {
+      EXPECT_GT(w.correlation_time_s, 20.0) << w.note;
+      EXPECT_LT(w.correlation_time_s, 45.0) << w.note;
+    } else {
+      EXPECT_NEAR(w.white_share.x(), 1.0, 0.25) << w.note;
+    }
+  }
+}
+
+TEST(FixErrorWhiteness, TooFewOrIrregularFixesGiveNoVerdict) {
   FixErrors e;
   e.duration_s = 20.0;  // 100 fixes
   e.gm_sigma_m = {0.6, 0.6, 1.2};
@@ -156,11 +178,10 @@ TEST(FixErrorWhiteness, TooFewOrUnevenFixesGiveNoVerdict) {
   EXPECT_NE(w.note.find("too few"), std::string::npos) << w.note;
   FixErrors white;
   white.white_sigma_m = {2.0, 2.0, 4.0};
-  std::vector<GnssFix> jittered = draw_fixes(white);
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> jitter(-0.02, 0.02);  // 10 % of the interval: no two even intervals
-  for (auto& f : jittered) f.t_s += jitter(rng);
-  w = measure_fix_error_whiteness(jittered);
+  std::vector<GnssFix> irregular = draw_fixes(white);
+  for (std::size_t i = 0; i < irregular.size(); ++i)
+    if (i % 4 >= 2) irregular[i].has_position = false;  // two of every four missing
+  w = measure_fix_error_whiteness(irregular);           // intervals of 0.2 and 0.6 s: no run of four regular ones
   EXPECT_FALSE(w.measured) << w.note;
   EXPECT_FALSE(measure_fix_error_whiteness({}).measured);
 }
