@@ -83,6 +83,10 @@ FixErrorWhiteness measure_fix_error_whiteness(std::span<const GnssFix> fixes, co
   for (std::size_t i = 1; i < p.size(); ++i) intervals.push_back(p[i].t_s - p[i - 1].t_s);
   const double T = median(intervals);
   w.interval_s = T;
+  if (!(T > 0.0) || !std::isfinite(T)) {  // most fixes share a time stamp
+    w.note = fmt::format("position fixes with a median interval of {} s: no rate to measure at, taken as white", T);
+    return w;
+  }
   std::vector<int> breaks_before(p.size(), 0);
   for (std::size_t i = 1; i < p.size(); ++i)
     breaks_before[i] = breaks_before[i - 1] + (std::abs(intervals[i - 1] - T) > kRegularSpacing * T ? 1 : 0);

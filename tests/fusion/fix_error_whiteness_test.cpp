@@ -184,6 +184,11 @@ TEST(FixErrorWhiteness, TooFewOrIrregularFixesGiveNoVerdict) {
   w = measure_fix_error_whiteness(irregular);           // intervals of 0.2 and 0.6 s: no run of four regular ones
   EXPECT_FALSE(w.measured) << w.note;
   EXPECT_FALSE(measure_fix_error_whiteness({}).measured);
+  std::vector<GnssFix> stamped_twice;  // every time stamp twice: a median interval of 0
+  for (const GnssFix& f : draw_fixes(white)) stamped_twice.insert(stamped_twice.end(), {f, f});
+  w = measure_fix_error_whiteness(stamped_twice);
+  EXPECT_FALSE(w.measured) << w.note;
+  EXPECT_FALSE(w.correlated);
 }
 
 }  // namespace
