@@ -108,8 +108,9 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
         "\"correlation_time_s\": {}}},\n",
         r.fix_error_inflation_s);
   } else {
-    j += fmt::format("  \"fix_error_model\": {{\"kind\": \"white\", \"source\": \"{}\"}},\n",
-                     r.fix_whiteness ? "measured" : "configuration");
+    // Measured white; taken as white for want of fixes to measure; or told so.
+    const char* white_source = r.fix_whiteness ? (r.fix_whiteness->measured ? "measured" : "default") : "configuration";
+    j += fmt::format("  \"fix_error_model\": {{\"kind\": \"white\", \"source\": \"{}\"}},\n", white_source);
   }
   if (r.fix_whiteness) {
     const fusion::FixErrorWhiteness& w = *r.fix_whiteness;

@@ -22,8 +22,8 @@ std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth,
   std::mt19937_64 rng(o.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   auto gauss3 = [&] { return Eigen::Vector3d(normal(rng), normal(rng), normal(rng)); };
-  // The white part has its own generator: the other errors' draws are those of the same seed without it.
-  // (and its own distribution: a normal distribution keeps the second value of each pair it draws).
+  // The white part has its own generator and distribution (a normal distribution keeps the second value of each pair
+  // it draws): the other errors' draws are those of the same seed without it.
   std::mt19937_64 rng_white(o.seed ^ 0x9e3779b97f4a7c15ULL);
   std::normal_distribution<double> normal_white(0.0, 1.0);
   auto gauss3_white = [&] {
