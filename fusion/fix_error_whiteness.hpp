@@ -7,18 +7,19 @@
 //
 // Method: third differences of the positions at a lag of m fixes (interval T),
 //   d(m) = p(t + 3mT) - 3 p(t + 2mT) + 3 p(t + mT) - p(t),
-// cancel the vehicle's motion up to a constant acceleration (the jerk's share, j (mT)^3, is millimetres at 1 s). Runs
-// need each interval within 50 % of the median T; uneven times (time-stamp jitter) take the divided difference's
-// weights, which cancel a constant acceleration at any spacing and are (-1, 3, -3, 1) when even.
+// cancel the vehicle's motion up to a constant acceleration (a jerk j leaves j (mT)^3: 5 cm at 1 s for 0.05 m/s^3;
+// it adds to the slope below, so a tau comes out short). Runs need each interval within 50 % of the median T;
+// uneven times (time-stamp jitter) take the divided difference's weights, which cancel a constant acceleration at any
+// spacing and are (-1, 3, -3, 1) when even.
 // For a fix error e = w + c, w white (variance s_w^2), c Gauss-Markov (s_c^2, tau), q = exp(-mT / tau):
 //   Var d(m) = 20 s_w^2 + s_c^2 (20 - 30 q + 12 q^2 - 2 q^3) = 20 s_w^2 + 12 s_c^2 mT / tau + O((mT / tau)^3).
 // Two lags, 1 and M (MT about 1 s), give the white part (the intercept; the slope is taken off only when above twice
-// its 1-sigma) and s_c^2 / tau (the slope), each as a share
-// of the fixes' stated variance s^2 = s_w^2 + s_c^2, per axis. Each variance is robust (the median of d^2 / s^2 over
+// its 1-sigma) and s_c^2 / tau (the slope), each as a share of the fixes' stated variance s^2 = s_w^2 + s_c^2, per
+// axis. Each variance is robust (the median of d^2 / s^2 over
 // 0.4549, the median of chi-square with one degree of freedom): a jump or an outlier does not move it. The slope's
 // 1-sigma comes from eight contiguous blocks of the file.
 // Verdict (horizontal axes): white when the white part explains at least half the stated variance (a simulator's
-// white noise; fixes at 1 Hz and below whose errors decorrelate between fixes). Else Gauss-Markov with
+// white noise; errors that decorrelate within the fix interval). Else Gauss-Markov with
 // s_c^2 = (1 - white share) s^2 per axis and tau = 12 (s_c^2 / s^2) T / slope; when the slope is below twice its
 // 1-sigma the correlation is slower than the lags can see and tau is that bound, 12 (s_c^2 / s^2) T / (2 sigma).
 // tau is kept within [MT, max_correlation_time_s].
