@@ -9,9 +9,11 @@
 #       scenarios/mems_datasheet_fuse.toml)] [--from-s 60]
 #       [--nhc on|off] [--sigma "0.5 0.5 1.0"] [--velocity-sigma 0.05] [--correlation S] [--interval S]
 #       [--told-correlation S] [--told-sigma "N E D"] [--outage "START DURATION"] [--accel-bias-mg MG]
-#       [--gyro-bias-dph DPH] [--rate HZ (default 5)] [--white-sigma "N E D"] [--stated-sigma "N E D"] [--clean]
+#       [--gyro-bias-dph DPH] [--rate HZ (default 5)] [--white-sigma "N E D"] [--stated-sigma "N E D"]
+#       [--velocity-correlation S] [--clean]
 # --rate: the fixes per second; --white-sigma: a white part on top of the (correlated) errors; --stated-sigma: the
-# sigma the fix file states, when not the true one (gnsssim).
+# sigma the fix file states, when not the true one; --velocity-correlation: the velocity errors Gauss-Markov with that
+# time (a receiver that smooths its velocities; gnsssim).
 # --accel-bias-mg, --gyro-bias-dph: the unit's turn-on biases (1 sigma) in the simulation and in the filter's
 # datasheet model alike (accel_bias_mg, gyro_bias_dph in the scenario's and the fuse configuration's [imu]; e.g. 5 mg
 # and 1080 deg/h against the ADIS16405's 50 and 10800).
@@ -29,7 +31,7 @@ set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="$here/build"; seeds="1 2 3 4 5"; out="${TMPDIR:-/tmp}/mems_fusion"; fixes=vel; filter=ekf; nhc=on
 sigma="0.5 0.5 1.0"; velocity_sigma=0.05; correlation=0; interval=0; told=auto; told_sigma=""; outage=""; clean=0
-accel_bias_mg=""; gyro_bias_dph=""; rate=5; white_sigma=""; stated_sigma=""
+accel_bias_mg=""; gyro_bias_dph=""; rate=5; white_sigma=""; stated_sigma=""; velocity_correlation=0
 scenario="$here/scenarios/mems_drive_adis16405.toml"; fuse_config="$here/scenarios/mems_datasheet_fuse.toml"; from_s=60
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -44,6 +46,7 @@ while [ $# -gt 0 ]; do
     --fuse-config) fuse_config="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
     --from-s) from_s="$2"; shift 2 ;; --rate) rate="$2"; shift 2 ;;
     --white-sigma) white_sigma="$2"; shift 2 ;; --stated-sigma) stated_sigma="$2"; shift 2 ;;
+    --velocity-correlation) velocity_correlation="$2"; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -78,8 +81,9 @@ for seed in $seeds; do
   "$U" simulate --scenario "$out/scenario_$seed.toml" --out "$run/sim" --quiet >/dev/null
   # shellcheck disable=SC2086
   "$U" gnsssim --truth "$run/sim/truth.csv" --rate "$rate" --first 0.137 --sigma $sigma --velocity-sigma \
-      "$velocity_sigma" --correlation "$correlation" $velocity_flag ${white_sigma:+--white-sigma $white_sigma} \
-      ${stated_sigma:+--stated-sigma $stated_sigma} --seed "$seed" --out "$run/gnss.csv" >/dev/null
+      "$velocity_sigma" --velocity-correlation "$velocity_correlation" --correlation "$correlation" $velocity_flag \
+      ${white_sigma:+--white-sigma $white_sigma} ${stated_sigma:+--stated-sigma $stated_sigma} --seed "$seed" \
+      --out "$run/gnss.csv" >/dev/null
   # shellcheck disable=SC2086
   "$U" fuse --imu "$run/sim/imu.csv" --gnss "$run/gnss.csv" --config "$config" --filter "$filter" --align motion \
       $outage_flag --out "$run/fuse" --quiet >/dev/null

@@ -82,9 +82,9 @@ std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFi
   return out;
 }
 
-// A fix row as the loose filter takes it: its velocity only when the configuration uses velocities, at the configured
-// sigma (the fix file carries position sigmas only).
-fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c) {
+// A fix row as the loose filter takes it: its velocity only when the configuration uses velocities, at
+// velocity_sigma_mps (the fix file carries position sigmas only).
+fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c, double velocity_sigma_mps) {
   fusion::GnssFix f;
   f.t_s = r.t_s;
   f.lat_rad = r.lat_rad;
@@ -93,7 +93,7 @@ fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c) {
   f.sigma_pos_ned_m = r.sigma_ned_m;
   f.has_velocity = r.has_velocity && c.use_velocity;
   f.v_n_mps = r.v_n;
-  f.sigma_vel_n_mps = Eigen::Vector3d::Constant(c.velocity_sigma_mps);
+  f.sigma_vel_n_mps = Eigen::Vector3d::Constant(velocity_sigma_mps);
   return f;
 }
 
@@ -315,7 +315,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
     std::vector<fusion::GnssFix> usable;
     for (const GnssFixRow& r : gnss) {
       if (in_outage(s, r.t_s) || (s.gnss_until_s && r.t_s > *s.gnss_until_s)) continue;
-      usable.push_back(loose_fix(r, c));
+      usable.push_back(loose_fix(r, c, c.velocity_sigma_mps));
     }
     const fusion::FixErrorWhiteness& w = result.fix_whiteness.emplace(fusion::measure_fix_error_whiteness(usable));
     if (w.correlated) {
@@ -324,7 +324,13 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       o.fix_error.sigma_ned_m = c.fix_error_sigma_ned_m ? *c.fix_error_sigma_ned_m : w.sigma_ned_m;
       o.fix_error_correlation_s = 0.0;
     }
+    if (c.use_velocity) {  // and the velocities against the told sigma: a receiver may smooth them
+      const fusion::VelocityWhiteness& v =
+          result.velocity_whiteness.emplace(fusion::measure_velocity_whiteness(usable, c.velocity_sigma_mps));
+      result.velocity_sigma_mps = c.velocity_sigma_mps * std::sqrt(v.variance_factor);
+    }
   }
+  if (!result.velocity_whiteness) result.velocity_sigma_mps = c.velocity_sigma_mps;
   result.fix_error = o.fix_error;
   result.fix_error_inflation_s = o.fix_error_correlation_s;
   std::vector<fusion::OdometerSpeed> odometer;
@@ -410,7 +416,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
         continue;
       }
       if (result.odometer) result.odometer->gnss_last_used_s = r.t_s;
-      integration.add_fix(loose_fix(r, c));
+      integration.add_fix(loose_fix(r, c, result.velocity_sigma_mps));
       ++result.fixes_used;
     }
     for (; a < attitude.size() && attitude[a].t_s <= imu[k].t_s; ++a) {

@@ -103,6 +103,9 @@ struct FuseResult {
   std::optional<fusion::FixErrorWhiteness> fix_whiteness;
   fusion::FixErrorOptions fix_error;   // enabled: carried as states
   double fix_error_inflation_s = 0.0;  // > 0: the variance inflated for this correlation time
+  // The velocities' error model (measured with the positions'), and the 1-sigma each velocity fix was used at [m/s].
+  std::optional<fusion::VelocityWhiteness> velocity_whiteness;
+  double velocity_sigma_mps = 0.0;
   fusion::IntegrationCounters counters;
   std::vector<fusion::RecoveryEvent> recovery_events;  // lock-out recoveries (fusion/lockout_recovery.hpp)
   long long fixes_used = 0, fixes_before_start = 0, fixes_in_outage = 0;

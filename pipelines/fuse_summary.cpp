@@ -122,6 +122,15 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
         w.white_share.z(), w.growth.x(), w.growth.y(), w.growth.z(), w.correlation_time_is_bound,
         io::json_escape(w.note));
   }
+  if (r.velocity_whiteness) {
+    const fusion::VelocityWhiteness& v = *r.velocity_whiteness;
+    j += fmt::format(
+        "  \"velocity_whiteness\": {{\"measured\": {}, \"correlated\": {}, \"interval_s\": {}, \"differences\": {}, "
+        "\"white_share_ne\": [{:.4f}, {:.4f}], \"correlation_time_s\": {}, \"sigma_used_mps\": {}, \"note\": "
+        "\"{}\"}},\n",
+        v.measured, v.correlated, v.interval_s, v.differences, v.white_share.x(), v.white_share.y(),
+        v.correlation_time_s, r.velocity_sigma_mps, io::json_escape(v.note));
+  }
   if (s.gnss_until_s)
     j += fmt::format("  \"gnss_until_s\": {},\n  \"fixes_after_gnss_until\": {},\n", *s.gnss_until_s,
                      r.fixes_after_gnss_until);

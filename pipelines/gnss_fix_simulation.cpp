@@ -36,6 +36,12 @@ std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth,
   Eigen::Vector3d err = o.sigma_ned_m.cwiseProduct(gauss3());  // stationary start
   const double phi = o.correlation_time_s > 0.0 ? std::exp(-dt / o.correlation_time_s) : 0.0;
   const double drive = std::sqrt(1.0 - phi * phi);
+  if (!(o.velocity_correlation_time_s >= 0.0))
+    throw io::InputError("GNSS simulation", "the velocity correlation time must not be negative");
+  const double phi_v = o.velocity_correlation_time_s > 0.0 ? std::exp(-dt / o.velocity_correlation_time_s) : 0.0;
+  const double drive_v = std::sqrt(1.0 - phi_v * phi_v);
+  Eigen::Vector3d verr = Eigen::Vector3d::Zero();
+  bool first_velocity = true;
   bool first = true;
   for (double t = o.first_time_s + k * dt; t <= truth.end_s() + 1e-9; t = o.first_time_s + (++k) * dt) {
     if (!first) err = phi * err + drive * o.sigma_ned_m.cwiseProduct(gauss3());
@@ -54,7 +60,13 @@ std::vector<GnssCsvRow> simulate_gnss_fixes(const ins::TruthInterpolator& truth,
     f.height_m = h - e.z();
     f.sigma_ned_m = column;
     f.has_velocity = o.with_velocity;
-    if (o.with_velocity) f.v_n = ins::C_en(lat, lon).transpose() * m.v_e + o.sigma_velocity_mps * gauss3();
+    if (o.with_velocity) {  // one draw per fix either way: white velocity errors are those of before
+      const Eigen::Vector3d g = gauss3();
+      verr = first_velocity ? Eigen::Vector3d(o.sigma_velocity_mps * g)
+                            : phi_v * verr + drive_v * o.sigma_velocity_mps * g;
+      first_velocity = false;
+      f.v_n = ins::C_en(lat, lon).transpose() * m.v_e + verr;
+    }
     fixes.push_back(f);
   }
   return fixes;

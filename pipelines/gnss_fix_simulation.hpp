@@ -2,8 +2,8 @@
 // Simulated external GNSS fixes from a truth trajectory (for `ultratrack gnsssim`, tests and the loose
 // integration figures): position (and optionally velocity) of an antenna at lever_arm_b at times
 // t0 + k / rate, with first-order Gauss-Markov position errors (white when correlation_time_s = 0), an optional white
-// part on top, and white velocity errors, from a seeded generator. Units SI; NED errors; times on the truth's time
-// line.
+// part on top, and white (or Gauss-Markov) velocity errors, from a seeded generator. Units SI; NED errors; times on the
+// truth's time line.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,7 +27,8 @@ struct GnssFixSimulationOptions {
   Eigen::Vector3d white_sigma_ned_m = Eigen::Vector3d::Zero();
   std::optional<Eigen::Vector3d> stated_sigma_ned_m;
   bool with_velocity = true;
-  double sigma_velocity_mps = 0.05;                       // white, per axis
+  double sigma_velocity_mps = 0.05;                       // per axis (stationary 1-sigma when correlated)
+  double velocity_correlation_time_s = 0.0;               // 0: white velocity errors; else Gauss-Markov
   Eigen::Vector3d lever_arm_b = Eigen::Vector3d::Zero();  // antenna in body axes from the IMU [m]
   std::uint64_t seed = 1;
 };

@@ -142,6 +142,7 @@ void run_fuse_command(const FuseCommandOptions& o) {
   fmt::print("fuse: aligned {}: roll {:.3f} pitch {:.3f} yaw {:.3f} deg\n", r.alignment_note,
              e.roll_rad / io::kRadPerDeg, e.pitch_rad / io::kRadPerDeg, e.yaw_rad / io::kRadPerDeg);
   if (r.fix_whiteness) fmt::print("fuse: {}\n", r.fix_whiteness->note);
+  if (r.velocity_whiteness && r.velocity_whiteness->measured) fmt::print("fuse: {}\n", r.velocity_whiteness->note);
   fmt::print("fuse: {:.1f} s navigated in {:.2f} s; fixes used {}, updates accepted {}, rejected {}{}\n",
              r.end_s - r.start_s, wall_s, r.fixes_used, r.counters.accepted, r.counters.rejected,
              r.fixes_in_outage ? fmt::format(", {} dropped in outages", r.fixes_in_outage) : std::string());

@@ -21,7 +21,7 @@ namespace {
 
 struct GnssSimOptions {
   std::string truth_file, out_file;
-  double rate_hz = 1.0, first_s = 0.0, correlation_s = 0.0, velocity_sigma_mps = 0.05;
+  double rate_hz = 1.0, first_s = 0.0, correlation_s = 0.0, velocity_sigma_mps = 0.05, velocity_correlation_s = 0.0;
   std::vector<double> sigma_m{1.5, 1.5, 3.0};
   std::vector<double> lever_arm_m{0.0, 0.0, 0.0};
   std::vector<double> white_sigma_m, stated_sigma_m;
@@ -34,6 +34,8 @@ void run_gnsssim(const GnssSimOptions& o) {
   if (nav.size() < 2) throw io::InputError(o.truth_file, "needs at least two rows");
   if (!(o.velocity_sigma_mps > 0.0)) throw io::InputError("command line", "--velocity-sigma must be positive");
   if (o.correlation_s < 0.0) throw io::InputError("command line", "--correlation must not be negative");
+  if (o.velocity_correlation_s < 0.0)
+    throw io::InputError("command line", "--velocity-correlation must not be negative");
   pipelines::GnssFixSimulationOptions s;
   s.rate_hz = o.rate_hz;
   s.first_time_s = o.first_s;
@@ -44,6 +46,7 @@ void run_gnsssim(const GnssSimOptions& o) {
     s.stated_sigma_ned_m = Eigen::Vector3d(o.stated_sigma_m[0], o.stated_sigma_m[1], o.stated_sigma_m[2]);
   s.with_velocity = !o.no_velocity;
   s.sigma_velocity_mps = o.velocity_sigma_mps;
+  s.velocity_correlation_time_s = o.velocity_correlation_s;
   s.lever_arm_b = {o.lever_arm_m[0], o.lever_arm_m[1], o.lever_arm_m[2]};
   s.seed = o.seed;
   const ins::TruthInterpolator truth(pipelines::truth_samples_from_nav(nav));
@@ -73,6 +76,8 @@ void add_gnsssim_command(CLI::App& app) {
                   "N E D sigma written in the file (default the true total: a receiver that misstates its accuracy)")
       ->expected(3);
   cmd->add_option("--velocity-sigma", o->velocity_sigma_mps, "velocity 1-sigma in m/s (default 0.05)");
+  cmd->add_option("--velocity-correlation", o->velocity_correlation_s,
+                  "velocity error correlation time in s (default 0: white; a receiver that smooths its velocities)");
   cmd->add_flag("--no-velocity", o->no_velocity, "leave the velocity columns empty");
   cmd->add_option("--lever-arm", o->lever_arm_m, "antenna in body axes from the IMU, m (x y z)")->expected(3);
   cmd->add_option("--seed", o->seed, "random seed (default 1)");

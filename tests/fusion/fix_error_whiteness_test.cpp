@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Whether fixes are white at their rate (fusion/fix_error_whiteness.hpp), on fixes whose errors this test draws
-// itself: a vehicle on a 50 m circle at 5 m/s that climbs and sinks (jerk 0.05 m/s^3, third differences of 5 cm at a
-// 1 s lag), positions through GeographicLib's local frame, errors white, first-order Gauss-Markov, or both. The
-// truths are the drawn models: white share sigma_w^2 / sigma^2 and tau. Tolerances: the robust variances of a few
-// thousand third differences scatter by about 5 %, so the shares are held to +-25 %; tau for 30 s came out 26-41 s
-// over 20 seeds with a white part on top and 21-29 s at 1 Hz (the circle's jerk adds to the 2 s lag there), so it is
-// held to 20-45 s.
+// Whether fixes are white at their rate (fusion/fix_error_whiteness.hpp), positions and velocities, on fixes whose
+// errors this test draws itself: a vehicle on a 50 m circle at 5 m/s that climbs and sinks (jerk 0.05 m/s^3, third
+// differences of 5 cm at a 1 s lag), positions through GeographicLib's local frame, errors white, first-order
+// Gauss-Markov, or both. The truths are the drawn models: white share sigma_w^2 / sigma^2 and tau. Tolerances: the
+// robust variances of a few thousand third differences scatter by about 5 %, so the shares are held to +-25 %; tau for
+// 30 s came out 26-41 s over 20 seeds with a white part on top and 21-29 s at 1 Hz (the circle's jerk adds to the 2 s
+// lag there), so it is held to 20-45 s.
 #include "fusion/fix_error_whiteness.hpp"
 
 #include <gtest/gtest.h>
@@ -25,6 +25,8 @@ struct FixErrors {
   Eigen::Vector3d gm_sigma_m = Eigen::Vector3d::Zero(), white_sigma_m = Eigen::Vector3d::Zero();
   double tau_s = 30.0;
   std::optional<Eigen::Vector3d> stated_sigma_m;  // else the true total
+  double velocity_sigma_mps = 0.0;                // velocity errors: 0 none (no velocity columns)
+  double velocity_tau_s = 0.0;                    // 0 white, else Gauss-Markov
   unsigned seed = 1;
 };
 
@@ -35,6 +37,10 @@ std::vector<GnssFix> draw_fixes(const FixErrors& e) {
   auto gauss = [&] { return Eigen::Vector3d(n01(rng), n01(rng), n01(rng)); };
   const double dt = 1.0 / e.rate_hz, phi = std::exp(-dt / e.tau_s);
   Eigen::Vector3d gm = e.gm_sigma_m.cwiseProduct(gauss());
+  const double phi_v = e.velocity_tau_s > 0.0 ? std::exp(-dt / e.velocity_tau_s) : 0.0;
+  // Drawn only with velocities: the position errors' draws stay those of the same seed without them.
+  Eigen::Vector3d verr =
+      e.velocity_sigma_mps > 0.0 ? Eigen::Vector3d(e.velocity_sigma_mps * gauss()) : Eigen::Vector3d::Zero();
   const Eigen::Vector3d stated =
       e.stated_sigma_m.value_or((e.gm_sigma_m.cwiseAbs2() + e.white_sigma_m.cwiseAbs2()).cwiseSqrt());
   std::vector<GnssFix> out;
@@ -52,6 +58,11 @@ std::vector<GnssFix> draw_fixes(const FixErrors& e) {
     f.lon_rad = lon * std::numbers::pi / 180.0;
     f.height_m = h;
     f.sigma_pos_ned_m = stated;
+    if (e.velocity_sigma_mps > 0.0) {  // the circle's velocity and the climb's, NED
+      verr = phi_v * verr + std::sqrt(1.0 - phi_v * phi_v) * e.velocity_sigma_mps * gauss();
+      f.has_velocity = true;
+      f.v_n_mps = Eigen::Vector3d(5.0 * std::cos(w * t), 5.0 * std::sin(w * t), -0.15 * std::cos(0.05 * t)) + verr;
+    }
     out.push_back(f);
   }
   return out;
@@ -189,6 +200,52 @@ TEST(FixErrorWhiteness, TooFewOrIrregularFixesGiveNoVerdict) {
   w = measure_fix_error_whiteness(stamped_twice);
   EXPECT_FALSE(w.measured) << w.note;
   EXPECT_FALSE(w.correlated);
+}
+
+// Velocities: white at the told sigma, white under a told sigma twice too large (cautious, kept), and smoothed by a
+// receiver (Gauss-Markov 1 s at 20 Hz: tau measured, the variance widened by 1 + 2 tau / T).
+TEST(VelocityWhiteness, WhiteVelocitiesAreUsedAsTold) {
+  FixErrors e;
+  e.rate_hz = 20.0;
+  e.white_sigma_m = {0.6, 0.6, 1.2};
+  e.velocity_sigma_mps = 0.05;
+  const std::vector<GnssFix> fixes = draw_fixes(e);
+  VelocityWhiteness v = measure_velocity_whiteness(fixes, 0.05);
+  ASSERT_TRUE(v.measured) << v.note;
+  EXPECT_FALSE(v.correlated) << v.note;
+  EXPECT_NEAR(v.white_share.x(), 1.0, 0.25);
+  EXPECT_EQ(v.variance_factor, 1.0);
+  v = measure_velocity_whiteness(fixes, 0.1);  // told twice the noise: a white share of 0.25, no slope
+  EXPECT_FALSE(v.correlated) << v.note;
+  EXPECT_NEAR(v.white_share.y(), 0.25, 0.07);
+  EXPECT_EQ(v.variance_factor, 1.0);
+}
+
+TEST(VelocityWhiteness, SmoothedVelocitiesGiveTheirCorrelationTime) {
+  for (const unsigned seed : {1u, 2u}) {
+    FixErrors e;
+    e.rate_hz = 20.0;
+    e.white_sigma_m = {0.6, 0.6, 1.2};
+    e.velocity_sigma_mps = 0.05;
+    e.velocity_tau_s = 1.0;
+    e.seed = seed;
+    const VelocityWhiteness v = measure_velocity_whiteness(draw_fixes(e), 0.05);
+    ASSERT_TRUE(v.correlated) << v.note;
+    EXPECT_GT(v.correlation_time_s, 0.7) << v.note;
+    EXPECT_LT(v.correlation_time_s, 1.4) << v.note;
+    EXPECT_NEAR(v.variance_factor, 1.0 + 2.0 * v.correlation_time_s / 0.05, 1e-9);
+  }
+}
+
+TEST(VelocityWhiteness, NoVelocitiesOrTooFewGiveNoVerdict) {
+  FixErrors e;
+  e.white_sigma_m = {2.0, 2.0, 4.0};  // no velocity columns
+  EXPECT_FALSE(measure_velocity_whiteness(draw_fixes(e), 0.1).measured);
+  e.velocity_sigma_mps = 0.05;
+  e.duration_s = 20.0;
+  const VelocityWhiteness v = measure_velocity_whiteness(draw_fixes(e), 0.05);
+  EXPECT_FALSE(v.measured);
+  EXPECT_EQ(v.variance_factor, 1.0);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 // (fusion/fix_error_whiteness.hpp) and carries them as states, so its position sigma holds; taken as white it does not.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -39,7 +40,8 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 double wrapped(double a_rad) { return std::remainder(a_rad, 2.0 * std::numbers::pi); }
 
 // The rover of rover_slow_bmi088.toml with the unit of this seed, simulated into the scratch folder, and its
-// position-only fixes with 0.6/0.6/1.2 m Gauss-Markov errors of 30 s at rate_hz from first_s.
+// fixes with 0.6/0.6/1.2 m Gauss-Markov errors of 30 s at rate_hz from first_s, position only unless
+// velocity_tau_s >= 0 (then velocities with 0.05 m/s errors of that correlation time).
 struct Rover {
   sim::Scenario scenario;
   sim::SimulationResult simulated;
@@ -48,7 +50,8 @@ struct Rover {
   std::filesystem::path imu_file;
 };
 
-Rover simulate_rover(std::uint64_t seed, const std::string& name, double rate_hz, double first_s) {
+Rover simulate_rover(std::uint64_t seed, const std::string& name, double rate_hz, double first_s,
+                     double velocity_tau_s = -1.0) {
   const auto scenario_file = test::scenarios_dir() / "rover_slow_bmi088.toml";
   Rover r;
   r.scenario = config::read_scenario(scenario_file);
@@ -62,7 +65,9 @@ Rover simulate_rover(std::uint64_t seed, const std::string& name, double rate_hz
   fix_options.first_time_s = first_s;
   fix_options.sigma_ned_m = Eigen::Vector3d(0.6, 0.6, 1.2);
   fix_options.correlation_time_s = 30.0;
-  fix_options.with_velocity = false;
+  fix_options.with_velocity = velocity_tau_s >= 0.0;  // 0.05 m/s, Gauss-Markov with this time (0: white)
+  fix_options.sigma_velocity_mps = 0.05;
+  fix_options.velocity_correlation_time_s = std::max(velocity_tau_s, 0.0);
   fix_options.seed = seed;
   r.fixes = simulate_gnss_fixes(ins::TruthInterpolator(r.truth), fix_options);
   return r;
@@ -119,12 +124,13 @@ TEST(FuseSlowPlatform, StandstillBiasesAndALongerTrackGiveAnHonestHeading) {
 struct PositionStats {
   double horizontal_rms_m = 0.0;
   double inside_3sigma = 0.0;  // rows with every axis inside 3 of its sigma
+  double yaw_rms_rad = 0.0;
 };
 
 // Rows from 60 s on against the truth (IMU point; no lever arm).
 PositionStats position_stats(const std::vector<ins::ImuIncrement>& imu, const std::vector<GnssFixRow>& fixes,
                              const ins::TruthInterpolator& truth, const FuseSettings& s, FuseResult* result) {
-  double h2 = 0.0;
+  double h2 = 0.0, y2 = 0.0;
   long long rows = 0, inside = 0;
   *result = fuse(imu, fixes, {}, s, [&](const ins::NavState& nav, const NavSigma& sig) {
     if (nav.t_s < 60.0 || nav.t_s > truth.end_s()) return;
@@ -133,9 +139,13 @@ PositionStats position_stats(const std::vector<ins::ImuIncrement>& imu, const st
     const Eigen::Vector3d e = ins::C_en(nav.lat_rad, nav.lon_rad).transpose() * d_e;
     h2 += e.head<2>().squaredNorm();
     inside += (e.cwiseAbs().array() <= 3.0 * sig.position_ned_m.array()).all();
+    const double yaw = wrapped(ins::euler_from_quaternion(nav.q_nb).yaw_rad -
+                               ins::euler_from_quaternion(truth.attitude(nav.t_s)).yaw_rad);
+    y2 += yaw * yaw;
     ++rows;
   });
-  return {std::sqrt(h2 / static_cast<double>(rows)), static_cast<double>(inside) / static_cast<double>(rows)};
+  const auto n = static_cast<double>(rows);
+  return {std::sqrt(h2 / n), static_cast<double>(inside) / n, std::sqrt(y2 / n)};
 }
 
 TEST(FuseSlowPlatform, MeasuredFixCorrelationKeepsTheDefaultConfigurationHonest) {
@@ -177,6 +187,42 @@ TEST(FuseSlowPlatform, MeasuredFixCorrelationKeepsTheDefaultConfigurationHonest)
     EXPECT_FALSE(white_result.fix_whiteness.has_value());
     EXPECT_FALSE(white_result.fix_error.enabled);
     EXPECT_LT(white.inside_3sigma, 0.5);
+  }
+}
+
+// A receiver that smooths its 20 Hz velocities (errors Gauss-Markov 1 s, told 0.05 m/s): fuse measures the
+// correlation and widens each velocity's sigma by sqrt(1 + 2 tau / T). Taken as white (the configuration states the
+// positions' model, so nothing is measured) the velocities are trusted 40 times too much and steer the heading (yaw
+// 57 and 25 deg RMS on these seeds, under half of the rows inside 3 sigma); measured, 2.7 and 7.8 deg and honest.
+TEST(FuseSlowPlatform, SmoothedVelocitiesAreWidenedNotTakenAsWhite) {
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const Rover rover = simulate_rover(seed, "rover_velocity", 20.0, 0.037, 1.0);
+    const ins::TruthInterpolator truth(rover.truth);
+    const std::vector<ins::ImuIncrement> imu = ins::read_imu_csv(rover.imu_file);
+    FuseSettings s;
+    s.config = config::read_fuse_config(test::scenarios_dir() / "rover_minimal_fuse.toml");
+    s.config.velocity_sigma_mps = 0.05;
+    s.align = AlignMode::Motion;
+    FuseResult measured;
+    const PositionStats with = position_stats(imu, rover.fixes, truth, s, &measured);
+    ASSERT_TRUE(measured.velocity_whiteness && measured.velocity_whiteness->correlated);
+    const double tau = measured.velocity_whiteness->correlation_time_s;
+    EXPECT_GT(tau, 0.7);
+    EXPECT_LT(tau, 1.4);
+    EXPECT_NEAR(measured.velocity_sigma_mps, 0.05 * std::sqrt(1.0 + 2.0 * tau / 0.05), 1e-9);
+    EXPECT_GE(with.inside_3sigma, 0.9);
+
+    s.config.fix_error_auto = false;  // the positions' model stated: the velocities are taken as told
+    s.config.fix_error_correlation_s = 30.0;
+    s.config.fix_error_sigma_ned_m = Eigen::Vector3d(0.6, 0.6, 1.2);
+    FuseResult told;
+    const PositionStats white = position_stats(imu, rover.fixes, truth, s, &told);
+    EXPECT_FALSE(told.velocity_whiteness.has_value());
+    EXPECT_EQ(told.velocity_sigma_mps, 0.05);
+    EXPECT_LT(with.yaw_rms_rad, 0.5 * white.yaw_rms_rad)
+        << with.yaw_rms_rad / kDeg << " against " << white.yaw_rms_rad / kDeg << " deg";
+    EXPECT_LT(with.horizontal_rms_m, white.horizontal_rms_m);
   }
 }
 
