@@ -171,10 +171,16 @@ FixErrorWhiteness measure_fix_error_whiteness(std::span<const GnssFix> fixes, co
 
   const double white_horizontal = 0.5 * (w.white_share.x() + w.white_share.y());
   if (white_horizontal >= o.white_share_threshold) {
+    for (int a = 0; a < 3; ++a)
+      if (w.white_share(a) > o.understated_share) w.sigma_scale(a) = std::sqrt(w.white_share(a));
     w.note = fmt::format(
         "position fixes every {:.3g} s: errors white at that rate (white share of the stated variance {:.2f} / "
-        "{:.2f} / {:.2f} N/E/D), used as white",
-        T, w.white_share.x(), w.white_share.y(), w.white_share.z());
+        "{:.2f} / {:.2f} N/E/D), used as white{}",
+        T, w.white_share.x(), w.white_share.y(), w.white_share.z(),
+        w.sigma_scale.maxCoeff() > 1.0
+            ? fmt::format(", the stated sigmas widened {:.2f} / {:.2f} / {:.2f} times to the noise measured",
+                          w.sigma_scale.x(), w.sigma_scale.y(), w.sigma_scale.z())
+            : std::string());
     return w;
   }
   w.correlated = true;
@@ -236,10 +242,14 @@ VelocityWhiteness measure_velocity_whiteness(std::span<const GnssFix> fixes, dou
     }
   }
   if (correlated_axes < 2) {
+    const double share = 0.5 * (w.white_share.x() + w.white_share.y());
+    if (share > o.understated_share) w.variance_factor = share;  // noisier than told: widened to the noise
     w.note = fmt::format(
         "velocity fixes every {:.3g} s: errors white at that rate for the told {} m/s (white share "
-        "{:.2f} / {:.2f} N/E), used as told",
-        T, sigma_mps, w.white_share.x(), w.white_share.y());
+        "{:.2f} / {:.2f} N/E), {}",
+        T, sigma_mps, w.white_share.x(), w.white_share.y(),
+        w.variance_factor > 1.0 ? fmt::format("noisier than told: sigma widened {:.2f} times", std::sqrt(share))
+                                : std::string("used as told"));
     return w;
   }
   w.correlated = true;

@@ -41,6 +41,7 @@ struct FixWhitenessOptions {
   double long_lag_s = 1.0;                // M = round(long_lag_s / T), within [2, 20]
   int min_differences = 200;              // third differences needed at each lag for a verdict
   double white_share_threshold = 0.5;     // white below this share of the stated variance: correlated
+  double understated_share = 1.5;         // white above this share: the stated sigma understates the noise
   double max_correlation_time_s = 300.0;  // tau at most this
 };
 
@@ -58,7 +59,10 @@ struct FixErrorWhiteness {
   double correlation_time_s = 0.0;
   bool correlation_time_is_bound = false;                 // the slope was not significant: tau is its lower bound
   Eigen::Vector3d sigma_ned_m = Eigen::Vector3d::Zero();  // the correlated part's 1-sigma (median stated sigma)
-  std::string note;                                       // one line for the user
+  // White, per axis: the stated sigmas times this (the root of a white share above understated_share, else 1): the
+  // data show more white noise than the file states.
+  Eigen::Vector3d sigma_scale = Eigen::Vector3d::Ones();
+  std::string note;  // one line for the user
 };
 
 // fixes: in time order; those without a position are skipped.
@@ -69,7 +73,8 @@ FixErrorWhiteness measure_fix_error_whiteness(std::span<const GnssFix> fixes, co
 // cm/s at 5 Hz, against 0.22 m/s of 0.05 m/s white noise). A receiver that smooths its velocities shows a slope above
 // twice its 1-sigma; then tau = 12 (1 - white share) T / slope, and each velocity's variance is widened by 1 + 2 tau /
 // T, the information of the 2 tau / T + 1 fixes that share an error. Without a significant slope the velocities are
-// used as told (a told sigma above the white noise is cautious, not wrong). Horizontal axes decide.
+// used as told (a told sigma above the white noise is cautious, not wrong), unless their white noise is above it
+// (a white share above understated_share): the variance is then widened by that share. Horizontal axes decide.
 struct VelocityWhiteness {
   bool measured = false, correlated = false;
   double interval_s = 0.0;

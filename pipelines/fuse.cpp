@@ -84,13 +84,15 @@ std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFi
 
 // A fix row as the loose filter takes it: its velocity only when the configuration uses velocities, at
 // velocity_sigma_mps (the fix file carries position sigmas only).
-fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c, double velocity_sigma_mps) {
+// position_sigma_scale: the file's position sigmas times this (fixes noisier than they state).
+fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c, double velocity_sigma_mps,
+                          const Eigen::Vector3d& position_sigma_scale = Eigen::Vector3d::Ones()) {
   fusion::GnssFix f;
   f.t_s = r.t_s;
   f.lat_rad = r.lat_rad;
   f.lon_rad = r.lon_rad;
   f.height_m = r.height_m;
-  f.sigma_pos_ned_m = r.sigma_ned_m;
+  f.sigma_pos_ned_m = r.sigma_ned_m.cwiseProduct(position_sigma_scale);
   f.has_velocity = r.has_velocity && c.use_velocity;
   f.v_n_mps = r.v_n;
   f.sigma_vel_n_mps = Eigen::Vector3d::Constant(velocity_sigma_mps);
@@ -416,7 +418,9 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
         continue;
       }
       if (result.odometer) result.odometer->gnss_last_used_s = r.t_s;
-      integration.add_fix(loose_fix(r, c, result.velocity_sigma_mps));
+      integration.add_fix(
+          loose_fix(r, c, result.velocity_sigma_mps,
+                    result.fix_whiteness ? result.fix_whiteness->sigma_scale : Eigen::Vector3d::Ones()));
       ++result.fixes_used;
     }
     for (; a < attitude.size() && attitude[a].t_s <= imu[k].t_s; ++a) {

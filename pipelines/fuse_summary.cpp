@@ -117,10 +117,10 @@ std::string fuse_summary_json(const FuseResult& r, const FuseSettings& s, const 
     j += fmt::format(
         "  \"fix_whiteness\": {{\"measured\": {}, \"correlated\": {}, \"interval_s\": {}, \"long_lag\": {}, "
         "\"differences\": {}, \"white_share_ned\": [{:.4f}, {:.4f}, {:.4f}], \"growth_ned\": [{:.3f}, {:.3f}, {:.3f}], "
-        "\"correlation_time_is_bound\": {}, \"note\": \"{}\"}},\n",
+        "\"correlation_time_is_bound\": {}, \"sigma_scale_ned\": [{:.4f}, {:.4f}, {:.4f}], \"note\": \"{}\"}},\n",
         w.measured, w.correlated, w.interval_s, w.long_lag, w.differences, w.white_share.x(), w.white_share.y(),
-        w.white_share.z(), w.growth.x(), w.growth.y(), w.growth.z(), w.correlation_time_is_bound,
-        io::json_escape(w.note));
+        w.white_share.z(), w.growth.x(), w.growth.y(), w.growth.z(), w.correlation_time_is_bound, w.sigma_scale.x(),
+        w.sigma_scale.y(), w.sigma_scale.z(), io::json_escape(w.note));
   }
   if (r.velocity_whiteness) {
     const fusion::VelocityWhiteness& v = *r.velocity_whiteness;

@@ -82,7 +82,21 @@ TEST(FixErrorWhiteness, WhiteFixesOnATurningClimbingVehicleAreWhite) {
       EXPECT_NEAR(w.white_share(a), 1.0, 0.25) << "axis " << a;
       EXPECT_NEAR(w.growth(a), 1.0, 0.3) << "axis " << a;
     }
+    EXPECT_EQ(w.sigma_scale, Eigen::Vector3d::Ones());  // as stated
   }
+}
+
+// White fixes that state half their noise: the white share reads 4, and the sigmas are widened to the noise (the root
+// of the share: 2 within the share's +-25 %, so 1.75-2.25).
+TEST(FixErrorWhiteness, WhiteFixesNoisierThanStatedAreWidenedToTheirNoise) {
+  FixErrors e;
+  e.white_sigma_m = {2.0, 2.0, 4.0};
+  e.stated_sigma_m = Eigen::Vector3d(1.0, 1.0, 2.0);
+  const FixErrorWhiteness w = measure_fix_error_whiteness(draw_fixes(e));
+  ASSERT_TRUE(w.measured) << w.note;
+  EXPECT_FALSE(w.correlated) << w.note;
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(w.sigma_scale(a), 2.0, 0.25) << "axis " << a;
+  EXPECT_NE(w.note.find("widened"), std::string::npos) << w.note;
 }
 
 TEST(FixErrorWhiteness, GaussMarkovFixesAt20HzGiveTheirCorrelationTimeAndSigma) {
@@ -219,6 +233,9 @@ TEST(VelocityWhiteness, WhiteVelocitiesAreUsedAsTold) {
   EXPECT_FALSE(v.correlated) << v.note;
   EXPECT_NEAR(v.white_share.y(), 0.25, 0.07);
   EXPECT_EQ(v.variance_factor, 1.0);
+  v = measure_velocity_whiteness(fixes, 0.025);  // told half the noise: widened by the share, 4 +- 25 %
+  EXPECT_FALSE(v.correlated) << v.note;
+  EXPECT_NEAR(v.variance_factor, 4.0, 1.0) << v.note;
 }
 
 TEST(VelocityWhiteness, SmoothedVelocitiesGiveTheirCorrelationTime) {
