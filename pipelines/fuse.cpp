@@ -86,7 +86,7 @@ std::vector<fusion::GnssVelocitySample> gnss_velocities(const std::vector<GnssFi
 // velocity_sigma_mps (the fix file carries position sigmas only).
 // position_sigma_scale: the file's position sigmas times this (fixes noisier than they state).
 fusion::GnssFix loose_fix(const GnssFixRow& r, const FuseConfig& c, double velocity_sigma_mps,
-                          const Eigen::Vector3d& position_sigma_scale = Eigen::Vector3d::Ones()) {
+                          const Eigen::Vector3d& position_sigma_scale) {
   fusion::GnssFix f;
   f.t_s = r.t_s;
   f.lat_rad = r.lat_rad;
@@ -313,13 +313,17 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
 
   fusion::IntegrationOptions o = integration_options(n, c, fusion::Coupling::kLoose, s.filter);
   o.attitude = attitude_options;
+  // How each fix is weighted: as stated and told, unless the fixes' own errors say otherwise.
+  result.velocity_sigma_mps = c.velocity_sigma_mps;
+  Eigen::Vector3d position_sigma_scale = Eigen::Vector3d::Ones();
   if (c.fix_error_auto && !gnss.empty()) {  // the fixes' own errors: white at their rate, or correlated
     std::vector<fusion::GnssFix> usable;
     for (const GnssFixRow& r : gnss) {
       if (in_outage(s, r.t_s) || (s.gnss_until_s && r.t_s > *s.gnss_until_s)) continue;
-      usable.push_back(loose_fix(r, c, c.velocity_sigma_mps));
+      usable.push_back(loose_fix(r, c, c.velocity_sigma_mps, position_sigma_scale));
     }
     const fusion::FixErrorWhiteness& w = result.fix_whiteness.emplace(fusion::measure_fix_error_whiteness(usable));
+    position_sigma_scale = w.sigma_scale;
     if (w.correlated) {
       o.fix_error.enabled = true;
       o.fix_error.correlation_time_s = w.correlation_time_s;
@@ -332,7 +336,6 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
       result.velocity_sigma_mps = c.velocity_sigma_mps * std::sqrt(v.variance_factor);
     }
   }
-  if (!result.velocity_whiteness) result.velocity_sigma_mps = c.velocity_sigma_mps;
   result.fix_error = o.fix_error;
   result.fix_error_inflation_s = o.fix_error_correlation_s;
   std::vector<fusion::OdometerSpeed> odometer;
@@ -418,9 +421,7 @@ FuseResult fuse(const std::vector<ins::ImuIncrement>& imu, const std::vector<Gns
         continue;
       }
       if (result.odometer) result.odometer->gnss_last_used_s = r.t_s;
-      integration.add_fix(
-          loose_fix(r, c, result.velocity_sigma_mps,
-                    result.fix_whiteness ? result.fix_whiteness->sigma_scale : Eigen::Vector3d::Ones()));
+      integration.add_fix(loose_fix(r, c, result.velocity_sigma_mps, position_sigma_scale));
       ++result.fixes_used;
     }
     for (; a < attitude.size() && attitude[a].t_s <= imu[k].t_s; ++a) {
